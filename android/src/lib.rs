@@ -1,0 +1,81 @@
+//! The Android side of the phantogram core: today only the mapping from Android's sensor API to the
+//! core's sensor events; the JNI bridge, surface and lifecycle handling come with the shell
+//! (issue #6).
+//!
+//! Android's sensor frame *is* the core's device frame and its units are the core's (m/s² with
+//! gravity, rad/s, µT; `SensorEvent.timestamp` in ns), so values pass through unchanged; only the
+//! sensor type numbers need mapping.
+
+use phantogram::glam::{Quat, Vec3};
+use phantogram::sensors::{SensorEvent, SensorKind};
+
+/// `android.hardware.Sensor.TYPE_*` values the shell forwards.
+pub mod sensor_type {
+    pub const ACCELEROMETER: i32 = 1;
+    pub const MAGNETIC_FIELD: i32 = 2;
+    pub const GYROSCOPE: i32 = 4;
+    pub const LINEAR_ACCELERATION: i32 = 10;
+    pub const ROTATION_VECTOR: i32 = 11;
+    pub const GAME_ROTATION_VECTOR: i32 = 15;
+}
+
+/// The core's kind for an Android sensor type; `None` for types the core does not use.
+pub fn sensor_kind(android_type: i32) -> Option<SensorKind> {
+    match android_type {
+        sensor_type::ACCELEROMETER => Some(SensorKind::Accelerometer),
+        sensor_type::MAGNETIC_FIELD => Some(SensorKind::Magnetometer),
+        sensor_type::GYROSCOPE => Some(SensorKind::Gyroscope),
+        sensor_type::LINEAR_ACCELERATION => Some(SensorKind::LinearAcceleration),
+        sensor_type::ROTATION_VECTOR => Some(SensorKind::RotationVector),
+        _ => None,
+    }
+}
+
+/// Builds a core event from an Android `SensorEvent` (`timestamp`, `values`). `None` for unused
+/// types or too few values. The rotation vector's `values` are `x, y, z[, w]`; older devices omit
+/// `w`, which is then recovered from the unit norm.
+pub fn event_from_android(android_type: i32, timestamp_ns: i64, values: &[f32]) -> Option<SensorEvent> {
+    let kind = sensor_kind(android_type)?;
+    if values.len() < 3 {
+        return None;
+    }
+    let v = Vec3::new(values[0], values[1], values[2]);
+    if kind.is_orientation() {
+        let w = values
+            .get(3)
+            .copied()
+            .unwrap_or_else(|| (1.0 - v.length_squared()).max(0.0).sqrt());
+        Some(SensorEvent::orientation(
+            kind,
+            timestamp_ns,
+            Quat::from_xyzw(v.x, v.y, v.z, w),
+        ))
+    } else {
+        Some(SensorEvent::vector(kind, timestamp_ns, v))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn maps_types_and_values() {
+        let e = event_from_android(sensor_type::ACCELEROMETER, 42, &[0.0, 0.0, 9.81]).unwrap();
+        assert_eq!(
+            (e.kind, e.t_ns, e.vec3()),
+            (SensorKind::Accelerometer, 42, Vec3::new(0.0, 0.0, 9.81))
+        );
+        assert!(event_from_android(sensor_type::GAME_ROTATION_VECTOR, 0, &[0.0; 4]).is_none());
+        assert!(event_from_android(sensor_type::GYROSCOPE, 0, &[0.0; 2]).is_none());
+        // Rotation vector without w: w from the unit norm.
+        let half = std::f32::consts::FRAC_PI_4;
+        let e = event_from_android(sensor_type::ROTATION_VECTOR, 0, &[half.sin(), 0.0, 0.0]).unwrap();
+        assert!(
+            e.quat()
+                .unwrap()
+                .angle_between(Quat::from_rotation_x(std::f32::consts::FRAC_PI_2))
+                < 1e-5
+        );
+    }
+}

@@ -1,0 +1,227 @@
+//! `phantogram`: the desktop command-line tool.
+//!
+//! * `phantogram replay LOG` replays a sensor log (the project's format, or any export that
+//!   [`phantogram::sensorlog::import`] recognises) and prints, at a chosen interval of sensor time,
+//!   the cyclopean eye position (mm, device frame) and the direction towards the world-fixed light.
+//! * `phantogram import SRC --out FILE` converts an export into the project's log format.
+//! * `phantogram info LOG` summarises a log: duration, events and rate per sensor.
+
+use std::io::{BufWriter, Write};
+use std::path::PathBuf;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use phantogram::eyes::EyeModel;
+use phantogram::replay::{Pace, replay};
+use phantogram::sensorlog::{self, LogError, LogReader, import::SourceFormat};
+use phantogram::sensors::{SensorEvent, SensorKind};
+use phantogram::{Session, SessionConfig};
+
+#[derive(Parser)]
+#[command(
+    name = "phantogram",
+    version,
+    about = "Handheld phantogram tools: replay and convert sensor logs"
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Replay a sensor log and print the eye position and light direction over time.
+    Replay {
+        /// A phantogram log, a BROAD CSV, or a recording folder (Android raw, Sensor Logger, phyphox).
+        log: PathBuf,
+        /// Interval between printed rows, milliseconds of sensor time.
+        #[arg(long, default_value_t = 100.0)]
+        every_ms: f64,
+        /// Print comma-separated values instead of a table.
+        #[arg(long)]
+        csv: bool,
+        /// Pace the replay at the recording's speed (times this factor) instead of as fast as possible.
+        #[arg(long, value_name = "SPEED")]
+        realtime: Option<f64>,
+        /// Low-pass time constant of the gravity viewpoint, seconds (the paper: c = 0.1 at 100 Hz ≈ 0.095 s).
+        #[arg(long, default_value_t = phantogram::attitude::LowPassAttitude::DEFAULT_TAU_S)]
+        tau_s: f32,
+        /// Viewing distance, centimetres.
+        #[arg(long, default_value_t = EyeModel::DEFAULT_VIEWING_DISTANCE_M * 100.0)]
+        distance_cm: f32,
+        /// Make the pose at this many seconds into the log count as "straight on" (flat-angle calibration).
+        #[arg(long, value_name = "SECONDS")]
+        flat_at_s: Option<f64>,
+    },
+    /// Convert a recording into the phantogram log format (gzip when OUT ends in .gz).
+    Import {
+        src: PathBuf,
+        #[arg(long)]
+        out: PathBuf,
+    },
+    /// Summarise a log: duration, events and rate per sensor.
+    Info { log: PathBuf },
+}
+
+fn main() {
+    if let Err(e) = run(Cli::parse()) {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Replay {
+            log,
+            every_ms,
+            csv,
+            realtime,
+            tau_s,
+            distance_cm,
+            flat_at_s,
+        } => replay_command(&log, every_ms, csv, realtime, tau_s, distance_cm, flat_at_s),
+        Command::Import { src, out } => {
+            let imported = sensorlog::import::import(&src)?;
+            sensorlog::write_log(&out, &imported.meta, &imported.events)?;
+            eprintln!("wrote {} events to {}", imported.events.len(), out.display());
+            Ok(())
+        }
+        Command::Info { log } => info_command(&log),
+    }
+}
+
+/// Events from any source: streamed for the project's own format, imported whole otherwise.
+fn open_events(path: &std::path::Path) -> Result<Box<dyn Iterator<Item = Result<SensorEvent, LogError>>>> {
+    Ok(match sensorlog::import::detect(path)? {
+        SourceFormat::Phantogram => Box::new(LogReader::open(path)?),
+        _ => Box::new(sensorlog::import::import(path)?.events.into_iter().map(Ok)),
+    })
+}
+
+fn replay_command(
+    log: &std::path::Path,
+    every_ms: f64,
+    csv: bool,
+    realtime: Option<f64>,
+    tau_s: f32,
+    distance_cm: f32,
+    flat_at_s: Option<f64>,
+) -> Result<()> {
+    if !(every_ms.is_finite() && every_ms > 0.0) {
+        bail!("--every-ms must be a positive number of milliseconds, got {every_ms}");
+    }
+    if let Some(speed) = realtime {
+        if !(speed.is_finite() && speed > 0.0) {
+            bail!("--realtime must be a positive speed factor, got {speed}");
+        }
+    }
+    let mut config = SessionConfig {
+        viewpoint_tau_s: tau_s,
+        ..SessionConfig::default()
+    };
+    config.eyes.viewing_distance_m = distance_cm / 100.0;
+    let mut session = Session::new(config).context("invalid settings")?;
+    let events = open_events(log)?;
+    let pace = realtime.map_or(Pace::AsFastAsPossible, |speed| Pace::RealTime { speed });
+    let interval_ns = (every_ms * 1e6).round().max(1.0) as i64;
+
+    let stdout = std::io::stdout();
+    let mut out = BufWriter::new(stdout.lock());
+    if csv {
+        writeln!(out, "t_s,eye_x_mm,eye_y_mm,eye_z_mm,light_x,light_y,light_z")?;
+    } else {
+        writeln!(
+            out,
+            "{:>9} {:>9} {:>9} {:>9}   {:>7} {:>7} {:>7}",
+            "t_s", "eye_x_mm", "eye_y_mm", "eye_z_mm", "light_x", "light_y", "light_z"
+        )?;
+    }
+    let mut t0 = None;
+    let mut flat_pending = flat_at_s;
+    let mut flat_error = None;
+    let mut write_error = None;
+    let summary = replay(events, &mut session, interval_ns, pace, |session, t_ns, view| {
+        let t0 = *t0.get_or_insert(t_ns);
+        let t_s = (t_ns - t0) as f64 * 1e-9;
+        // Takes effect from the next frame, as a tap on the phone would.
+        if flat_pending.is_some_and(|at| t_s >= at) {
+            flat_pending = None;
+            if let Err(e) = session.calibrate_flat_angle() {
+                flat_error = Some(e);
+            }
+        }
+        let e = view.eyes.cyclopean_m * 1000.0;
+        let l = view.toward_light_device;
+        let row = if csv {
+            writeln!(
+                out,
+                "{t_s:.3},{:.2},{:.2},{:.2},{:.4},{:.4},{:.4}",
+                e.x, e.y, e.z, l.x, l.y, l.z
+            )
+        } else {
+            writeln!(
+                out,
+                "{t_s:>9.3} {:>9.2} {:>9.2} {:>9.2}   {:>7.4} {:>7.4} {:>7.4}",
+                e.x, e.y, e.z, l.x, l.y, l.z
+            )
+        };
+        if let Err(err) = row {
+            write_error.get_or_insert(err);
+        }
+    })?;
+    if let Some(e) = flat_error {
+        bail!("flat-angle calibration failed: {e}");
+    }
+    if let Some(at) = flat_pending {
+        bail!("--flat-at-s {at} is beyond the end of the log");
+    }
+    if let Some(err) = write_error {
+        if err.kind() != std::io::ErrorKind::BrokenPipe {
+            return Err(err.into());
+        }
+    }
+    out.flush().ok();
+    let s = summary.stats;
+    eprintln!(
+        "{} events ({} accepted, {} rejected: {} non-finite, {} duplicate, {} backward time stamps), {} frames",
+        summary.events_read,
+        s.accepted,
+        s.rejected(),
+        s.rejected_non_finite,
+        s.rejected_duplicate,
+        s.rejected_backward,
+        summary.frames
+    );
+    Ok(())
+}
+
+fn info_command(path: &std::path::Path) -> Result<()> {
+    let mut counts = [0u64; SensorKind::ALL.len()];
+    let mut span: [Option<(i64, i64)>; SensorKind::ALL.len()] = [None; SensorKind::ALL.len()];
+    let mut non_finite = 0u64;
+    for event in open_events(path)? {
+        let e = event?;
+        let i = SensorKind::ALL.iter().position(|k| *k == e.kind).unwrap_or(0);
+        counts[i] += 1;
+        non_finite += u64::from(!e.is_finite());
+        span[i] = Some(span[i].map_or((e.t_ns, e.t_ns), |(a, b)| (a.min(e.t_ns), b.max(e.t_ns))));
+    }
+    println!("{:<20} {:>9} {:>10} {:>9}", "sensor", "events", "duration_s", "rate_hz");
+    for (i, kind) in SensorKind::ALL.iter().enumerate() {
+        let Some((a, b)) = span[i] else { continue };
+        let dur = (b - a) as f64 * 1e-9;
+        let rate = if dur > 0.0 { (counts[i] - 1) as f64 / dur } else { 0.0 };
+        println!(
+            "{:<20} {:>9} {:>10.3} {:>9.1}",
+            format!("{kind:?}"),
+            counts[i],
+            dur,
+            rate
+        );
+    }
+    if non_finite > 0 {
+        println!("{non_finite} events hold NaN or infinite values");
+    }
+    Ok(())
+}

@@ -1,0 +1,68 @@
+//! # Phantogram core
+//!
+//! A phone held in the hand becomes a window onto a museum artifact that stays put in the real world
+//! (a *phantogram*, after "Handheld phantograms", CHI 2011). This crate holds everything except the
+//! platform shells: the physical model of the screen and the viewer's eyes, the off-axis stereo
+//! projection, the viewpoint from the motion sensors, the world-fixed light, front-space containment,
+//! and the sensor-log plumbing used to replay recordings on the desktop.
+//!
+//! ## Frames and units (defined here, once, and used everywhere)
+//!
+//! * **Units**: lengths in metres (`_m`; `_mm` where millimetres are printed), angles in radians
+//!   (`_rad`; `_deg` only for human-facing input and output), time stamps in integer nanoseconds
+//!   (`t_ns`, any epoch, the sensor clock), durations in seconds (`_s`). Accelerometer readings are in
+//!   m/s² *including* gravity, gyroscope readings in rad/s, magnetometer readings in µT.
+//! * **Device frame** = Android's sensor frame, fixed to the phone in its natural (portrait)
+//!   orientation: origin at the centre of the screen's glass, **x** to the right, **y** up along the
+//!   screen, **z** out of the glass towards the viewer. The glass is the plane `z = 0`; the screen
+//!   rectangle is centred on the origin. Display rotation (portrait/landscape) changes only which
+//!   device axis the *display's* right and up point along (see [`screen`]), never this frame.
+//!   A phone lying face up on a table reads `+9.81` m/s² on the accelerometer's z axis: the
+//!   accelerometer measures the reaction to gravity, which points **up**.
+//! * **World frame**: x east, y north, z up (ENU), the frame of Android's rotation vector and of the
+//!   BROAD benchmark's ground truth.
+//! * **Orientations** are unit quaternions rotating device-frame vectors into the world frame
+//!   (`device_to_world`).
+//! * **The scene lives in the device frame**: the artifact sits in a diorama box behind and in front
+//!   of the glass. As the phone turns, the viewer's eyes and the world light move *in the device
+//!   frame*; the artifact does not.
+//! * **Pixels**: display pixel coordinates have their origin at the top-left corner of the display
+//!   as the viewer sees it, x to the right, y down; pixel `(i, j)` covers `[i, i+1) × [j, j+1)`, so
+//!   its centre is `(i + 0.5, j + 0.5)`.
+//! * **Depth**: reverse-Z in wgpu's clip space: the near plane maps to depth 1, the far plane to 0
+//!   (or infinity to 0), for even precision over the diorama; compare with `Greater`.
+//!
+//! ## Threading
+//!
+//! Sensor events may be pushed from any thread through [`sensors::SensorInbox`] (shared by `Arc`);
+//! everything else is plain data owned by the thread that renders. Nothing here blocks for long:
+//! the inbox holds a mutex only to append or drain a queue.
+//!
+//! ## Panics and errors
+//!
+//! Data from outside (files, sensors, FFI) never panics the library: bad files yield
+//! [`sensorlog::LogError`] naming file and line, bad sensor samples are rejected and counted
+//! ([`sensors::SensorStats`]), bad configuration yields typed errors. Panics would indicate a bug.
+//!
+//! ## Dependencies
+//!
+//! `glam` for small-vector maths (the chosen stack), `thiserror` for error types, `flate2` for the
+//! gzip-compressed recordings and logs. The `cli` feature (on by default, off for the phone crates)
+//! adds `clap` and `anyhow` for the `phantogram` binary.
+
+pub mod attitude;
+pub mod containment;
+pub mod eyes;
+pub mod light;
+pub mod lowpass;
+pub mod projection;
+pub mod replay;
+pub mod screen;
+pub mod sensorlog;
+pub mod sensors;
+pub mod session;
+pub mod synthetic;
+pub mod viewpoint;
+
+pub use glam;
+pub use session::{FrameView, Session, SessionConfig, SessionError};

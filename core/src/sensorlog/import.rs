@@ -1,0 +1,602 @@
+//! Importers for real sensor exports, each into time-ordered [`SensorEvent`]s in the crate's device
+//! frame and units. Which one applies is detected from the path ([`import`]):
+//!
+//! | source | looks like | notes |
+//! |---|---|---|
+//! | project log | file starting `phantogram-sensor-log` | see [`super`] |
+//! | Android raw dump | folder with `accelerometer.txt[.gz]` | `t x y z` per line, phone-clock seconds; `gyroscope[-calibrated]`, `magnetometer[-calibrated]`, `rotation-vector` (`t x y z w [accuracy]`) optional; `mocap.csv.gz` + `timeAlignment.txt` become ground truth |
+//! | Sensor Logger | folder with `Accelerometer.csv` whose header has `seconds_elapsed` | `time` in ns, columns named `x y z` in any order; its `Accelerometer.csv` has gravity removed and becomes linear acceleration; `AccelerometerUncalibrated.csv` (with gravity) is used as the accelerometer when present; `Orientation.csv` (`qx qy qz qw`) as the rotation vector |
+//! | phyphox | folder with `Accelerometer.csv` whose header has `"Time (s)"` | seconds, Android frame, accelerometer with gravity |
+//! | BROAD | CSV (gzip or not) with header `t_s,acc_x,…` | one row per sample with all three sensors and the ground-truth quaternion; rows with NaN ground truth simply have none |
+//!
+//! All of Android, phyphox and BROAD already use (or, for BROAD's IMU, define) a right-handed
+//! sensor frame, taken as the device frame unchanged.
+//!
+//! Errors name the file and the 1-based line. Files that are part of a folder but not sensor
+//! streams (licences, `record.properties`, derived outputs such as Sensor Logger's
+//! `imu_orientation.csv` whose angle convention is undocumented) are not read; the log's meta lists
+//! what was read.
+
+use std::path::{Path, PathBuf};
+
+use glam::{Mat3, Quat, Vec3};
+
+use super::{Lines, LogError, LogReader, parse_f64, seconds_to_ns};
+use crate::sensors::{SensorEvent, SensorKind};
+
+/// A whole imported recording.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct ImportedLog {
+    pub meta: Vec<(String, String)>,
+    /// Sorted by time stamp (stable: equal times keep file order).
+    pub events: Vec<SensorEvent>,
+}
+
+impl ImportedLog {
+    fn note(&mut self, key: &str, value: impl Into<String>) {
+        self.meta.push((key.to_owned(), value.into()));
+    }
+
+    fn finish(mut self) -> Self {
+        self.events.sort_by_key(|e| e.t_ns);
+        self
+    }
+
+    pub fn count(&self, kind: SensorKind) -> usize {
+        self.events.iter().filter(|e| e.kind == kind).count()
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SourceFormat {
+    Phantogram,
+    AndroidRaw,
+    SensorLogger,
+    Phyphox,
+    Broad,
+}
+
+impl SourceFormat {
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Phantogram => "phantogram",
+            Self::AndroidRaw => "android-raw",
+            Self::SensorLogger => "sensor-logger",
+            Self::Phyphox => "phyphox",
+            Self::Broad => "broad",
+        }
+    }
+}
+
+fn first_line(path: &Path) -> Result<String, LogError> {
+    Ok(Lines::open(path)?.next_owned()?.unwrap_or_default())
+}
+
+/// `dir/base` or `dir/base.gz`, whichever exists.
+fn find(dir: &Path, base: &str) -> Option<PathBuf> {
+    [dir.join(base), dir.join(format!("{base}.gz"))]
+        .into_iter()
+        .find(|p| p.is_file())
+}
+
+pub fn detect(path: &Path) -> Result<SourceFormat, LogError> {
+    if path.is_dir() {
+        if find(path, "accelerometer.txt").is_some() {
+            return Ok(SourceFormat::AndroidRaw);
+        }
+        if let Some(acc) = find(path, "Accelerometer.csv") {
+            let header = header_names(&first_line(&acc)?);
+            if header.iter().any(|h| h == "seconds_elapsed") {
+                return Ok(SourceFormat::SensorLogger);
+            }
+            if header.first().is_some_and(|h| h == "time") {
+                return Ok(SourceFormat::Phyphox);
+            }
+            return Err(LogError::parse(
+                &acc,
+                1,
+                "unrecognised CSV header (expected Sensor Logger's or phyphox's)",
+            ));
+        }
+        return Err(LogError::format(
+            path,
+            "unrecognised folder: expected an Android raw dump (accelerometer.txt[.gz]) or a Sensor Logger / phyphox export (Accelerometer.csv)",
+        ));
+    }
+    let line = first_line(path)?;
+    if line.starts_with(super::MAGIC) {
+        Ok(SourceFormat::Phantogram)
+    } else if line.starts_with("t_s,acc_x") {
+        Ok(SourceFormat::Broad)
+    } else if !path.exists() {
+        Err(LogError::io(path, std::io::ErrorKind::NotFound.into()))
+    } else {
+        Err(LogError::parse(
+            path,
+            1,
+            "unrecognised file: expected a phantogram sensor log or a BROAD CSV (or pass a recording folder)",
+        ))
+    }
+}
+
+/// Imports any supported source, detected from `path`.
+pub fn import(path: &Path) -> Result<ImportedLog, LogError> {
+    match detect(path)? {
+        SourceFormat::Phantogram => {
+            let reader = LogReader::open(path)?;
+            let meta = reader.meta().to_vec();
+            let events = reader.collect::<Result<Vec<_>, _>>()?;
+            Ok(ImportedLog { meta, events })
+        }
+        SourceFormat::AndroidRaw => import_android_raw(path),
+        SourceFormat::SensorLogger => import_sensor_logger(path),
+        SourceFormat::Phyphox => import_phyphox(path),
+        SourceFormat::Broad => import_broad(path),
+    }
+}
+
+fn display_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+fn started(format: SourceFormat, path: &Path) -> ImportedLog {
+    let mut log = ImportedLog::default();
+    log.note("source", display_name(path));
+    log.note("importer", format.name());
+    log
+}
+
+/// Whitespace-separated numeric rows: `t x y z [w [more…]]`, `min..=max` columns.
+fn read_whitespace_rows(
+    path: &Path,
+    min_cols: usize,
+    max_cols: usize,
+    mut row: impl FnMut(&[f64]) -> Result<(), String>,
+) -> Result<(), LogError> {
+    let mut lines = Lines::open(path)?;
+    let mut values = Vec::with_capacity(max_cols);
+    while lines.advance()? {
+        let line = lines.current().trim();
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        values.clear();
+        for f in line.split_whitespace() {
+            values.push(parse_f64(f).map_err(|m| lines.error(m))?);
+        }
+        if values.len() < min_cols || values.len() > max_cols {
+            let m = format!("expected {min_cols}..={max_cols} columns, found {}", values.len());
+            return Err(lines.error(m));
+        }
+        row(&values).map_err(|m| lines.error(m))?;
+    }
+    Ok(())
+}
+
+/// Header names, normalised: quotes and units in parentheses dropped, lower case
+/// (`"X (m/s^2)"` → `x`).
+fn header_names(line: &str) -> Vec<String> {
+    line.split(',')
+        .map(|h| {
+            let h = h.trim().trim_matches('"');
+            let h = h.split(" (").next().unwrap_or(h);
+            h.trim().to_lowercase()
+        })
+        .collect()
+}
+
+/// A CSV with a header row: calls `row` with the raw fields of the `wanted` columns, in that order.
+fn read_csv(path: &Path, wanted: &[&str], mut row: impl FnMut(&[&str]) -> Result<(), String>) -> Result<(), LogError> {
+    let mut lines = Lines::open(path)?;
+    let Some(header) = lines.next_owned()? else {
+        return Err(LogError::format(path, "empty file: expected a CSV header"));
+    };
+    let names = header_names(&header);
+    let mut index = Vec::with_capacity(wanted.len());
+    for w in wanted {
+        match names.iter().position(|n| n == w) {
+            Some(i) => index.push(i),
+            None => return Err(lines.error(format!("CSV header lacks column {w:?}"))),
+        }
+    }
+    let needed = index.iter().max().map_or(0, |m| m + 1);
+    while lines.advance()? {
+        let line = lines.current();
+        if line.trim().is_empty() {
+            continue;
+        }
+        // Per-row vectors: they borrow this line, which the next `advance` replaces.
+        let fields: Vec<&str> = line.split(',').collect();
+        if fields.len() < needed {
+            let m = format!("expected at least {needed} columns, found {}", fields.len());
+            return Err(lines.error(m));
+        }
+        let picked: Vec<&str> = index.iter().map(|&i| fields[i]).collect();
+        row(&picked).map_err(|m| lines.error(m))?;
+    }
+    Ok(())
+}
+
+fn vec3(v: &[f64]) -> Vec3 {
+    Vec3::new(v[0] as f32, v[1] as f32, v[2] as f32)
+}
+
+fn parse_fields(fields: &[&str]) -> Result<Vec<f64>, String> {
+    fields.iter().map(|f| parse_f64(f)).collect()
+}
+
+// ---------------------------------------------------------------------------------------------
+// Android raw dumps (Inria benchmarks-attitude-smartphones layout)
+
+pub fn import_android_raw(dir: &Path) -> Result<ImportedLog, LogError> {
+    let mut log = started(SourceFormat::AndroidRaw, dir);
+    let acc = find(dir, "accelerometer.txt")
+        .ok_or_else(|| LogError::format(dir, "no accelerometer.txt[.gz] in this folder"))?;
+    let streams = [
+        (Some(acc), SensorKind::Accelerometer),
+        (
+            find(dir, "gyroscope-calibrated.txt").or_else(|| find(dir, "gyroscope.txt")),
+            SensorKind::Gyroscope,
+        ),
+        (
+            find(dir, "magnetometer-calibrated.txt").or_else(|| find(dir, "magnetometer.txt")),
+            SensorKind::Magnetometer,
+        ),
+        (find(dir, "rotation-vector.txt"), SensorKind::RotationVector),
+    ];
+    for (path, kind) in streams {
+        let Some(path) = path else { continue };
+        let (min, max) = if kind.is_orientation() { (5, 6) } else { (4, 4) };
+        let events = &mut log.events;
+        read_whitespace_rows(&path, min, max, |v| {
+            let t_ns = seconds_to_ns(v[0])?;
+            events.push(if kind.is_orientation() {
+                // Android's rotation vector: x y z w (w present on API ≥ 18).
+                let q = Quat::from_xyzw(v[1] as f32, v[2] as f32, v[3] as f32, v[4] as f32);
+                SensorEvent::orientation(kind, t_ns, q)
+            } else {
+                SensorEvent::vector(kind, t_ns, vec3(&v[1..4]))
+            });
+            Ok(())
+        })?;
+        log.note("read", display_name(&path));
+    }
+    if let Some(mocap) = find(dir, "mocap.csv") {
+        match find(dir, "timeAlignment.txt") {
+            Some(align) => {
+                let offset_s = read_time_alignment(&align)?;
+                import_mocap(&mocap, offset_s, &mut log.events)?;
+                log.note("read", display_name(&mocap));
+                log.note(
+                    "ground_truth",
+                    "mocap rotation; heading is the motion-capture room's, not north",
+                );
+            }
+            None => log.note(
+                "skipped",
+                "mocap.csv: no timeAlignment.txt to put it on the phone clock",
+            ),
+        }
+    }
+    Ok(log.finish())
+}
+
+fn read_time_alignment(path: &Path) -> Result<f64, LogError> {
+    let mut offset = None;
+    read_whitespace_rows(path, 1, 1, |v| {
+        if offset.replace(v[0]).is_some() {
+            return Err("expected a single number".into());
+        }
+        if !v[0].is_finite() {
+            return Err("time alignment is not finite".into());
+        }
+        Ok(())
+    })?;
+    offset.ok_or_else(|| LogError::format(path, "empty time alignment file"))
+}
+
+/// `t_mocap_s, r00…r22, up…`: `R` maps world vectors into the body (its third column is world up
+/// in the body frame), so device → world is `Rᵀ`. Phone time = mocap time − alignment.
+fn import_mocap(path: &Path, align_s: f64, out: &mut Vec<SensorEvent>) -> Result<(), LogError> {
+    let cols = [
+        "t_mocap_s",
+        "r00",
+        "r01",
+        "r02",
+        "r10",
+        "r11",
+        "r12",
+        "r20",
+        "r21",
+        "r22",
+    ];
+    read_csv(path, &cols, |f| {
+        let v = parse_fields(f)?;
+        if v[1..].iter().any(|x| !x.is_finite()) {
+            return Ok(()); // tracking lost
+        }
+        let row = |i: usize| Vec3::new(v[1 + 3 * i] as f32, v[2 + 3 * i] as f32, v[3 + 3 * i] as f32);
+        // Columns of Rᵀ are the rows of R.
+        let m = Mat3::from_cols(row(0), row(1), row(2));
+        let det = m.determinant();
+        if (det - 1.0).abs() > 0.05 {
+            return Err(format!("rotation matrix is not a rotation (determinant {det})"));
+        }
+        let t_ns = seconds_to_ns(v[0] - align_s)?;
+        out.push(SensorEvent::orientation(
+            SensorKind::GroundTruth,
+            t_ns,
+            Quat::from_mat3(&m).normalize(),
+        ));
+        Ok(())
+    })
+}
+
+// ---------------------------------------------------------------------------------------------
+// Sensor Logger
+
+pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
+    let mut log = started(SourceFormat::SensorLogger, dir);
+    let uncal = find(dir, "AccelerometerUncalibrated.csv");
+    let streams = [
+        (
+            find(dir, "Accelerometer.csv"),
+            if uncal.is_some() {
+                None
+            } else {
+                Some(SensorKind::LinearAcceleration)
+            },
+        ),
+        (uncal, Some(SensorKind::Accelerometer)),
+        (find(dir, "Gyroscope.csv"), Some(SensorKind::Gyroscope)),
+        (find(dir, "Magnetometer.csv"), Some(SensorKind::Magnetometer)),
+    ];
+    for (path, kind) in streams {
+        let (Some(path), Some(kind)) = (path, kind) else {
+            continue;
+        };
+        let events = &mut log.events;
+        read_csv(&path, &["time", "x", "y", "z"], |f| {
+            let t_ns = parse_ns(f[0])?;
+            let v = parse_fields(&f[1..])?;
+            events.push(SensorEvent::vector(kind, t_ns, vec3(&v)));
+            Ok(())
+        })?;
+        log.note("read", display_name(&path));
+    }
+    if log.count(SensorKind::LinearAcceleration) > 0 {
+        log.note(
+            "note",
+            "Accelerometer.csv has gravity removed: imported as linear acceleration",
+        );
+    }
+    if let Some(path) = find(dir, "Orientation.csv") {
+        let events = &mut log.events;
+        read_csv(&path, &["time", "qx", "qy", "qz", "qw"], |f| {
+            let t_ns = parse_ns(f[0])?;
+            let v = parse_fields(&f[1..])?;
+            let q = Quat::from_xyzw(v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32);
+            events.push(SensorEvent::orientation(SensorKind::RotationVector, t_ns, q));
+            Ok(())
+        })?;
+        log.note("read", display_name(&path));
+    }
+    Ok(log.finish())
+}
+
+/// Integer nanoseconds, or a float (some exports write `1.76e18`).
+fn parse_ns(field: &str) -> Result<i64, String> {
+    let f = field.trim().trim_matches('"');
+    if let Ok(t) = f.parse::<i64>() {
+        return Ok(t);
+    }
+    let t = parse_f64(f)?;
+    if t.is_finite() && t.abs() < 9.2e18 {
+        Ok(t.round() as i64)
+    } else {
+        Err(format!("time stamp {field:?} is not usable"))
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// phyphox
+
+pub fn import_phyphox(dir: &Path) -> Result<ImportedLog, LogError> {
+    let mut log = started(SourceFormat::Phyphox, dir);
+    let streams = [
+        ("Accelerometer.csv", SensorKind::Accelerometer),
+        ("Gyroscope.csv", SensorKind::Gyroscope),
+        ("Magnetometer.csv", SensorKind::Magnetometer),
+        ("Linear Accelerometer.csv", SensorKind::LinearAcceleration),
+    ];
+    for (name, kind) in streams {
+        let Some(path) = find(dir, name) else { continue };
+        let events = &mut log.events;
+        read_csv(&path, &["time", "x", "y", "z"], |f| {
+            let v = parse_fields(f)?;
+            events.push(SensorEvent::vector(kind, seconds_to_ns(v[0])?, vec3(&v[1..])));
+            Ok(())
+        })?;
+        log.note("read", display_name(&path));
+    }
+    Ok(log.finish())
+}
+
+// ---------------------------------------------------------------------------------------------
+// BROAD
+
+pub fn import_broad(path: &Path) -> Result<ImportedLog, LogError> {
+    let mut log = started(SourceFormat::Broad, path);
+    let cols = [
+        "t_s", "acc_x", "acc_y", "acc_z", "gyr_x", "gyr_y", "gyr_z", "mag_x", "mag_y", "mag_z", "gt_qw", "gt_qx",
+        "gt_qy", "gt_qz",
+    ];
+    let events = &mut log.events;
+    read_csv(path, &cols, |f| {
+        let v = parse_fields(f)?;
+        let t_ns = seconds_to_ns(v[0])?;
+        events.push(SensorEvent::accelerometer(t_ns, vec3(&v[1..4])));
+        events.push(SensorEvent::gyroscope(t_ns, vec3(&v[4..7])));
+        events.push(SensorEvent::magnetometer(t_ns, vec3(&v[7..10])));
+        let q = Quat::from_xyzw(v[11] as f32, v[12] as f32, v[13] as f32, v[10] as f32);
+        if q.is_finite() {
+            events.push(SensorEvent::orientation(SensorKind::GroundTruth, t_ns, q));
+        }
+        Ok(())
+    })?;
+    log.note(
+        "ground_truth",
+        "optical motion capture, sensor → earth (east, north, up)",
+    );
+    Ok(log.finish())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::io::Write;
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("phantogram-import-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    fn write_gz(path: &Path, text: &str) {
+        let f = std::fs::File::create(path).unwrap();
+        let mut gz = flate2::write::GzEncoder::new(f, flate2::Compression::fast());
+        gz.write_all(text.as_bytes()).unwrap();
+        gz.finish().unwrap();
+    }
+
+    #[test]
+    fn android_raw_folder_with_ground_truth() {
+        let dir = temp_dir("android");
+        write_gz(&dir.join("accelerometer.txt.gz"), "0.5 0 0 9.81\n0.51 0 0.1 9.8\n");
+        write_gz(&dir.join("gyroscope-calibrated.txt.gz"), "0.505 0.1 0.2 0.3\n");
+        std::fs::write(dir.join("rotation-vector.txt"), "0.52 0 0 0 1 0.17\n").unwrap();
+        std::fs::write(dir.join("timeAlignment.txt"), "  6.5000000e-01\n").unwrap();
+        // Identity mocap at mocap time 1.2 s → phone time 0.55 s.
+        write_gz(
+            &dir.join("mocap.csv.gz"),
+            "t_mocap_s,r00,r01,r02,r10,r11,r12,r20,r21,r22,up_x,up_y,up_z\n1.2,1,0,0,0,1,0,0,0,1,0,0,1\n1.3,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN,NaN\n",
+        );
+        assert_eq!(detect(&dir).unwrap(), SourceFormat::AndroidRaw);
+        let log = import(&dir).unwrap();
+        let kinds: Vec<_> = log.events.iter().map(|e| (e.t_ns, e.kind)).collect();
+        assert_eq!(
+            kinds,
+            [
+                (500_000_000, SensorKind::Accelerometer),
+                (505_000_000, SensorKind::Gyroscope),
+                (510_000_000, SensorKind::Accelerometer),
+                (520_000_000, SensorKind::RotationVector),
+                (550_000_000, SensorKind::GroundTruth),
+            ]
+        );
+        assert_eq!(log.events[1].vec3(), Vec3::new(0.1, 0.2, 0.3));
+    }
+
+    #[test]
+    fn mocap_orientation_convention() {
+        // R maps world to body; pitched 30° about x, world up seen in the body is (0, sin, cos).
+        let dir = temp_dir("mocap");
+        let truth = Quat::from_rotation_x(30f32.to_radians()); // device → world
+        let r = Mat3::from_quat(truth.inverse()); // world → device
+        let rows = [r.row(0), r.row(1), r.row(2)];
+        let cells: Vec<String> = rows.iter().flat_map(|v| v.to_array()).map(|x| x.to_string()).collect();
+        let up = truth.inverse() * Vec3::Z;
+        let text = format!(
+            "t_mocap_s,r00,r01,r02,r10,r11,r12,r20,r21,r22,up_x,up_y,up_z\n0.0,{},{},{},{}\n",
+            cells.join(","),
+            up.x,
+            up.y,
+            up.z
+        );
+        std::fs::write(dir.join("mocap.csv"), text).unwrap();
+        let mut out = Vec::new();
+        import_mocap(&dir.join("mocap.csv"), 0.0, &mut out).unwrap();
+        let q = out[0].quat().unwrap();
+        assert!(q.angle_between(truth) < 1e-4);
+        // The file's up column is R's third column, as the convention requires.
+        assert!((rows[0].z - up.x).abs() < 1e-6 && (rows[1].z - up.y).abs() < 1e-6);
+    }
+
+    #[test]
+    fn sensor_logger_and_phyphox_headers() {
+        let dir = temp_dir("sl");
+        std::fs::write(
+            dir.join("Accelerometer.csv"),
+            "time,seconds_elapsed,z,y,x\n1000,0.0,3,2,1\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("Gyroscope.csv"),
+            "time,seconds_elapsed,z,y,x\n2000,0.0,0.3,0.2,0.1\n",
+        )
+        .unwrap();
+        assert_eq!(detect(&dir).unwrap(), SourceFormat::SensorLogger);
+        let log = import(&dir).unwrap();
+        assert_eq!(log.events[0].kind, SensorKind::LinearAcceleration);
+        assert_eq!(
+            log.events[0].vec3(),
+            Vec3::new(1.0, 2.0, 3.0),
+            "columns by name, not position"
+        );
+        assert_eq!(log.events[1].t_ns, 2000);
+
+        let dir = temp_dir("phyphox");
+        std::fs::write(
+            dir.join("Accelerometer.csv"),
+            "\"Time (s)\",\"X (m/s^2)\",\"Y (m/s^2)\",\"Z (m/s^2)\"\n3.4E-3,-4.8E-1,1.7E0,9.4E0\n",
+        )
+        .unwrap();
+        assert_eq!(detect(&dir).unwrap(), SourceFormat::Phyphox);
+        let log = import(&dir).unwrap();
+        assert_eq!(log.events[0].t_ns, 3_400_000);
+        assert_eq!(log.events[0].kind, SensorKind::Accelerometer);
+    }
+
+    #[test]
+    fn broad_rows_split_into_events() {
+        let dir = temp_dir("broad");
+        let path = dir.join("trial.csv");
+        std::fs::write(
+            &path,
+            "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,gt_qw,gt_qx,gt_qy,gt_qz,movement\n\
+             0.0,0,0,9.8,0,0,0,0,20,-40,NaN,NaN,NaN,NaN,0\n\
+             0.0035,0,0,9.8,0,0,0,0,20,-40,1,0,0,0,1\n",
+        )
+        .unwrap();
+        let log = import(&path).unwrap();
+        assert_eq!(log.count(SensorKind::Accelerometer), 2);
+        assert_eq!(
+            log.count(SensorKind::GroundTruth),
+            1,
+            "NaN ground truth is absence, not an error"
+        );
+        assert_eq!(log.events.last().unwrap().t_ns, 3_500_000);
+    }
+
+    #[test]
+    fn malformed_input_names_file_and_line() {
+        let dir = temp_dir("bad");
+        std::fs::write(dir.join("accelerometer.txt"), "0.5 0 0 9.81\n0.6 0 zero 9.81\n").unwrap();
+        let err = import(&dir).unwrap_err();
+        assert_eq!(err.line(), Some(2));
+        assert!(err.to_string().contains("accelerometer.txt:2:"), "{err}");
+
+        std::fs::write(dir.join("accelerometer.txt"), "0.5 0 0 9.81\n0.6 0 9.81\n").unwrap();
+        assert!(import(&dir).unwrap_err().to_string().contains("columns"));
+
+        let empty = temp_dir("empty");
+        assert!(matches!(import(&empty), Err(LogError::Format { .. })));
+        let other = empty.join("x.txt");
+        std::fs::write(&other, "hello\n").unwrap();
+        assert_eq!(import(&other).unwrap_err().line(), Some(1));
+        assert!(matches!(import(&empty.join("missing")), Err(LogError::Io { .. })));
+    }
+}

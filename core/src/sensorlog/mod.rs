@@ -1,0 +1,513 @@
+//! Sensor logs: the project's own recording format, its streaming reader and writer, and importers
+//! for real exports ([`import`]).
+//!
+//! ## Format, version 1
+//!
+//! UTF-8 text, one record per line, optionally gzip-compressed (detected from the gzip magic
+//! bytes, whatever the file name). Line-oriented so that it streams (a recorder appends, a reader
+//! needs no index), diffs, and survives truncation up to the last complete line.
+//!
+//! ```text
+//! phantogram-sensor-log 1
+//! # comment lines and blank lines are ignored
+//! meta source Thibaud_Nexus5_NoDist_AR
+//! acc 282310596 -0.45986938 4.028183 8.463165
+//! gyr 438408008 -0.7108307 1.4732819 1.0360565
+//! rot 641014209 0.07790387 0.121515125 -0.11503918 0.9828179
+//! ```
+//!
+//! * Line 1 names the format and its version; a reader refuses versions it does not know.
+//! * `meta KEY VALUE…` lines (only before the first event) carry free-form provenance.
+//! * Event lines: a tag, the time stamp in integer nanoseconds, then the values in the crate's
+//!   device frame and units. Tags: `acc` accelerometer (m/s², with gravity), `gyr` gyroscope
+//!   (rad/s), `mag` magnetometer (µT), `lin` linear acceleration (m/s², gravity removed), each with
+//!   `x y z`; `rot` platform rotation vector and `gt` ground-truth orientation, device → world
+//!   quaternions as `x y z w`. Values may be `NaN` or `inf`: a log records what the sensor said,
+//!   and the consumer ([`crate::sensors::SensorInbox`]) rejects and counts them.
+//! * Events are written in time order; readers do not reorder.
+//!
+//! Errors name the file and the 1-based line.
+
+pub mod import;
+
+use std::fs::File;
+use std::io::{self, BufRead, BufReader, BufWriter, Read, Write};
+use std::path::{Path, PathBuf};
+
+use flate2::Compression;
+use flate2::read::MultiGzDecoder;
+use flate2::write::GzEncoder;
+use thiserror::Error;
+
+use crate::sensors::{SensorEvent, SensorKind};
+
+/// First word of line 1.
+pub const MAGIC: &str = "phantogram-sensor-log";
+/// The version this crate writes and reads.
+pub const VERSION: u32 = 1;
+
+#[derive(Debug, Error)]
+pub enum LogError {
+    #[error("{}: {source}", path.display())]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: io::Error,
+    },
+    #[error("{}:{line}: {message}", path.display())]
+    Parse { path: PathBuf, line: u64, message: String },
+    #[error("{}: {message}", path.display())]
+    Format { path: PathBuf, message: String },
+}
+
+impl LogError {
+    pub fn io(path: &Path, source: io::Error) -> Self {
+        Self::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+
+    pub fn parse(path: &Path, line: u64, message: impl Into<String>) -> Self {
+        Self::Parse {
+            path: path.to_path_buf(),
+            line,
+            message: message.into(),
+        }
+    }
+
+    pub fn format(path: &Path, message: impl Into<String>) -> Self {
+        Self::Format {
+            path: path.to_path_buf(),
+            message: message.into(),
+        }
+    }
+
+    /// The 1-based line an error points at, if any.
+    pub fn line(&self) -> Option<u64> {
+        match self {
+            Self::Parse { line, .. } => Some(*line),
+            _ => None,
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::Io { path, .. } | Self::Parse { path, .. } | Self::Format { path, .. } => path,
+        }
+    }
+}
+
+fn tag(kind: SensorKind) -> &'static str {
+    match kind {
+        SensorKind::Accelerometer => "acc",
+        SensorKind::Gyroscope => "gyr",
+        SensorKind::Magnetometer => "mag",
+        SensorKind::RotationVector => "rot",
+        SensorKind::LinearAcceleration => "lin",
+        SensorKind::GroundTruth => "gt",
+    }
+}
+
+fn kind_of_tag(t: &str) -> Option<SensorKind> {
+    SensorKind::ALL.into_iter().find(|k| tag(*k) == t)
+}
+
+/// Opens a file for reading, transparently gunzipping it when it starts with the gzip magic.
+pub fn open_maybe_gz(path: &Path) -> Result<Box<dyn BufRead>, LogError> {
+    let mut file = BufReader::new(File::open(path).map_err(|e| LogError::io(path, e))?);
+    let head = file.fill_buf().map_err(|e| LogError::io(path, e))?;
+    if head.starts_with(&[0x1f, 0x8b]) {
+        Ok(Box::new(BufReader::new(MultiGzDecoder::new(file))))
+    } else {
+        Ok(Box::new(file))
+    }
+}
+
+/// Reads numbered lines, naming the file in every error.
+pub struct Lines {
+    path: PathBuf,
+    reader: Box<dyn BufRead>,
+    line_no: u64,
+    buf: String,
+}
+
+impl Lines {
+    pub fn open(path: &Path) -> Result<Self, LogError> {
+        Ok(Self::new(path, open_maybe_gz(path)?))
+    }
+
+    pub fn new(path: &Path, reader: Box<dyn BufRead>) -> Self {
+        Self {
+            path: path.to_path_buf(),
+            reader,
+            line_no: 0,
+            buf: String::new(),
+        }
+    }
+
+    pub fn path(&self) -> &Path {
+        &self.path
+    }
+
+    pub fn line_no(&self) -> u64 {
+        self.line_no
+    }
+
+    /// Moves to the next line; `false` at the end. Read it with [`Self::current`].
+    pub fn advance(&mut self) -> Result<bool, LogError> {
+        self.buf.clear();
+        let n = self.reader.read_line(&mut self.buf).map_err(|e| {
+            if e.kind() == io::ErrorKind::InvalidData {
+                LogError::parse(&self.path, self.line_no + 1, "not valid UTF-8 text")
+            } else {
+                LogError::io(&self.path, e)
+            }
+        })?;
+        if n == 0 {
+            return Ok(false);
+        }
+        self.line_no += 1;
+        Ok(true)
+    }
+
+    /// The current line without its line ending.
+    pub fn current(&self) -> &str {
+        self.buf.trim_end_matches(['\n', '\r'])
+    }
+
+    /// The next line, owned; `None` at the end. For headers, not for the bulk of a file.
+    pub fn next_owned(&mut self) -> Result<Option<String>, LogError> {
+        Ok(self.advance()?.then(|| self.current().to_owned()))
+    }
+
+    pub fn error(&self, message: impl Into<String>) -> LogError {
+        LogError::parse(&self.path, self.line_no, message)
+    }
+}
+
+/// Parses a float the way sensor exports write them (also `NaN`, `inf`).
+pub fn parse_f64(field: &str) -> Result<f64, String> {
+    let f = field.trim().trim_matches('"');
+    f.parse::<f64>()
+        .map_err(|_| format!("expected a number, found {field:?}"))
+}
+
+/// Seconds (as exported) to integer nanoseconds; refuses non-finite or absurd times.
+pub fn seconds_to_ns(t_s: f64) -> Result<i64, String> {
+    if !t_s.is_finite() || t_s.abs() > 9.0e9 {
+        return Err(format!("time stamp {t_s} s is not usable"));
+    }
+    Ok((t_s * 1e9).round() as i64)
+}
+
+/// Streaming reader of the project's format.
+pub struct LogReader {
+    lines: Lines,
+    meta: Vec<(String, String)>,
+    pending: Option<SensorEvent>,
+    failed: bool,
+}
+
+impl LogReader {
+    pub fn open(path: &Path) -> Result<Self, LogError> {
+        Self::from_lines(Lines::open(path)?)
+    }
+
+    /// Reads from any byte source; `name` is used in error messages.
+    pub fn from_reader(name: &Path, reader: impl Read + 'static) -> Result<Self, LogError> {
+        Self::from_lines(Lines::new(name, Box::new(BufReader::new(reader))))
+    }
+
+    fn from_lines(mut lines: Lines) -> Result<Self, LogError> {
+        let Some(header) = lines.next_owned()? else {
+            return Err(LogError::format(
+                lines.path(),
+                "empty file, not a phantogram sensor log",
+            ));
+        };
+        let mut words = header.split_whitespace();
+        if words.next() != Some(MAGIC) {
+            return Err(lines.error(format!(
+                "not a phantogram sensor log (line 1 should start with {MAGIC:?})"
+            )));
+        }
+        match words.next().map(str::parse::<u32>) {
+            Some(Ok(VERSION)) => {}
+            Some(Ok(v)) => {
+                return Err(lines.error(format!(
+                    "format version {v} is not supported (this build reads {VERSION})"
+                )));
+            }
+            _ => return Err(lines.error("missing or malformed format version")),
+        }
+        let mut reader = Self {
+            lines,
+            meta: Vec::new(),
+            pending: None,
+            failed: false,
+        };
+        // Read the header block (meta lines) up to the first event.
+        loop {
+            match reader.read_record(true)? {
+                Record::Meta(k, v) => reader.meta.push((k, v)),
+                Record::Event(e) => {
+                    reader.pending = Some(e);
+                    break;
+                }
+                Record::End => break,
+            }
+        }
+        Ok(reader)
+    }
+
+    pub fn meta(&self) -> &[(String, String)] {
+        &self.meta
+    }
+
+    pub fn path(&self) -> &Path {
+        self.lines.path()
+    }
+
+    fn read_record(&mut self, meta_allowed: bool) -> Result<Record, LogError> {
+        loop {
+            if !self.lines.advance()? {
+                return Ok(Record::End);
+            }
+            let line = self.lines.current().trim();
+            if line.is_empty() || line.starts_with('#') {
+                continue;
+            }
+            let (first, rest) = line.split_once(char::is_whitespace).unwrap_or((line, ""));
+            if first == "meta" {
+                if !meta_allowed {
+                    return Err(self.lines.error("meta line after the first event"));
+                }
+                let rest = rest.trim();
+                let (k, v) = rest.split_once(char::is_whitespace).unwrap_or((rest, ""));
+                if k.is_empty() {
+                    return Err(self.lines.error("meta line without a key"));
+                }
+                return Ok(Record::Meta(k.to_owned(), v.trim().to_owned()));
+            }
+            let event = parse_event(first, rest).map_err(|m| self.lines.error(m))?;
+            return Ok(Record::Event(event));
+        }
+    }
+}
+
+enum Record {
+    Meta(String, String),
+    Event(SensorEvent),
+    End,
+}
+
+fn parse_event(tag: &str, rest: &str) -> Result<SensorEvent, String> {
+    let kind = kind_of_tag(tag).ok_or_else(|| format!("unknown record type {tag:?}"))?;
+    let mut fields = rest.split_whitespace();
+    let t_ns = fields
+        .next()
+        .ok_or("missing time stamp")?
+        .parse::<i64>()
+        .map_err(|_| "time stamp is not an integer number of nanoseconds".to_owned())?;
+    let n = if kind.is_orientation() { 4 } else { 3 };
+    let mut value = [0f32; 4];
+    for (i, slot) in value.iter_mut().take(n).enumerate() {
+        let f = fields.next().ok_or_else(|| format!("expected {n} values, found {i}"))?;
+        *slot = parse_f64(f)? as f32;
+    }
+    if fields.next().is_some() {
+        return Err(format!("expected {n} values, found more"));
+    }
+    Ok(SensorEvent { t_ns, kind, value })
+}
+
+impl Iterator for LogReader {
+    type Item = Result<SensorEvent, LogError>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if let Some(e) = self.pending.take() {
+            return Some(Ok(e));
+        }
+        if self.failed {
+            return None;
+        }
+        match self.read_record(false) {
+            Ok(Record::Event(e)) => Some(Ok(e)),
+            Ok(Record::End) => None,
+            Ok(Record::Meta(..)) => unreachable!("read_record refuses meta after the header"),
+            Err(e) => {
+                self.failed = true;
+                Some(Err(e))
+            }
+        }
+    }
+}
+
+/// Streaming writer of the project's format. Gzip-compresses when the path ends in `.gz`.
+pub struct LogWriter {
+    path: PathBuf,
+    sink: Sink,
+}
+
+enum Sink {
+    Plain(BufWriter<File>),
+    Gzip(GzEncoder<BufWriter<File>>),
+}
+
+impl LogWriter {
+    pub fn create(path: &Path, meta: &[(String, String)]) -> Result<Self, LogError> {
+        let file = BufWriter::new(File::create(path).map_err(|e| LogError::io(path, e))?);
+        let sink = if path.extension().is_some_and(|e| e == "gz") {
+            Sink::Gzip(GzEncoder::new(file, Compression::default()))
+        } else {
+            Sink::Plain(file)
+        };
+        let mut w = Self {
+            path: path.to_path_buf(),
+            sink,
+        };
+        let mut header = format!("{MAGIC} {VERSION}\n");
+        for (k, v) in meta {
+            // Keys are single words; values end at the line.
+            let k = k.split_whitespace().collect::<Vec<_>>().join("_");
+            let v = v.replace(['\n', '\r'], " ");
+            header.push_str(&format!("meta {k} {v}\n"));
+        }
+        w.write_text(&header)?;
+        Ok(w)
+    }
+
+    fn write_text(&mut self, text: &str) -> Result<(), LogError> {
+        let result = match &mut self.sink {
+            Sink::Plain(f) => f.write_all(text.as_bytes()),
+            Sink::Gzip(gz) => gz.write_all(text.as_bytes()),
+        };
+        result.map_err(|e| LogError::io(&self.path, e))
+    }
+
+    pub fn write(&mut self, e: &SensorEvent) -> Result<(), LogError> {
+        let v = e.value;
+        let line = if e.kind.is_orientation() {
+            format!("{} {} {} {} {} {}\n", tag(e.kind), e.t_ns, v[0], v[1], v[2], v[3])
+        } else {
+            format!("{} {} {} {} {}\n", tag(e.kind), e.t_ns, v[0], v[1], v[2])
+        };
+        self.write_text(&line)
+    }
+
+    /// Flushes and closes the file; without it a gzip stream is incomplete.
+    pub fn finish(self) -> Result<(), LogError> {
+        let result = match self.sink {
+            Sink::Plain(mut f) => f.flush(),
+            Sink::Gzip(gz) => gz.finish().and_then(|mut f| f.flush()),
+        };
+        result.map_err(|e| LogError::io(&self.path, e))
+    }
+}
+
+/// Writes a whole log.
+pub fn write_log(path: &Path, meta: &[(String, String)], events: &[SensorEvent]) -> Result<(), LogError> {
+    let mut w = LogWriter::create(path, meta)?;
+    for e in events {
+        w.write(e)?;
+    }
+    w.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{Quat, Vec3};
+
+    fn temp(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("phantogram-log-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir.join(name)
+    }
+
+    fn sample_events() -> Vec<SensorEvent> {
+        vec![
+            SensorEvent::accelerometer(1_000, Vec3::new(0.1, -0.2, 9.81)),
+            SensorEvent::gyroscope(1_500, Vec3::new(1e-7, 3.25, -0.5)),
+            SensorEvent::magnetometer(2_000, Vec3::new(f32::NAN, 20.0, -40.0)),
+            SensorEvent::orientation(SensorKind::RotationVector, 2_500, Quat::from_rotation_x(0.3)),
+            SensorEvent::vector(SensorKind::LinearAcceleration, 3_000, Vec3::ONE),
+            SensorEvent::orientation(SensorKind::GroundTruth, 3_500, Quat::from_rotation_y(-1.0)),
+        ]
+    }
+
+    fn same(a: &SensorEvent, b: &SensorEvent) -> bool {
+        a.t_ns == b.t_ns
+            && a.kind == b.kind
+            && a.value
+                .iter()
+                .zip(b.value)
+                .all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()))
+    }
+
+    #[test]
+    fn round_trips_exactly_plain_and_gzip() {
+        let events = sample_events();
+        let meta = vec![("source".to_owned(), "unit test".to_owned())];
+        for name in ["rt.pglog", "rt.pglog.gz"] {
+            let path = temp(name);
+            write_log(&path, &meta, &events).unwrap();
+            let r = LogReader::open(&path).unwrap();
+            assert_eq!(r.meta(), &meta[..]);
+            let back: Vec<_> = r.collect::<Result<_, _>>().unwrap();
+            assert_eq!(back.len(), events.len());
+            for (a, b) in events.iter().zip(&back) {
+                assert!(same(a, b), "{a:?} != {b:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn errors_name_file_and_line() {
+        let cases = [
+            ("nope 1\n", 1, "not a phantogram"),
+            ("phantogram-sensor-log 2\n", 1, "version 2"),
+            ("phantogram-sensor-log 1\nacc 10 1 2\n", 2, "expected 3 values"),
+            ("phantogram-sensor-log 1\n# c\n\nacc 10 1 2 x\n", 4, "expected a number"),
+            ("phantogram-sensor-log 1\nacc 1.5 1 2 3\n", 2, "nanoseconds"),
+            ("phantogram-sensor-log 1\nacc 1 1 2 3\nmeta a b\n", 3, "meta line after"),
+            ("phantogram-sensor-log 1\nzzz 1 1 2 3\n", 2, "unknown record"),
+            ("phantogram-sensor-log 1\nrot 1 1 2 3 4 5\n", 2, "found more"),
+        ];
+        for (i, (text, line, needle)) in cases.into_iter().enumerate() {
+            let path = temp(&format!("bad{i}.pglog"));
+            std::fs::write(&path, text).unwrap();
+            let err = match LogReader::open(&path) {
+                Err(e) => e,
+                Ok(r) => r.filter_map(Result::err).next().expect("an error"),
+            };
+            assert_eq!(err.line(), Some(line), "{text:?}: {err}");
+            let shown = err.to_string();
+            assert!(shown.contains(&format!("bad{i}.pglog:{line}:")), "{shown}");
+            assert!(shown.contains(needle), "{shown}");
+        }
+    }
+
+    #[test]
+    fn empty_and_missing_files_are_clear_errors() {
+        let path = temp("empty.pglog");
+        std::fs::write(&path, "").unwrap();
+        assert!(LogReader::open(&path).err().unwrap().to_string().contains("empty file"));
+        let missing = temp("missing.pglog");
+        assert!(matches!(LogReader::open(&missing), Err(LogError::Io { .. })));
+    }
+
+    #[test]
+    fn truncated_gzip_is_an_error_not_a_panic() {
+        let path = temp("trunc.pglog.gz");
+        let events: Vec<_> = (0..2000)
+            .map(|i| SensorEvent::accelerometer(i, Vec3::splat(i as f32)))
+            .collect();
+        write_log(&path, &[], &events).unwrap();
+        let bytes = std::fs::read(&path).unwrap();
+        std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
+        let result: Result<Vec<_>, _> = LogReader::open(&path).and_then(|r| r.collect());
+        assert!(result.is_err());
+    }
+}

@@ -1,0 +1,266 @@
+//! The per-device state that turns sensor events into what one frame needs: both eyes, their
+//! off-axis projections, and the world-fixed light, all in the device frame.
+//!
+//! **Threading**: a [`Session`] belongs to the render thread. Sensor threads push through the
+//! [`SensorInbox`] returned by [`Session::inbox`] (an `Arc`, `Send + Sync`); [`Session::frame`]
+//! drains it. Nothing blocks.
+//!
+//! **Order of work per frame**: drain the inbox (sorted by time) → feed the orientation estimator →
+//! anchor the light the first time a full orientation is known → cyclopean eye from "up" and the
+//! flat-angle reference → stereo pair → three projections (left, right, and the cyclopean one for
+//! mono rendering).
+
+use std::sync::Arc;
+
+use glam::{Quat, Vec3};
+use thiserror::Error;
+
+use crate::attitude::{LowPassAttitude, OrientationEstimator, device_to_world_from_up};
+use crate::eyes::{EyeModel, EyeModelError, StereoEyes};
+use crate::light::WorldLight;
+use crate::projection::{DepthRange, OffAxisProjection, ProjectionError};
+use crate::screen::Screen;
+use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorStats};
+use crate::viewpoint::Viewpoint;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SessionConfig {
+    pub screen: Screen,
+    pub eyes: EyeModel,
+    pub depth: DepthRange,
+    /// Time constant of the paper's accelerometer low-pass, seconds.
+    pub viewpoint_tau_s: f32,
+    /// Where the world-fixed light appears when anchored, device frame (towards the light).
+    pub light_toward_device: Vec3,
+    pub inbox_capacity: usize,
+}
+
+impl Default for SessionConfig {
+    fn default() -> Self {
+        Self {
+            screen: Screen::default(),
+            eyes: EyeModel::default(),
+            depth: DepthRange::default(),
+            viewpoint_tau_s: LowPassAttitude::DEFAULT_TAU_S,
+            light_toward_device: WorldLight::default().toward_light_device(None),
+            inbox_capacity: SensorInbox::DEFAULT_CAPACITY,
+        }
+    }
+}
+
+#[derive(Debug, Error, PartialEq)]
+pub enum SessionError {
+    #[error(transparent)]
+    EyeModel(#[from] EyeModelError),
+    #[error(transparent)]
+    Projection(#[from] ProjectionError),
+    #[error("no accelerometer reading yet: cannot tell which way is up")]
+    NoGravityYet,
+}
+
+/// Everything one frame needs, device frame, metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrameView {
+    /// Time stamp of the newest sensor event taken into account.
+    pub sensor_t_ns: Option<i64>,
+    pub eyes: StereoEyes,
+    pub left: OffAxisProjection,
+    pub right: OffAxisProjection,
+    /// The cyclopean eye's projection, for mono rendering.
+    pub mono: OffAxisProjection,
+    /// Unit vector towards the world-fixed light.
+    pub toward_light_device: Vec3,
+    pub light_anchored: bool,
+}
+
+impl FrameView {
+    pub fn stereo_eyes_m(&self) -> [Vec3; 2] {
+        [self.eyes.left_m, self.eyes.right_m]
+    }
+}
+
+pub struct Session {
+    config: SessionConfig,
+    inbox: Arc<SensorInbox>,
+    estimator: Box<dyn OrientationEstimator>,
+    viewpoint: Viewpoint,
+    light: WorldLight,
+    batch: Vec<SensorEvent>,
+    newest_t_ns: Option<i64>,
+}
+
+impl std::fmt::Debug for Session {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Session")
+            .field("config", &self.config)
+            .field("viewpoint", &self.viewpoint)
+            .field("light", &self.light)
+            .field("newest_t_ns", &self.newest_t_ns)
+            .finish_non_exhaustive()
+    }
+}
+
+impl Session {
+    /// A session with the paper's low-pass estimator.
+    pub fn new(config: SessionConfig) -> Result<Self, SessionError> {
+        let estimator = LowPassAttitude::new(config.viewpoint_tau_s, config.viewpoint_tau_s);
+        Self::with_estimator(config, Box::new(estimator))
+    }
+
+    pub fn with_estimator(
+        config: SessionConfig,
+        estimator: Box<dyn OrientationEstimator>,
+    ) -> Result<Self, SessionError> {
+        config.eyes.validate()?;
+        // Fail early on a depth range no frame could use.
+        OffAxisProjection::new(&config.screen, Vec3::Z * config.eyes.viewing_distance_m, config.depth)?;
+        Ok(Self {
+            inbox: Arc::new(SensorInbox::with_capacity(config.inbox_capacity)),
+            light: WorldLight::new(config.light_toward_device),
+            config,
+            estimator,
+            viewpoint: Viewpoint::default(),
+            batch: Vec::new(),
+            newest_t_ns: None,
+        })
+    }
+
+    pub fn config(&self) -> &SessionConfig {
+        &self.config
+    }
+
+    /// The queue for sensor threads.
+    pub fn inbox(&self) -> Arc<SensorInbox> {
+        Arc::clone(&self.inbox)
+    }
+
+    /// Convenience for single-threaded callers (replay): validate and queue one event.
+    pub fn push(&self, event: SensorEvent) -> Result<(), Rejection> {
+        self.inbox.push(event)
+    }
+
+    pub fn stats(&self) -> SensorStats {
+        self.inbox.stats()
+    }
+
+    /// Drains the inbox into the estimator; returns how many events were used.
+    pub fn update(&mut self) -> usize {
+        self.batch.clear();
+        self.inbox.drain_into(&mut self.batch);
+        for e in &self.batch {
+            self.estimator.push(e);
+        }
+        if let Some(last) = self.batch.last() {
+            self.newest_t_ns = Some(self.newest_t_ns.map_or(last.t_ns, |t| t.max(last.t_ns)));
+        }
+        if !self.light.is_anchored() {
+            if let Some(q) = self.device_to_world() {
+                self.light.anchor(q);
+            }
+        }
+        self.batch.len()
+    }
+
+    /// The orientation used for the light: the estimator's, or from gravity alone (arbitrary but
+    /// fixed heading) when no magnetometer is available.
+    fn device_to_world(&self) -> Option<Quat> {
+        self.estimator
+            .device_to_world()
+            .or_else(|| device_to_world_from_up(self.estimator.up_device()?))
+    }
+
+    pub fn up_device(&self) -> Option<Vec3> {
+        self.estimator.up_device()
+    }
+
+    /// Makes the current holding pose count as straight on.
+    pub fn calibrate_flat_angle(&mut self) -> Result<(), SessionError> {
+        self.update();
+        let up = self.estimator.up_device().ok_or(SessionError::NoGravityYet)?;
+        if self.viewpoint.calibrate_flat_angle(up) {
+            Ok(())
+        } else {
+            Err(SessionError::NoGravityYet)
+        }
+    }
+
+    pub fn reset_flat_angle(&mut self) {
+        self.viewpoint.reset_flat_angle();
+    }
+
+    /// Ties the light's default direction to the room again, at the current pose.
+    pub fn recalibrate_light(&mut self) -> Result<(), SessionError> {
+        self.update();
+        let q = self.device_to_world().ok_or(SessionError::NoGravityYet)?;
+        self.light.anchor(q);
+        Ok(())
+    }
+
+    /// After a display rotation or a surface resize.
+    pub fn set_screen(&mut self, screen: Screen) {
+        self.config.screen = screen;
+    }
+
+    pub fn set_eye_model(&mut self, eyes: EyeModel) -> Result<(), SessionError> {
+        eyes.validate()?;
+        self.config.eyes = eyes;
+        Ok(())
+    }
+
+    /// Drains pending sensor events and computes this frame's eyes, projections and light.
+    pub fn frame(&mut self) -> Result<FrameView, SessionError> {
+        self.update();
+        let cfg = &self.config;
+        let cyclopean = self
+            .viewpoint
+            .cyclopean_eye_m(self.estimator.up_device(), cfg.eyes.viewing_distance_m);
+        let eyes = cfg.eyes.stereo_pair(&cfg.screen, cyclopean);
+        let project = |eye| OffAxisProjection::new(&cfg.screen, eye, cfg.depth);
+        Ok(FrameView {
+            sensor_t_ns: self.newest_t_ns,
+            left: project(eyes.left_m)?,
+            right: project(eyes.right_m)?,
+            mono: project(eyes.cyclopean_m)?,
+            eyes,
+            toward_light_device: self.light.toward_light_device(self.device_to_world()),
+            light_anchored: self.light.is_anchored(),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frame_before_any_sensor_data_is_straight_on() {
+        let mut s = Session::new(SessionConfig::default()).unwrap();
+        let f = s.frame().unwrap();
+        assert_eq!(f.eyes.cyclopean_m, Vec3::new(0.0, 0.0, 0.3));
+        assert!(!f.light_anchored);
+        assert_eq!(s.calibrate_flat_angle(), Err(SessionError::NoGravityYet));
+    }
+
+    #[test]
+    fn light_anchors_without_a_magnetometer() {
+        let mut s = Session::new(SessionConfig::default()).unwrap();
+        s.push(SensorEvent::accelerometer(1, Vec3::Z * 9.81)).unwrap();
+        let f = s.frame().unwrap();
+        assert!(f.light_anchored);
+        assert!(
+            f.toward_light_device
+                .distance(SessionConfig::default().light_toward_device)
+                < 1e-5
+        );
+    }
+
+    #[test]
+    fn bad_configuration_is_refused() {
+        let mut c = SessionConfig::default();
+        c.eyes.ipd_m = -1.0;
+        assert!(matches!(Session::new(c), Err(SessionError::EyeModel(_))));
+        let mut c = SessionConfig::default();
+        c.depth.far_m = 0.0;
+        assert!(matches!(Session::new(c), Err(SessionError::Projection(_))));
+    }
+}

@@ -1,0 +1,61 @@
+//! The iOS side of the phantogram core: today only the conversion from Core Motion's conventions to
+//! the core's sensor events; the C ABI, cbindgen header and Metal surface come with the shell
+//! (issue #6).
+//!
+//! Core Motion's device axes are the core's (x right, y up, z out of the screen), but its
+//! accelerometer reports in g with the opposite sign (a phone lying face up reads −1 g on z, where
+//! the core, like Android, reads +9.81 m/s²). Gyroscope (rad/s) and calibrated magnetic field (µT)
+//! pass through. Time stamps are seconds since boot (`CMLogItem.timestamp`).
+
+use phantogram::glam::Vec3;
+use phantogram::sensors::SensorEvent;
+
+/// Standard gravity used by Core Motion's g unit, m/s².
+pub const STANDARD_GRAVITY_M_S2: f64 = 9.80665;
+
+/// Seconds (Core Motion time stamp) to the core's integer nanoseconds; `None` if not finite.
+pub fn timestamp_ns(seconds: f64) -> Option<i64> {
+    (seconds.is_finite() && seconds.abs() < 9.0e9).then(|| (seconds * 1e9).round() as i64)
+}
+
+/// `CMAccelerometerData.acceleration` (g, iOS sign) → core accelerometer event (m/s², up positive).
+pub fn accelerometer_event(timestamp_s: f64, acceleration_g: [f64; 3]) -> Option<SensorEvent> {
+    let a = acceleration_g.map(|g| (-g * STANDARD_GRAVITY_M_S2) as f32);
+    Some(SensorEvent::accelerometer(
+        timestamp_ns(timestamp_s)?,
+        Vec3::from_array(a),
+    ))
+}
+
+/// `CMGyroData.rotationRate` (rad/s) → core gyroscope event.
+pub fn gyroscope_event(timestamp_s: f64, rate_rad_s: [f64; 3]) -> Option<SensorEvent> {
+    Some(SensorEvent::gyroscope(
+        timestamp_ns(timestamp_s)?,
+        Vec3::from_array(rate_rad_s.map(|v| v as f32)),
+    ))
+}
+
+/// `CMMagnetometerData.magneticField` (µT) → core magnetometer event.
+pub fn magnetometer_event(timestamp_s: f64, field_ut: [f64; 3]) -> Option<SensorEvent> {
+    Some(SensorEvent::magnetometer(
+        timestamp_ns(timestamp_s)?,
+        Vec3::from_array(field_ut.map(|v| v as f32)),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn face_up_reads_up_in_the_core_convention() {
+        let e = accelerometer_event(1.5, [0.0, 0.0, -1.0]).unwrap();
+        assert_eq!(e.t_ns, 1_500_000_000);
+        assert!((e.vec3() - Vec3::new(0.0, 0.0, 9.80665)).length() < 1e-5);
+        assert!(gyroscope_event(f64::NAN, [0.0; 3]).is_none());
+        assert_eq!(
+            magnetometer_event(0.0, [1.0, 2.0, 3.0]).unwrap().vec3(),
+            Vec3::new(1.0, 2.0, 3.0)
+        );
+    }
+}

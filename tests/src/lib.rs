@@ -1,0 +1,27 @@
+//! Helpers shared by the integration tests in `tests/tests/`.
+//!
+//! External recordings live outside the repository; tests find them through the environment
+//! variable [`DATA_ENV`] (`.ci/run` sets it to `../shared/data`). Without it, the tests that need
+//! them print a notice and pass vacuously *only* when the variable is unset; when it is set but
+//! wrong, they fail.
+
+use std::path::PathBuf;
+
+/// Environment variable naming the external data folder.
+pub const DATA_ENV: &str = "PHANTOGRAM_DATA";
+
+/// The external data folder, if configured. Panics (failing the test) if the variable is set but
+/// does not name a folder, so a misconfigured CI cannot silently skip.
+pub fn data_dir() -> Option<PathBuf> {
+    let dir = PathBuf::from(std::env::var_os(DATA_ENV)?);
+    assert!(dir.is_dir(), "{DATA_ENV}={} is not a folder", dir.display());
+    Some(dir)
+}
+
+/// A scratch folder unique to this process and `name`, emptied first.
+pub fn scratch(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("phantogram-it-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("create scratch folder");
+    dir
+}
