@@ -269,6 +269,7 @@ pub fn import_android_raw(dir: &Path) -> Result<ImportedLog, LogError> {
                 let offset_s = read_time_alignment(&align)?;
                 import_mocap(&mocap, offset_s, &mut log.events)?;
                 log.note("read", display_name(&mocap));
+                log.note("read", display_name(&align));
                 log.note(
                     "ground_truth",
                     "mocap rotation; heading is the motion-capture room's, not north",

@@ -1,0 +1,104 @@
+//! The `phantogram` binary end to end: the README's replay, its numbers, and its errors.
+
+use std::path::PathBuf;
+use std::process::Command;
+
+fn bin() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_phantogram"))
+}
+
+fn default_log() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/logs/tilt-sweep.pglog")
+}
+
+fn rows(stdout: &[u8]) -> Vec<Vec<f64>> {
+    String::from_utf8_lossy(stdout)
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').map(|f| f.parse().unwrap()).collect())
+        .collect()
+}
+
+#[test]
+fn replay_prints_the_eye_above_the_tilted_phone() {
+    let out = bin()
+        .args(["replay", "--csv", "--every-ms", "1000"])
+        .arg(default_log())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows = rows(&out.stdout);
+    assert_eq!(rows.len(), 13, "0 to 12 s every second");
+    // Held at 35° from horizontal: "up" in the device frame is (0, sin 35°, cos 35°), so with no
+    // flat-angle calibration the eye is 300 mm along it.
+    let (s, c) = 35f64.to_radians().sin_cos();
+    let first = &rows[0];
+    assert!(first[1].abs() < 1.0, "{first:?}");
+    assert!((first[2] - 300.0 * s).abs() < 1.0, "{first:?}");
+    assert!((first[3] - 300.0 * c).abs() < 1.0, "{first:?}");
+    let light = (first[4].powi(2) + first[5].powi(2) + first[6].powi(2)).sqrt();
+    assert!((light - 1.0).abs() < 1e-3);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("0 rejected"), "{stderr}");
+}
+
+#[test]
+fn flat_angle_calibration_makes_the_holding_pose_straight_on() {
+    let out = bin()
+        .args(["replay", "--csv", "--every-ms", "100", "--flat-at-s", "0.5"])
+        .arg(default_log())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let rows = rows(&out.stdout);
+    let at_1s = rows.iter().find(|r| (r[0] - 1.0).abs() < 1e-6).unwrap();
+    assert!(
+        at_1s[1].abs() < 2.0 && at_1s[2].abs() < 2.0 && (at_1s[3] - 300.0).abs() < 1.0,
+        "{at_1s:?}"
+    );
+}
+
+#[test]
+fn bad_input_is_a_clear_error() {
+    let dir = std::env::temp_dir().join(format!("phantogram-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.pglog");
+    std::fs::write(&bad, "phantogram-sensor-log 1\nacc 1 0 0 9.8\nacc 2 0 zero 9.8\n").unwrap();
+    let out = bin().arg("replay").arg(&bad).output().unwrap();
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("bad.pglog:3:"), "{stderr}");
+
+    let out = bin()
+        .args(["replay", "--every-ms", "-5"])
+        .arg(default_log())
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    let out = bin()
+        .args(["replay", "--flat-at-s", "99"])
+        .arg(default_log())
+        .output()
+        .unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("beyond the end"));
+    let out = bin().args(["replay", "/nonexistent/log"]).output().unwrap();
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/log"));
+}
+
+#[test]
+fn import_then_info_round_trip() {
+    let dir = std::env::temp_dir().join(format!("phantogram-cli-import-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let out_log = dir.join("copy.pglog.gz");
+    let status = bin()
+        .arg("import")
+        .arg(default_log())
+        .arg("--out")
+        .arg(&out_log)
+        .status()
+        .unwrap();
+    assert!(status.success());
+    let info = bin().arg("info").arg(&out_log).output().unwrap();
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(text.contains("Accelerometer") && text.contains("1201"), "{text}");
+}
