@@ -47,6 +47,15 @@ impl Aabb {
         Self::new(pivot + (self.min - pivot) * s, pivot + (self.max - pivot) * s)
     }
 
+    /// The `(n+1)³` points of a regular lattice spanning the box, corners included (`n ≥ 1`).
+    pub fn lattice(&self, n: u32) -> impl Iterator<Item = Vec3> + '_ {
+        let n = n.max(1);
+        let step = (self.max - self.min) / n as f32;
+        (0..=n).flat_map(move |i| {
+            (0..=n).flat_map(move |j| (0..=n).map(move |k| self.min + step * Vec3::new(i as f32, j as f32, k as f32)))
+        })
+    }
+
     pub fn corners(&self) -> [Vec3; 8] {
         let (a, b) = (self.min, self.max);
         [
@@ -207,25 +216,21 @@ mod tests {
     /// inside the rectangle from every eye.
     fn inside_all(bounds: &Aabb, eyes: &[Vec3], s: &Screen) -> bool {
         let half = s.half_extent_device_m();
-        let n = 6;
-        for i in 0..=n {
-            for j in 0..=n {
-                for k in 0..=n {
-                    let t = Vec3::new(i as f32, j as f32, k as f32) / n as f32;
-                    let p = bounds.min + (bounds.max - bounds.min) * t;
-                    if p.z <= 0.0 {
-                        continue;
-                    }
-                    for &e in eyes {
-                        let hit = e + (p - e) * (e.z / (e.z - p.z));
-                        if p.z >= e.z || hit.x.abs() > half.x + 1e-6 || hit.y.abs() > half.y + 1e-6 {
-                            return false;
-                        }
-                    }
-                }
-            }
-        }
-        true
+        bounds.lattice(6).filter(|p| p.z > 0.0).all(|p| {
+            eyes.iter().all(|&e| {
+                let hit = e + (p - e) * (e.z / (e.z - p.z));
+                p.z < e.z && hit.x.abs() <= half.x + 1e-6 && hit.y.abs() <= half.y + 1e-6
+            })
+        })
+    }
+
+    #[test]
+    fn lattice_spans_the_box() {
+        let b = Aabb::new(Vec3::ZERO, Vec3::new(1.0, 2.0, 3.0));
+        let pts: Vec<_> = b.lattice(2).collect();
+        assert_eq!(pts.len(), 27);
+        assert!(pts.contains(&Vec3::ZERO) && pts.contains(&Vec3::new(1.0, 2.0, 3.0)));
+        assert!(pts.contains(&Vec3::new(0.5, 1.0, 1.5)));
     }
 
     #[test]

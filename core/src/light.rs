@@ -19,13 +19,16 @@ pub struct WorldLight {
 }
 
 impl Default for WorldLight {
-    /// Over the viewer's left shoulder: up-left and in front of the glass, the classic key light.
     fn default() -> Self {
-        Self::new(Vec3::new(-0.4, 0.5, 0.77))
+        Self::new(Self::DEFAULT_TOWARD_LIGHT_DEVICE)
     }
 }
 
 impl WorldLight {
+    /// Over the viewer's left shoulder: up-left and in front of the glass, the classic key light.
+    /// (Not normalised; [`Self::new`] normalises.)
+    pub const DEFAULT_TOWARD_LIGHT_DEVICE: Vec3 = Vec3::new(-0.4, 0.5, 0.77);
+
     /// `toward_light_device`: where the light should appear at anchoring time, device frame.
     /// A degenerate vector falls back to straight above the glass.
     pub fn new(toward_light_device: Vec3) -> Self {

@@ -51,7 +51,8 @@ impl SensorKind {
         SensorKind::GroundTruth,
     ];
 
-    fn index(self) -> usize {
+    /// Position in [`Self::ALL`], for per-sensor tables.
+    pub fn index(self) -> usize {
         self as usize
     }
 

@@ -42,7 +42,7 @@ impl Default for SessionConfig {
             eyes: EyeModel::default(),
             depth: DepthRange::default(),
             viewpoint_tau_s: LowPassAttitude::DEFAULT_TAU_S,
-            light_toward_device: WorldLight::default().toward_light_device(None),
+            light_toward_device: WorldLight::DEFAULT_TOWARD_LIGHT_DEVICE,
             inbox_capacity: SensorInbox::DEFAULT_CAPACITY,
         }
     }
@@ -249,7 +249,7 @@ mod tests {
         assert!(f.light_anchored);
         assert!(
             f.toward_light_device
-                .distance(SessionConfig::default().light_toward_device)
+                .distance(SessionConfig::default().light_toward_device.normalize())
                 < 1e-5
         );
     }

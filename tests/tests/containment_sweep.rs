@@ -20,22 +20,12 @@ fn artifact() -> Aabb {
 /// (eye index, point, ndc).
 fn escapes(view: &FrameView, bounds: &Aabb) -> Vec<(usize, Vec3, [f32; 2])> {
     let mut out = Vec::new();
-    let n = 8;
-    for i in 0..=n {
-        for j in 0..=n {
-            for k in 0..=n {
-                let t = Vec3::new(i as f32, j as f32, k as f32) / n as f32;
-                let p = bounds.min + (bounds.max - bounds.min) * t;
-                if p.z <= 0.0 {
-                    continue;
-                }
-                for (e, proj) in [view.left, view.right].iter().enumerate() {
-                    let q = proj.project(p).expect("in front of the eye");
-                    let inside = q.ndc.abs().max_element() <= 1.0 + 1e-4 && (0.0..=1.0).contains(&q.depth);
-                    if !inside {
-                        out.push((e, p, q.ndc.to_array()));
-                    }
-                }
+    for p in bounds.lattice(8).filter(|p| p.z > 0.0) {
+        for (e, proj) in [view.left, view.right].iter().enumerate() {
+            let q = proj.project(p).expect("in front of the eye");
+            let inside = q.ndc.abs().max_element() <= 1.0 + 1e-4 && (0.0..=1.0).contains(&q.depth);
+            if !inside {
+                out.push((e, p, q.ndc.to_array()));
             }
         }
     }

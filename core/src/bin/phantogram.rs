@@ -202,7 +202,7 @@ fn info_command(path: &std::path::Path) -> Result<()> {
     let mut non_finite = 0u64;
     for event in open_events(path)? {
         let e = event?;
-        let i = SensorKind::ALL.iter().position(|k| *k == e.kind).unwrap_or(0);
+        let i = e.kind.index();
         counts[i] += 1;
         non_finite += u64::from(!e.is_finite());
         span[i] = Some(span[i].map_or((e.t_ns, e.t_ns), |(a, b)| (a.min(e.t_ns), b.max(e.t_ns))));
