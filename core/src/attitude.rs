@@ -25,6 +25,12 @@ pub trait OrientationEstimator: Send {
     /// Device → world (east, north, up) rotation, once both gravity and a usable magnetic field
     /// are known.
     fn device_to_world(&self) -> Option<Quat>;
+    /// Device → world predicted forward to `t_ns` (a frame's display time). Estimators that
+    /// cannot predict return the current estimate.
+    fn predict_device_to_world(&self, t_ns: i64) -> Option<Quat> {
+        let _ = t_ns;
+        self.device_to_world()
+    }
     /// Clears all state (e.g. after the sensors restart).
     fn reset(&mut self);
 }

@@ -53,8 +53,10 @@
 pub mod attitude;
 pub mod containment;
 pub mod eyes;
+pub mod fusion;
 pub mod light;
 pub mod lowpass;
+pub mod orientation_eval;
 pub mod projection;
 pub mod replay;
 pub mod screen;

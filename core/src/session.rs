@@ -17,19 +17,43 @@ use thiserror::Error;
 
 use crate::attitude::{LowPassAttitude, OrientationEstimator, device_to_world_from_up};
 use crate::eyes::{EyeModel, EyeModelError, StereoEyes};
+use crate::fusion::{FusedOrientation, FusionParams};
 use crate::light::WorldLight;
 use crate::projection::{DepthRange, OffAxisProjection, ProjectionError};
 use crate::screen::Screen;
 use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorStats};
 use crate::viewpoint::Viewpoint;
 
+/// Which orientation estimator drives the viewpoint and the light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EstimatorChoice {
+    /// The paper's accelerometer (and magnetometer) low-pass, with this time constant in seconds.
+    LowPass { tau_s: f32 },
+    /// Gyroscope + accelerometer + magnetometer fusion ([`crate::fusion`]).
+    Fused(FusionParams),
+}
+
+impl EstimatorChoice {
+    pub fn build(&self) -> Box<dyn OrientationEstimator> {
+        match self {
+            Self::LowPass { tau_s } => Box::new(LowPassAttitude::new(*tau_s, *tau_s)),
+            Self::Fused(params) => Box::new(FusedOrientation::new(*params)),
+        }
+    }
+}
+
+impl Default for EstimatorChoice {
+    fn default() -> Self {
+        Self::Fused(FusionParams::default())
+    }
+}
+
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SessionConfig {
     pub screen: Screen,
     pub eyes: EyeModel,
     pub depth: DepthRange,
-    /// Time constant of the paper's accelerometer low-pass, seconds.
-    pub viewpoint_tau_s: f32,
+    pub estimator: EstimatorChoice,
     /// Where the world-fixed light appears when anchored, device frame (towards the light).
     pub light_toward_device: Vec3,
     pub inbox_capacity: usize,
@@ -41,7 +65,7 @@ impl Default for SessionConfig {
             screen: Screen::default(),
             eyes: EyeModel::default(),
             depth: DepthRange::default(),
-            viewpoint_tau_s: LowPassAttitude::DEFAULT_TAU_S,
+            estimator: EstimatorChoice::default(),
             light_toward_device: WorldLight::DEFAULT_TOWARD_LIGHT_DEVICE,
             inbox_capacity: SensorInbox::DEFAULT_CAPACITY,
         }
@@ -101,10 +125,9 @@ impl std::fmt::Debug for Session {
 }
 
 impl Session {
-    /// A session with the paper's low-pass estimator.
+    /// A session with the estimator named in `config`.
     pub fn new(config: SessionConfig) -> Result<Self, SessionError> {
-        let estimator = LowPassAttitude::new(config.viewpoint_tau_s, config.viewpoint_tau_s);
-        Self::with_estimator(config, Box::new(estimator))
+        Self::with_estimator(config, config.estimator.build())
     }
 
     pub fn with_estimator(
@@ -207,13 +230,29 @@ impl Session {
         Ok(())
     }
 
-    /// Drains pending sensor events and computes this frame's eyes, projections and light.
+    /// Drains pending sensor events and computes this frame's eyes, projections and light, for the
+    /// newest sensor state.
     pub fn frame(&mut self) -> Result<FrameView, SessionError> {
+        self.frame_at(None)
+    }
+
+    /// As [`Self::frame`], with the orientation predicted forward to `display_t_ns` (the time the
+    /// frame will be on screen, in the sensor clock) where the estimator can predict.
+    ///
+    /// Motion-to-photon budget on a 60 Hz phone, and what prediction covers: sensor sampling
+    /// ≤ 5 ms (200 Hz) + event delivery 2–10 ms + waiting for the frame ≤ 16.7 ms + rendering
+    /// ≈ 16.7 ms + scan-out ≈ 8 ms: some 40–55 ms from a motion to its photons. The shell passes
+    /// the expected presentation time (Choreographer's frame time plus the pipeline depth; Core
+    /// Animation's `targetTimestamp`) and the gyroscope carries the orientation over that interval.
+    pub fn frame_at(&mut self, display_t_ns: Option<i64>) -> Result<FrameView, SessionError> {
         self.update();
+        let predicted = display_t_ns.and_then(|t| self.estimator.predict_device_to_world(t));
+        let up = match predicted {
+            Some(q) => Some(q.inverse() * Vec3::Z),
+            None => self.estimator.up_device(),
+        };
         let cfg = &self.config;
-        let cyclopean = self
-            .viewpoint
-            .cyclopean_eye_m(self.estimator.up_device(), cfg.eyes.viewing_distance_m);
+        let cyclopean = self.viewpoint.cyclopean_eye_m(up, cfg.eyes.viewing_distance_m);
         let eyes = cfg.eyes.stereo_pair(&cfg.screen, cyclopean);
         let project = |eye| OffAxisProjection::new(&cfg.screen, eye, cfg.depth);
         Ok(FrameView {
@@ -222,7 +261,9 @@ impl Session {
             right: project(eyes.right_m)?,
             mono: project(eyes.cyclopean_m)?,
             eyes,
-            toward_light_device: self.light.toward_light_device(self.device_to_world()),
+            toward_light_device: self
+                .light
+                .toward_light_device(predicted.or_else(|| self.device_to_world())),
             light_anchored: self.light.is_anchored(),
         })
     }

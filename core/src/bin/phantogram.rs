@@ -11,10 +11,12 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
+use phantogram::attitude::{LowPassAttitude, OrientationEstimator};
 use phantogram::eyes::EyeModel;
 use phantogram::replay::{Pace, replay};
 use phantogram::sensorlog::{self, LogError, LogReader, import::SourceFormat};
 use phantogram::sensors::{SensorEvent, SensorKind};
+use phantogram::session::EstimatorChoice;
 use phantogram::{Session, SessionConfig};
 
 #[derive(Parser)]
@@ -43,8 +45,9 @@ enum Command {
         /// Pace the replay at the recording's speed (times this factor) instead of as fast as possible.
         #[arg(long, value_name = "SPEED")]
         realtime: Option<f64>,
-        /// Low-pass time constant of the gravity viewpoint, seconds (the paper: c = 0.1 at 100 Hz ≈ 0.095 s).
-        #[arg(long, default_value_t = phantogram::attitude::LowPassAttitude::DEFAULT_TAU_S)]
+        /// Use the paper's low-pass viewpoint with this time constant, seconds (c = 0.1 at 100 Hz ≈ 0.095 s)
+        /// instead of the fused estimator.
+        #[arg(long, default_value_t = LowPassAttitude::DEFAULT_TAU_S)]
         tau_s: f32,
         /// Viewing distance, centimetres.
         #[arg(long, default_value_t = EyeModel::DEFAULT_VIEWING_DISTANCE_M * 100.0)]
@@ -52,6 +55,10 @@ enum Command {
         /// Make the pose at this many seconds into the log count as "straight on" (flat-angle calibration).
         #[arg(long, value_name = "SECONDS")]
         flat_at_s: Option<f64>,
+        /// Instead of the eye/light table, print the orientation (device → world quaternion
+        /// w x y z) after each input sample time, as estimated by NAME.
+        #[arg(long, value_name = "NAME")]
+        estimator: Option<EstimatorName>,
     },
     /// Convert a recording into the phantogram log format (gzip when OUT ends in .gz).
     Import {
@@ -61,6 +68,31 @@ enum Command {
     },
     /// Summarise a log: duration, events and rate per sensor.
     Info { log: PathBuf },
+    /// Score estimators against recorded ground truth.
+    Eval {
+        #[command(subcommand)]
+        what: EvalWhat,
+    },
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum EstimatorName {
+    /// The paper's low-pass (time constant from --tau-s).
+    LowPass,
+    /// Gyroscope + accelerometer + magnetometer fusion.
+    Fused,
+    /// The platform's own rotation vector, where the log has one.
+    RotationVector,
+}
+
+#[derive(Subcommand)]
+enum EvalWhat {
+    /// Inclination/heading/total RMSE (BROAD's definitions) per trial and estimator, and means.
+    Orientation {
+        /// BROAD CSVs, phone recording folders, or folders containing them.
+        #[arg(required = true)]
+        paths: Vec<PathBuf>,
+    },
 }
 
 fn main() {
@@ -74,12 +106,20 @@ fn run(cli: Cli) -> Result<()> {
     match cli.command {
         Command::Replay {
             log,
+            csv,
+            tau_s,
+            estimator: Some(name),
+            ..
+        } => orientation_command(&log, name, tau_s, csv),
+        Command::Replay {
+            log,
             every_ms,
             csv,
             realtime,
             tau_s,
             distance_cm,
             flat_at_s,
+            estimator: None,
         } => replay_command(&log, every_ms, csv, realtime, tau_s, distance_cm, flat_at_s),
         Command::Import { src, out } => {
             let imported = sensorlog::import::import(&src)?;
@@ -88,6 +128,9 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Info { log } => info_command(&log),
+        Command::Eval {
+            what: EvalWhat::Orientation { paths },
+        } => eval_orientation_command(&paths),
     }
 }
 
@@ -116,10 +159,10 @@ fn replay_command(
             bail!("--realtime must be a positive speed factor, got {speed}");
         }
     }
-    let mut config = SessionConfig {
-        viewpoint_tau_s: tau_s,
-        ..SessionConfig::default()
-    };
+    let mut config = SessionConfig::default();
+    if tau_s != LowPassAttitude::DEFAULT_TAU_S {
+        config.estimator = EstimatorChoice::LowPass { tau_s };
+    }
     config.eyes.viewing_distance_m = distance_cm / 100.0;
     let mut session = Session::new(config).context("invalid settings")?;
     let events = open_events(log)?;
@@ -224,4 +267,157 @@ fn info_command(path: &std::path::Path) -> Result<()> {
         println!("{non_finite} events hold NaN or infinite values");
     }
     Ok(())
+}
+
+/// Recordings under `paths`: each path itself if it is one, else the recordings directly inside it.
+fn expand_recordings(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
+    let mut out = Vec::new();
+    for p in paths {
+        if sensorlog::import::detect(p).is_ok() {
+            out.push(p.clone());
+            continue;
+        }
+        if !p.is_dir() {
+            // Not a folder: let detection explain what is wrong with it.
+            sensorlog::import::detect(p)?;
+        }
+        let mut inside: Vec<PathBuf> = std::fs::read_dir(p)
+            .with_context(|| format!("reading {}", p.display()))?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|c| sensorlog::import::detect(c).is_ok())
+            .collect();
+        if inside.is_empty() {
+            bail!(
+                "{}: no recordings found (expected BROAD CSVs or phone recording folders)",
+                p.display()
+            );
+        }
+        inside.sort();
+        out.extend(inside);
+    }
+    Ok(out)
+}
+
+fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
+    use phantogram::orientation_eval::{CONVERGENCE_S, Trial, score_all};
+    let recordings = expand_recordings(paths)?;
+    let fmt = |v: Option<f64>| v.map_or("     -".to_owned(), |x| format!("{x:6.2}"));
+    println!(
+        "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7}",
+        "trial", "estimator", "incl", "head", "total", "c.incl", "c.head", "ns/evt"
+    );
+    // Per estimator: sums for the means.
+    let mut sums: Vec<(String, usize, f64, f64, usize, f64)> = Vec::new();
+    for (i, path) in recordings.iter().enumerate() {
+        eprintln!("[{}/{}] {}", i + 1, recordings.len(), path.display());
+        let trial = Trial::load(path)?;
+        for s in score_all(&trial) {
+            println!(
+                "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7.0}",
+                trial.name,
+                s.estimator,
+                fmt(Some(s.main.inclination_deg)),
+                fmt(s.main.heading_deg),
+                fmt(s.main.total_deg),
+                fmt(Some(s.convergence.inclination_deg)),
+                fmt(s.convergence.heading_deg),
+                s.ns_per_event
+            );
+            // "low-pass c=… (best)" rows are grouped as one estimator for the means.
+            let key = if s.estimator.ends_with("(best)") {
+                "low-pass best c".to_owned()
+            } else {
+                s.estimator.clone()
+            };
+            let group = if s.main.heading_deg.is_some() { "BROAD" } else { "phone" };
+            let key = format!("{group}: {key}");
+            let entry = match sums.iter_mut().find(|e| e.0 == key) {
+                Some(e) => e,
+                None => {
+                    sums.push((key, 0, 0.0, 0.0, 0, 0.0));
+                    sums.last_mut().expect("just pushed")
+                }
+            };
+            entry.1 += 1;
+            entry.2 += s.main.inclination_deg;
+            entry.3 += s.main.heading_deg.unwrap_or(0.0);
+            entry.5 += s.ns_per_event;
+            entry.4 += usize::from(s.main.heading_deg.is_some());
+        }
+    }
+    println!();
+    println!("means over trials (main rows: after the first {CONVERGENCE_S} s, movement phases where marked):");
+    println!(
+        "{:<46} {:>7} {:>6} {:>6} {:>7}",
+        "estimator", "trials", "incl", "head", "ns/evt"
+    );
+    for (key, n, incl, head, n_head, ns) in &sums {
+        let head = if *n_head > 0 {
+            format!("{:6.2}", head / *n_head as f64)
+        } else {
+            "     -".into()
+        };
+        println!(
+            "{key:<46} {n:>7} {:>6.2} {head:>6} {:>7.0}",
+            incl / *n as f64,
+            ns / *n as f64
+        );
+    }
+    Ok(())
+}
+
+fn orientation_command(log: &std::path::Path, name: EstimatorName, tau_s: f32, csv: bool) -> Result<()> {
+    let mut estimator: Box<dyn OrientationEstimator> = match name {
+        EstimatorName::LowPass => Box::new(LowPassAttitude::new(tau_s, tau_s)),
+        EstimatorName::Fused => Box::new(phantogram::fusion::FusedOrientation::default()),
+        EstimatorName::RotationVector => Box::new(phantogram::orientation_eval::PlatformRotationVector::default()),
+    };
+    let stdout = std::io::stdout();
+    let mut out = BufWriter::new(stdout.lock());
+    let sep = if csv { "," } else { " " };
+    if csv {
+        writeln!(out, "t_s,w,x,y,z")?;
+    } else {
+        writeln!(out, "{:>14} {:>10} {:>10} {:>10} {:>10}", "t_s", "w", "x", "y", "z")?;
+    }
+    let row = |out: &mut BufWriter<_>, t_ns: i64, est: &dyn OrientationEstimator| -> std::io::Result<()> {
+        let t = t_ns as f64 * 1e-9;
+        match est.device_to_world() {
+            Some(q) if csv => writeln!(out, "{t:.6}{sep}{}{sep}{}{sep}{}{sep}{}", q.w, q.x, q.y, q.z),
+            Some(q) => writeln!(out, "{t:>14.6} {:>10.6} {:>10.6} {:>10.6} {:>10.6}", q.w, q.x, q.y, q.z),
+            None if csv => writeln!(out, "{t:.6}{sep}NaN{sep}NaN{sep}NaN{sep}NaN"),
+            None => writeln!(out, "{t:>14.6} {:>10} {:>10} {:>10} {:>10}", "-", "-", "-", "-"),
+        }
+    };
+    // One row per distinct input time stamp, after every event of that time (BROAD rows carry
+    // three sensors at once). Ground truth is not an input.
+    let mut pending_t: Option<i64> = None;
+    for event in open_events(log)? {
+        let e = event?;
+        if e.kind == SensorKind::GroundTruth {
+            continue;
+        }
+        if let Some(t) = pending_t.filter(|t| *t != e.t_ns) {
+            if let Err(err) = row(&mut out, t, estimator.as_ref()) {
+                return broken_pipe_is_fine(err);
+            }
+        }
+        estimator.push(&e);
+        pending_t = Some(e.t_ns);
+    }
+    if let Some(t) = pending_t {
+        if let Err(err) = row(&mut out, t, estimator.as_ref()) {
+            return broken_pipe_is_fine(err);
+        }
+    }
+    out.flush().or_else(broken_pipe_is_fine)
+}
+
+/// Output cut short by a closed pipe (`| head`) is not an error.
+fn broken_pipe_is_fine(err: std::io::Error) -> Result<()> {
+    if err.kind() == std::io::ErrorKind::BrokenPipe {
+        Ok(())
+    } else {
+        Err(err.into())
+    }
 }

@@ -454,6 +454,22 @@ pub fn import_broad(path: &Path) -> Result<ImportedLog, LogError> {
     Ok(log.finish())
 }
 
+/// BROAD's `movement` column: `(t_ns, moving)` per row, for scoring only the motion phases.
+pub fn read_broad_movement(path: &Path) -> Result<Vec<(i64, bool)>, LogError> {
+    let mut out = Vec::new();
+    read_csv(path, &["t_s", "movement"], |f| {
+        let t_ns = seconds_to_ns(parse_f64(f[0])?)?;
+        let moving = match f[1].trim() {
+            "1" | "1.0" | "true" => true,
+            "0" | "0.0" | "false" => false,
+            other => return Err(format!("movement flag must be 0 or 1, found {other:?}")),
+        };
+        out.push((t_ns, moving));
+        Ok(())
+    })?;
+    Ok(out)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -1,0 +1,338 @@
+//! Scoring orientation estimators against recorded ground truth, with the BROAD benchmark's
+//! definitions (Laidig et al. 2021; `broad_utils.py`):
+//!
+//! * error quaternion in the earth frame `q_e = q_est ⊗ q_gt⁻¹`;
+//! * total error `2·acos(|w|)`, heading error `2·atan(|z / w|)`, inclination error
+//!   `2·acos(√(w² + z²))`;
+//! * RMSE over the rows marked as movement (BROAD) or over all ground-truth rows (phone
+//!   recordings, whose motion capture has no such mark).
+//!
+//! Phone recordings' ground truth has the motion-capture room's heading, not north, so only the
+//! inclination error is scored there (it does not depend on the reference's heading). The first
+//! [`CONVERGENCE_S`] seconds of each trial are scored separately, as convergence, and left out of
+//! the main figures.
+//!
+//! Estimators see the events in time order; at each ground-truth time stamp the estimate is read
+//! (no prediction).
+
+use std::path::Path;
+use std::time::Instant;
+
+use glam::DQuat;
+
+use crate::attitude::{LowPassAttitude, OrientationEstimator};
+use crate::fusion::FusedOrientation;
+use crate::lowpass::time_constant_from_paper_coefficient;
+use crate::sensorlog::LogError;
+use crate::sensorlog::import::{self, SourceFormat};
+use crate::sensors::{SensorEvent, SensorKind};
+
+/// Seconds at the start of a trial reported separately as convergence.
+pub const CONVERGENCE_S: f64 = 5.0;
+
+/// What the ground truth of a trial supports.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TruthFrame {
+    /// Earth frame with north: inclination, heading and total errors.
+    EastNorthUp,
+    /// Heading of an arbitrary room: inclination only.
+    ArbitraryHeading,
+}
+
+/// A recording with ground truth.
+#[derive(Clone, Debug)]
+pub struct Trial {
+    pub name: String,
+    pub events: Vec<SensorEvent>,
+    pub truth_frame: TruthFrame,
+    /// Movement phases (BROAD): `(t_ns, moving)` at each row; `None` scores every row.
+    pub movement: Option<Vec<(i64, bool)>>,
+}
+
+impl Trial {
+    pub fn load(path: &Path) -> Result<Self, LogError> {
+        let format = import::detect(path)?;
+        let log = import::import(path)?;
+        let name = path
+            .file_name()
+            .map(|n| {
+                n.to_string_lossy()
+                    .trim_end_matches(".csv.gz")
+                    .trim_end_matches(".csv")
+                    .to_owned()
+            })
+            .unwrap_or_else(|| path.display().to_string());
+        let (truth_frame, movement) = match format {
+            SourceFormat::Broad => (TruthFrame::EastNorthUp, Some(import::read_broad_movement(path)?)),
+            _ => (TruthFrame::ArbitraryHeading, None),
+        };
+        if !log.events.iter().any(|e| e.kind == SensorKind::GroundTruth) {
+            return Err(LogError::format(path, "no ground-truth orientation in this recording"));
+        }
+        Ok(Self {
+            name,
+            events: log.events,
+            truth_frame,
+            movement,
+        })
+    }
+
+    /// Median accelerometer rate, Hz (for converting the paper's per-sample coefficient).
+    pub fn accel_rate_hz(&self) -> f64 {
+        let mut dts: Vec<i64> = self
+            .events
+            .iter()
+            .filter(|e| e.kind == SensorKind::Accelerometer)
+            .map(|e| e.t_ns)
+            .collect::<Vec<_>>()
+            .windows(2)
+            .map(|w| w[1] - w[0])
+            .filter(|d| *d > 0)
+            .collect();
+        if dts.is_empty() {
+            return 100.0;
+        }
+        dts.sort_unstable();
+        1e9 / dts[dts.len() / 2] as f64
+    }
+
+    pub fn has(&self, kind: SensorKind) -> bool {
+        self.events.iter().any(|e| e.kind == kind)
+    }
+}
+
+/// RMSEs in degrees over a set of rows.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Rmse {
+    pub rows: usize,
+    pub inclination_deg: f64,
+    /// `None` where the ground truth has no north.
+    pub heading_deg: Option<f64>,
+    pub total_deg: Option<f64>,
+}
+
+#[derive(Default)]
+struct Accumulator {
+    n: usize,
+    incl: f64,
+    head: f64,
+    total: f64,
+}
+
+impl Accumulator {
+    fn add(&mut self, est: DQuat, truth: DQuat) {
+        let e = (est * truth.inverse()).normalize();
+        let incl = 2.0 * (e.w * e.w + e.z * e.z).sqrt().clamp(0.0, 1.0).acos();
+        let head = 2.0 * (e.z / e.w).abs().atan();
+        let total = 2.0 * e.w.abs().clamp(0.0, 1.0).acos();
+        self.n += 1;
+        self.incl += incl * incl;
+        self.head += head * head;
+        self.total += total * total;
+    }
+
+    fn finish(&self, frame: TruthFrame) -> Rmse {
+        let r = |s: f64| {
+            if self.n == 0 {
+                f64::NAN
+            } else {
+                (s / self.n as f64).sqrt().to_degrees()
+            }
+        };
+        let north = frame == TruthFrame::EastNorthUp;
+        Rmse {
+            rows: self.n,
+            inclination_deg: r(self.incl),
+            heading_deg: north.then(|| r(self.head)),
+            total_deg: north.then(|| r(self.total)),
+        }
+    }
+}
+
+/// One estimator's score on one trial.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Score {
+    pub estimator: String,
+    /// Rows after the convergence period (and in movement phases, where marked).
+    pub main: Rmse,
+    /// Rows in the first [`CONVERGENCE_S`] seconds.
+    pub convergence: Rmse,
+    /// Wall time per sensor event (accelerometer, gyroscope or magnetometer), nanoseconds.
+    pub ns_per_event: f64,
+    /// Ground-truth rows where the estimator had no estimate yet.
+    pub rows_without_estimate: usize,
+}
+
+/// Runs `estimator` over the trial and scores it. Orientation-free estimators (no magnetometer
+/// heading) are still scored for inclination; their heading error is meaningless but reported
+/// as computed.
+pub fn score(trial: &Trial, name: &str, estimator: &mut dyn OrientationEstimator) -> Score {
+    let t0 = trial.events.first().map_or(0, |e| e.t_ns);
+    let mut movement = trial.movement.as_deref().map(|m| m.iter().peekable());
+    let mut main = Accumulator::default();
+    let mut conv = Accumulator::default();
+    let mut missing = 0;
+    let mut sensor_events = 0usize;
+    let mut busy = std::time::Duration::ZERO;
+    let mut pending: Vec<SensorEvent> = Vec::with_capacity(8);
+    let mut flush = |estimator: &mut dyn OrientationEstimator, pending: &mut Vec<SensorEvent>| {
+        let start = Instant::now();
+        for e in pending.iter() {
+            estimator.push(e);
+        }
+        busy += start.elapsed();
+        sensor_events += pending.len();
+        pending.clear();
+    };
+    for e in &trial.events {
+        if e.kind != SensorKind::GroundTruth {
+            // Batch events between ground-truth rows so the timer brackets real work.
+            pending.push(*e);
+            continue;
+        }
+        flush(estimator, &mut pending);
+        let Some(truth) = e.quat() else { continue };
+        let moving = match &mut movement {
+            Some(iter) => {
+                while iter.peek().is_some_and(|(t, _)| *t < e.t_ns) {
+                    iter.next();
+                }
+                iter.peek().is_some_and(|(t, m)| *t == e.t_ns && *m)
+            }
+            None => true,
+        };
+        let Some(est) = estimator.device_to_world() else {
+            missing += 1;
+            continue;
+        };
+        let (est, truth) = (est.as_dquat(), truth.as_dquat());
+        let in_convergence = (e.t_ns - t0) as f64 * 1e-9 < CONVERGENCE_S;
+        // The inclination error does not depend on the reference's heading (a rotation about the
+        // vertical on either side leaves the tilt angle unchanged), so room-frame truth scores it
+        // the same way; heading and total are withheld there (`Accumulator::finish`).
+        if in_convergence {
+            conv.add(est, truth);
+        } else if moving {
+            main.add(est, truth);
+        }
+    }
+    flush(estimator, &mut pending);
+    Score {
+        estimator: name.to_owned(),
+        main: main.finish(trial.truth_frame),
+        convergence: conv.finish(trial.truth_frame),
+        ns_per_event: busy.as_nanos() as f64 / sensor_events.max(1) as f64,
+        rows_without_estimate: missing,
+    }
+}
+
+/// The platform's own rotation vector as an "estimator", for comparison.
+#[derive(Clone, Debug, Default)]
+pub struct PlatformRotationVector {
+    latest: Option<glam::Quat>,
+}
+
+impl OrientationEstimator for PlatformRotationVector {
+    fn push(&mut self, event: &SensorEvent) {
+        if event.kind == SensorKind::RotationVector {
+            if let Some(q) = event.quat() {
+                self.latest = Some(q);
+            }
+        }
+    }
+
+    fn up_device(&self) -> Option<glam::Vec3> {
+        self.latest.map(|q| q.inverse() * glam::Vec3::Z)
+    }
+
+    fn device_to_world(&self) -> Option<glam::Quat> {
+        self.latest
+    }
+
+    fn reset(&mut self) {
+        self.latest = None;
+    }
+}
+
+/// The paper's low-pass coefficients tried when searching for the best `c` of a trial.
+pub const LOW_PASS_C_GRID: [f32; 10] = [0.002, 0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5];
+
+/// All scores for one trial: low-pass at c = 0.1, low-pass at its best c (lowest main
+/// inclination RMSE over [`LOW_PASS_C_GRID`]), the fused estimator, and the platform rotation
+/// vector where the recording has one.
+pub fn score_all(trial: &Trial) -> Vec<Score> {
+    let rate = trial.accel_rate_hz() as f32;
+    let low_pass = |c: f32| {
+        let tau = time_constant_from_paper_coefficient(c, rate).unwrap_or(0.0);
+        let mut est = LowPassAttitude::new(tau, tau);
+        score(trial, &format!("low-pass c={c}"), &mut est)
+    };
+    let mut out = vec![low_pass(0.1)];
+    let best = LOW_PASS_C_GRID
+        .iter()
+        .map(|&c| low_pass(c))
+        .min_by(|a, b| a.main.inclination_deg.total_cmp(&b.main.inclination_deg));
+    if let Some(mut best) = best {
+        best.estimator = format!("{} (best)", best.estimator);
+        out.push(best);
+    }
+    out.push(score(trial, "fused", &mut FusedOrientation::default()));
+    if trial.has(SensorKind::RotationVector) {
+        out.push(score(
+            trial,
+            "platform rotation vector",
+            &mut PlatformRotationVector::default(),
+        ));
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::synthetic::{ImuSpec, tilt_sweep};
+
+    #[test]
+    fn error_definitions_match_broad() {
+        // A pure heading error of 10° and a pure tilt error of 4°.
+        let truth = DQuat::from_rotation_x(0.3);
+        let mut acc = Accumulator::default();
+        acc.add(DQuat::from_rotation_z(10f64.to_radians()) * truth, truth);
+        let r = acc.finish(TruthFrame::EastNorthUp);
+        assert!((r.heading_deg.unwrap() - 10.0).abs() < 1e-9 && r.inclination_deg < 1e-6);
+        let mut acc = Accumulator::default();
+        acc.add(DQuat::from_rotation_y(4f64.to_radians()) * truth, truth);
+        let r = acc.finish(TruthFrame::EastNorthUp);
+        assert!((r.inclination_deg - 4.0).abs() < 1e-9 && r.heading_deg.unwrap() < 1e-6);
+        assert!((r.total_deg.unwrap() - 4.0).abs() < 1e-9);
+        // The inclination error ignores any heading offset of the reference (room-frame truth).
+        let est = DQuat::from_rotation_y(0.05) * truth;
+        let offset_truth = DQuat::from_rotation_z(1.0) * truth;
+        let mut acc = Accumulator::default();
+        acc.add(est, offset_truth);
+        let r = acc.finish(TruthFrame::ArbitraryHeading);
+        assert!((r.inclination_deg - 0.05f64.to_degrees()).abs() < 1e-6);
+        assert_eq!(r.heading_deg, None);
+    }
+
+    #[test]
+    fn scores_a_synthetic_trial() {
+        let trial = Trial {
+            name: "synthetic".into(),
+            events: tilt_sweep(&ImuSpec::default()),
+            truth_frame: TruthFrame::EastNorthUp,
+            movement: None,
+        };
+        let scores = score_all(&trial);
+        let fused = scores.iter().find(|s| s.estimator == "fused").unwrap();
+        let paper = &scores[0];
+        assert!(fused.main.rows > 600);
+        assert!(fused.main.inclination_deg < 0.5, "{fused:?}");
+        assert!(fused.main.heading_deg.unwrap() < 1.0, "{fused:?}");
+        // The low-pass lags while the phone turns: clearly worse.
+        assert!(
+            paper.main.inclination_deg > 2.0 * fused.main.inclination_deg,
+            "{paper:?}"
+        );
+    }
+}
