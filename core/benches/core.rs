@@ -7,6 +7,7 @@
 use std::hint::black_box;
 use std::time::Instant;
 
+use phantogram::session::EstimatorChoice;
 use phantogram::synthetic::{ImuSpec, tilt_sweep};
 use phantogram::{Session, SessionConfig};
 
@@ -22,19 +23,29 @@ fn main() {
     let events = tilt_sweep(&ImuSpec::default());
     let inertial: Vec<_> = events.iter().copied().filter(|e| !e.kind.is_orientation()).collect();
 
-    let mut per_event = Vec::new();
-    for _ in 0..rounds {
-        let mut session = Session::new(SessionConfig::default()).expect("default config");
-        let start = Instant::now();
-        // Push and consume in batches of 4, as a 100 Hz sensor stream drains into 60 Hz frames.
-        for chunk in inertial.chunks(4) {
-            for e in chunk {
-                let _ = session.push(*e);
+    let per_event = |config: SessionConfig| {
+        let mut samples = Vec::new();
+        for _ in 0..rounds {
+            let mut session = Session::new(config).expect("valid config");
+            let start = Instant::now();
+            // Push and consume in batches of 4, as a 100 Hz sensor stream drains into 60 Hz frames.
+            for chunk in inertial.chunks(4) {
+                for e in chunk {
+                    let _ = session.push(*e);
+                }
+                black_box(session.update());
             }
-            black_box(session.update());
+            samples.push(start.elapsed().as_nanos() as f64 / inertial.len() as f64);
         }
-        per_event.push(start.elapsed().as_nanos() as f64 / inertial.len() as f64);
-    }
+        median(samples)
+    };
+    let fused = per_event(SessionConfig::default());
+    let low_pass = per_event(SessionConfig {
+        estimator: EstimatorChoice::LowPass {
+            tau_s: phantogram::attitude::LowPassAttitude::DEFAULT_TAU_S,
+        },
+        ..SessionConfig::default()
+    });
 
     let frames = if quick { 1_000 } else { 100_000 };
     let mut per_frame = Vec::new();
@@ -51,12 +62,10 @@ fn main() {
         per_frame.push(start.elapsed().as_nanos() as f64 / frames as f64);
     }
 
+    println!("sensor update, fused estimator (push + drain + estimate):  {fused:8.1} ns/event");
+    println!("sensor update, paper's low-pass (push + drain + estimate): {low_pass:8.1} ns/event");
     println!(
-        "sensor update (push + drain + estimator): {:8.1} ns/event",
-        median(per_event)
-    );
-    println!(
-        "frame (viewpoint + 3 projections + light): {:8.1} ns/frame",
+        "frame (viewpoint + 3 projections + light), fused:          {:8.1} ns/frame",
         median(per_frame)
     );
 }

@@ -33,9 +33,12 @@
 //! Events are taken one at a time, in time order, from any mix of rates. Non-finite samples,
 //! samples whose time stamp does not advance, accelerometer readings above
 //! [`FusionParams::max_accel_m_s2`] (shocks, glitches) and gyroscope readings above
-//! [`FusionParams::max_gyro_rad_s`] are ignored and counted. A gap longer than
-//! [`FusionParams::max_gap_s`] in a stream restarts that stream's filter with a short averaging
-//! window, so the estimate recovers within a second or so instead of the filter's time constant.
+//! [`FusionParams::max_gyro_rad_s`] are ignored and counted. A gap in the gyroscope stream is
+//! bridged at the mean of the rates on either side (hand motion is smooth over a second); if the
+//! gap is long or the rates either side disagree, the inclination filter also restarts with a
+//! short averaging window and the heading is averaged afresh, so the estimate recovers within a
+//! second or so instead of the filters' time constants. Gaps in the accelerometer or magnetometer alone need
+//! no restart: the gyroscope carried the frame.
 //! With no gyroscope (none yet, or none for [`FusionParams::gyro_timeout_s`]) the output falls back
 //! to the paper's low-pass ([`crate::attitude::LowPassAttitude`]); with no magnetometer the heading
 //! is simply not corrected (6-D).
@@ -83,8 +86,14 @@ pub struct FusionParams {
     pub max_accel_m_s2: f64,
     /// Gyroscope readings with a larger norm are glitches, rad/s (beyond the common ±2000 °/s range).
     pub max_gyro_rad_s: f64,
-    /// A longer silence in a stream restarts its filter, s.
+    /// Longest interval integrated as one ordinary sample, s.
     pub max_gap_s: f64,
+    /// Longer gyroscope gaps are bridged at the mean rate on either side; up to this length, and
+    /// if the rates either side agree within [`Self::max_bridge_doubt_rad`], the filters carry on,
+    /// else they restart, s.
+    pub max_bridge_s: f64,
+    /// Largest uncertainty |Δω|·Δt/2 of a bridged gap that the filters carry on through, rad.
+    pub max_bridge_doubt_rad: f64,
     /// Averaging window after a start or a gap, s.
     pub reinit_window_s: f64,
     /// With no gyroscope event for this long, fall back to the low-pass, s.
@@ -109,6 +118,8 @@ impl Default for FusionParams {
             max_accel_m_s2: 8.0 * 9.80665,
             max_gyro_rad_s: 40.0,
             max_gap_s: 0.2,
+            max_bridge_s: 2.0,
+            max_bridge_doubt_rad: 5f64.to_radians(),
             reinit_window_s: 0.5,
             gyro_timeout_s: 0.5,
         }
@@ -122,6 +133,7 @@ pub struct FusionStats {
     pub ignored_stale_time: u64,
     pub ignored_accel_shock: u64,
     pub ignored_gyro_glitch: u64,
+    pub gaps_bridged: u64,
     pub restarts_after_gap: u64,
     pub mag_rejected: u64,
 }
@@ -395,19 +407,32 @@ impl FusedOrientation {
                 return;
             }
             let dt = (t_ns - last_t) as f64 * 1e-9;
-            if dt > self.params.max_gap_s {
-                // The rotation during the gap is unknown: restart the inclination filter from
-                // fresh samples and let the heading re-converge, instead of trusting a frame that
-                // stood still while the phone moved.
-                self.acc_lp.restart(self.params.reinit_window_s);
-                self.heading_corrections = 0;
-                self.stats.restarts_after_gap += 1;
+            let prev = self.last_gyr.map_or(w, |(_, p)| p);
+            if dt <= self.params.max_gap_s {
+                // The sample stands for the interval ending at its time stamp (trapezoidal
+                // integration measured 0.15° worse on BROAD: these IMUs average over the
+                // preceding interval).
+                self.q_gyr = (self.q_gyr * DQuat::from_scaled_axis((w - self.bias) * dt)).normalize();
+            } else {
+                // A gap. Bridge it at the mean of the rates on either side: hand motion is
+                // smooth over a second, and any guess beats assuming the phone stood still.
+                self.q_gyr = (self.q_gyr * DQuat::from_scaled_axis((0.5 * (prev + w) - self.bias) * dt)).normalize();
+                // The bridge is trustworthy when it is short and the two rates agree (its error is
+                // at most about |Δω|·Δt/2); then no filter needs restarting (measured on a phone
+                // trial: a 1 s dropout then stays within 1.4° of the undisturbed run, against
+                // 6.7° when every gap restarts the filters). Otherwise restart the inclination
+                // filter from fresh samples and average the heading afresh, rather than trust a
+                // frame that may be far off.
+                let doubt_rad = (w - prev).length() * dt * 0.5;
+                if dt <= self.params.max_bridge_s && doubt_rad <= self.params.max_bridge_doubt_rad {
+                    self.stats.gaps_bridged += 1;
+                } else {
+                    self.acc_lp.restart(self.params.reinit_window_s);
+                    self.heading_corrections = 0;
+                    self.stats.restarts_after_gap += 1;
+                }
             }
-            // Across a gap the rate is unknown: integrate at most one gap's worth.
             let dt = dt.min(self.params.max_gap_s);
-            // The sample stands for the interval ending at its time stamp (trapezoidal integration
-            // measured 0.15° worse on BROAD: these IMUs average over the preceding interval).
-            self.q_gyr = (self.q_gyr * DQuat::from_scaled_axis((w - self.bias) * dt)).normalize();
             self.update_rest_gyro(w, dt);
             self.rotation_since_candidate_rad += ((w - self.bias) * dt).length();
         }
@@ -442,10 +467,8 @@ impl FusedOrientation {
             Some(last) => (t_ns - last) as f64 * 1e-9,
             None => 0.0,
         };
-        if dt > self.params.max_gap_s {
-            self.acc_lp.restart(self.params.reinit_window_s);
-            self.stats.restarts_after_gap += 1;
-        }
+        // A gap in this stream alone needs no restart: the gyroscope carried the frame, so the
+        // filter's memory of gravity is still valid (long gyroscope gaps restart it there).
         self.last_acc_t_ns = Some(t_ns);
         let dt = dt.min(self.params.max_gap_s);
 
@@ -482,10 +505,6 @@ impl FusedOrientation {
             None => 0.0,
         };
         self.last_mag_t_ns = Some(t_ns);
-        if dt > self.params.max_gap_s {
-            // After a silence, let the heading re-converge quickly.
-            self.heading_corrections = 0;
-        }
         let dt = dt.min(self.params.max_gap_s);
         if !self.acc_ready || !self.gyro_is_live(t_ns) {
             return;
@@ -535,6 +554,7 @@ impl FusedOrientation {
             if !adopt {
                 return;
             }
+            // A new reference field: average the heading afresh.
             self.mag_ref = Some(here);
             self.mag_candidate = None;
             self.mag_reject_s = 0.0;

@@ -102,3 +102,35 @@ fn import_then_info_round_trip() {
     let text = String::from_utf8_lossy(&info.stdout);
     assert!(text.contains("Accelerometer") && text.contains("1201"), "{text}");
 }
+
+#[test]
+fn replay_with_an_estimator_prints_one_orientation_per_sample_time() {
+    let out = bin()
+        .args(["replay", "--estimator", "fused", "--csv"])
+        .arg(default_log())
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(text.lines().next(), Some("t_s,w,x,y,z"));
+    let rows = rows(&out.stdout);
+    // The synthetic log samples at 0, 10, 20, 30 ms… (100 Hz inertial, 50 Hz magnetometer): one
+    // row per distinct time, 0 to 12 s.
+    assert_eq!(rows.len(), 1201);
+    assert!(rows.windows(2).all(|w| w[1][0] > w[0][0]));
+    for r in &rows {
+        let norm = (r[1] * r[1] + r[2] * r[2] + r[3] * r[3] + r[4] * r[4]).sqrt();
+        assert!((norm - 1.0).abs() < 1e-4, "{r:?}");
+    }
+    // At rest at the end the phone is pitched 35° about x with north ahead: q ≈ (cos 17.5°, sin 17.5°, 0, 0).
+    let last = rows.last().unwrap();
+    let half = 17.5f64.to_radians();
+    let dot = (last[1] * half.cos() + last[2] * half.sin()).abs();
+    assert!(dot > 0.9998, "{last:?}"); // within about 2°
+    let bad = bin()
+        .args(["replay", "--estimator", "nonsense"])
+        .arg(default_log())
+        .output()
+        .unwrap();
+    assert!(!bad.status.success());
+}

@@ -301,7 +301,11 @@ fn expand_recordings(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
     use phantogram::orientation_eval::{CONVERGENCE_S, Trial, score_all};
     let recordings = expand_recordings(paths)?;
-    let fmt = |v: Option<f64>| v.map_or("     -".to_owned(), |x| format!("{x:6.2}"));
+    // "-" where there is nothing to score (no north in the truth, or no truth in that period).
+    let fmt = |v: Option<f64>| {
+        v.filter(|x| x.is_finite())
+            .map_or("     -".to_owned(), |x| format!("{x:6.2}"))
+    };
     println!(
         "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7}",
         "trial", "estimator", "incl", "head", "total", "c.incl", "c.head", "ns/evt"
