@@ -50,6 +50,8 @@
 //! gzip-compressed recordings and logs. The `cli` feature (on by default, off for the phone crates)
 //! adds `clap` and `anyhow` for the `phantogram` binary.
 
+pub mod anaglyph;
+pub mod artifact;
 pub mod attitude;
 pub mod containment;
 pub mod eyes;
@@ -58,6 +60,8 @@ pub mod light;
 pub mod lowpass;
 pub mod orientation_eval;
 pub mod projection;
+#[cfg(feature = "render")]
+pub mod render;
 pub mod replay;
 pub mod screen;
 pub mod sensorlog;

@@ -60,6 +60,29 @@ enum Command {
         #[arg(long, value_name = "NAME")]
         estimator: Option<EstimatorName>,
     },
+    /// Render a sensor log as phantogram frames (PNG), headless.
+    Render {
+        /// A glTF model (not supported yet: the default artifact is rendered).
+        model: Option<PathBuf>,
+        /// The sensor log to replay (any format `replay` accepts).
+        #[arg(long)]
+        log: PathBuf,
+        /// Folder for the frames (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Frame size in pixels, WxH, with the screen's aspect ratio (1080:2400 for the default phone).
+        #[arg(long, default_value = "540x1200")]
+        size: String,
+        /// Anaglyph method: dubois, dubois-green-magenta, dubois-amber-blue, half-color, optimized, gray, color, mono.
+        #[arg(long, default_value = "dubois")]
+        anaglyph: phantogram::anaglyph::Method,
+        /// Interval between frames, milliseconds of sensor time.
+        #[arg(long, default_value_t = 100.0)]
+        every: f64,
+        /// Make the pose at this many seconds into the log count as "straight on".
+        #[arg(long, value_name = "SECONDS")]
+        flat_at_s: Option<f64>,
+    },
     /// Convert a recording into the phantogram log format (gzip when OUT ends in .gz).
     Import {
         src: PathBuf,
@@ -128,6 +151,15 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Info { log } => info_command(&log),
+        Command::Render {
+            model,
+            log,
+            out,
+            size,
+            anaglyph,
+            every,
+            flat_at_s,
+        } => render_command(model.as_deref(), &log, &out, &size, anaglyph, every, flat_at_s),
         Command::Eval {
             what: EvalWhat::Orientation { paths },
         } => eval_orientation_command(&paths),
@@ -424,4 +456,122 @@ fn broken_pipe_is_fine(err: std::io::Error) -> Result<()> {
     } else {
         Err(err.into())
     }
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32)> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .with_context(|| format!("--size {text:?}: expected WxH, e.g. 540x1200"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|n| *n > 0);
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => bail!("--size {text:?}: expected two positive whole numbers, WxH"),
+    }
+}
+
+fn render_command(
+    model: Option<&std::path::Path>,
+    log: &std::path::Path,
+    out_dir: &std::path::Path,
+    size: &str,
+    method: phantogram::anaglyph::Method,
+    every_ms: f64,
+    flat_at_s: Option<f64>,
+) -> Result<()> {
+    use phantogram::containment::{ContainmentSmoother, required_push_back_m};
+    use phantogram::render::{FrameInput, Gpu, Renderer};
+
+    if let Some(m) = model {
+        // TODO(issue #3): glTF 2.0 loading (with Draco and the listed extensions) is not built yet.
+        bail!(
+            "{}: loading glTF models is not implemented yet; omit MODEL to render the default artifact",
+            m.display()
+        );
+    }
+    if !(every_ms.is_finite() && every_ms > 0.0) {
+        bail!("--every must be a positive number of milliseconds, got {every_ms}");
+    }
+    let (width, height) = parse_size(size)?;
+    let config = SessionConfig::default();
+    let screen = config.screen;
+    let aspect = width as f64 / height as f64;
+    let screen_aspect = screen.width_m() as f64 / screen.height_m() as f64;
+    if (aspect / screen_aspect - 1.0).abs() > 0.02 {
+        bail!(
+            "--size {width}x{height} does not match the screen's aspect ratio {}:{} (the image would be stretched)",
+            screen.width_px(),
+            screen.height_px()
+        );
+    }
+    let events: Vec<SensorEvent> = open_events(log)?.collect::<Result<_, _>>()?;
+    let (Some(first), Some(last)) = (events.first(), events.last()) else {
+        bail!("{}: the log has no events", log.display());
+    };
+    let interval_ns = (every_ms * 1e6).round().max(1.0) as i64;
+    let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
+
+    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    let mesh = phantogram::artifact::default_artifact();
+    let bounds = mesh.bounds().context("the default artifact is empty")?;
+    let gpu = Gpu::headless()?;
+    eprintln!("rendering on {}", gpu.describe());
+    let mut renderer = Renderer::new(gpu, &mesh)?;
+    let mut session = Session::new(config).context("invalid settings")?;
+    let mut smoother = ContainmentSmoother::default();
+
+    let bar = indicatif::ProgressBar::new(frames_expected);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} elapsed, ETA {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let t0 = first.t_ns;
+    let mut index = 0u64;
+    let mut failure: Option<anyhow::Error> = None;
+    let mut flat_pending = flat_at_s;
+    replay(
+        events.into_iter().map(Ok),
+        &mut session,
+        interval_ns,
+        Pace::AsFastAsPossible,
+        |session, t_ns, view| {
+            if failure.is_some() {
+                return;
+            }
+            if flat_pending.is_some_and(|at| (t_ns - t0) as f64 * 1e-9 >= at) {
+                flat_pending = None;
+                if let Err(e) = session.calibrate_flat_angle() {
+                    failure = Some(anyhow::anyhow!("flat-angle calibration failed: {e}"));
+                    return;
+                }
+            }
+            let required = required_push_back_m(&bounds, &view.stereo_eyes_m(), &session.config().screen);
+            let push = smoother.update(required, interval_ns as f32 * 1e-9);
+            let input = FrameInput::from_view(view, session.up_device(), phantogram::glam::Vec3::Z * -push);
+            let result = renderer
+                .render(&input, method, width, height)
+                .map_err(anyhow::Error::from)
+                .and_then(|pixels| {
+                    let path = out_dir.join(format!("frame_{index:05}.png"));
+                    image::save_buffer(&path, &pixels, width, height, image::ExtendedColorType::Rgba8)
+                        .with_context(|| format!("writing {}", path.display()))
+                });
+            if let Err(e) = result {
+                failure = Some(e);
+            }
+            index += 1;
+            bar.inc(1);
+        },
+    )?;
+    bar.finish_and_clear();
+    if let Some(e) = failure {
+        return Err(e);
+    }
+    if let Some(at) = flat_pending {
+        bail!("--flat-at-s {at} is beyond the end of the log");
+    }
+    eprintln!(
+        "wrote {index} frames ({width}x{height}, {method}) to {}",
+        out_dir.display()
+    );
+    Ok(())
 }

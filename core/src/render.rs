@@ -1,0 +1,700 @@
+//! The renderer: draws the artifact for each eye with its own off-axis projection and composes
+//! the pair (anaglyph or mono) in linear light. Headless today (frames read back as images); the
+//! window surface for the desktop viewer and the phones builds on the same passes.
+//!
+//! ## Passes per frame
+//! 1. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
+//!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
+//!    Mono renders only the cyclopean eye. The light and materials are shared by both eyes.
+//! 2. Composition pass: tone mapping (Khronos PBR Neutral, exposure) of each eye, then the
+//!    anaglyph matrices ([`crate::anaglyph`]) in linear light, into an `Rgba8UnormSrgb` target.
+//!
+//! ## Devices
+//! [`Gpu::headless`] asks wgpu for any adapter of the backends in `WGPU_BACKEND` (default: all),
+//! preferring real hardware and falling back to a software one (Mesa's lavapipe, which is how tests
+//! and CI run: Debian's `mesa-vulkan-drivers`). No display is needed.
+//!
+//! **Threading**: a [`Renderer`] belongs to one thread; wgpu's device and queue are internally
+//! synchronised. **Panics**: none on bad input; GPU failures come back as [`RenderError`].
+
+use glam::{Mat4, Vec3};
+use thiserror::Error;
+use wgpu::util::DeviceExt;
+
+use crate::anaglyph::Method;
+use crate::artifact::{Mesh, Vertex};
+use crate::projection::OffAxisProjection;
+use crate::session::FrameView;
+
+/// WGSL sources, validated by naga in the tests.
+pub const SCENE_WGSL: &str = include_str!("../../shaders/scene.wgsl");
+pub const COMPOSE_WGSL: &str = include_str!("../../shaders/compose.wgsl");
+
+const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
+/// Background radiance behind the artifact: a neutral mid-dark grey, the inside of the diorama
+/// box. Light enough for black glaze to read against it, dark enough for the red/cyan filters.
+const CLEAR_RADIANCE: wgpu::Color = wgpu::Color {
+    r: 0.07,
+    g: 0.07,
+    b: 0.075,
+    a: 1.0,
+};
+
+#[derive(Debug, Error)]
+pub enum RenderError {
+    #[error(
+        "no GPU adapter found (for software rendering on Linux install Mesa's Vulkan driver: apt-get install mesa-vulkan-drivers libvulkan1)"
+    )]
+    NoAdapter,
+    #[error("could not open the GPU device: {0}")]
+    Device(String),
+    #[error("frame size {width}×{height} is not supported (1 to {max} pixels per side)")]
+    BadSize { width: u32, height: u32, max: u32 },
+    #[error("the mesh is empty")]
+    EmptyMesh,
+    #[error("reading the frame back from the GPU failed: {0}")]
+    Readback(String),
+}
+
+/// An adapter, device and queue.
+pub struct Gpu {
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+}
+
+impl Gpu {
+    /// A device without any window, on the first adapter that works: hardware first, then a
+    /// software fallback.
+    pub fn headless() -> Result<Self, RenderError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        let mut adapter = None;
+        for force_fallback_adapter in [false, true] {
+            let found = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter,
+                compatible_surface: None,
+                // Limit bucketing hides hardware from untrusted web content; not our case.
+                apply_limit_buckets: false,
+            }));
+            if let Ok(a) = found {
+                adapter = Some(a);
+                break;
+            }
+        }
+        let adapter = adapter.ok_or(RenderError::NoAdapter)?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("phantogram"),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device(e.to_string()))?;
+        Ok(Self { adapter, device, queue })
+    }
+
+    /// The adapter's name and backend, for logs.
+    pub fn describe(&self) -> String {
+        let info = self.adapter.get_info();
+        format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+    }
+}
+
+/// Per-eye uniform block; matches `Eye` in `scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct EyeUniform {
+    view_proj: [[f32; 4]; 4],
+    eye_pos: [f32; 4],
+    toward_light: [f32; 4],
+    light: [f32; 4],
+    up: [f32; 4],
+}
+
+/// Matches `Compose` in `compose.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct ComposeUniform {
+    left: [[f32; 4]; 3],
+    right: [[f32; 4]; 3],
+    params: [f32; 4],
+}
+
+/// Lighting shared by both eyes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lighting {
+    /// Radiance of the directional light, linear RGB.
+    pub light_rgb: Vec3,
+    /// Ambient level.
+    pub ambient: f32,
+    /// Linear exposure multiplier before tone mapping.
+    pub exposure: f32,
+}
+
+impl Default for Lighting {
+    fn default() -> Self {
+        Self {
+            light_rgb: Vec3::new(3.2, 3.05, 2.85),
+            ambient: 0.22,
+            exposure: 1.0,
+        }
+    }
+}
+
+/// What to draw for one frame, in the device frame.
+#[derive(Clone, Copy, Debug)]
+pub struct FrameInput<'a> {
+    pub left: &'a OffAxisProjection,
+    pub right: &'a OffAxisProjection,
+    pub mono: &'a OffAxisProjection,
+    pub toward_light: Vec3,
+    /// "Up" in the device frame (for the ambient term); +z if unknown.
+    pub up: Vec3,
+    /// Translation applied to the mesh this frame (containment's push-back).
+    pub offset: Vec3,
+}
+
+impl<'a> FrameInput<'a> {
+    pub fn from_view(view: &'a FrameView, up: Option<Vec3>, offset: Vec3) -> Self {
+        Self {
+            left: &view.left,
+            right: &view.right,
+            mono: &view.mono,
+            toward_light: view.toward_light_device,
+            up: up.unwrap_or(Vec3::Z),
+            offset,
+        }
+    }
+}
+
+struct Targets {
+    width: u32,
+    height: u32,
+    hdr: [wgpu::TextureView; 2],
+    depth: wgpu::TextureView,
+    output: wgpu::Texture,
+    output_view: wgpu::TextureView,
+    readback: wgpu::Buffer,
+    padded_row: u32,
+    compose_bind: [wgpu::BindGroup; 2],
+}
+
+/// Draws one mesh as a phantogram.
+pub struct Renderer {
+    gpu: Gpu,
+    scene_pipeline: wgpu::RenderPipeline,
+    compose_pipeline: wgpu::RenderPipeline,
+    eye_buffers: [wgpu::Buffer; 2],
+    eye_bind: [wgpu::BindGroup; 2],
+    compose_buffer: wgpu::Buffer,
+    compose_layout: wgpu::BindGroupLayout,
+    vertex_buffer: wgpu::Buffer,
+    index_buffer: wgpu::Buffer,
+    index_count: u32,
+    targets: Option<Targets>,
+    pub lighting: Lighting,
+}
+
+impl Renderer {
+    pub fn new(gpu: Gpu, mesh: &Mesh) -> Result<Self, RenderError> {
+        if mesh.indices.is_empty() || mesh.vertices.is_empty() {
+            return Err(RenderError::EmptyMesh);
+        }
+        let device = &gpu.device;
+        let scene_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("scene.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(SCENE_WGSL.into()),
+        });
+        let compose_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("compose.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(COMPOSE_WGSL.into()),
+        });
+
+        let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("eye"),
+            entries: &[wgpu::BindGroupLayoutEntry {
+                binding: 0,
+                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
+                ty: wgpu::BindingType::Buffer {
+                    ty: wgpu::BufferBindingType::Uniform,
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            }],
+        });
+        let eye_buffers = [0, 1].map(|i| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(if i == 0 { "eye left" } else { "eye right" }),
+                size: std::mem::size_of::<EyeUniform>() as u64,
+                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+                mapped_at_creation: false,
+            })
+        });
+        let eye_bind = [0, 1].map(|i| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("eye"),
+                layout: &eye_layout,
+                entries: &[wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: eye_buffers[i].as_entire_binding(),
+                }],
+            })
+        });
+        let scene_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("scene"),
+            bind_group_layouts: &[Some(&eye_layout)],
+            immediate_size: 0,
+        });
+        let vertex_attributes =
+            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2];
+        let scene_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("scene"),
+            layout: Some(&scene_layout),
+            vertex: wgpu::VertexState {
+                module: &scene_module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &vertex_attributes,
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                front_face: wgpu::FrontFace::Ccw,
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::Greater),
+                stencil: Default::default(),
+                bias: Default::default(),
+            }),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &scene_module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(HDR_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+
+        let compose_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("compose"),
+            entries: &[
+                texture_entry(0),
+                texture_entry(1),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Buffer {
+                        ty: wgpu::BufferBindingType::Uniform,
+                        has_dynamic_offset: false,
+                        min_binding_size: None,
+                    },
+                    count: None,
+                },
+            ],
+        });
+        let compose_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("compose"),
+            bind_group_layouts: &[Some(&compose_layout)],
+            immediate_size: 0,
+        });
+        let compose_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("compose"),
+            layout: Some(&compose_pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &compose_module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &compose_module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(OUTPUT_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        let compose_buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("compose"),
+            size: std::mem::size_of::<ComposeUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let (vertex_buffer, index_buffer) = upload(device, mesh);
+        Ok(Self {
+            scene_pipeline,
+            compose_pipeline,
+            eye_buffers,
+            eye_bind,
+            compose_buffer,
+            compose_layout,
+            vertex_buffer,
+            index_buffer,
+            index_count: mesh.indices.len() as u32,
+            targets: None,
+            lighting: Lighting::default(),
+            gpu,
+        })
+    }
+
+    pub fn gpu(&self) -> &Gpu {
+        &self.gpu
+    }
+
+    /// Replaces the mesh drawn (keeps pipelines and targets).
+    pub fn set_mesh(&mut self, mesh: &Mesh) -> Result<(), RenderError> {
+        if mesh.indices.is_empty() || mesh.vertices.is_empty() {
+            return Err(RenderError::EmptyMesh);
+        }
+        let (vertex_buffer, index_buffer) = upload(&self.gpu.device, mesh);
+        self.vertex_buffer = vertex_buffer;
+        self.index_buffer = index_buffer;
+        self.index_count = mesh.indices.len() as u32;
+        Ok(())
+    }
+
+    fn targets(&mut self, width: u32, height: u32) -> Result<&Targets, RenderError> {
+        let max = self.gpu.device.limits().max_texture_dimension_2d;
+        if width == 0 || height == 0 || width > max || height > max {
+            return Err(RenderError::BadSize { width, height, max });
+        }
+        if self
+            .targets
+            .as_ref()
+            .is_none_or(|t| (t.width, t.height) != (width, height))
+        {
+            self.targets = Some(self.create_targets(width, height));
+        }
+        Ok(self.targets.as_ref().expect("just created"))
+    }
+
+    fn create_targets(&self, width: u32, height: u32) -> Targets {
+        let device = &self.gpu.device;
+        let size = wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        };
+        let texture = |label, format, usage| {
+            device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(label),
+                size,
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format,
+                usage,
+                view_formats: &[],
+            })
+        };
+        let hdr_usage = wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING;
+        let hdr = [
+            texture("hdr left", HDR_FORMAT, hdr_usage).create_view(&Default::default()),
+            texture("hdr right", HDR_FORMAT, hdr_usage).create_view(&Default::default()),
+        ];
+        let depth =
+            texture("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT).create_view(&Default::default());
+        let output = texture(
+            "output",
+            OUTPUT_FORMAT,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        );
+        let output_view = output.create_view(&Default::default());
+        let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: padded_row as u64 * height as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        // Bind group 0 composes left with right; bind group 1 reads the left image twice (mono).
+        let compose_bind = [(0usize, 1usize), (0, 0)].map(|(a, b)| {
+            device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("compose"),
+                layout: &self.compose_layout,
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: wgpu::BindingResource::TextureView(&hdr[a]),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&hdr[b]),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: self.compose_buffer.as_entire_binding(),
+                    },
+                ],
+            })
+        });
+        Targets {
+            width,
+            height,
+            hdr,
+            depth,
+            output,
+            output_view,
+            readback,
+            padded_row,
+            compose_bind,
+        }
+    }
+
+    fn eye_uniform(&self, proj: &OffAxisProjection, input: &FrameInput) -> EyeUniform {
+        // The mesh moves by `offset` (push-back): fold it into the projection.
+        let view_proj = proj.view_proj * Mat4::from_translation(input.offset);
+        let l = self.lighting;
+        EyeUniform {
+            view_proj: view_proj.to_cols_array_2d(),
+            // Shading happens in mesh coordinates, so the eye moves the other way.
+            eye_pos: (proj.eye_m - input.offset).extend(1.0).to_array(),
+            toward_light: input.toward_light.normalize_or(Vec3::Z).extend(0.0).to_array(),
+            light: l.light_rgb.extend(l.ambient).to_array(),
+            up: input.up.normalize_or(Vec3::Z).extend(0.0).to_array(),
+        }
+    }
+
+    /// Renders one frame of `width × height` pixels and reads it back as 8-bit sRGB RGBA, rows top
+    /// to bottom.
+    pub fn render(
+        &mut self,
+        input: &FrameInput,
+        method: Method,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, RenderError> {
+        let eyes: Vec<&OffAxisProjection> = if method.is_stereo() {
+            vec![input.left, input.right]
+        } else {
+            vec![input.mono]
+        };
+        self.render_views(&eyes, input, method, width, height)
+    }
+
+    /// Renders `projection` alone (no stereo composition), e.g. one eye's image for tests.
+    pub fn render_single(
+        &mut self,
+        projection: &OffAxisProjection,
+        input: &FrameInput,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, RenderError> {
+        self.render_views(&[projection], input, Method::Mono, width, height)
+    }
+
+    fn render_views(
+        &mut self,
+        eyes: &[&OffAxisProjection],
+        input: &FrameInput,
+        method: Method,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, RenderError> {
+        self.targets(width, height)?;
+        let uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input)).collect();
+        let (lm, rm) = method.matrices();
+        let row = |m: [f32; 3]| [m[0], m[1], m[2], 0.0];
+        let compose = ComposeUniform {
+            left: lm.map(row),
+            right: rm.map(row),
+            params: [self.lighting.exposure, 0.0, 0.0, 0.0],
+        };
+        let queue = &self.gpu.queue;
+        for (buffer, u) in self.eye_buffers.iter().zip(&uniforms) {
+            queue.write_buffer(buffer, 0, bytemuck::bytes_of(u));
+        }
+        queue.write_buffer(&self.compose_buffer, 0, bytemuck::bytes_of(&compose));
+
+        let targets = self.targets.as_ref().expect("created above");
+        let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        for (i, _) in uniforms.iter().enumerate() {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("scene"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &targets.hdr[i],
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(CLEAR_RADIANCE),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &targets.depth,
+                    // Reverse-Z: 0 is infinitely far.
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(0.0),
+                        store: wgpu::StoreOp::Discard,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.scene_pipeline);
+            pass.set_bind_group(0, &self.eye_bind[i], &[]);
+            pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
+            pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..self.index_count, 0, 0..1);
+        }
+        {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("compose"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: &targets.output_view,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.compose_pipeline);
+            let bind = if uniforms.len() == 2 { 0 } else { 1 };
+            pass.set_bind_group(0, &targets.compose_bind[bind], &[]);
+            pass.draw(0..3, 0..1);
+        }
+        encoder.copy_texture_to_buffer(
+            targets.output.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &targets.readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(targets.padded_row),
+                    rows_per_image: Some(targets.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: targets.width,
+                height: targets.height,
+                depth_or_array_layers: 1,
+            },
+        );
+        queue.submit([encoder.finish()]);
+        read_back(&self.gpu.device, targets)
+    }
+}
+
+fn upload(device: &wgpu::Device, mesh: &Mesh) -> (wgpu::Buffer, wgpu::Buffer) {
+    let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("vertices"),
+        contents: bytemuck::cast_slice(&mesh.vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("indices"),
+        contents: bytemuck::cast_slice(&mesh.indices),
+        usage: wgpu::BufferUsages::INDEX,
+    });
+    (vertices, indices)
+}
+
+fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    }
+}
+
+fn read_back(device: &wgpu::Device, targets: &Targets) -> Result<Vec<u8>, RenderError> {
+    let slice = targets.readback.slice(..);
+    let (tx, rx) = std::sync::mpsc::channel();
+    slice.map_async(wgpu::MapMode::Read, move |r| {
+        let _ = tx.send(r);
+    });
+    device
+        .poll(wgpu::PollType::wait_indefinitely())
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    rx.recv()
+        .map_err(|e| RenderError::Readback(e.to_string()))?
+        .map_err(|e| RenderError::Readback(e.to_string()))?;
+    let row_bytes = (targets.width * 4) as usize;
+    let mut pixels = Vec::with_capacity(row_bytes * targets.height as usize);
+    {
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        for row in data.chunks(targets.padded_row as usize).take(targets.height as usize) {
+            pixels.extend_from_slice(&row[..row_bytes]);
+        }
+    }
+    targets.readback.unmap();
+    Ok(pixels)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn validate(name: &str, source: &str) {
+        let module =
+            naga::front::wgsl::parse_str(source).unwrap_or_else(|e| panic!("{name}: {}", e.emit_to_string(source)));
+        naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        )
+        .validate(&module)
+        .unwrap_or_else(|e| panic!("{name}: {e:?}"));
+    }
+
+    /// Every `shaders/*.wgsl` file parses and validates (naga), not only the ones compiled in.
+    #[test]
+    fn every_shader_validates() {
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+        let mut n = 0;
+        for entry in std::fs::read_dir(&dir).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "wgsl") {
+                validate(&path.display().to_string(), &std::fs::read_to_string(&path).unwrap());
+                n += 1;
+            }
+        }
+        assert!(n >= 2, "found {n} shaders in {}", dir.display());
+        validate("scene", SCENE_WGSL);
+        validate("compose", COMPOSE_WGSL);
+    }
+
+    #[test]
+    fn a_broken_shader_fails_validation() {
+        let bad = SCENE_WGSL.replace("vec4<f32>(direct + ambient, 1.0)", "vec3<f32>(direct + ambient)");
+        let parsed = naga::front::wgsl::parse_str(&bad);
+        let failed = match parsed {
+            Err(_) => true,
+            Ok(m) => naga::valid::Validator::new(naga::valid::ValidationFlags::all(), Default::default())
+                .validate(&m)
+                .is_err(),
+        };
+        assert!(failed);
+    }
+
+    #[test]
+    fn uniform_layouts_match_the_shaders() {
+        // WGSL sizes: Eye = mat4 (64) + 4 × vec4 (64); Compose = 7 × vec4.
+        assert_eq!(std::mem::size_of::<EyeUniform>(), 128);
+        assert_eq!(std::mem::size_of::<ComposeUniform>(), 112);
+        assert_eq!(std::mem::size_of::<Vertex>(), 48);
+    }
+}

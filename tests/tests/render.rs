@@ -1,0 +1,231 @@
+//! Rendering on the GPU (Mesa's lavapipe in CI): geometric truth against the core's projection,
+//! golden images of the default artifact, and the anaglyph composition against its CPU reference.
+//!
+//! Without a GPU adapter these tests print a notice and return, except under CI (`CI` set), where
+//! a missing adapter fails them: `.ci/run` installs `mesa-vulkan-drivers`.
+//!
+//! Golden images live in `tests/golden/`. On a mismatch the test writes `NAME-actual.png` and
+//! `NAME-difference.png` beside the golden image (git-ignored). `PHANTOGRAM_BLESS=1` rewrites the
+//! golden images from the current output; look at them before committing.
+
+use std::path::PathBuf;
+
+use phantogram::anaglyph::Method;
+use phantogram::artifact::{Mesh, default_artifact};
+use phantogram::glam::Vec3;
+use phantogram::projection::{DepthRange, OffAxisProjection};
+use phantogram::render::{FrameInput, Gpu, Renderer};
+use phantogram::screen::Screen;
+use phantogram::{FrameView, Session, SessionConfig};
+
+fn gpu() -> Option<Gpu> {
+    match Gpu::headless() {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no GPU adapter ({e}): skipping rendering tests");
+            None
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    }
+}
+
+/// The output size used by the tests: the default phone's aspect, small for lavapipe.
+const W: u32 = 180;
+const H: u32 = 400;
+
+/// The view of a phone held 35° from horizontal, uncalibrated (the viewer looks obliquely, the
+/// classic phantogram view).
+fn oblique_view() -> (FrameView, Vec3) {
+    let mut s = Session::new(SessionConfig::default()).unwrap();
+    let tilt = 35f32.to_radians();
+    let up = Vec3::new(0.0, tilt.sin(), tilt.cos());
+    s.push(phantogram::sensors::SensorEvent::accelerometer(1, up * 9.81))
+        .unwrap();
+    (s.frame().unwrap(), up)
+}
+
+fn luminance(px: &[u8]) -> f32 {
+    0.2126 * px[0] as f32 + 0.7152 * px[1] as f32 + 0.0722 * px[2] as f32
+}
+
+/// Centroid (pixel coordinates, centre of pixel = +0.5) of the pixels whose luminance differs
+/// from the background's (the top-left pixel's) by more than `threshold`.
+fn marker_centroid(pixels: &[u8], threshold: f32) -> Option<(f32, f32)> {
+    let background = luminance(&pixels[..4]);
+    let (mut sx, mut sy, mut n) = (0.0f64, 0.0f64, 0u32);
+    for (i, px) in pixels.chunks(4).enumerate() {
+        if (luminance(px) - background).abs() > threshold {
+            sx += (i as u32 % W) as f64 + 0.5;
+            sy += (i as u32 / W) as f64 + 0.5;
+            n += 1;
+        }
+    }
+    (n > 0).then(|| ((sx / n as f64) as f32, (sy / n as f64) as f32))
+}
+
+fn marker_mesh(at: Vec3) -> Mesh {
+    let mut m = Mesh::default();
+    m.push_cube(at, 0.0006, [1.0, 1.0, 1.0, 1.0]);
+    m
+}
+
+#[test]
+fn markers_land_on_the_predicted_pixel_in_each_eye() {
+    let Some(gpu) = gpu() else { return };
+    let screen = Screen::default();
+    let (view, up) = oblique_view();
+    let scale = W as f32 / screen.width_px() as f32;
+    let points = [
+        Vec3::new(0.012, -0.02, 0.025), // in front of the glass
+        Vec3::new(-0.015, 0.03, -0.03), // behind it
+        Vec3::new(0.008, 0.01, 0.0),    // on it
+    ];
+    let mut renderer = Renderer::new(gpu, &marker_mesh(points[0])).unwrap();
+    for p in points {
+        renderer.set_mesh(&marker_mesh(p)).unwrap();
+        let input = FrameInput {
+            toward_light: Vec3::new(0.2, -0.3, 1.0),
+            ..FrameInput::from_view(&view, Some(up), Vec3::ZERO)
+        };
+        let mut centroids = Vec::new();
+        for (name, proj) in [("left", &view.left), ("right", &view.right)] {
+            let pixels = renderer.render_single(proj, &input, W, H).unwrap();
+            let got = marker_centroid(&pixels, 30.0).unwrap_or_else(|| panic!("marker {p} not visible ({name})"));
+            let want = proj.project(p).unwrap().pixel * scale;
+            let err = ((got.0 - want.x).powi(2) + (got.1 - want.y).powi(2)).sqrt();
+            println!(
+                "marker {p} {name} eye: rendered {got:?}, predicted ({:.2}, {:.2}), error {err:.3} px",
+                want.x, want.y
+            );
+            assert!(err < 1.0, "marker {p}, {name} eye: {err} px from the prediction");
+            centroids.push(got);
+        }
+        let disparity = centroids[1].0 - centroids[0].0;
+        println!("marker {p}: horizontal disparity {disparity:+.2} px");
+        if p.z == 0.0 {
+            assert!(
+                disparity.abs() < 0.25,
+                "a point on the glass has disparity {disparity} px"
+            );
+        } else if p.z > 0.0 {
+            // In front of the glass: crossed disparity (the right eye sees it further left).
+            assert!(disparity < -1.0, "{disparity}");
+        } else {
+            assert!(disparity > 1.0, "{disparity}");
+        }
+    }
+}
+
+fn golden_path(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("golden")
+        .join(format!("{name}.png"))
+}
+
+/// Compares with `tests/golden/NAME.png`: fails if more than `max_fraction` of the pixels differ
+/// by more than `tolerance` in any channel; writes actual and difference images on failure.
+fn check_golden(name: &str, pixels: &[u8], tolerance: u8, max_fraction: f64) {
+    let path = golden_path(name);
+    let save = |p: &PathBuf, data: &[u8]| image::save_buffer(p, data, W, H, image::ExtendedColorType::Rgba8).unwrap();
+    if std::env::var_os("PHANTOGRAM_BLESS").is_some() {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        save(&path, pixels);
+        return;
+    }
+    let golden = image::open(&path)
+        .unwrap_or_else(|e| panic!("{}: {e} (run with PHANTOGRAM_BLESS=1 to create it)", path.display()))
+        .to_rgba8();
+    assert_eq!(golden.dimensions(), (W, H), "{name}: golden image size");
+    let mut diff = vec![0u8; pixels.len()];
+    let mut bad = 0usize;
+    for (i, (a, b)) in pixels.chunks(4).zip(golden.as_raw().chunks(4)).enumerate() {
+        let d = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
+        if d > tolerance {
+            bad += 1;
+        }
+        let v = d.saturating_mul(8);
+        diff[i * 4..i * 4 + 4].copy_from_slice(&[v, v, v, 255]);
+    }
+    let fraction = bad as f64 / (W * H) as f64;
+    if fraction > max_fraction {
+        let stem = path.with_extension("");
+        save(&PathBuf::from(format!("{}-actual.png", stem.display())), pixels);
+        save(&PathBuf::from(format!("{}-difference.png", stem.display())), &diff);
+        panic!(
+            "{name}: {bad} pixels ({:.3} %) differ by more than {tolerance} (allowed {:.3} %); see {}-actual.png and -difference.png",
+            fraction * 100.0,
+            max_fraction * 100.0,
+            stem.display()
+        );
+    }
+}
+
+#[test]
+fn default_artifact_matches_its_golden_images() {
+    let Some(gpu) = gpu() else { return };
+    let (view, up) = oblique_view();
+    let mut renderer = Renderer::new(gpu, &default_artifact()).unwrap();
+    let input = FrameInput::from_view(&view, Some(up), Vec3::ZERO);
+    for (name, method) in [
+        ("amphora-mono", Method::Mono),
+        ("amphora-dubois", Method::DuboisRedCyan),
+    ] {
+        let pixels = renderer.render(&input, method, W, H).unwrap();
+        // Rasterisation may differ by a unit here and there across Mesa versions; a broken
+        // projection, light or composition changes thousands of pixels.
+        check_golden(name, &pixels, 3, 0.002);
+    }
+}
+
+#[test]
+fn gpu_composition_matches_the_cpu_reference() {
+    // Two flat-coloured walls, one per eye: a large quad behind the glass lit head-on, seen by
+    // both eyes; the composed pixel at the centre must equal Method::compose of the two eyes'
+    // pixels (in linear light), for every method.
+    let Some(gpu) = gpu() else { return };
+    let mut mesh = Mesh::default();
+    mesh.push_cube(Vec3::new(0.0, 0.0, -0.5), 0.3, [0.6, 0.3, 0.1, 1.0]);
+    let screen = Screen::default();
+    let left = OffAxisProjection::new(&screen, Vec3::new(-0.03, 0.0, 0.3), DepthRange::default()).unwrap();
+    let right = OffAxisProjection::new(&screen, Vec3::new(0.03, 0.0, 0.3), DepthRange::default()).unwrap();
+    let mut renderer = Renderer::new(gpu, &mesh).unwrap();
+    let input = FrameInput {
+        left: &left,
+        right: &right,
+        mono: &left,
+        toward_light: Vec3::Z,
+        up: Vec3::Y,
+        offset: Vec3::ZERO,
+    };
+    let centre = ((H / 2) * W + W / 2) as usize * 4;
+    let to_linear = |c: u8| {
+        let c = c as f32 / 255.0;
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    let eye = |r: &mut Renderer, p: &OffAxisProjection| {
+        let px = r.render_single(p, &input, W, H).unwrap();
+        [0, 1, 2].map(|c| to_linear(px[centre + c]))
+    };
+    let (l, r) = (eye(&mut renderer, &left), eye(&mut renderer, &right));
+    for method in Method::ALL {
+        let px = renderer.render(&input, method, W, H).unwrap();
+        let got = [0, 1, 2].map(|c| to_linear(px[centre + c]));
+        let want = if method.is_stereo() {
+            method.compose(l, r)
+        } else {
+            method.compose(l, l)
+        };
+        for c in 0..3 {
+            assert!(
+                (got[c] - want[c]).abs() < 0.01,
+                "{method}: channel {c}: {} vs {}",
+                got[c],
+                want[c]
+            );
+        }
+    }
+}
