@@ -1,37 +1,67 @@
-// Scene pass: one eye's view of the artifact, lit by the world-fixed directional light, written as
-// linear HDR radiance. Metallic–roughness shading: Lambert diffuse + GGX / Smith / Schlick
-// specular (the glTF BRDF), plus a small hemispherical ambient term.
+// Scene pass: one eye's view, lit by the world-fixed directional light, written as linear HDR
+// radiance. glTF metallic–roughness shading: Lambert diffuse + GGX / Smith / Schlick specular,
+// normal, occlusion and emissive maps, alpha mask and blend, and a small hemispherical ambient.
 //
-// Coordinates: vertex positions and normals are in the device frame (metres); `eye.view_proj` is
-// the core's off-axis projection (reverse-Z, wgpu clip space).
+// Coordinates: positions, normals and tangents are in the device frame (metres); `eye.view_proj`
+// is the core's off-axis projection (reverse-Z, wgpu clip space).
 
 struct Eye {
     view_proj: mat4x4<f32>,
-    // Eye position, device frame (w unused).
+    // Eye position in mesh coordinates (w unused).
     eye_pos: vec4<f32>,
-    // Unit vector towards the light, device frame (w unused).
+    // Unit vector towards the light (w unused).
     toward_light: vec4<f32>,
     // Light radiance (rgb, linear) and, in w, the ambient level.
     light: vec4<f32>,
-    // "Up" in the device frame for the hemispherical ambient (w unused).
+    // "Up" in the device frame, for the hemispherical ambient (w unused).
     up: vec4<f32>,
+};
+
+struct Material {
+    base_color: vec4<f32>,
+    // rgb: emissive radiance factor; w: normal-map scale.
+    emissive: vec4<f32>,
+    // x: metallic, y: roughness, z: alpha cutoff (negative: no mask), w: occlusion strength.
+    params: vec4<f32>,
+    // UV set (0 or 1) of the base colour, metallic-roughness, normal and occlusion textures.
+    uv_sets: vec4<f32>,
+    // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended.
+    flags: vec4<f32>,
+    // KHR_texture_transform rows for the five slots, in the order above plus emissive.
+    transforms: array<vec4<f32>, 10>,
 };
 
 @group(0) @binding(0) var<uniform> eye: Eye;
 
+@group(1) @binding(0) var<uniform> material: Material;
+@group(1) @binding(1) var base_texture: texture_2d<f32>;
+@group(1) @binding(2) var base_sampler: sampler;
+@group(1) @binding(3) var mr_texture: texture_2d<f32>;
+@group(1) @binding(4) var mr_sampler: sampler;
+@group(1) @binding(5) var normal_texture: texture_2d<f32>;
+@group(1) @binding(6) var normal_sampler: sampler;
+@group(1) @binding(7) var occlusion_texture: texture_2d<f32>;
+@group(1) @binding(8) var occlusion_sampler: sampler;
+@group(1) @binding(9) var emissive_texture: texture_2d<f32>;
+@group(1) @binding(10) var emissive_sampler: sampler;
+
 struct VsIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
-    @location(2) color: vec4<f32>,
-    @location(3) material: vec2<f32>,
+    @location(2) tangent: vec4<f32>,
+    @location(3) uv: vec4<f32>,
+    @location(4) color: vec4<f32>,
+    @location(5) material: vec2<f32>,
 };
 
 struct VsOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
     @location(1) normal: vec3<f32>,
-    @location(2) color: vec4<f32>,
-    @location(3) material: vec2<f32>,
+    @location(2) tangent: vec4<f32>,
+    @location(3) uv: vec4<f32>,
+    @location(4) color: vec4<f32>,
+    @location(5) material: vec2<f32>,
 };
 
 @vertex
@@ -40,6 +70,8 @@ fn vs_main(v: VsIn) -> VsOut {
     out.clip = eye.view_proj * vec4<f32>(v.position, 1.0);
     out.world = v.position;
     out.normal = v.normal;
+    out.tangent = v.tangent;
+    out.uv = v.uv;
     out.color = v.color;
     out.material = v.material;
     return out;
@@ -47,13 +79,22 @@ fn vs_main(v: VsIn) -> VsOut {
 
 const PI: f32 = 3.14159265;
 
+fn slot_uv(slot: u32, uv_set: f32, uv: vec4<f32>) -> vec2<f32> {
+    var coords = uv.xy;
+    if (uv_set > 0.5) {
+        coords = uv.zw;
+    }
+    let p = vec3<f32>(coords, 1.0);
+    return vec2<f32>(dot(material.transforms[slot * 2u].xyz, p), dot(material.transforms[slot * 2u + 1u].xyz, p));
+}
+
 fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
     return a2 / (PI * d * d);
 }
 
-// Smith visibility (height-correlated, combined with the 1 / (4 n·l n·v) term).
+// Smith visibility (height-correlated, including the 1 / (4 n·l n·v) term).
 fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
@@ -63,17 +104,40 @@ fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
 
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    // Open surfaces (the amphora's mouth) are seen from inside too.
+    // Sample everything first: derivatives need uniform control flow.
+    let base_sample = textureSample(base_texture, base_sampler, slot_uv(0u, material.uv_sets.x, in.uv));
+    let mr_sample = textureSample(mr_texture, mr_sampler, slot_uv(1u, material.uv_sets.y, in.uv));
+    let normal_sample = textureSample(normal_texture, normal_sampler, slot_uv(2u, material.uv_sets.z, in.uv));
+    let occlusion_sample = textureSample(occlusion_texture, occlusion_sampler, slot_uv(3u, material.uv_sets.w, in.uv));
+    let emissive_sample = textureSample(emissive_texture, emissive_sampler, slot_uv(4u, material.flags.x, in.uv));
+
+    let base_rgba = in.color * material.base_color * base_sample;
+    if (material.params.z >= 0.0 && base_rgba.a < material.params.z) {
+        discard;
+    }
+
+    // Open and double-sided surfaces are lit from the side that faces the eye.
     var n = normalize(in.normal);
+    var t = in.tangent.xyz;
+    var handedness = in.tangent.w;
     if (!front) {
         n = -n;
+        t = -t;
     }
+    if (material.flags.y > 0.5 && dot(t, t) > 1e-8) {
+        let tn = normalize(t - n * dot(n, t));
+        let bn = cross(n, tn) * select(1.0, -1.0, handedness < 0.0);
+        var m = normal_sample.xyz * 2.0 - vec3<f32>(1.0);
+        m = vec3<f32>(m.xy * material.emissive.w, m.z);
+        n = normalize(tn * m.x + bn * m.y + n * m.z);
+    }
+
     let v = normalize(eye.eye_pos.xyz - in.world);
     let l = normalize(eye.toward_light.xyz);
     let h = normalize(l + v);
-    let base = in.color.rgb;
-    let metallic = clamp(in.material.x, 0.0, 1.0);
-    let roughness = clamp(in.material.y, 0.045, 1.0);
+    let base = base_rgba.rgb;
+    let metallic = clamp(material.params.x * mr_sample.b * in.material.x, 0.0, 1.0);
+    let roughness = clamp(material.params.y * mr_sample.g * in.material.y, 0.045, 1.0);
     let alpha = roughness * roughness;
 
     let n_dot_l = max(dot(n, l), 0.0);
@@ -88,9 +152,15 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     let direct = (diffuse + specular) * eye.light.rgb * n_dot_l;
 
     // Hemispherical ambient: brighter from above; metals reflect it tinted by their colour.
+    let occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);
     let sky = 0.5 + 0.5 * dot(n, normalize(eye.up.xyz));
-    let ambient_light = eye.light.w * mix(0.35, 1.0, sky);
+    let ambient_light = eye.light.w * mix(0.35, 1.0, sky) * occlusion;
     let ambient = ambient_light * mix(base * (1.0 - metallic), f0 * 0.8, metallic);
+    let emissive = material.emissive.rgb * emissive_sample.rgb;
 
-    return vec4<f32>(direct + ambient, 1.0);
+    var out_alpha = 1.0;
+    if (material.flags.z > 0.5) {
+        out_alpha = base_rgba.a;
+    }
+    return vec4<f32>(direct + ambient + emissive, out_alpha);
 }

@@ -11,72 +11,9 @@
 
 use glam::{Vec2, Vec3};
 
-use crate::containment::Aabb;
+use crate::model::Model;
 
-/// One vertex: position and normal in the device frame (metres), linear base colour with alpha,
-/// and the metallic–roughness material parameters.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
-#[cfg_attr(feature = "render", derive(bytemuck::Pod, bytemuck::Zeroable))]
-pub struct Vertex {
-    pub position: [f32; 3],
-    pub normal: [f32; 3],
-    pub color: [f32; 4],
-    /// `[metallic, roughness]`.
-    pub material: [f32; 2],
-}
-
-/// A triangle mesh, counter-clockwise front faces.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Mesh {
-    pub vertices: Vec<Vertex>,
-    pub indices: Vec<u32>,
-}
-
-impl Mesh {
-    /// Axis-aligned bounds of the vertices; `None` for an empty mesh.
-    pub fn bounds(&self) -> Option<Aabb> {
-        let first = Vec3::from(self.vertices.first()?.position);
-        let (min, max) = self.vertices.iter().fold((first, first), |(lo, hi), v| {
-            let p = Vec3::from(v.position);
-            (lo.min(p), hi.max(p))
-        });
-        Some(Aabb::new(min, max))
-    }
-
-    pub fn translate(&mut self, by: Vec3) {
-        for v in &mut self.vertices {
-            v.position = (Vec3::from(v.position) + by).to_array();
-        }
-    }
-
-    /// Appends a small axis-aligned cube (for markers and tests).
-    pub fn push_cube(&mut self, centre: Vec3, half: f32, color: [f32; 4]) {
-        let faces = [
-            (Vec3::X, Vec3::Y, Vec3::Z),
-            (-Vec3::X, Vec3::Z, Vec3::Y),
-            (Vec3::Y, Vec3::Z, Vec3::X),
-            (-Vec3::Y, Vec3::X, Vec3::Z),
-            (Vec3::Z, Vec3::X, Vec3::Y),
-            (-Vec3::Z, Vec3::Y, Vec3::X),
-        ];
-        for (n, u, v) in faces {
-            let base = self.vertices.len() as u32;
-            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
-                let p = centre + (n + u * a + v * b) * half;
-                self.vertices.push(Vertex {
-                    position: p.to_array(),
-                    normal: n.to_array(),
-                    color,
-                    material: [0.0, 0.8],
-                });
-            }
-            // u × v = n for every face above, so this winding is counter-clockwise seen from n.
-            self.indices
-                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
-        }
-    }
-}
+pub use crate::model::{Mesh, Vertex};
 
 /// Linear-RGB colours and materials of the amphora.
 const TERRACOTTA: [f32; 4] = [0.50, 0.19, 0.075, 1.0];
@@ -183,6 +120,9 @@ pub fn amphora(base_z_m: f32) -> Mesh {
             mesh.vertices.push(Vertex {
                 position: [r * c, r * s, z],
                 normal: n.to_array(),
+                // Along increasing φ; the frieze is painted per vertex, so no normal map uses it.
+                tangent: [-s, c, 0.0, 1.0],
+                uv: [j as f32 / segments as f32, 1.0 - t, 0.0, 0.0],
                 color,
                 material,
             });
@@ -202,6 +142,8 @@ pub fn amphora(base_z_m: f32) -> Mesh {
     mesh.vertices.push(Vertex {
         position: [0.0, 0.0, base_z_m],
         normal: [0.0, 0.0, -1.0],
+        tangent: [1.0, 0.0, 0.0, 1.0],
+        uv: [0.5, 1.0, 0.0, 0.0],
         color: BLACK_GLAZE,
         material: GLAZE_MATERIAL,
     });
@@ -211,9 +153,14 @@ pub fn amphora(base_z_m: f32) -> Mesh {
     mesh
 }
 
-/// The default artifact placed as it is shown: standing 24 mm out of the glass.
+/// The default artifact's mesh placed as it is shown: standing 24 mm out of the glass.
 pub fn default_artifact() -> Mesh {
     amphora(0.024 - AMPHORA_HEIGHT_M)
+}
+
+/// The default artifact as a model (one vertex-painted material).
+pub fn default_model() -> Model {
+    Model::from_painted_mesh("amphora", default_artifact())
 }
 
 #[cfg(test)]
@@ -246,18 +193,5 @@ mod tests {
         }
         let count = |c: [f32; 4]| m.vertices.iter().filter(|v| v.color == c).count();
         assert!(count(GOLD) > 100 && count(BLACK_GLAZE) > 1000 && count(TERRACOTTA) > 1000);
-    }
-
-    #[test]
-    fn cube_faces_wind_outwards() {
-        let mut m = Mesh::default();
-        m.push_cube(Vec3::ZERO, 1.0, [1.0; 4]);
-        for tri in m.indices.chunks(3) {
-            let p = |i: u32| Vec3::from(m.vertices[i as usize].position);
-            let (a, b, c) = (p(tri[0]), p(tri[1]), p(tri[2]));
-            let n = (b - a).cross(c - a);
-            let centre = (a + b + c) / 3.0;
-            assert!(n.dot(centre) > 0.0, "triangle {tri:?} winds inwards");
-        }
     }
 }

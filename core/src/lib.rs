@@ -58,6 +58,7 @@ pub mod eyes;
 pub mod fusion;
 pub mod light;
 pub mod lowpass;
+pub mod model;
 pub mod orientation_eval;
 pub mod projection;
 #[cfg(feature = "render")]

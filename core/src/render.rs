@@ -5,9 +5,17 @@
 //! ## Passes per frame
 //! 1. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
 //!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
-//!    Mono renders only the cyclopean eye. The light and materials are shared by both eyes.
+//!    Opaque and masked primitives first, then blended ones back to front (depth test, no depth
+//!    write). Mono renders only the cyclopean eye. Light, materials and textures are shared by
+//!    both eyes; only the small per-eye uniform differs.
 //! 2. Composition pass: tone mapping (Khronos PBR Neutral, exposure) of each eye, then the
 //!    anaglyph matrices ([`crate::anaglyph`]) in linear light, into an `Rgba8UnormSrgb` target.
+//!
+//! ## Models
+//! [`Model`]s upload as one vertex and index buffer per primitive, one bind group per material
+//! (uniform block, five textures and their samplers; missing textures bind 1×1 defaults), and
+//! textures with full mip chains generated here (colour textures averaged in linear light, then
+//! viewed as sRGB so the sampler decodes them).
 //!
 //! ## Devices
 //! [`Gpu::headless`] asks wgpu for any adapter of the backends in `WGPU_BACKEND` (default: all),
@@ -22,7 +30,7 @@ use thiserror::Error;
 use wgpu::util::DeviceExt;
 
 use crate::anaglyph::Method;
-use crate::artifact::{Mesh, Vertex};
+use crate::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
 use crate::projection::OffAxisProjection;
 use crate::session::FrameView;
 
@@ -52,8 +60,10 @@ pub enum RenderError {
     Device(String),
     #[error("frame size {width}×{height} is not supported (1 to {max} pixels per side)")]
     BadSize { width: u32, height: u32, max: u32 },
-    #[error("the mesh is empty")]
-    EmptyMesh,
+    #[error("the model has nothing to draw")]
+    EmptyModel,
+    #[error("the GPU rejected {what}: {message}")]
+    Gpu { what: &'static str, message: String },
     #[error("reading the frame back from the GPU failed: {0}")]
     Readback(String),
 }
@@ -121,6 +131,63 @@ struct ComposeUniform {
     params: [f32; 4],
 }
 
+/// Matches `Material` in `scene.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
+struct MaterialUniform {
+    base_color: [f32; 4],
+    emissive: [f32; 4],
+    params: [f32; 4],
+    uv_sets: [f32; 4],
+    flags: [f32; 4],
+    transforms: [[f32; 4]; 10],
+}
+
+impl MaterialUniform {
+    fn new(m: &Material) -> Self {
+        let slots = [
+            m.base_color_texture,
+            m.metallic_roughness_texture,
+            m.normal_texture.map(|(t, _)| t),
+            m.occlusion_texture.map(|(t, _)| t),
+            m.emissive_texture,
+        ];
+        let mut transforms = [[0.0; 4]; 10];
+        for (i, slot) in slots.iter().enumerate() {
+            let rows = slot.map(|t| t.transform).unwrap_or_default().rows();
+            transforms[2 * i] = [rows[0][0], rows[0][1], rows[0][2], 0.0];
+            transforms[2 * i + 1] = [rows[1][0], rows[1][1], rows[1][2], 0.0];
+        }
+        let set = |t: Option<TextureRef>| t.map_or(0.0, |t| t.tex_coord as f32);
+        Self {
+            base_color: m.base_color,
+            emissive: [
+                m.emissive[0],
+                m.emissive[1],
+                m.emissive[2],
+                m.normal_texture.map_or(1.0, |(_, s)| s),
+            ],
+            params: [
+                m.metallic,
+                m.roughness,
+                match m.alpha {
+                    AlphaMode::Mask(cutoff) => cutoff,
+                    _ => -1.0,
+                },
+                m.occlusion_texture.map_or(0.0, |(_, s)| s),
+            ],
+            uv_sets: [set(slots[0]), set(slots[1]), set(slots[2]), set(slots[3])],
+            flags: [
+                set(slots[4]),
+                f32::from(u8::from(m.normal_texture.is_some())),
+                f32::from(u8::from(m.alpha == AlphaMode::Blend)),
+                0.0,
+            ],
+            transforms,
+        }
+    }
+}
+
 /// Lighting shared by both eyes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Lighting {
@@ -180,27 +247,66 @@ struct Targets {
     compose_bind: [wgpu::BindGroup; 2],
 }
 
-/// Draws one mesh as a phantogram.
+struct GpuPrimitive {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+    material: usize,
+    centre: Vec3,
+}
+
+struct GpuMaterial {
+    bind: wgpu::BindGroup,
+    double_sided: bool,
+    blend: bool,
+    // Kept alive for the bind group.
+    _uniform: wgpu::Buffer,
+}
+
+/// A model on the GPU.
+struct GpuModel {
+    primitives: Vec<GpuPrimitive>,
+    materials: Vec<GpuMaterial>,
+}
+
+/// Scene pipelines by (double-sided, blended).
+struct ScenePipelines {
+    variants: [[wgpu::RenderPipeline; 2]; 2],
+}
+
+impl ScenePipelines {
+    fn get(&self, double_sided: bool, blend: bool) -> &wgpu::RenderPipeline {
+        &self.variants[usize::from(double_sided)][usize::from(blend)]
+    }
+}
+
+/// Draws one model as a phantogram.
 pub struct Renderer {
     gpu: Gpu,
-    scene_pipeline: wgpu::RenderPipeline,
+    scene: ScenePipelines,
     compose_pipeline: wgpu::RenderPipeline,
     eye_buffers: [wgpu::Buffer; 2],
     eye_bind: [wgpu::BindGroup; 2],
     compose_buffer: wgpu::Buffer,
     compose_layout: wgpu::BindGroupLayout,
-    vertex_buffer: wgpu::Buffer,
-    index_buffer: wgpu::Buffer,
-    index_count: u32,
+    material_layout: wgpu::BindGroupLayout,
+    model: GpuModel,
     targets: Option<Targets>,
     pub lighting: Lighting,
 }
 
 impl Renderer {
-    pub fn new(gpu: Gpu, mesh: &Mesh) -> Result<Self, RenderError> {
-        if mesh.indices.is_empty() || mesh.vertices.is_empty() {
-            return Err(RenderError::EmptyMesh);
+    pub fn new(gpu: Gpu, model: &Model) -> Result<Self, RenderError> {
+        if model.triangle_count() == 0 {
+            return Err(RenderError::EmptyModel);
         }
+        let device = gpu.device.clone();
+        checked(&device, "the renderer's pipelines or the model", || {
+            Self::build(gpu, model)
+        })
+    }
+
+    fn build(gpu: Gpu, model: &Model) -> Self {
         let device = &gpu.device;
         let scene_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("scene.wgsl"),
@@ -213,16 +319,7 @@ impl Renderer {
 
         let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("eye"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::VERTEX_FRAGMENT,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            }],
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
         });
         let eye_buffers = [0, 1].map(|i| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -242,49 +339,87 @@ impl Renderer {
                 }],
             })
         });
+        let mut material_entries = vec![uniform_entry(0, wgpu::ShaderStages::FRAGMENT)];
+        for slot in 0..5u32 {
+            material_entries.push(wgpu::BindGroupLayoutEntry {
+                binding: 1 + 2 * slot,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Texture {
+                    sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                    view_dimension: wgpu::TextureViewDimension::D2,
+                    multisampled: false,
+                },
+                count: None,
+            });
+            material_entries.push(wgpu::BindGroupLayoutEntry {
+                binding: 2 + 2 * slot,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            });
+        }
+        let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("material"),
+            entries: &material_entries,
+        });
         let scene_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("scene"),
-            bind_group_layouts: &[Some(&eye_layout)],
+            bind_group_layouts: &[Some(&eye_layout), Some(&material_layout)],
             immediate_size: 0,
         });
-        let vertex_attributes =
-            wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x2];
-        let scene_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("scene"),
-            layout: Some(&scene_layout),
-            vertex: wgpu::VertexState {
-                module: &scene_module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Vertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &vertex_attributes,
-                })],
-            },
-            primitive: wgpu::PrimitiveState {
-                topology: wgpu::PrimitiveTopology::TriangleList,
-                front_face: wgpu::FrontFace::Ccw,
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::Greater),
-                stencil: Default::default(),
-                bias: Default::default(),
-            }),
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &scene_module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(HDR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let vertex_attributes = wgpu::vertex_attr_array![
+            0 => Float32x3, 1 => Float32x3, 2 => Float32x4, 3 => Float32x4, 4 => Float32x4, 5 => Float32x2
+        ];
+        let scene_pipeline = |double_sided: bool, blend: bool| {
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("scene"),
+                layout: Some(&scene_layout),
+                vertex: wgpu::VertexState {
+                    module: &scene_module,
+                    entry_point: Some("vs_main"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(wgpu::VertexBufferLayout {
+                        array_stride: std::mem::size_of::<Vertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &vertex_attributes,
+                    })],
+                },
+                primitive: wgpu::PrimitiveState {
+                    topology: wgpu::PrimitiveTopology::TriangleList,
+                    front_face: wgpu::FrontFace::Ccw,
+                    cull_mode: (!double_sided).then_some(wgpu::Face::Back),
+                    ..Default::default()
+                },
+                depth_stencil: Some(wgpu::DepthStencilState {
+                    format: DEPTH_FORMAT,
+                    // Blended surfaces are drawn back to front over the opaque ones and must not
+                    // hide each other.
+                    depth_write_enabled: Some(!blend),
+                    depth_compare: Some(wgpu::CompareFunction::Greater),
+                    stencil: Default::default(),
+                    bias: Default::default(),
+                }),
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module: &scene_module,
+                    entry_point: Some("fs_main"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: HDR_FORMAT,
+                        blend: blend.then_some(wgpu::BlendState::ALPHA_BLENDING),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        };
+        let scene = ScenePipelines {
+            variants: [
+                [scene_pipeline(false, false), scene_pipeline(false, true)],
+                [scene_pipeline(true, false), scene_pipeline(true, true)],
+            ],
+        };
 
         let compose_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("compose"),
@@ -335,36 +470,34 @@ impl Renderer {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let (vertex_buffer, index_buffer) = upload(device, mesh);
-        Ok(Self {
-            scene_pipeline,
+        let gpu_model = upload_model(&gpu, &material_layout, model);
+        Self {
+            scene,
             compose_pipeline,
             eye_buffers,
             eye_bind,
             compose_buffer,
             compose_layout,
-            vertex_buffer,
-            index_buffer,
-            index_count: mesh.indices.len() as u32,
+            material_layout,
+            model: gpu_model,
             targets: None,
             lighting: Lighting::default(),
             gpu,
-        })
+        }
     }
 
     pub fn gpu(&self) -> &Gpu {
         &self.gpu
     }
 
-    /// Replaces the mesh drawn (keeps pipelines and targets).
-    pub fn set_mesh(&mut self, mesh: &Mesh) -> Result<(), RenderError> {
-        if mesh.indices.is_empty() || mesh.vertices.is_empty() {
-            return Err(RenderError::EmptyMesh);
+    /// Replaces the model drawn (keeps pipelines and targets).
+    pub fn set_model(&mut self, model: &Model) -> Result<(), RenderError> {
+        if model.triangle_count() == 0 {
+            return Err(RenderError::EmptyModel);
         }
-        let (vertex_buffer, index_buffer) = upload(&self.gpu.device, mesh);
-        self.vertex_buffer = vertex_buffer;
-        self.index_buffer = index_buffer;
-        self.index_count = mesh.indices.len() as u32;
+        self.model = checked(&self.gpu.device, "the model", || {
+            upload_model(&self.gpu, &self.material_layout, model)
+        })?;
         Ok(())
     }
 
@@ -546,11 +679,25 @@ impl Renderer {
                 }),
                 ..Default::default()
             });
-            pass.set_pipeline(&self.scene_pipeline);
             pass.set_bind_group(0, &self.eye_bind[i], &[]);
-            pass.set_vertex_buffer(0, self.vertex_buffer.slice(..));
-            pass.set_index_buffer(self.index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..self.index_count, 0, 0..1);
+            // Opaque and masked first; then blended, farthest first, as this eye sees them.
+            let eye_at = Vec3::from_slice(&uniforms[i].eye_pos[..3]);
+            let mut blended: Vec<&GpuPrimitive> = Vec::new();
+            for p in &self.model.primitives {
+                if self.model.materials[p.material].blend {
+                    blended.push(p);
+                } else {
+                    self.draw_primitive(&mut pass, p);
+                }
+            }
+            blended.sort_by(|a, b| {
+                b.centre
+                    .distance_squared(eye_at)
+                    .total_cmp(&a.centre.distance_squared(eye_at))
+            });
+            for p in blended {
+                self.draw_primitive(&mut pass, p);
+            }
         }
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -587,23 +734,260 @@ impl Renderer {
                 depth_or_array_layers: 1,
             },
         );
-        queue.submit([encoder.finish()]);
+        checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()]))?;
         read_back(&self.gpu.device, targets)
     }
 }
 
-fn upload(device: &wgpu::Device, mesh: &Mesh) -> (wgpu::Buffer, wgpu::Buffer) {
-    let vertices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("vertices"),
-        contents: bytemuck::cast_slice(&mesh.vertices),
-        usage: wgpu::BufferUsages::VERTEX,
+impl Renderer {
+    fn draw_primitive(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive) {
+        let m = &self.model.materials[p.material];
+        pass.set_pipeline(self.scene.get(m.double_sided, m.blend));
+        pass.set_bind_group(1, &m.bind, &[]);
+        pass.set_vertex_buffer(0, p.vertices.slice(..));
+        pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..p.index_count, 0, 0..1);
+    }
+}
+
+/// Runs `f` inside a validation error scope, turning what wgpu would otherwise report to its
+/// uncaptured-error handler (which panics by default) into a [`RenderError`].
+fn checked<T>(device: &wgpu::Device, what: &'static str, f: impl FnOnce() -> T) -> Result<T, RenderError> {
+    let scope = device.push_error_scope(wgpu::ErrorFilter::Validation);
+    let out = f();
+    match pollster::block_on(scope.pop()) {
+        Some(e) => Err(RenderError::Gpu {
+            what,
+            message: e.to_string(),
+        }),
+        None => Ok(out),
+    }
+}
+
+fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    }
+}
+
+fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn linear_to_srgb(c: f32) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// The full mip chain of an RGBA8 image (2×2 box filter; odd sizes clamp at the edge). Colour
+/// data is averaged in linear light, alpha and data textures as stored.
+pub fn mip_chain(width: u32, height: u32, rgba8: &[u8], srgb: bool) -> Vec<(u32, u32, Vec<u8>)> {
+    let mut levels = vec![(width, height, rgba8.to_vec())];
+    while let Some((w, h, data)) = levels.last().filter(|(w, h, _)| *w > 1 || *h > 1) {
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let mut next = vec![0u8; (nw * nh * 4) as usize];
+        for y in 0..nh {
+            for x in 0..nw {
+                for c in 0..4 {
+                    let mut sum = 0.0f32;
+                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        let sx = (2 * x + dx).min(w - 1);
+                        let sy = (2 * y + dy).min(h - 1);
+                        let v = data[((sy * w + sx) * 4 + c) as usize];
+                        sum += if srgb && c < 3 {
+                            srgb_to_linear(v)
+                        } else {
+                            v as f32 / 255.0
+                        };
+                    }
+                    let avg = sum * 0.25;
+                    next[((y * nw + x) * 4 + c) as usize] = if srgb && c < 3 {
+                        linear_to_srgb(avg)
+                    } else {
+                        (avg * 255.0 + 0.5) as u8
+                    };
+                }
+            }
+        }
+        levels.push((nw, nh, next));
+    }
+    levels
+}
+
+fn upload_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8], srgb: bool) -> wgpu::TextureView {
+    let levels = mip_chain(width, height, rgba8, srgb);
+    let format = if srgb {
+        wgpu::TextureFormat::Rgba8UnormSrgb
+    } else {
+        wgpu::TextureFormat::Rgba8Unorm
+    };
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
     });
-    let indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("indices"),
-        contents: bytemuck::cast_slice(&mesh.indices),
-        usage: wgpu::BufferUsages::INDEX,
-    });
-    (vertices, indices)
+    for (level, (w, h, data)) in levels.iter().enumerate() {
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: level as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            data,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 4),
+                rows_per_image: Some(*h),
+            },
+            wgpu::Extent3d {
+                width: *w,
+                height: *h,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    texture.create_view(&Default::default())
+}
+
+fn create_sampler(device: &wgpu::Device, s: &Sampler) -> wgpu::Sampler {
+    let address = |w: Wrap| match w {
+        Wrap::Repeat => wgpu::AddressMode::Repeat,
+        Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+        Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
+    };
+    let filter = |linear: bool| {
+        if linear {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        }
+    };
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("material"),
+        address_mode_u: address(s.wrap_u),
+        address_mode_v: address(s.wrap_v),
+        mag_filter: filter(s.mag_linear),
+        min_filter: filter(s.min_linear),
+        mipmap_filter: if s.mip_linear {
+            wgpu::MipmapFilterMode::Linear
+        } else {
+            wgpu::MipmapFilterMode::Nearest
+        },
+        ..Default::default()
+    })
+}
+
+fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> GpuModel {
+    let device = &gpu.device;
+    // Each image once per colour space it is used in.
+    let mut views: std::collections::HashMap<(usize, bool), wgpu::TextureView> = Default::default();
+    for m in &model.materials {
+        for (t, srgb) in m.textures() {
+            if let (Some(img), std::collections::hash_map::Entry::Vacant(e)) =
+                (model.images.get(t.image), views.entry((t.image, srgb)))
+            {
+                e.insert(upload_texture(gpu, &img.name, img.width, img.height, &img.rgba8, srgb));
+            }
+        }
+    }
+    let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
+    let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
+    let default_sampler = create_sampler(device, &Sampler::default());
+    let materials = model
+        .materials
+        .iter()
+        .map(|m| {
+            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("material"),
+                contents: bytemuck::bytes_of(&MaterialUniform::new(m)),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let slots = [
+                (m.base_color_texture, true, &white),
+                (m.metallic_roughness_texture, false, &white),
+                (m.normal_texture.map(|(t, _)| t), false, &flat_normal),
+                (m.occlusion_texture.map(|(t, _)| t), false, &white),
+                (m.emissive_texture, true, &white),
+            ];
+            let samplers: Vec<wgpu::Sampler> = slots
+                .iter()
+                .map(|(t, _, _)| t.map_or_else(|| default_sampler.clone(), |t| create_sampler(device, &t.sampler)))
+                .collect();
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            }];
+            for (i, (t, srgb, fallback)) in slots.iter().enumerate() {
+                let view = t.and_then(|t| views.get(&(t.image, *srgb))).unwrap_or(fallback);
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 1 + 2 * i as u32,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 2 + 2 * i as u32,
+                    resource: wgpu::BindingResource::Sampler(&samplers[i]),
+                });
+            }
+            GpuMaterial {
+                bind: device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&m.name),
+                    layout,
+                    entries: &entries,
+                }),
+                double_sided: m.double_sided,
+                blend: m.alpha == AlphaMode::Blend,
+                _uniform: uniform,
+            }
+        })
+        .collect();
+    let primitives = model
+        .primitives
+        .iter()
+        .filter(|p| !p.mesh.indices.is_empty())
+        .map(|p| GpuPrimitive {
+            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("vertices"),
+                contents: bytemuck::cast_slice(&p.mesh.vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("indices"),
+                contents: bytemuck::cast_slice(&p.mesh.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            }),
+            index_count: p.mesh.indices.len() as u32,
+            material: p.material.min(model.materials.len().saturating_sub(1)),
+            centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
+        })
+        .collect();
+    GpuModel { primitives, materials }
 }
 
 fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
@@ -679,7 +1063,9 @@ mod tests {
 
     #[test]
     fn a_broken_shader_fails_validation() {
-        let bad = SCENE_WGSL.replace("vec4<f32>(direct + ambient, 1.0)", "vec3<f32>(direct + ambient)");
+        let good = "return vec4<f32>(direct + ambient + emissive, out_alpha);";
+        assert!(SCENE_WGSL.contains(good), "the sabotage below must apply");
+        let bad = SCENE_WGSL.replace(good, "return vec3<f32>(direct);");
         let parsed = naga::front::wgsl::parse_str(&bad);
         let failed = match parsed {
             Err(_) => true,
@@ -695,6 +1081,23 @@ mod tests {
         // WGSL sizes: Eye = mat4 (64) + 4 × vec4 (64); Compose = 7 × vec4.
         assert_eq!(std::mem::size_of::<EyeUniform>(), 128);
         assert_eq!(std::mem::size_of::<ComposeUniform>(), 112);
-        assert_eq!(std::mem::size_of::<Vertex>(), 48);
+        // Material = 5 × vec4 + array<vec4, 10>.
+        assert_eq!(std::mem::size_of::<MaterialUniform>(), 240);
+        // Vertex = 3 + 3 + 4 + 4 + 4 + 2 floats.
+        assert_eq!(std::mem::size_of::<Vertex>(), 80);
+    }
+
+    #[test]
+    fn mips_average_colour_in_linear_light() {
+        // A 2×1 image, black and white: the 1×1 mip is 50 % linear grey (188 in sRGB), not 128.
+        let levels = mip_chain(2, 1, &[0, 0, 0, 255, 255, 255, 255, 255], true);
+        assert_eq!(levels.len(), 2);
+        let (w, h, px) = &levels[1];
+        assert_eq!((*w, *h), (1, 1));
+        assert_eq!(px[0], 188);
+        assert_eq!(px[3], 255);
+        let data = mip_chain(2, 1, &[0, 0, 0, 0, 255, 255, 255, 255], false);
+        assert_eq!(data[1].2[0], 128);
+        assert_eq!(mip_chain(5, 3, &[7u8; 60], false).len(), 3);
     }
 }

@@ -11,8 +11,9 @@
 use std::path::PathBuf;
 
 use phantogram::anaglyph::Method;
-use phantogram::artifact::{Mesh, default_artifact};
+use phantogram::artifact::default_model;
 use phantogram::glam::Vec3;
+use phantogram::model::{Mesh, Model};
 use phantogram::projection::{DepthRange, OffAxisProjection};
 use phantogram::render::{FrameInput, Gpu, Renderer};
 use phantogram::screen::Screen;
@@ -63,10 +64,10 @@ fn marker_centroid(pixels: &[u8], threshold: f32) -> Option<(f32, f32)> {
     (n > 0).then(|| ((sx / n as f64) as f32, (sy / n as f64) as f32))
 }
 
-fn marker_mesh(at: Vec3) -> Mesh {
+fn marker_model(at: Vec3) -> Model {
     let mut m = Mesh::default();
     m.push_cube(at, 0.0006, [1.0, 1.0, 1.0, 1.0]);
-    m
+    Model::from_painted_mesh("marker", m)
 }
 
 #[test]
@@ -80,9 +81,9 @@ fn markers_land_on_the_predicted_pixel_in_each_eye() {
         Vec3::new(-0.015, 0.03, -0.03), // behind it
         Vec3::new(0.008, 0.01, 0.0),    // on it
     ];
-    let mut renderer = Renderer::new(gpu, &marker_mesh(points[0])).unwrap();
+    let mut renderer = Renderer::new(gpu, &marker_model(points[0])).unwrap();
     for p in points {
-        renderer.set_mesh(&marker_mesh(p)).unwrap();
+        renderer.set_model(&marker_model(p)).unwrap();
         let input = FrameInput {
             toward_light: Vec3::new(0.2, -0.3, 1.0),
             ..FrameInput::from_view(&view, Some(up), Vec3::ZERO)
@@ -164,7 +165,7 @@ fn check_golden(name: &str, pixels: &[u8], tolerance: u8, max_fraction: f64) {
 fn default_artifact_matches_its_golden_images() {
     let Some(gpu) = gpu() else { return };
     let (view, up) = oblique_view();
-    let mut renderer = Renderer::new(gpu, &default_artifact()).unwrap();
+    let mut renderer = Renderer::new(gpu, &default_model()).unwrap();
     let input = FrameInput::from_view(&view, Some(up), Vec3::ZERO);
     for (name, method) in [
         ("amphora-mono", Method::Mono),
@@ -178,6 +179,47 @@ fn default_artifact_matches_its_golden_images() {
 }
 
 #[test]
+fn shared_models_match_their_golden_images() {
+    let Some(data) = phantogram_integration::data_dir() else {
+        eprintln!("PHANTOGRAM_DATA is not set: skipping golden images of the shared models");
+        return;
+    };
+    let Some(gpu) = gpu() else { return };
+    let (view, up) = oblique_view();
+    let input = FrameInput::from_view(&view, Some(up), Vec3::ZERO);
+    let screen = Screen::default();
+    let cases = [
+        ("duck-mono", "khronos/Duck/glTF-Binary/Duck.glb", Method::Mono),
+        (
+            "sea-turtle-draco-dubois",
+            "heritage/smithsonian_nmnh_sea_turtle/sea_turtle-150k-1024-low.glb",
+            Method::DuboisRedCyan,
+        ),
+        (
+            "damaged-helmet-mono",
+            "khronos/DamagedHelmet/glTF-Binary/DamagedHelmet.glb",
+            Method::Mono,
+        ),
+    ];
+    let mut renderer: Option<Renderer> = None;
+    let mut gpu = Some(gpu);
+    for (name, file, method) in cases {
+        let mut model = phantogram::model::load_model(&data.join("models").join(file)).unwrap();
+        model.fit_to_diorama(&screen, &Default::default());
+        let r = match (&mut renderer, gpu.take()) {
+            (Some(r), _) => {
+                r.set_model(&model).unwrap();
+                r
+            }
+            (None, Some(g)) => renderer.insert(Renderer::new(g, &model).unwrap()),
+            (None, None) => unreachable!("a renderer or a GPU is always at hand"),
+        };
+        let pixels = r.render(&input, method, W, H).unwrap();
+        check_golden(name, &pixels, 3, 0.002);
+    }
+}
+
+#[test]
 fn gpu_composition_matches_the_cpu_reference() {
     // Two flat-coloured walls, one per eye: a large quad behind the glass lit head-on, seen by
     // both eyes; the composed pixel at the centre must equal Method::compose of the two eyes'
@@ -185,6 +227,7 @@ fn gpu_composition_matches_the_cpu_reference() {
     let Some(gpu) = gpu() else { return };
     let mut mesh = Mesh::default();
     mesh.push_cube(Vec3::new(0.0, 0.0, -0.5), 0.3, [0.6, 0.3, 0.1, 1.0]);
+    let mesh = Model::from_painted_mesh("wall", mesh);
     let screen = Screen::default();
     let left = OffAxisProjection::new(&screen, Vec3::new(-0.03, 0.0, 0.3), DepthRange::default()).unwrap();
     let right = OffAxisProjection::new(&screen, Vec3::new(0.03, 0.0, 0.3), DepthRange::default()).unwrap();

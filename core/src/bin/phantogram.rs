@@ -62,7 +62,7 @@ enum Command {
     },
     /// Render a sensor log as phantogram frames (PNG), headless.
     Render {
-        /// A glTF model (not supported yet: the default artifact is rendered).
+        /// A glTF 2.0 model (.gltf or .glb); the default artifact when omitted.
         model: Option<PathBuf>,
         /// The sensor log to replay (any format `replay` accepts).
         #[arg(long)]
@@ -82,6 +82,13 @@ enum Command {
         /// Make the pose at this many seconds into the log count as "straight on".
         #[arg(long, value_name = "SECONDS")]
         flat_at_s: Option<f64>,
+        /// Fraction of a loaded model's height that stands in front of the glass.
+        #[arg(long, default_value_t = 0.4)]
+        protrude: f32,
+        /// How a loaded model is placed: standing out of the glass, facing the viewer from within
+        /// it (reliefs, tablets), or auto (facing when thin front to back).
+        #[arg(long, value_enum, default_value = "auto")]
+        placement: PlacementArg,
     },
     /// Convert a recording into the phantogram log format (gzip when OUT ends in .gz).
     Import {
@@ -96,6 +103,13 @@ enum Command {
         #[command(subcommand)]
         what: EvalWhat,
     },
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum PlacementArg {
+    Auto,
+    Standing,
+    Facing,
 }
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -159,7 +173,23 @@ fn run(cli: Cli) -> Result<()> {
             anaglyph,
             every,
             flat_at_s,
-        } => render_command(model.as_deref(), &log, &out, &size, anaglyph, every, flat_at_s),
+            protrude,
+            placement,
+        } => render_command(RenderArgs {
+            model: model.as_deref(),
+            log: &log,
+            out_dir: &out,
+            size: &size,
+            method: anaglyph,
+            every_ms: every,
+            flat_at_s,
+            protrude,
+            placement: match placement {
+                PlacementArg::Auto => phantogram::model::Placement::Auto,
+                PlacementArg::Standing => phantogram::model::Placement::Standing,
+                PlacementArg::Facing => phantogram::model::Placement::Facing,
+            },
+        }),
         Command::Eval {
             what: EvalWhat::Orientation { paths },
         } => eval_orientation_command(&paths),
@@ -469,24 +499,36 @@ fn parse_size(text: &str) -> Result<(u32, u32)> {
     }
 }
 
-fn render_command(
-    model: Option<&std::path::Path>,
-    log: &std::path::Path,
-    out_dir: &std::path::Path,
-    size: &str,
+struct RenderArgs<'a> {
+    model: Option<&'a std::path::Path>,
+    log: &'a std::path::Path,
+    out_dir: &'a std::path::Path,
+    size: &'a str,
     method: phantogram::anaglyph::Method,
     every_ms: f64,
     flat_at_s: Option<f64>,
-) -> Result<()> {
+    protrude: f32,
+    placement: phantogram::model::Placement,
+}
+
+fn render_command(args: RenderArgs) -> Result<()> {
     use phantogram::containment::{ContainmentSmoother, required_push_back_m};
+    use phantogram::model::DioramaFit;
     use phantogram::render::{FrameInput, Gpu, Renderer};
 
-    if let Some(m) = model {
-        // TODO(issue #3): glTF 2.0 loading (with Draco and the listed extensions) is not built yet.
-        bail!(
-            "{}: loading glTF models is not implemented yet; omit MODEL to render the default artifact",
-            m.display()
-        );
+    let RenderArgs {
+        model: model_path,
+        log,
+        out_dir,
+        size,
+        method,
+        every_ms,
+        flat_at_s,
+        protrude,
+        placement,
+    } = args;
+    if !(0.0..=1.0).contains(&protrude) {
+        bail!("--protrude must be a fraction between 0 and 1, got {protrude}");
     }
     if !(every_ms.is_finite() && every_ms > 0.0) {
         bail!("--every must be a positive number of milliseconds, got {every_ms}");
@@ -510,12 +552,34 @@ fn render_command(
     let interval_ns = (every_ms * 1e6).round().max(1.0) as i64;
     let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
 
+    let model = match model_path {
+        Some(path) => {
+            let mut model = phantogram::model::load_model(path)?;
+            for w in &model.warnings {
+                eprintln!("warning: {}: {w}", path.display());
+            }
+            let fit = DioramaFit {
+                placement,
+                protrude_fraction: protrude,
+                ..DioramaFit::default()
+            };
+            model.fit_to_diorama(&screen, &fit);
+            eprintln!(
+                "{}: {} triangles, {} materials, {} images",
+                path.display(),
+                model.triangle_count(),
+                model.materials.len(),
+                model.images.len()
+            );
+            model
+        }
+        None => phantogram::artifact::default_model(),
+    };
+    let bounds = model.bounds().context("the model is empty")?;
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
-    let mesh = phantogram::artifact::default_artifact();
-    let bounds = mesh.bounds().context("the default artifact is empty")?;
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
-    let mut renderer = Renderer::new(gpu, &mesh)?;
+    let mut renderer = Renderer::new(gpu, &model)?;
     let mut session = Session::new(config).context("invalid settings")?;
     let mut smoother = ContainmentSmoother::default();
 

@@ -1,0 +1,1129 @@
+//! Models: triangle meshes with metallic–roughness materials and textures, in the device frame,
+//! and the glTF 2.0 loader that produces them (feature `models`).
+//!
+//! ## Loading glTF
+//! * `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary container).
+//! * Geometry through our own accessor reader, which handles every component type, normalised or
+//!   not, byte strides and sparse accessors, so `KHR_mesh_quantization` needs no special case.
+//!   `KHR_draco_mesh_compression` primitives are decoded with `draco-core` (pure Rust: no C++
+//!   toolchain on the phone builds).
+//! * Node transforms are baked into the vertices (negative determinants flip the winding).
+//! * Materials: base colour, metallic–roughness, normal (with scale), occlusion (with strength)
+//!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform`, alpha
+//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded (PNG, JPEG) to RGBA8. (Texture
+//!   transforms on normal and occlusion textures are not read yet: gltf-rs does not expose them.)
+//! * Tangents come from the file or, where a normal map needs them, from MikkTSpace
+//!   (`bevy_mikktspace`, the reference algorithm that normal maps are baked against).
+//! * Smithsonian Voyager scans: when a `scene.svx.json` beside the file lists it as a derivative,
+//!   [`load_model`] applies the model's rotation from that scene (the scans are stored in the
+//!   scanner's frame), see [`voyager_rotation`].
+//! * A file that *requires* an extension we do not implement fails with
+//!   [`ModelError::UnsupportedExtension`] naming it; [`SUPPORTED_EXTENSIONS`] lists those we do.
+//!
+//! ## Frames
+//! glTF is +Y up, +Z front, metres. [`Model::fit_to_diorama`] turns a standing object's +Y into
+//! the device's +Z (out of the glass towards the viewer) and its +Z into −Y (facing the bottom
+//! edge, where the viewer holds the phone); a flat one (relief, tablet) keeps its axes, lying in
+//! the glass with its front towards the viewer ([`Placement`]). It then scales the model to the
+//! diorama and places it straddling the glass.
+
+use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
+
+use crate::containment::Aabb;
+use crate::screen::Screen;
+
+/// One vertex: position and normal (device frame, metres), tangent (xyz, w = handedness),
+/// texture coordinates (`[u0, v0, u1, v1]`), linear vertex colour with alpha, and per-vertex
+/// `[metallic, roughness]` multipliers (1 for loaded models; the procedural artifact paints them).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[cfg_attr(feature = "render", derive(bytemuck::Pod, bytemuck::Zeroable))]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub tangent: [f32; 4],
+    pub uv: [f32; 4],
+    pub color: [f32; 4],
+    pub material: [f32; 2],
+}
+
+/// A triangle mesh, counter-clockwise front faces.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    /// Axis-aligned bounds of the vertices; `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let first = Vec3::from(self.vertices.first()?.position);
+        let (min, max) = self.vertices.iter().fold((first, first), |(lo, hi), v| {
+            let p = Vec3::from(v.position);
+            (lo.min(p), hi.max(p))
+        });
+        Some(Aabb::new(min, max))
+    }
+
+    /// Applies an affine transform to positions, normals and tangents.
+    pub fn transform(&mut self, m: Mat4) {
+        let linear = Mat3::from_mat4(m);
+        let normal_m = linear.inverse().transpose();
+        for v in &mut self.vertices {
+            v.position = m.transform_point3(Vec3::from(v.position)).to_array();
+            v.normal = (normal_m * Vec3::from(v.normal)).normalize_or_zero().to_array();
+            let t = Vec4::from(v.tangent);
+            let tt = (linear * t.truncate()).normalize_or_zero();
+            v.tangent = tt.extend(t.w).to_array();
+        }
+        if linear.determinant() < 0.0 {
+            for tri in self.indices.chunks_mut(3) {
+                tri.swap(1, 2);
+            }
+        }
+    }
+
+    pub fn translate(&mut self, by: Vec3) {
+        self.transform(Mat4::from_translation(by));
+    }
+
+    /// Appends a small axis-aligned cube (markers, tests).
+    pub fn push_cube(&mut self, centre: Vec3, half: f32, color: [f32; 4]) {
+        let faces = [
+            (Vec3::X, Vec3::Y, Vec3::Z),
+            (-Vec3::X, Vec3::Z, Vec3::Y),
+            (Vec3::Y, Vec3::Z, Vec3::X),
+            (-Vec3::Y, Vec3::X, Vec3::Z),
+            (Vec3::Z, Vec3::X, Vec3::Y),
+            (-Vec3::Z, Vec3::Y, Vec3::X),
+        ];
+        for (n, u, v) in faces {
+            let base = self.vertices.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let p = centre + (n + u * a + v * b) * half;
+                self.vertices.push(Vertex {
+                    position: p.to_array(),
+                    normal: n.to_array(),
+                    tangent: u.extend(1.0).to_array(),
+                    uv: [(a + 1.0) * 0.5, (1.0 - b) * 0.5, 0.0, 0.0],
+                    color,
+                    material: [0.0, 0.8],
+                });
+            }
+            // u × v = n for every face above, so this winding is counter-clockwise seen from n.
+            self.indices
+                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    Opaque,
+    /// Fragments with alpha below the cutoff are discarded.
+    Mask(f32),
+    Blend,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Repeat,
+    ClampToEdge,
+    MirroredRepeat,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampler {
+    pub mag_linear: bool,
+    pub min_linear: bool,
+    pub mip_linear: bool,
+    pub wrap_u: Wrap,
+    pub wrap_v: Wrap,
+}
+
+impl Default for Sampler {
+    /// glTF leaves filtering to the implementation: trilinear, repeat.
+    fn default() -> Self {
+        Self {
+            mag_linear: true,
+            min_linear: true,
+            mip_linear: true,
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::Repeat,
+        }
+    }
+}
+
+/// `KHR_texture_transform`: `uv' = T · R · S · uv`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    pub offset: [f32; 2],
+    pub rotation_rad: f32,
+    pub scale: [f32; 2],
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self {
+            offset: [0.0, 0.0],
+            rotation_rad: 0.0,
+            scale: [1.0, 1.0],
+        }
+    }
+}
+
+impl UvTransform {
+    /// The two rows of the 2×3 matrix, as the extension defines it (rotation counter-clockwise
+    /// in UV space, which has v pointing down).
+    pub fn rows(&self) -> [[f32; 3]; 2] {
+        let (s, c) = self.rotation_rad.sin_cos();
+        let [sx, sy] = self.scale;
+        let [ox, oy] = self.offset;
+        [[c * sx, s * sy, ox], [-s * sx, c * sy, oy]]
+    }
+
+    pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
+        let r = self.rows();
+        [
+            r[0][0] * uv[0] + r[0][1] * uv[1] + r[0][2],
+            r[1][0] * uv[0] + r[1][1] * uv[1] + r[1][2],
+        ]
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// Index into [`Model::images`].
+    pub image: usize,
+    /// Which UV set: 0 or 1.
+    pub tex_coord: u32,
+    pub transform: UvTransform,
+    pub sampler: Sampler,
+}
+
+/// glTF metallic–roughness material. Colours are linear.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub base_color: [f32; 4],
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Emissive colour times `KHR_materials_emissive_strength`.
+    pub emissive: [f32; 3],
+    pub alpha: AlphaMode,
+    pub double_sided: bool,
+    pub base_color_texture: Option<TextureRef>,
+    /// Roughness in G, metallic in B.
+    pub metallic_roughness_texture: Option<TextureRef>,
+    pub normal_texture: Option<(TextureRef, f32)>,
+    pub occlusion_texture: Option<(TextureRef, f32)>,
+    pub emissive_texture: Option<TextureRef>,
+}
+
+impl Default for Material {
+    /// glTF's default material: white, fully metallic, fully rough.
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color: [1.0; 4],
+            metallic: 1.0,
+            roughness: 1.0,
+            emissive: [0.0; 3],
+            alpha: AlphaMode::Opaque,
+            double_sided: false,
+            base_color_texture: None,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            occlusion_texture: None,
+            emissive_texture: None,
+        }
+    }
+}
+
+impl Material {
+    /// For meshes that paint colour and metallic/roughness per vertex (the procedural artifact).
+    pub fn vertex_painted() -> Self {
+        Self {
+            name: "vertex painted".into(),
+            double_sided: true,
+            ..Self::default()
+        }
+    }
+
+    /// Every texture the material uses, with whether it holds colour (sRGB-encoded) data.
+    pub fn textures(&self) -> impl Iterator<Item = (TextureRef, bool)> + '_ {
+        [
+            self.base_color_texture.map(|t| (t, true)),
+            self.metallic_roughness_texture.map(|t| (t, false)),
+            self.normal_texture.map(|(t, _)| (t, false)),
+            self.occlusion_texture.map(|(t, _)| (t, false)),
+            self.emissive_texture.map(|t| (t, true)),
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// An RGBA8 image as stored in the file (colour textures sRGB-encoded, data textures linear).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Primitive {
+    pub mesh: Mesh,
+    /// Index into [`Model::materials`].
+    pub material: usize,
+}
+
+/// A whole model: primitives, materials and images, all positions in one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Model {
+    pub name: String,
+    pub primitives: Vec<Primitive>,
+    pub materials: Vec<Material>,
+    pub images: Vec<Image>,
+    /// Things in the file that were skipped (non-triangle primitives, …), for the user to see.
+    pub warnings: Vec<String>,
+}
+
+/// Which way a glTF model (+Y up, +Z front) is turned into the diorama.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Placement {
+    /// Standing, unless the model is thin front to back (a relief, a tablet, a panel): then facing.
+    #[default]
+    Auto,
+    /// +Y along the glass normal: the object stands out of the glass towards the viewer (vases,
+    /// statues).
+    Standing,
+    /// +Z along the glass normal, +Y up the screen: the object lies in the glass, its front
+    /// towards the viewer (reliefs, paintings, coins).
+    Facing,
+}
+
+impl Placement {
+    /// The rotation from glTF axes to the device frame, given the model's extent in glTF axes.
+    pub fn rotation(self, extent: Vec3) -> Quat {
+        let facing = match self {
+            Placement::Standing => false,
+            Placement::Facing => true,
+            // Thin front to back: under a third of both its width and height.
+            Placement::Auto => extent.z < extent.x.min(extent.y) / 3.0,
+        };
+        if facing {
+            Quat::IDENTITY
+        } else {
+            Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)
+        }
+    }
+}
+
+/// How a model is placed in the diorama.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DioramaFit {
+    pub placement: Placement,
+    /// Largest height (along the glass normal), m.
+    pub max_height_m: f32,
+    /// Largest extent across the glass, as a fraction of the screen's shorter side.
+    pub max_width_fraction: f32,
+    /// Fraction of the model's height that stands in front of the glass.
+    pub protrude_fraction: f32,
+}
+
+impl Default for DioramaFit {
+    /// 62 mm tall at most (the default artifact's height), 70 % of the screen's width across,
+    /// 40 % in front of the glass.
+    fn default() -> Self {
+        Self {
+            placement: Placement::Auto,
+            max_height_m: 0.062,
+            max_width_fraction: 0.7,
+            protrude_fraction: 0.4,
+        }
+    }
+}
+
+impl Model {
+    /// A one-material model from a mesh painted per vertex.
+    pub fn from_painted_mesh(name: &str, mesh: Mesh) -> Self {
+        Self {
+            name: name.into(),
+            primitives: vec![Primitive { mesh, material: 0 }],
+            materials: vec![Material::vertex_painted()],
+            images: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    pub fn bounds(&self) -> Option<Aabb> {
+        self.primitives
+            .iter()
+            .filter_map(|p| p.mesh.bounds())
+            .reduce(|a, b| Aabb::new(a.min.min(b.min), a.max.max(b.max)))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.primitives.iter().map(|p| p.mesh.indices.len() / 3).sum()
+    }
+
+    pub fn transform(&mut self, m: Mat4) {
+        for p in &mut self.primitives {
+            p.mesh.transform(m);
+        }
+    }
+
+    /// Turns a glTF (+Y up, +Z front) model into the device frame as `fit.placement` says, scales
+    /// it into the diorama and places it straddling the glass, centred on the screen. Returns the
+    /// scale applied.
+    pub fn fit_to_diorama(&mut self, screen: &Screen, fit: &DioramaFit) -> f32 {
+        let Some(b) = self.bounds() else { return 1.0 };
+        self.transform(Mat4::from_quat(fit.placement.rotation(b.max - b.min)));
+        let Some(b) = self.bounds() else { return 1.0 };
+        let size = b.max - b.min;
+        let across = screen.panel_width_m().min(screen.panel_height_m()) * fit.max_width_fraction;
+        let scale = [fit.max_height_m / size.z, across / size.x, across / size.y]
+            .into_iter()
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .fold(f32::INFINITY, f32::min);
+        let scale = if scale.is_finite() { scale } else { 1.0 };
+        let centre = (b.min + b.max) * 0.5;
+        let base_z = -size.z * scale * (1.0 - fit.protrude_fraction);
+        let m = Mat4::from_translation(Vec3::new(0.0, 0.0, base_z))
+            * Mat4::from_scale(Vec3::splat(scale))
+            * Mat4::from_translation(Vec3::new(-centre.x, -centre.y, -b.min.z));
+        self.transform(m);
+        scale
+    }
+}
+
+#[cfg(feature = "models")]
+pub use loader::{ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_model, voyager_rotation};
+
+#[cfg(feature = "models")]
+mod loader {
+    use std::path::{Path, PathBuf};
+
+    use base64::Engine as _;
+    use glam::{Mat4, Quat, Vec3};
+    use gltf::accessor::{DataType, Dimensions};
+    use thiserror::Error;
+
+    use super::*;
+
+    /// Extensions this loader implements; a file requiring any other fails to load.
+    pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
+        "KHR_draco_mesh_compression",
+        "KHR_mesh_quantization",
+        "KHR_texture_transform",
+        "KHR_materials_emissive_strength",
+    ];
+
+    #[derive(Debug, Error)]
+    pub enum ModelError {
+        #[error("{}: {source}", path.display())]
+        Io {
+            path: PathBuf,
+            #[source]
+            source: std::io::Error,
+        },
+        #[error("{}: not a valid glTF file: {message}", path.display())]
+        Parse { path: PathBuf, message: String },
+        #[error(
+            "{}: requires the glTF extension {name}, which is not supported (supported: KHR_draco_mesh_compression, KHR_mesh_quantization, KHR_texture_transform, KHR_materials_emissive_strength)",
+            path.display()
+        )]
+        UnsupportedExtension { path: PathBuf, name: String },
+        #[error("{}: {what}: {message}", path.display())]
+        Data {
+            path: PathBuf,
+            what: String,
+            message: String,
+        },
+        #[error("{}: no triangles to draw", path.display())]
+        Empty { path: PathBuf },
+    }
+
+    struct Ctx<'a> {
+        path: &'a Path,
+        buffers: Vec<Vec<u8>>,
+    }
+
+    impl Ctx<'_> {
+        fn data(&self, what: impl Into<String>, message: impl Into<String>) -> ModelError {
+            ModelError::Data {
+                path: self.path.to_path_buf(),
+                what: what.into(),
+                message: message.into(),
+            }
+        }
+
+        fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8], ModelError> {
+            let buf = self
+                .buffers
+                .get(view.buffer().index())
+                .ok_or_else(|| self.data(format!("bufferView {}", view.index()), "buffer missing"))?;
+            buf.get(view.offset()..view.offset() + view.length()).ok_or_else(|| {
+                self.data(
+                    format!("bufferView {}", view.index()),
+                    "extends past the end of its buffer",
+                )
+            })
+        }
+
+        /// Reads an accessor as `f32` rows of `n` components (normalised integers mapped to
+        /// [0, 1] or [−1, 1] as the spec says; other integers converted as they are).
+        fn read_f32(&self, accessor: &gltf::Accessor, n: usize) -> Result<Vec<f32>, ModelError> {
+            let what = || format!("accessor {}", accessor.index());
+            let comps = accessor.dimensions().multiplicity();
+            if comps < n.min(comps) {
+                return Err(self.data(what(), "too few components"));
+            }
+            let count = accessor.count();
+            let ty = accessor.data_type();
+            let size = ty.size();
+            let normalized = accessor.normalized();
+            let convert = |bytes: &[u8]| -> f32 {
+                match ty {
+                    DataType::F32 => f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]),
+                    DataType::U8 => {
+                        let v = bytes[0] as f32;
+                        if normalized { v / 255.0 } else { v }
+                    }
+                    DataType::I8 => {
+                        let v = bytes[0] as i8 as f32;
+                        if normalized { (v / 127.0).max(-1.0) } else { v }
+                    }
+                    DataType::U16 => {
+                        let v = u16::from_le_bytes([bytes[0], bytes[1]]) as f32;
+                        if normalized { v / 65535.0 } else { v }
+                    }
+                    DataType::I16 => {
+                        let v = i16::from_le_bytes([bytes[0], bytes[1]]) as f32;
+                        if normalized { (v / 32767.0).max(-1.0) } else { v }
+                    }
+                    DataType::U32 => u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as f32,
+                }
+            };
+            let mut out = vec![0.0f32; count * n];
+            if let Some(view) = accessor.view() {
+                let bytes = self.view_bytes(&view)?;
+                let elem = size * comps;
+                let stride = view.stride().unwrap_or(elem);
+                let start = accessor.offset();
+                if count > 0 && start + stride * (count - 1) + elem > bytes.len() {
+                    return Err(self.data(what(), "extends past the end of its buffer view"));
+                }
+                for i in 0..count {
+                    let base = start + i * stride;
+                    for c in 0..n.min(comps) {
+                        out[i * n + c] = convert(&bytes[base + c * size..base + (c + 1) * size]);
+                    }
+                }
+            }
+            if let Some(sparse) = accessor.sparse() {
+                let idx_view = sparse.indices().view();
+                let idx_bytes = self.view_bytes(&idx_view)?;
+                let idx_size = match sparse.indices().index_type() {
+                    gltf::accessor::sparse::IndexType::U8 => 1,
+                    gltf::accessor::sparse::IndexType::U16 => 2,
+                    gltf::accessor::sparse::IndexType::U32 => 4,
+                };
+                let val_bytes = self.view_bytes(&sparse.values().view())?;
+                for k in 0..sparse.count() {
+                    let o = sparse.indices().offset() + k * idx_size;
+                    let ib = idx_bytes
+                        .get(o..o + idx_size)
+                        .ok_or_else(|| self.data(what(), "sparse indices out of range"))?;
+                    let i = match idx_size {
+                        1 => ib[0] as usize,
+                        2 => u16::from_le_bytes([ib[0], ib[1]]) as usize,
+                        _ => u32::from_le_bytes([ib[0], ib[1], ib[2], ib[3]]) as usize,
+                    };
+                    if i >= count {
+                        return Err(self.data(what(), "sparse index past the accessor's count"));
+                    }
+                    let vo = sparse.values().offset() + k * size * comps;
+                    let vb = val_bytes
+                        .get(vo..vo + size * comps)
+                        .ok_or_else(|| self.data(what(), "sparse values out of range"))?;
+                    for c in 0..n.min(comps) {
+                        out[i * n + c] = convert(&vb[c * size..(c + 1) * size]);
+                    }
+                }
+            }
+            Ok(out)
+        }
+
+        fn read_indices(&self, accessor: &gltf::Accessor) -> Result<Vec<u32>, ModelError> {
+            if accessor.dimensions() != Dimensions::Scalar
+                || !matches!(accessor.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+            {
+                return Err(self.data(
+                    format!("accessor {}", accessor.index()),
+                    "indices must be unsigned scalars",
+                ));
+            }
+            Ok(self.read_f32(accessor, 1)?.into_iter().map(|v| v as u32).collect())
+        }
+    }
+
+    fn data_uri(uri: &str) -> Option<Result<Vec<u8>, base64::DecodeError>> {
+        let rest = uri.strip_prefix("data:")?;
+        let (_, payload) = rest.split_once(";base64,")?;
+        Some(base64::engine::general_purpose::STANDARD.decode(payload))
+    }
+
+    fn load_uri(path: &Path, uri: &str) -> Result<Vec<u8>, ModelError> {
+        if let Some(decoded) = data_uri(uri) {
+            return decoded.map_err(|e| ModelError::Parse {
+                path: path.to_path_buf(),
+                message: format!("bad data URI: {e}"),
+            });
+        }
+        let file = path.parent().unwrap_or(Path::new(".")).join(percent_decode(uri));
+        std::fs::read(&file).map_err(|source| ModelError::Io { path: file, source })
+    }
+
+    fn percent_decode(uri: &str) -> String {
+        let bytes = uri.as_bytes();
+        let mut out = Vec::with_capacity(bytes.len());
+        let mut i = 0;
+        while i < bytes.len() {
+            if bytes[i] == b'%' && i + 2 < bytes.len() {
+                if let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16) {
+                    out.push(v);
+                    i += 3;
+                    continue;
+                }
+            }
+            out.push(bytes[i]);
+            i += 1;
+        }
+        String::from_utf8_lossy(&out).into_owned()
+    }
+
+    fn sampler_of(t: &gltf::Texture) -> Sampler {
+        use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+        let s = t.sampler();
+        let wrap = |w: WrappingMode| match w {
+            WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+            WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+            WrappingMode::Repeat => Wrap::Repeat,
+        };
+        let (min_linear, mip_linear) = match s.min_filter() {
+            Some(MinFilter::Nearest | MinFilter::NearestMipmapNearest) => (false, false),
+            Some(MinFilter::NearestMipmapLinear) => (false, true),
+            Some(MinFilter::LinearMipmapNearest) => (true, false),
+            _ => (true, true),
+        };
+        Sampler {
+            mag_linear: !matches!(s.mag_filter(), Some(MagFilter::Nearest)),
+            min_linear,
+            mip_linear,
+            wrap_u: wrap(s.wrap_s()),
+            wrap_v: wrap(s.wrap_t()),
+        }
+    }
+
+    fn texture_ref(
+        t: &gltf::Texture,
+        tex_coord: u32,
+        transform: Option<gltf::texture::TextureTransform>,
+    ) -> TextureRef {
+        let (transform, tex_coord) = match transform {
+            Some(tt) => (
+                UvTransform {
+                    offset: tt.offset(),
+                    rotation_rad: tt.rotation(),
+                    scale: tt.scale(),
+                },
+                tt.tex_coord().unwrap_or(tex_coord),
+            ),
+            None => (UvTransform::default(), tex_coord),
+        };
+        TextureRef {
+            image: t.source().index(),
+            tex_coord: tex_coord.min(1),
+            transform,
+            sampler: sampler_of(t),
+        }
+    }
+
+    fn material_of(m: &gltf::Material) -> Material {
+        let pbr = m.pbr_metallic_roughness();
+        let info = |i: gltf::texture::Info| texture_ref(&i.texture(), i.tex_coord(), i.texture_transform());
+        let strength = m.emissive_strength().unwrap_or(1.0);
+        let e = m.emissive_factor();
+        Material {
+            name: m.name().unwrap_or("unnamed").to_owned(),
+            // glTF colour factors are linear already.
+            base_color: pbr.base_color_factor(),
+            metallic: pbr.metallic_factor(),
+            roughness: pbr.roughness_factor(),
+            emissive: [e[0] * strength, e[1] * strength, e[2] * strength],
+            alpha: match m.alpha_mode() {
+                gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+                gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+                gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+            },
+            double_sided: m.double_sided(),
+            base_color_texture: pbr.base_color_texture().map(info),
+            metallic_roughness_texture: pbr.metallic_roughness_texture().map(info),
+            // TODO(issue #3): gltf-rs exposes KHR_texture_transform only on `Info`, so normal and
+            // occlusion textures are read untransformed for now.
+            normal_texture: m
+                .normal_texture()
+                .map(|n| (texture_ref(&n.texture(), n.tex_coord(), None), n.scale())),
+            occlusion_texture: m
+                .occlusion_texture()
+                .map(|o| (texture_ref(&o.texture(), o.tex_coord(), None), o.strength())),
+            emissive_texture: m.emissive_texture().map(info),
+        }
+    }
+
+    /// Attribute data of one primitive before assembly.
+    #[derive(Default)]
+    struct Attributes {
+        positions: Vec<f32>,
+        normals: Option<Vec<f32>>,
+        tangents: Option<Vec<f32>>,
+        uv0: Option<Vec<f32>>,
+        uv1: Option<Vec<f32>>,
+        colors: Option<(Vec<f32>, usize)>,
+        indices: Option<Vec<u32>>,
+    }
+
+    fn read_plain(ctx: &Ctx, prim: &gltf::Primitive) -> Result<Attributes, ModelError> {
+        use gltf::Semantic;
+        let mut a = Attributes::default();
+        for (semantic, accessor) in prim.attributes() {
+            match semantic {
+                Semantic::Positions => a.positions = ctx.read_f32(&accessor, 3)?,
+                Semantic::Normals => a.normals = Some(ctx.read_f32(&accessor, 3)?),
+                Semantic::Tangents => a.tangents = Some(ctx.read_f32(&accessor, 4)?),
+                Semantic::TexCoords(0) => a.uv0 = Some(ctx.read_f32(&accessor, 2)?),
+                Semantic::TexCoords(1) => a.uv1 = Some(ctx.read_f32(&accessor, 2)?),
+                Semantic::Colors(0) => {
+                    let n = accessor.dimensions().multiplicity();
+                    a.colors = Some((ctx.read_f32(&accessor, n)?, n));
+                }
+                _ => {}
+            }
+        }
+        if let Some(idx) = prim.indices() {
+            a.indices = Some(ctx.read_indices(&idx)?);
+        }
+        Ok(a)
+    }
+
+    fn read_draco(
+        ctx: &Ctx,
+        prim: &gltf::Primitive,
+        ext: &gltf::json::Value,
+        views: &[gltf::buffer::View],
+    ) -> Result<Attributes, ModelError> {
+        let what = || format!("mesh primitive {} (Draco)", prim.index());
+        let view_index = ext
+            .get("bufferView")
+            .and_then(|v| v.as_u64())
+            .ok_or_else(|| ctx.data(what(), "KHR_draco_mesh_compression without a bufferView"))?;
+        let view = views
+            .get(view_index as usize)
+            .ok_or_else(|| ctx.data(what(), format!("bufferView {view_index} does not exist")))?;
+        let mut buffer = draco_core::DecoderBuffer::new(ctx.view_bytes(view)?);
+        let mut decoder = draco_core::MeshDecoder::new();
+        let mut mesh = draco_core::Mesh::new();
+        decoder
+            .decode(&mut buffer, &mut mesh)
+            .map_err(|e| ctx.data(what(), format!("Draco decoding failed: {e}")))?;
+        let n = mesh.num_points();
+        let attrs = ext
+            .get("attributes")
+            .and_then(|v| v.as_object())
+            .ok_or_else(|| ctx.data(what(), "KHR_draco_mesh_compression without attributes"))?;
+        let get = |name: &str, comps: usize| -> Result<Option<Vec<f32>>, ModelError> {
+            let Some(id) = attrs.get(name).and_then(|v| v.as_u64()) else {
+                return Ok(None);
+            };
+            let att = mesh
+                .attribute_by_unique_id(id as u32)
+                .ok_or_else(|| ctx.data(what(), format!("Draco attribute {id} ({name}) missing")))?;
+            Ok(Some(att.read_f32s(n, comps)))
+        };
+        let positions = get("POSITION", 3)?.ok_or_else(|| ctx.data(what(), "no POSITION"))?;
+        let colors = match attrs.get("COLOR_0").and_then(|v| v.as_u64()) {
+            Some(id) => {
+                let comps = mesh
+                    .attribute_by_unique_id(id as u32)
+                    .map_or(4, |a| a.num_components() as usize)
+                    .clamp(3, 4);
+                get("COLOR_0", comps)?.map(|c| (c, comps))
+            }
+            None => None,
+        };
+        let indices = mesh.faces().iter().flat_map(|f| f.iter().map(|p| p.0)).collect();
+        Ok(Attributes {
+            positions,
+            normals: get("NORMAL", 3)?,
+            tangents: get("TANGENT", 4)?,
+            uv0: get("TEXCOORD_0", 2)?,
+            uv1: get("TEXCOORD_1", 2)?,
+            colors,
+            indices: Some(indices),
+        })
+    }
+
+    struct MikkGeometry<'a> {
+        mesh: &'a mut Mesh,
+    }
+
+    impl bevy_mikktspace::Geometry for MikkGeometry<'_> {
+        fn num_faces(&self) -> usize {
+            self.mesh.indices.len() / 3
+        }
+        fn num_vertices_of_face(&self, _face: usize) -> usize {
+            3
+        }
+        fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].position
+        }
+        fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+            self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].normal
+        }
+        fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+            let uv = self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].uv;
+            [uv[0], uv[1]]
+        }
+        fn set_tangent(&mut self, tangent_space: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
+            if let Some(ts) = tangent_space {
+                let i = self.mesh.indices[face * 3 + vert] as usize;
+                self.mesh.vertices[i].tangent = ts.tangent_encoded();
+            }
+        }
+    }
+
+    /// Builds the vertices; computes smooth normals where the file has none.
+    fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
+        let n = a.positions.len() / 3;
+        let check = |v: &Option<Vec<f32>>, comps: usize, name: &str| -> Result<(), ModelError> {
+            match v {
+                Some(v) if v.len() != n * comps => {
+                    Err(ctx.data(what.to_owned(), format!("{name} count differs from POSITION")))
+                }
+                _ => Ok(()),
+            }
+        };
+        check(&a.normals, 3, "NORMAL")?;
+        check(&a.tangents, 4, "TANGENT")?;
+        check(&a.uv0, 2, "TEXCOORD_0")?;
+        check(&a.uv1, 2, "TEXCOORD_1")?;
+        let indices = a.indices.unwrap_or_else(|| (0..n as u32).collect());
+        if indices.len() % 3 != 0 {
+            return Err(ctx.data(what.to_owned(), "index count is not a multiple of 3"));
+        }
+        if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+            return Err(ctx.data(what.to_owned(), format!("index {bad} past the {n} vertices")));
+        }
+        let mut mesh = Mesh {
+            vertices: (0..n)
+                .map(|i| {
+                    let p = [a.positions[i * 3], a.positions[i * 3 + 1], a.positions[i * 3 + 2]];
+                    let normal = a
+                        .normals
+                        .as_ref()
+                        .map_or([0.0; 3], |v| [v[i * 3], v[i * 3 + 1], v[i * 3 + 2]]);
+                    let tangent = a.tangents.as_ref().map_or([1.0, 0.0, 0.0, 1.0], |v| {
+                        [v[i * 4], v[i * 4 + 1], v[i * 4 + 2], v[i * 4 + 3]]
+                    });
+                    let uv0 = a.uv0.as_ref().map_or([0.0; 2], |v| [v[i * 2], v[i * 2 + 1]]);
+                    let uv1 = a.uv1.as_ref().map_or([0.0; 2], |v| [v[i * 2], v[i * 2 + 1]]);
+                    let color = a.colors.as_ref().map_or([1.0; 4], |(v, c)| {
+                        let k = i * c;
+                        [v[k], v[k + 1], v[k + 2], if *c == 4 { v[k + 3] } else { 1.0 }]
+                    });
+                    Vertex {
+                        position: p,
+                        normal,
+                        tangent,
+                        uv: [uv0[0], uv0[1], uv1[0], uv1[1]],
+                        color,
+                        material: [1.0, 1.0],
+                    }
+                })
+                .collect(),
+            indices,
+        };
+        if a.normals.is_none() {
+            smooth_normals(&mut mesh);
+        }
+        if a.tangents.is_none()
+            && a.uv0.is_some()
+            && bevy_mikktspace::generate_tangents(&mut MikkGeometry { mesh: &mut mesh }).is_err()
+        {
+            // Degenerate UVs: keep the placeholder tangents; normal maps then shade as flat.
+        }
+        Ok(mesh)
+    }
+
+    fn smooth_normals(mesh: &mut Mesh) {
+        let mut acc = vec![Vec3::ZERO; mesh.vertices.len()];
+        for tri in mesh.indices.chunks(3) {
+            let p = |k: usize| Vec3::from(mesh.vertices[tri[k] as usize].position);
+            let n = (p(1) - p(0)).cross(p(2) - p(0));
+            for &i in tri {
+                acc[i as usize] += n;
+            }
+        }
+        for (v, n) in mesh.vertices.iter_mut().zip(acc) {
+            v.normal = n.normalize_or(Vec3::Z).to_array();
+        }
+    }
+
+    /// The orientation a Smithsonian Voyager scene gives this model file: Voyager scenes
+    /// (`scene.svx.json` beside the derivatives) store scans in their scanner's frame and rotate
+    /// them upright in `models[].rotation`. `None` when there is no such scene, it does not list
+    /// this file, or it cannot be read (the model then loads as stored).
+    pub fn voyager_rotation(model_path: &Path) -> Option<Quat> {
+        let file_name = model_path.file_name()?.to_str()?;
+        let text = std::fs::read_to_string(model_path.parent()?.join("scene.svx.json")).ok()?;
+        let scene: serde_json::Value = serde_json::from_str(&text).ok()?;
+        let model = scene.get("models")?.as_array()?.iter().find(|m| {
+            m.get("derivatives").and_then(|d| d.as_array()).is_some_and(|ds| {
+                ds.iter().any(|d| {
+                    d.get("assets").and_then(|a| a.as_array()).is_some_and(|assets| {
+                        assets
+                            .iter()
+                            .any(|a| a.get("uri").and_then(|u| u.as_str()) == Some(file_name))
+                    })
+                })
+            })
+        })?;
+        let r: Vec<f32> = model
+            .get("rotation")?
+            .as_array()?
+            .iter()
+            .filter_map(|v| v.as_f64().map(|x| x as f32))
+            .collect();
+        let q = Quat::from_xyzw(*r.first()?, *r.get(1)?, *r.get(2)?, *r.get(3)?);
+        (q.length() > 0.5).then(|| q.normalize())
+    }
+
+    /// Loads a model as its publisher meant it to be seen: [`load_gltf`], then the orientation of a
+    /// Voyager scene beside the file, if any ([`voyager_rotation`]).
+    pub fn load_model(path: &Path) -> Result<Model, ModelError> {
+        let mut model = load_gltf(path)?;
+        if let Some(q) = voyager_rotation(path) {
+            model.transform(Mat4::from_quat(q));
+            model
+                .warnings
+                .push("oriented by the Voyager scene beside it (scene.svx.json)".into());
+        }
+        Ok(model)
+    }
+
+    /// Loads a `.gltf` or `.glb` file, in the file's own frame.
+    pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
+        let bytes = std::fs::read(path).map_err(|source| ModelError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| ModelError::Parse {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+        let doc = &gltf.document;
+        if let Some(name) = doc.extensions_required().find(|e| !SUPPORTED_EXTENSIONS.contains(e)) {
+            return Err(ModelError::UnsupportedExtension {
+                path: path.to_path_buf(),
+                name: name.to_owned(),
+            });
+        }
+        let mut buffers = Vec::new();
+        for b in doc.buffers() {
+            let data = match b.source() {
+                gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| ModelError::Parse {
+                    path: path.to_path_buf(),
+                    message: "buffer refers to a GLB binary chunk that is missing".into(),
+                })?,
+                gltf::buffer::Source::Uri(uri) => load_uri(path, uri)?,
+            };
+            if data.len() < b.length() {
+                return Err(ModelError::Parse {
+                    path: path.to_path_buf(),
+                    message: format!(
+                        "buffer {} is {} bytes, shorter than its declared {}",
+                        b.index(),
+                        data.len(),
+                        b.length()
+                    ),
+                });
+            }
+            buffers.push(data);
+        }
+        let ctx = Ctx { path, buffers };
+        let views: Vec<gltf::buffer::View> = doc.views().collect();
+
+        let mut images = Vec::new();
+        for img in doc.images() {
+            let (raw, name) = match img.source() {
+                gltf::image::Source::View { view, .. } => {
+                    (ctx.view_bytes(&view)?.to_vec(), format!("image {}", img.index()))
+                }
+                gltf::image::Source::Uri { uri, .. } => (load_uri(path, uri)?, uri.chars().take(60).collect()),
+            };
+            let decoded = image::load_from_memory(&raw)
+                .map_err(|e| ctx.data(format!("image {} ({name})", img.index()), e.to_string()))?
+                .to_rgba8();
+            images.push(Image {
+                name,
+                width: decoded.width(),
+                height: decoded.height(),
+                rgba8: decoded.into_raw(),
+            });
+        }
+
+        let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m)).collect();
+        let default_material = materials.len();
+        materials.push(Material::default());
+
+        let mut model = Model {
+            name: path
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default(),
+            images,
+            ..Model::default()
+        };
+        let scene = doc.default_scene().or_else(|| doc.scenes().next());
+        let roots: Vec<gltf::Node> = match &scene {
+            Some(s) => s.nodes().collect(),
+            None => doc.nodes().collect(),
+        };
+        let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
+        while let Some((node, parent)) = stack.pop() {
+            let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+            if let Some(mesh) = node.mesh() {
+                for prim in mesh.primitives() {
+                    let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+                    if prim.mode() != gltf::mesh::Mode::Triangles {
+                        model
+                            .warnings
+                            .push(format!("{what}: {:?} primitives are not drawn", prim.mode()));
+                        continue;
+                    }
+                    let attributes = match prim.extension_value("KHR_draco_mesh_compression") {
+                        Some(ext) => read_draco(&ctx, &prim, ext, &views)?,
+                        None => read_plain(&ctx, &prim)?,
+                    };
+                    let mut m = assemble(&ctx, attributes, &what)?;
+                    m.transform(world);
+                    model.primitives.push(Primitive {
+                        mesh: m,
+                        material: prim.material().index().unwrap_or(default_material),
+                    });
+                }
+            }
+            for child in node.children() {
+                stack.push((child, world));
+            }
+        }
+        for p in &model.primitives {
+            let mat = &materials[p.material];
+            if let Some(t) = mat.textures().find(|(t, _)| t.image >= model.images.len()) {
+                return Err(ctx.data(
+                    format!("material {}", mat.name),
+                    format!("texture image {} does not exist", t.0.image),
+                ));
+            }
+        }
+        model.materials = materials;
+        if model.triangle_count() == 0 {
+            return Err(ModelError::Empty {
+                path: path.to_path_buf(),
+            });
+        }
+        Ok(model)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uv_transform_matches_the_extension_definition() {
+        // Rotation by 90° maps (1, 0) to (0, −1) in UV space (counter-clockwise with v down).
+        let t = UvTransform {
+            offset: [0.5, 0.25],
+            rotation_rad: std::f32::consts::FRAC_PI_2,
+            scale: [2.0, 3.0],
+        };
+        let uv = t.apply([1.0, 0.0]);
+        assert!(
+            (uv[0] - 0.5).abs() < 1e-6 && (uv[1] - (0.25 - 2.0)).abs() < 1e-6,
+            "{uv:?}"
+        );
+        assert_eq!(UvTransform::default().apply([0.3, 0.7]), [0.3, 0.7]);
+    }
+
+    #[test]
+    fn cube_faces_wind_outwards() {
+        let mut m = Mesh::default();
+        m.push_cube(Vec3::ZERO, 1.0, [1.0; 4]);
+        for tri in m.indices.chunks(3) {
+            let p = |i: u32| Vec3::from(m.vertices[i as usize].position);
+            let (a, b, c) = (p(tri[0]), p(tri[1]), p(tri[2]));
+            let n = (b - a).cross(c - a);
+            let centre = (a + b + c) / 3.0;
+            assert!(n.dot(centre) > 0.0, "triangle {tri:?} winds inwards");
+        }
+    }
+
+    #[test]
+    fn mirroring_transform_flips_the_winding() {
+        let mut m = Mesh::default();
+        m.push_cube(Vec3::ZERO, 1.0, [1.0; 4]);
+        m.transform(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+        for tri in m.indices.chunks(3) {
+            let p = |i: u32| Vec3::from(m.vertices[i as usize].position);
+            let n = (p(tri[1]) - p(tri[0])).cross(p(tri[2]) - p(tri[0]));
+            assert!(n.dot((p(tri[0]) + p(tri[1]) + p(tri[2])) / 3.0) > 0.0);
+        }
+    }
+
+    #[test]
+    fn fitting_stands_the_model_up_and_straddles_the_glass() {
+        // A 2 m tall, 1 m wide box, +Y up.
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::ZERO, 0.5, [1.0; 4]);
+        mesh.transform(Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)));
+        let mut model = Model::from_painted_mesh("box", mesh);
+        let fit = DioramaFit {
+            placement: Placement::Standing,
+            ..DioramaFit::default()
+        };
+        model.fit_to_diorama(&Screen::default(), &fit);
+        let b = model.bounds().unwrap();
+        assert!(
+            (b.max.z - b.min.z - fit.max_height_m).abs() < 1e-6,
+            "height along z: {b:?}"
+        );
+        assert!((b.max.z - fit.max_height_m * fit.protrude_fraction).abs() < 1e-6);
+        assert!((b.min.x + b.max.x).abs() < 1e-6 && (b.min.y + b.max.y).abs() < 1e-6);
+    }
+
+    #[test]
+    fn auto_placement_lays_flat_things_in_the_glass() {
+        let panel = Vec3::new(1.0, 0.8, 0.05);
+        let vase = Vec3::new(0.4, 1.0, 0.4);
+        assert_eq!(Placement::Auto.rotation(panel), Quat::IDENTITY);
+        assert_eq!(Placement::Auto.rotation(vase), Placement::Standing.rotation(vase));
+        // Standing: glTF up becomes the glass normal, glTF front the screen's bottom edge.
+        let q = Placement::Standing.rotation(vase);
+        assert!((q * Vec3::Y - Vec3::Z).length() < 1e-6 && (q * Vec3::Z + Vec3::Y).length() < 1e-6);
+    }
+}

@@ -1,0 +1,227 @@
+//! glTF loading on the models in `$PHANTOGRAM_DATA/models` (skipped with a notice without it),
+//! and loader behaviour on small files made here.
+
+use std::path::{Path, PathBuf};
+
+use phantogram::glam::Vec3;
+use phantogram::model::{ModelError, load_gltf, load_model};
+use phantogram::render::{FrameInput, Gpu, Renderer};
+use phantogram::screen::Screen;
+use phantogram::{Session, SessionConfig};
+use phantogram_integration::{DATA_ENV, data_dir, scratch};
+
+fn models_dir() -> Option<PathBuf> {
+    match data_dir() {
+        Some(d) => Some(d.join("models")),
+        None => {
+            eprintln!("{DATA_ENV} is not set: skipping the tests on the shared models");
+            None
+        }
+    }
+}
+
+fn gltf_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(dir).unwrap().map(|e| e.unwrap().path()).collect();
+    entries.sort();
+    for p in entries {
+        if p.is_dir() {
+            gltf_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "gltf" || e == "glb") {
+            out.push(p);
+        }
+    }
+}
+
+#[test]
+fn every_shared_model_loads_and_renders() {
+    let Some(dir) = models_dir() else { return };
+    let mut files = Vec::new();
+    gltf_files(&dir, &mut files);
+    assert!(files.len() >= 15, "found {} models", files.len());
+    let gpu = match Gpu::headless() {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no GPU ({e}): loading only");
+            None
+        }
+        Err(e) => panic!("{e}"),
+    };
+    let mut renderer: Option<Renderer> = None;
+    let mut gpu = gpu;
+    let mut session = Session::new(SessionConfig::default()).unwrap();
+    let view = session.frame().unwrap();
+    let screen = Screen::default();
+    for f in files {
+        let name = f.strip_prefix(&dir).unwrap().display().to_string();
+        let mut model = load_model(&f).unwrap_or_else(|e| panic!("{e}"));
+        assert!(model.triangle_count() > 0, "{name}");
+        model.fit_to_diorama(&screen, &Default::default());
+        let b = model.bounds().unwrap();
+        assert!(b.min.is_finite() && b.max.is_finite(), "{name}: {b:?}");
+        println!(
+            "{name}: {} triangles, {} materials, {} images{}",
+            model.triangle_count(),
+            model.materials.len(),
+            model.images.len(),
+            if model.warnings.is_empty() {
+                String::new()
+            } else {
+                format!(" ({})", model.warnings.join("; "))
+            }
+        );
+        let r = match (&mut renderer, gpu.take()) {
+            (Some(r), _) => {
+                r.set_model(&model).unwrap_or_else(|e| panic!("{name}: {e}"));
+                r
+            }
+            (None, Some(g)) => renderer.insert(Renderer::new(g, &model).unwrap_or_else(|e| panic!("{name}: {e}"))),
+            (None, None) => continue,
+        };
+        let pixels = r
+            .render(
+                &FrameInput::from_view(&view, None, Vec3::ZERO),
+                phantogram::anaglyph::Method::Mono,
+                90,
+                200,
+            )
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let background = [pixels[0], pixels[1], pixels[2]];
+        let drawn = pixels.chunks(4).filter(|p| p[..3] != background).count();
+        assert!(drawn > 200, "{name}: only {drawn} pixels show the model");
+    }
+}
+
+#[test]
+fn draco_turtle_decodes_like_the_reference_decoder() {
+    let Some(dir) = models_dir() else { return };
+    let t = dir.join("heritage/smithsonian_nmnh_sea_turtle");
+    for (draco, plain) in [
+        (
+            "sea_turtle-150k-1024-low.glb",
+            "decoded/sea_turtle-150k-1024-low-nodraco.glb",
+        ),
+        ("sea_turtle-20k-thumb.glb", "decoded/sea_turtle-20k-thumb-nodraco.glb"),
+    ] {
+        let a = load_gltf(&t.join(draco)).unwrap();
+        let b = load_gltf(&t.join(plain)).unwrap();
+        assert_eq!(a.triangle_count(), b.triangle_count(), "{draco}");
+        // Both in the file's own frame (load_gltf applies no Voyager orientation).
+        let (ba, bb) = (a.bounds().unwrap(), b.bounds().unwrap());
+        assert!(
+            (ba.min - bb.min).length() < 1e-4 && (ba.max - bb.max).length() < 1e-4,
+            "{draco}: bounds {ba:?} vs {bb:?}"
+        );
+        assert_eq!(a.images.len(), b.images.len());
+    }
+}
+
+#[test]
+fn quantized_duck_matches_the_float_duck() {
+    let Some(dir) = models_dir() else { return };
+    let a = load_gltf(&dir.join("khronos/Duck/glTF-Binary/Duck.glb")).unwrap();
+    let b = load_gltf(&dir.join("khronos/Duck/glTF-Quantized/Duck.gltf")).unwrap();
+    assert_eq!(a.triangle_count(), b.triangle_count());
+    let (ba, bb) = (a.bounds().unwrap(), b.bounds().unwrap());
+    assert!(
+        (ba.min - bb.min).length() < 0.05 && (ba.max - bb.max).length() < 0.05,
+        "{ba:?} vs {bb:?}"
+    );
+    // KHR_texture_transform undoes the UV quantization: transformed UVs agree within a texel.
+    let ta = a.materials[a.primitives[0].material].base_color_texture.unwrap();
+    let tb = b.materials[b.primitives[0].material].base_color_texture.unwrap();
+    // The quantized file reorders vertices: match each vertex to those at (nearly) the same
+    // position and normal; at a UV seam several share a position, so take the best of them.
+    let vb = &b.primitives[0].mesh.vertices;
+    let size = (ba.max - ba.min).length();
+    let mut worst = 0.0f32;
+    for va in a.primitives[0].mesh.vertices.iter().step_by(7) {
+        let pa = Vec3::from(va.position);
+        let ua = ta.transform.apply([va.uv[0], va.uv[1]]);
+        let best = vb
+            .iter()
+            .filter(|v| {
+                pa.distance(Vec3::from(v.position)) < 2e-3 * size
+                    && Vec3::from(v.normal).dot(Vec3::from(va.normal)) > 0.9
+            })
+            .map(|v| {
+                let ub = tb.transform.apply([v.uv[0], v.uv[1]]);
+                (ua[0] - ub[0]).abs().max((ua[1] - ub[1]).abs())
+            })
+            .fold(f32::INFINITY, f32::min);
+        assert!(best.is_finite(), "no vertex of the quantized duck near {pa}");
+        worst = worst.max(best);
+    }
+    assert!(worst < 2.0 / 512.0, "UVs differ by {worst}");
+}
+
+/// A minimal glTF with one triangle; `extra` is spliced into the top-level object.
+fn tiny_gltf(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    // Three positions: (0,0,0), (1,0,0), (0,1,0) as little-endian f32.
+    let mut bin = Vec::new();
+    for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
+        bin.extend_from_slice(&v.to_le_bytes());
+    }
+    let uri = format!("data:application/octet-stream;base64,{}", base64_encode(&bin));
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}}{extra},
+        "buffers":[{{"byteLength":36,"uri":"{uri}"}}],
+        "bufferViews":[{{"buffer":0,"byteLength":36}}],
+        "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
+        "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
+        "nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#
+    );
+    let path = dir.join(name);
+    std::fs::write(&path, json).unwrap();
+    path
+}
+
+fn base64_encode(bytes: &[u8]) -> String {
+    const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+    let mut s = String::new();
+    for c in bytes.chunks(3) {
+        let n = (c[0] as u32) << 16 | (*c.get(1).unwrap_or(&0) as u32) << 8 | *c.get(2).unwrap_or(&0) as u32;
+        for k in 0..4 {
+            if k <= c.len() {
+                s.push(T[(n >> (18 - 6 * k) & 63) as usize] as char);
+            } else {
+                s.push('=');
+            }
+        }
+    }
+    s
+}
+
+#[test]
+fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
+    let dir = scratch("gltf");
+    let ok = load_gltf(&tiny_gltf(&dir, "tri.gltf", "")).unwrap();
+    assert_eq!(ok.triangle_count(), 1);
+    // No normals in the file: computed, facing +z.
+    assert_eq!(ok.primitives[0].mesh.vertices[0].normal, [0.0, 0.0, 1.0]);
+
+    let needs = tiny_gltf(
+        &dir,
+        "volume.gltf",
+        r#","extensionsUsed":["KHR_materials_volume"],"extensionsRequired":["KHR_materials_volume"]"#,
+    );
+    match load_gltf(&needs) {
+        Err(ModelError::UnsupportedExtension { name, .. }) => assert_eq!(name, "KHR_materials_volume"),
+        other => panic!("expected an unsupported-extension error, got {other:?}"),
+    }
+    // Merely *used* (optional) extensions are fine.
+    let optional = tiny_gltf(&dir, "optional.gltf", r#","extensionsUsed":["KHR_materials_volume"]"#);
+    assert!(load_gltf(&optional).is_ok());
+
+    let broken = dir.join("broken.gltf");
+    std::fs::write(&broken, "{ not json").unwrap();
+    assert!(matches!(load_gltf(&broken), Err(ModelError::Parse { .. })));
+    assert!(matches!(
+        load_gltf(&dir.join("missing.glb")),
+        Err(ModelError::Io { .. })
+    ));
+    let text = load_gltf(&needs).unwrap_err().to_string();
+    assert!(
+        text.contains("volume.gltf") && text.contains("KHR_materials_volume"),
+        "{text}"
+    );
+}
