@@ -3,6 +3,8 @@
 //! * `assets` — regenerate what the project generates itself into `assets/` (the synthetic tilt
 //!   log). Deterministic: running it twice gives identical files.
 //! * `bench core` — run the core benchmark (ns per sensor update and per frame).
+//! * `bench render` — cold load-to-first-frame of the Draco turtle, stereo/mono frame-time ratio
+//!   at 1080×2400, peak memory (`PHANTOGRAM_DATA` for the turtle).
 //! * `bench orientation` — score the orientation estimators on the recordings in
 //!   `$PHANTOGRAM_DATA/imu` and write the table to `benchmarks/orientation.md`.
 //! * `ci` — what `.ci/run` runs after installing packages: fmt check, clippy, tests.
@@ -19,13 +21,14 @@ fn main() -> Result<()> {
         ["assets"] => assets(),
         ["bench", "core"] | ["bench"] => cargo(&["bench", "-p", "phantogram", "--bench", "core"]),
         ["bench", "orientation"] => bench_orientation(),
+        ["bench", "render"] => cargo(&["bench", "-p", "phantogram", "--bench", "render"]),
         ["ci"] => {
             cargo(&["fmt", "--all", "--check"])?;
             cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"])?;
             cargo(&["test", "--workspace"])
         }
         [] | ["help"] | ["--help"] => {
-            println!("usage: cargo xtask <assets | bench core | bench orientation | ci>");
+            println!("usage: cargo xtask <assets | bench core | bench render | bench orientation | ci>");
             Ok(())
         }
         other => bail!("unknown task {other:?}; try `cargo xtask help`"),

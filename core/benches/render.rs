@@ -1,0 +1,110 @@
+//! `cargo bench -p phantogram --bench render` (or `cargo xtask bench render`): rendering figures
+//! that the tests do not assert, because this machine is shared and noisy.
+//!
+//! * cold load-to-first-frame of the Draco-compressed Smithsonian sea turtle (needs
+//!   `PHANTOGRAM_DATA`; skipped with a notice otherwise): file read, Draco decoding, image
+//!   decoding, mip generation, upload, pipeline creation and one 1080×2400 stereo frame read back;
+//! * stereo (Dubois) / mono frame time at 1080×2400 for the default artifact and the turtle,
+//!   as the median of several frames each, measured in the same run;
+//! * peak resident memory of the process (VmHWM).
+//!
+//! Frame times include reading the frame back to the CPU, as `phantogram render` does.
+
+use std::time::Instant;
+
+use phantogram::anaglyph::Method;
+use phantogram::glam::Vec3;
+use phantogram::model::{DioramaFit, Model};
+use phantogram::render::{FrameInput, Gpu, Renderer};
+use phantogram::{Session, SessionConfig};
+
+const W: u32 = 1080;
+const H: u32 = 2400;
+
+fn median_ms(mut samples: Vec<f64>) -> f64 {
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
+fn peak_rss_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+fn frame_times(renderer: &mut Renderer, input: &FrameInput, method: Method, frames: usize) -> f64 {
+    renderer.render(input, method, W, H).expect("warm-up frame");
+    let samples = (0..frames)
+        .map(|_| {
+            let start = Instant::now();
+            std::hint::black_box(renderer.render(input, method, W, H).expect("frame"));
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    median_ms(samples)
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--test" || a == "--list");
+    let frames = if quick { 1 } else { 7 };
+    let gpu = match Gpu::headless() {
+        Ok(g) => g,
+        Err(e) => {
+            println!("no GPU adapter: {e}");
+            return;
+        }
+    };
+    println!("adapter: {}", gpu.describe());
+    let mut session = Session::new(SessionConfig::default()).expect("default config");
+    let tilt = 35f32.to_radians();
+    let up = Vec3::new(0.0, tilt.sin(), tilt.cos());
+    session
+        .push(phantogram::sensors::SensorEvent::accelerometer(1, up * 9.81))
+        .expect("valid event");
+    let view = session.frame().expect("frame");
+    let input = FrameInput::from_view(&view, Some(up), Vec3::ZERO);
+
+    let turtle_path = std::env::var_os("PHANTOGRAM_DATA").map(|d| {
+        std::path::PathBuf::from(d).join("models/heritage/smithsonian_nmnh_sea_turtle/sea_turtle-150k-1024-low.glb")
+    });
+    let mut models: Vec<(String, Model)> = vec![("amphora".into(), phantogram::artifact::default_model())];
+    let mut renderer = None;
+    let mut gpu = Some(gpu);
+    match turtle_path.filter(|p| p.exists()) {
+        Some(path) => {
+            let start = Instant::now();
+            let mut turtle = phantogram::model::load_model(&path).expect("the turtle loads");
+            turtle.fit_to_diorama(&SessionConfig::default().screen, &DioramaFit::default());
+            let loaded = start.elapsed();
+            let mut r = Renderer::new(gpu.take().expect("unused"), &turtle).expect("renderer");
+            r.render(&input, Method::DuboisRedCyan, W, H).expect("first frame");
+            let first = start.elapsed();
+            println!(
+                "sea turtle (Draco, 150k triangles): cold load-to-first-frame {:.0} ms (load + decode {:.0} ms)",
+                first.as_secs_f64() * 1e3,
+                loaded.as_secs_f64() * 1e3
+            );
+            renderer = Some(r);
+            models.push(("sea turtle".into(), turtle));
+        }
+        None => println!("PHANTOGRAM_DATA not set: skipping the sea turtle"),
+    }
+    let mut renderer = match (renderer, gpu) {
+        (Some(r), _) => r,
+        (None, Some(g)) => Renderer::new(g, &models[0].1).expect("renderer"),
+        (None, None) => unreachable!(),
+    };
+    for (name, model) in &models {
+        renderer.set_model(model).expect("model");
+        let mono = frame_times(&mut renderer, &input, Method::Mono, frames);
+        let stereo = frame_times(&mut renderer, &input, Method::DuboisRedCyan, frames);
+        println!(
+            "{name}, {W}x{H}: mono {mono:.1} ms, stereo {stereo:.1} ms, stereo/mono {:.2}x",
+            stereo / mono
+        );
+    }
+    if let Some(mib) = peak_rss_mib() {
+        println!("peak resident memory: {mib:.0} MiB");
+    }
+}
