@@ -15,6 +15,10 @@ struct Eye {
     light: vec4<f32>,
     // "Up" in the device frame, for the hemispherical ambient (w unused).
     up: vec4<f32>,
+    // Mesh coordinates → shadow-map clip space (orthographic, from the light).
+    light_view_proj: mat4x4<f32>,
+    // x: shadow-map texel size in metres; y: 1 if shadows are on.
+    shadow: vec4<f32>,
 };
 
 struct Material {
@@ -32,6 +36,8 @@ struct Material {
 };
 
 @group(0) @binding(0) var<uniform> eye: Eye;
+@group(0) @binding(1) var shadow_map: texture_depth_2d;
+@group(0) @binding(2) var shadow_sampler: sampler_comparison;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_texture: texture_2d<f32>;
@@ -64,6 +70,12 @@ struct VsOut {
     @location(5) material: vec2<f32>,
 };
 
+// Shadow pass: depth only, from the light.
+@vertex
+fn vs_shadow(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
+    return eye.light_view_proj * vec4<f32>(position, 1.0);
+}
+
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
     var out: VsOut;
@@ -86,6 +98,33 @@ fn slot_uv(slot: u32, uv_set: f32, uv: vec4<f32>) -> vec2<f32> {
     }
     let p = vec3<f32>(coords, 1.0);
     return vec2<f32>(dot(material.transforms[slot * 2u].xyz, p), dot(material.transforms[slot * 2u + 1u].xyz, p));
+}
+
+// Fraction of the light reaching `world` (1 = lit): 3×3 percentage-closer filtering of the
+// shadow map. The lookup point moves one and a half texels along the normal, and further at
+// grazing light, which removes acne without the detached shadows (peter-panning) that a large
+// constant bias gives.
+fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
+    if (eye.shadow.y < 0.5) {
+        return 1.0;
+    }
+    let texel = eye.shadow.x;
+    let n_dot_l = clamp(dot(n, l), 0.05, 1.0);
+    let offset = n * texel * (1.5 + 2.0 * sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l);
+    let p = eye.light_view_proj * vec4<f32>(world + offset, 1.0);
+    let uv = vec2<f32>(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5);
+    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || p.z > 1.0) {
+        return 1.0;
+    }
+    let size = vec2<f32>(textureDimensions(shadow_map));
+    var lit = 0.0;
+    for (var dy = -1; dy <= 1; dy = dy + 1) {
+        for (var dx = -1; dx <= 1; dx = dx + 1) {
+            let o = vec2<f32>(f32(dx), f32(dy)) / size;
+            lit = lit + textureSampleCompareLevel(shadow_map, shadow_sampler, uv + o, p.z);
+        }
+    }
+    return lit / 9.0;
 }
 
 fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
@@ -149,7 +188,8 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     let fresnel = f0 + (vec3<f32>(1.0) - f0) * pow(1.0 - v_dot_h, 5.0);
     let specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
     let diffuse = (vec3<f32>(1.0) - fresnel) * (1.0 - metallic) * base / PI;
-    let direct = (diffuse + specular) * eye.light.rgb * n_dot_l;
+    let geometric_n = normalize(select(-in.normal, in.normal, front));
+    let direct = (diffuse + specular) * eye.light.rgb * n_dot_l * light_visibility(in.world, geometric_n, l);
 
     // Hemispherical ambient: brighter from above; metals reflect it tinted by their colour.
     let occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);

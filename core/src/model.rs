@@ -359,6 +359,43 @@ impl Model {
         }
     }
 
+    /// Adds the diorama's floor: a matte neutral plane parallel to the glass under the model (at
+    /// its lowest point), reaching `reach` screen sizes out so it fills oblique views. It is what
+    /// the model stands on and where its shadow falls, the phantogram's main depth cue.
+    pub fn add_floor(&mut self, screen: &Screen, reach: f32) {
+        let Some(b) = self.bounds() else { return };
+        let (hw, hh) = (screen.panel_width_m() * reach, screen.panel_height_m() * reach);
+        let z = b.min.z;
+        let corner = |x: f32, y: f32, u: f32, v: f32| Vertex {
+            position: [x, y, z],
+            normal: [0.0, 0.0, 1.0],
+            tangent: [1.0, 0.0, 0.0, 1.0],
+            uv: [u, v, 0.0, 0.0],
+            color: [1.0; 4],
+            material: [1.0, 1.0],
+        };
+        let mesh = Mesh {
+            vertices: vec![
+                corner(-hw, -hh, 0.0, 1.0),
+                corner(hw, -hh, 1.0, 1.0),
+                corner(hw, hh, 1.0, 0.0),
+                corner(-hw, hh, 0.0, 0.0),
+            ],
+            indices: vec![0, 1, 2, 0, 2, 3],
+        };
+        self.materials.push(Material {
+            name: "diorama floor".into(),
+            base_color: [0.18, 0.18, 0.18, 1.0],
+            metallic: 0.0,
+            roughness: 0.9,
+            ..Material::default()
+        });
+        self.primitives.push(Primitive {
+            mesh,
+            material: self.materials.len() - 1,
+        });
+    }
+
     pub fn bounds(&self) -> Option<Aabb> {
         self.primitives
             .iter()

@@ -39,6 +39,9 @@ pub const SCENE_WGSL: &str = include_str!("../../shaders/scene.wgsl");
 pub const COMPOSE_WGSL: &str = include_str!("../../shaders/compose.wgsl");
 
 const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+/// Shadow map resolution: 2048² texels over the scene's extent (about 40 µm per texel for the
+/// default artifact and its floor).
+const SHADOW_SIZE: u32 = 2048;
 const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 const OUTPUT_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 /// Background radiance behind the artifact: a neutral mid-dark grey, the inside of the diorama
@@ -120,6 +123,8 @@ struct EyeUniform {
     toward_light: [f32; 4],
     light: [f32; 4],
     up: [f32; 4],
+    light_view_proj: [[f32; 4]; 4],
+    shadow: [f32; 4],
 }
 
 /// Matches `Compose` in `compose.wgsl`.
@@ -197,6 +202,8 @@ pub struct Lighting {
     pub ambient: f32,
     /// Linear exposure multiplier before tone mapping.
     pub exposure: f32,
+    /// Shadows from the directional light (one shadow map per frame, shared by both eyes).
+    pub shadows: bool,
 }
 
 impl Default for Lighting {
@@ -205,6 +212,7 @@ impl Default for Lighting {
             light_rgb: Vec3::new(3.2, 3.05, 2.85),
             ambient: 0.22,
             exposure: 1.0,
+            shadows: true,
         }
     }
 }
@@ -267,6 +275,34 @@ struct GpuMaterial {
 struct GpuModel {
     primitives: Vec<GpuPrimitive>,
     materials: Vec<GpuMaterial>,
+    bounds: crate::containment::Aabb,
+}
+
+/// The orthographic light view over `bounds` (mesh coordinates) and its texel size in metres.
+pub fn light_view_proj(bounds: &crate::containment::Aabb, toward_light: Vec3) -> (Mat4, f32) {
+    let l = toward_light.normalize_or(Vec3::Z);
+    let centre = (bounds.min + bounds.max) * 0.5;
+    let radius = (bounds.max - bounds.min).length() * 0.5 + 1e-4;
+    let up = if l.z.abs() < 0.9 { Vec3::Z } else { Vec3::Y };
+    let view = Mat4::look_at_rh(centre + l * (2.0 * radius), centre, up);
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for c in bounds.corners() {
+        let p = view.transform_point3(c);
+        lo = lo.min(p);
+        hi = hi.max(p);
+    }
+    // A texel of margin on every side so PCF taps at the edge stay inside.
+    let margin = (hi.x - lo.x).max(hi.y - lo.y) / SHADOW_SIZE as f32 * 2.0;
+    let proj = Mat4::orthographic_rh(
+        lo.x - margin,
+        hi.x + margin,
+        lo.y - margin,
+        hi.y + margin,
+        -hi.z - margin,
+        -lo.z + margin,
+    );
+    let texel = ((hi.x - lo.x).max(hi.y - lo.y) + 2.0 * margin) / SHADOW_SIZE as f32;
+    (proj * view, texel)
 }
 
 /// Scene pipelines by (double-sided, blended).
@@ -291,6 +327,9 @@ pub struct Renderer {
     compose_layout: wgpu::BindGroupLayout,
     material_layout: wgpu::BindGroupLayout,
     model: GpuModel,
+    shadow_pipeline: wgpu::RenderPipeline,
+    shadow_bind: wgpu::BindGroup,
+    shadow_view: wgpu::TextureView,
     targets: Option<Targets>,
     pub lighting: Lighting,
 }
@@ -319,7 +358,47 @@ impl Renderer {
 
         let eye_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("eye"),
-            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT)],
+            entries: &[
+                uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::D2,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 2,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
+                    count: None,
+                },
+            ],
+        });
+        let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow map"),
+            size: wgpu::Extent3d {
+                width: SHADOW_SIZE,
+                height: SHADOW_SIZE,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: DEPTH_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let shadow_view = shadow_texture.create_view(&Default::default());
+        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
         });
         let eye_buffers = [0, 1].map(|i| {
             device.create_buffer(&wgpu::BufferDescriptor {
@@ -333,11 +412,35 @@ impl Renderer {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("eye"),
                 layout: &eye_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: eye_buffers[i].as_entire_binding(),
-                }],
+                entries: &[
+                    wgpu::BindGroupEntry {
+                        binding: 0,
+                        resource: eye_buffers[i].as_entire_binding(),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 1,
+                        resource: wgpu::BindingResource::TextureView(&shadow_view),
+                    },
+                    wgpu::BindGroupEntry {
+                        binding: 2,
+                        resource: wgpu::BindingResource::Sampler(&shadow_sampler),
+                    },
+                ],
             })
+        });
+        // The shadow pass reads only the light's matrix (the same in both eye blocks) and must
+        // not bind the shadow map it writes.
+        let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("shadow"),
+            entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
+        });
+        let shadow_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow"),
+            layout: &shadow_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: eye_buffers[0].as_entire_binding(),
+            }],
         });
         let mut material_entries = vec![uniform_entry(0, wgpu::ShaderStages::FRAGMENT)];
         for slot in 0..5u32 {
@@ -420,6 +523,47 @@ impl Renderer {
                 [scene_pipeline(true, false), scene_pipeline(true, true)],
             ],
         };
+        let shadow_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow"),
+            bind_group_layouts: &[Some(&shadow_layout)],
+            immediate_size: 0,
+        });
+        let position_only = wgpu::vertex_attr_array![0 => Float32x3];
+        let shadow_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow"),
+            layout: Some(&shadow_pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &scene_module,
+                entry_point: Some("vs_shadow"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &position_only,
+                })],
+            },
+            // Both faces cast: open and double-sided surfaces must shadow too.
+            primitive: wgpu::PrimitiveState {
+                cull_mode: None,
+                ..Default::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: DEPTH_FORMAT,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(wgpu::CompareFunction::LessEqual),
+                stencil: Default::default(),
+                // Slope-scaled bias against acne on surfaces at a grazing angle to the light.
+                bias: wgpu::DepthBiasState {
+                    constant: 2,
+                    slope_scale: 2.0,
+                    clamp: 0.0,
+                },
+            }),
+            multisample: Default::default(),
+            fragment: None,
+            multiview_mask: None,
+            cache: None,
+        });
 
         let compose_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("compose"),
@@ -480,6 +624,9 @@ impl Renderer {
             compose_layout,
             material_layout,
             model: gpu_model,
+            shadow_pipeline,
+            shadow_bind,
+            shadow_view,
             targets: None,
             lighting: Lighting::default(),
             gpu,
@@ -589,7 +736,7 @@ impl Renderer {
         }
     }
 
-    fn eye_uniform(&self, proj: &OffAxisProjection, input: &FrameInput) -> EyeUniform {
+    fn eye_uniform(&self, proj: &OffAxisProjection, input: &FrameInput, shadow: (Mat4, f32)) -> EyeUniform {
         // The mesh moves by `offset` (push-back): fold it into the projection.
         let view_proj = proj.view_proj * Mat4::from_translation(input.offset);
         let l = self.lighting;
@@ -600,6 +747,8 @@ impl Renderer {
             toward_light: input.toward_light.normalize_or(Vec3::Z).extend(0.0).to_array(),
             light: l.light_rgb.extend(l.ambient).to_array(),
             up: input.up.normalize_or(Vec3::Z).extend(0.0).to_array(),
+            light_view_proj: shadow.0.to_cols_array_2d(),
+            shadow: [shadow.1, f32::from(u8::from(l.shadows)), 0.0, 0.0],
         }
     }
 
@@ -640,7 +789,8 @@ impl Renderer {
         height: u32,
     ) -> Result<Vec<u8>, RenderError> {
         self.targets(width, height)?;
-        let uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input)).collect();
+        let shadow = light_view_proj(&self.model.bounds, input.toward_light);
+        let uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input, shadow)).collect();
         let (lm, rm) = method.matrices();
         let row = |m: [f32; 3]| [m[0], m[1], m[2], 0.0];
         let compose = ComposeUniform {
@@ -656,6 +806,34 @@ impl Renderer {
 
         let targets = self.targets.as_ref().expect("created above");
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
+        if self.lighting.shadows {
+            // Once per frame, for both eyes.
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("shadow"),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                    view: &self.shadow_view,
+                    depth_ops: Some(wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(1.0),
+                        store: wgpu::StoreOp::Store,
+                    }),
+                    stencil_ops: None,
+                }),
+                ..Default::default()
+            });
+            pass.set_pipeline(&self.shadow_pipeline);
+            pass.set_bind_group(0, &self.shadow_bind, &[]);
+            for p in self
+                .model
+                .primitives
+                .iter()
+                .filter(|p| !self.model.materials[p.material].blend)
+            {
+                pass.set_vertex_buffer(0, p.vertices.slice(..));
+                pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
+                pass.draw_indexed(0..p.index_count, 0, 0..1);
+            }
+        }
         for (i, _) in uniforms.iter().enumerate() {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("scene"),
@@ -987,7 +1165,14 @@ fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> Gpu
             centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
         })
         .collect();
-    GpuModel { primitives, materials }
+    let bounds = model
+        .bounds()
+        .unwrap_or(crate::containment::Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05)));
+    GpuModel {
+        primitives,
+        materials,
+        bounds,
+    }
 }
 
 fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
@@ -1078,8 +1263,8 @@ mod tests {
 
     #[test]
     fn uniform_layouts_match_the_shaders() {
-        // WGSL sizes: Eye = mat4 (64) + 4 × vec4 (64); Compose = 7 × vec4.
-        assert_eq!(std::mem::size_of::<EyeUniform>(), 128);
+        // WGSL sizes: Eye = mat4 + 4 × vec4 + mat4 + vec4; Compose = 7 × vec4.
+        assert_eq!(std::mem::size_of::<EyeUniform>(), 208);
         assert_eq!(std::mem::size_of::<ComposeUniform>(), 112);
         // Material = 5 × vec4 + array<vec4, 10>.
         assert_eq!(std::mem::size_of::<MaterialUniform>(), 240);

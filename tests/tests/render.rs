@@ -176,6 +176,12 @@ fn default_artifact_matches_its_golden_images() {
         // projection, light or composition changes thousands of pixels.
         check_golden(name, &pixels, 3, 0.002);
     }
+    // As the README's command shows it: on the diorama floor, with its shadow.
+    let mut staged = default_model();
+    staged.add_floor(&Screen::default(), 2.5);
+    renderer.set_model(&staged).unwrap();
+    let pixels = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
+    check_golden("amphora-floor-dubois", &pixels, 3, 0.002);
 }
 
 #[test]
@@ -271,4 +277,87 @@ fn gpu_composition_matches_the_cpu_reference() {
             );
         }
     }
+}
+
+/// A floor at z = −30 mm seen straight on, with a cube above it or resting on it, lit obliquely.
+fn shadow_scene(cube_centre: Vec3, half: f32, shadows: bool) -> Option<(Vec<u8>, OffAxisProjection)> {
+    let gpu = gpu()?;
+    let screen = Screen::default();
+    let mut mesh = Mesh::default();
+    mesh.push_cube(cube_centre, half, [0.8, 0.8, 0.8, 1.0]);
+    // A tiny marker at the floor's depth so add_floor puts the floor at z = −30 mm.
+    mesh.push_cube(Vec3::new(0.03, 0.06, -0.0305), 0.0005, [0.5, 0.5, 0.5, 1.0]);
+    let mut model = Model::from_painted_mesh("shadow test", mesh);
+    model.add_floor(&screen, 2.0);
+    let eye = Vec3::new(0.0, 0.0, 0.3);
+    let mono = OffAxisProjection::new(&screen, eye, DepthRange::default()).unwrap();
+    let mut renderer = Renderer::new(gpu, &model).unwrap();
+    renderer.lighting.shadows = shadows;
+    let input = FrameInput {
+        left: &mono,
+        right: &mono,
+        mono: &mono,
+        toward_light: Vec3::new(0.5, 0.0, 1.0),
+        up: Vec3::Z,
+        offset: Vec3::ZERO,
+    };
+    Some((renderer.render(&input, Method::Mono, W, H).unwrap(), mono))
+}
+
+fn luminance_at(pixels: &[u8], proj: &OffAxisProjection, p: Vec3) -> f32 {
+    let px = proj.project(p).unwrap().pixel * (W as f32 / Screen::default().width_px() as f32);
+    let i = (px.y as u32 * W + px.x as u32) as usize * 4;
+    luminance(&pixels[i..i + 4])
+}
+
+#[test]
+fn shadows_fall_where_the_light_says() {
+    // Cube centre 15 mm above the floor; light along (0.5, 0, 1): the shadow's centre lands
+    // 7.5 mm towards −x on the floor.
+    let centre = Vec3::new(0.0, 0.0, -0.015);
+    let Some((pixels, proj)) = shadow_scene(centre, 0.004, true) else {
+        return;
+    };
+    let floor_z = -0.03;
+    let shadow = Vec3::new(-0.0075, 0.0, floor_z);
+    let mirror = Vec3::new(0.0075, 0.0, floor_z);
+    let (dark, lit) = (
+        luminance_at(&pixels, &proj, shadow),
+        luminance_at(&pixels, &proj, mirror),
+    );
+    println!("floor luminance: in the predicted shadow {dark}, at its mirror image {lit}");
+    assert!(dark < 0.6 * lit, "shadow {dark} vs lit {lit}");
+}
+
+#[test]
+fn lit_floor_has_no_acne_and_resting_objects_no_gap() {
+    let Some((with, proj)) = shadow_scene(Vec3::new(0.0, 0.0, -0.026), 0.004, true) else {
+        return;
+    };
+    let Some((without, _)) = shadow_scene(Vec3::new(0.0, 0.0, -0.026), 0.004, false) else {
+        return;
+    };
+    // Acne: a lit stretch of floor away from the cube is as bright with shadows as without,
+    // everywhere in a 12 × 12 mm patch.
+    let mut worst = 0.0f32;
+    for i in 0..12 {
+        for j in 0..12 {
+            let p = Vec3::new(0.008 + i as f32 * 0.001, 0.01 + j as f32 * 0.001, -0.03);
+            worst = worst.max((luminance_at(&with, &proj, p) - luminance_at(&without, &proj, p)).abs());
+        }
+    }
+    assert!(
+        worst <= 2.0,
+        "self-shadowing on a lit floor: luminance differs by up to {worst}"
+    );
+    // Peter-panning: the cube rests on the floor (bottom at −30 mm); its shadow starts at its
+    // edge, so the floor half a millimetre beyond the shadowed side is dark.
+    let beside = Vec3::new(-0.0045, 0.0, -0.03);
+    let far = Vec3::new(-0.0045, 0.012, -0.03);
+    let (near_l, far_l) = (luminance_at(&with, &proj, beside), luminance_at(&with, &proj, far));
+    println!("floor beside the resting cube {near_l}, away from it {far_l}");
+    assert!(
+        near_l < 0.6 * far_l,
+        "shadow detached from a resting object: {near_l} vs {far_l}"
+    );
 }

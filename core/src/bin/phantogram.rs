@@ -89,6 +89,9 @@ enum Command {
         /// it (reliefs, tablets), or auto (facing when thin front to back).
         #[arg(long, value_enum, default_value = "auto")]
         placement: PlacementArg,
+        /// Leave out the diorama floor under the model (and the shadow cast on it).
+        #[arg(long)]
+        no_floor: bool,
     },
     /// Convert a recording into the phantogram log format (gzip when OUT ends in .gz).
     Import {
@@ -175,6 +178,7 @@ fn run(cli: Cli) -> Result<()> {
             flat_at_s,
             protrude,
             placement,
+            no_floor,
         } => render_command(RenderArgs {
             model: model.as_deref(),
             log: &log,
@@ -189,6 +193,7 @@ fn run(cli: Cli) -> Result<()> {
                 PlacementArg::Standing => phantogram::model::Placement::Standing,
                 PlacementArg::Facing => phantogram::model::Placement::Facing,
             },
+            floor: !no_floor,
         }),
         Command::Eval {
             what: EvalWhat::Orientation { paths },
@@ -509,6 +514,7 @@ struct RenderArgs<'a> {
     flat_at_s: Option<f64>,
     protrude: f32,
     placement: phantogram::model::Placement,
+    floor: bool,
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
@@ -526,6 +532,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         flat_at_s,
         protrude,
         placement,
+        floor,
     } = args;
     if !(0.0..=1.0).contains(&protrude) {
         bail!("--protrude must be a fraction between 0 and 1, got {protrude}");
@@ -575,7 +582,12 @@ fn render_command(args: RenderArgs) -> Result<()> {
         }
         None => phantogram::artifact::default_model(),
     };
+    // Containment concerns the artifact, not the floor under it.
     let bounds = model.bounds().context("the model is empty")?;
+    let mut model = model;
+    if floor {
+        model.add_floor(&screen, 2.5);
+    }
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
