@@ -68,6 +68,8 @@ pub mod screen;
 pub mod sensorlog;
 pub mod sensors;
 pub mod session;
+#[cfg(feature = "render")]
+pub mod surface;
 pub mod synthetic;
 pub mod viewpoint;
 

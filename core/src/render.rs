@@ -71,8 +71,10 @@ pub enum RenderError {
     Readback(String),
 }
 
-/// An adapter, device and queue.
+/// An instance, adapter, device and queue.
 pub struct Gpu {
+    /// Kept to create window surfaces ([`crate::surface`]).
+    pub instance: wgpu::Instance,
     pub adapter: wgpu::Adapter,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
@@ -83,12 +85,33 @@ impl Gpu {
     /// software fallback.
     pub fn headless() -> Result<Self, RenderError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::with_instance(instance, None)
+    }
+
+    /// A device able to present to windows of `display` (a winit event loop or window, an
+    /// Android or iOS display handle): the instance keeps the display connection, and the adapter
+    /// is chosen to present to `probe`, a window of that display.
+    pub fn for_display(
+        display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
+        probe: std::sync::Arc<dyn wgpu::WindowHandle>,
+    ) -> Result<Self, RenderError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(display));
+        let surface = instance
+            .create_surface(window_target(probe))
+            .map_err(|e| RenderError::Device(format!("cannot create a surface for the window: {e}")))?;
+        let gpu = Self::with_instance(instance.clone(), Some(&surface))?;
+        drop(surface);
+        Ok(gpu)
+    }
+
+    /// A device on `instance` whose adapter can present to `surface` (if given).
+    pub fn with_instance(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self, RenderError> {
         let mut adapter = None;
         for force_fallback_adapter in [false, true] {
             let found = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
                 power_preference: wgpu::PowerPreference::HighPerformance,
                 force_fallback_adapter,
-                compatible_surface: None,
+                compatible_surface: surface,
                 // Limit bucketing hides hardware from untrusted web content; not our case.
                 apply_limit_buckets: false,
             }));
@@ -104,7 +127,12 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| RenderError::Device(e.to_string()))?;
-        Ok(Self { adapter, device, queue })
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+        })
     }
 
     /// The adapter's name and backend, for logs.
@@ -112,6 +140,18 @@ impl Gpu {
         let info = self.adapter.get_info();
         format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
     }
+}
+
+/// A shared window handle as a surface target. The display connection lives in the instance
+/// ([`Gpu::for_display`]), so only the window handle is needed.
+pub(crate) fn window_target(window: std::sync::Arc<dyn wgpu::WindowHandle>) -> wgpu::SurfaceTarget<'static> {
+    struct SharedWindow(std::sync::Arc<dyn wgpu::WindowHandle>);
+    impl wgpu::rwh::HasWindowHandle for SharedWindow {
+        fn window_handle(&self) -> Result<wgpu::rwh::WindowHandle<'_>, wgpu::rwh::HandleError> {
+            self.0.window_handle()
+        }
+    }
+    wgpu::SurfaceTarget::Window(Box::new(SharedWindow(window)))
 }
 
 /// Per-eye uniform block; matches `Eye` in `scene.wgsl`.
@@ -231,6 +271,15 @@ pub struct FrameInput<'a> {
 }
 
 impl<'a> FrameInput<'a> {
+    /// The projections a method draws: both eyes for stereo, the cyclopean eye for mono.
+    fn eyes_for(&self, method: Method) -> Vec<&'a OffAxisProjection> {
+        if method.is_stereo() {
+            vec![self.left, self.right]
+        } else {
+            vec![self.mono]
+        }
+    }
+
     pub fn from_view(view: &'a FrameView, up: Option<Vec3>, offset: Vec3) -> Self {
         Self {
             left: &view.left,
@@ -320,7 +369,10 @@ impl ScenePipelines {
 pub struct Renderer {
     gpu: Gpu,
     scene: ScenePipelines,
-    compose_pipeline: wgpu::RenderPipeline,
+    /// Composition pipelines by target format (offscreen sRGB RGBA; a surface's may differ).
+    compose_pipelines: std::collections::HashMap<wgpu::TextureFormat, wgpu::RenderPipeline>,
+    compose_module: wgpu::ShaderModule,
+    compose_pipeline_layout: wgpu::PipelineLayout,
     eye_buffers: [wgpu::Buffer; 2],
     eye_bind: [wgpu::BindGroup; 2],
     compose_buffer: wgpu::Buffer,
@@ -587,27 +639,8 @@ impl Renderer {
             bind_group_layouts: &[Some(&compose_layout)],
             immediate_size: 0,
         });
-        let compose_pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("compose"),
-            layout: Some(&compose_pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &compose_module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &compose_module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(OUTPUT_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let compose_pipeline =
+            create_compose_pipeline(device, &compose_module, &compose_pipeline_layout, OUTPUT_FORMAT);
         let compose_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("compose"),
             size: std::mem::size_of::<ComposeUniform>() as u64,
@@ -617,7 +650,9 @@ impl Renderer {
         let gpu_model = upload_model(&gpu, &material_layout, model);
         Self {
             scene,
-            compose_pipeline,
+            compose_pipelines: [(OUTPUT_FORMAT, compose_pipeline)].into_iter().collect(),
+            compose_module,
+            compose_pipeline_layout,
             eye_buffers,
             eye_bind,
             compose_buffer,
@@ -761,12 +796,7 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, RenderError> {
-        let eyes: Vec<&OffAxisProjection> = if method.is_stereo() {
-            vec![input.left, input.right]
-        } else {
-            vec![input.mono]
-        };
-        self.render_views(&eyes, input, method, width, height)
+        self.render_views(&input.eyes_for(method), input, method, width, height)
     }
 
     /// Renders `projection` alone (no stereo composition), e.g. one eye's image for tests.
@@ -789,6 +819,63 @@ impl Renderer {
         height: u32,
     ) -> Result<Vec<u8>, RenderError> {
         self.targets(width, height)?;
+        let output_view = self.targets.as_ref().expect("created above").output_view.clone();
+        let mut encoder = self.encode_frame(eyes, input, method, &output_view, OUTPUT_FORMAT)?;
+        let targets = self.targets.as_ref().expect("created above");
+        encoder.copy_texture_to_buffer(
+            targets.output.as_image_copy(),
+            wgpu::TexelCopyBufferInfo {
+                buffer: &targets.readback,
+                layout: wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(targets.padded_row),
+                    rows_per_image: Some(targets.height),
+                },
+            },
+            wgpu::Extent3d {
+                width: targets.width,
+                height: targets.height,
+                depth_or_array_layers: 1,
+            },
+        );
+        let queue = &self.gpu.queue;
+        checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()]))?;
+        read_back(&self.gpu.device, targets)
+    }
+
+    /// Renders one frame into `target` (e.g. a surface's current texture) of `format` and
+    /// `width × height` pixels, and submits it; the caller presents.
+    pub fn render_to_view(
+        &mut self,
+        input: &FrameInput,
+        method: Method,
+        target: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        width: u32,
+        height: u32,
+    ) -> Result<(), RenderError> {
+        self.targets(width, height)?;
+        let encoder = self.encode_frame(&input.eyes_for(method), input, method, target, format)?;
+        let queue = &self.gpu.queue;
+        checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()])).map(drop)
+    }
+
+    /// Writes the uniforms and records the shadow, scene and composition passes into `target`.
+    fn encode_frame(
+        &mut self,
+        eyes: &[&OffAxisProjection],
+        input: &FrameInput,
+        method: Method,
+        target: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+    ) -> Result<wgpu::CommandEncoder, RenderError> {
+        if !self.compose_pipelines.contains_key(&format) {
+            let device = self.gpu.device.clone();
+            let pipeline = checked(&device, "the composition pipeline for this surface format", || {
+                create_compose_pipeline(&device, &self.compose_module, &self.compose_pipeline_layout, format)
+            })?;
+            self.compose_pipelines.insert(format, pipeline);
+        }
         let shadow = light_view_proj(&self.model.bounds, input.toward_light);
         let uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input, shadow)).collect();
         let (lm, rm) = method.matrices();
@@ -804,7 +891,7 @@ impl Renderer {
         }
         queue.write_buffer(&self.compose_buffer, 0, bytemuck::bytes_of(&compose));
 
-        let targets = self.targets.as_ref().expect("created above");
+        let targets = self.targets.as_ref().expect("the caller sized the targets");
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         if self.lighting.shadows {
             // Once per frame, for both eyes.
@@ -834,7 +921,7 @@ impl Renderer {
                 pass.draw_indexed(0..p.index_count, 0, 0..1);
             }
         }
-        for (i, _) in uniforms.iter().enumerate() {
+        for (i, u) in uniforms.iter().enumerate() {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("scene"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -859,7 +946,7 @@ impl Renderer {
             });
             pass.set_bind_group(0, &self.eye_bind[i], &[]);
             // Opaque and masked first; then blended, farthest first, as this eye sees them.
-            let eye_at = Vec3::from_slice(&uniforms[i].eye_pos[..3]);
+            let eye_at = Vec3::from_slice(&u.eye_pos[..3]);
             let mut blended: Vec<&GpuPrimitive> = Vec::new();
             for p in &self.model.primitives {
                 if self.model.materials[p.material].blend {
@@ -881,7 +968,7 @@ impl Renderer {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("compose"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &targets.output_view,
+                    view: target,
                     depth_slice: None,
                     resolve_target: None,
                     ops: wgpu::Operations {
@@ -891,30 +978,42 @@ impl Renderer {
                 })],
                 ..Default::default()
             });
-            pass.set_pipeline(&self.compose_pipeline);
+            pass.set_pipeline(&self.compose_pipelines[&format]);
             let bind = if uniforms.len() == 2 { 0 } else { 1 };
             pass.set_bind_group(0, &targets.compose_bind[bind], &[]);
             pass.draw(0..3, 0..1);
         }
-        encoder.copy_texture_to_buffer(
-            targets.output.as_image_copy(),
-            wgpu::TexelCopyBufferInfo {
-                buffer: &targets.readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(targets.padded_row),
-                    rows_per_image: Some(targets.height),
-                },
-            },
-            wgpu::Extent3d {
-                width: targets.width,
-                height: targets.height,
-                depth_or_array_layers: 1,
-            },
-        );
-        checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()]))?;
-        read_back(&self.gpu.device, targets)
+        Ok(encoder)
     }
+}
+
+fn create_compose_pipeline(
+    device: &wgpu::Device,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some("compose"),
+        layout: Some(layout),
+        vertex: wgpu::VertexState {
+            module,
+            entry_point: Some("vs_main"),
+            compilation_options: Default::default(),
+            buffers: &[],
+        },
+        primitive: Default::default(),
+        depth_stencil: None,
+        multisample: Default::default(),
+        fragment: Some(wgpu::FragmentState {
+            module,
+            entry_point: Some("fs_main"),
+            compilation_options: Default::default(),
+            targets: &[Some(format.into())],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
 }
 
 impl Renderer {

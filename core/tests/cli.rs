@@ -134,3 +134,58 @@ fn replay_with_an_estimator_prints_one_orientation_per_sample_time() {
         .unwrap();
     assert!(!bad.status.success());
 }
+
+/// The window path end to end under a virtual X server: the surface lifecycle self-test
+/// (suspend, a skipped draw, resume, resizes) and 20 presented frames. Needs `xvfb-run`; skipped
+/// with a notice without it, except under CI, which installs it.
+#[test]
+fn viewer_runs_its_surface_lifecycle_in_a_window() {
+    let xvfb = std::process::Command::new("xvfb-run").arg("--help").output();
+    if xvfb.is_err() {
+        assert!(std::env::var_os("CI").is_none(), "CI must provide xvfb-run");
+        eprintln!("xvfb-run not found: skipping the window test");
+        return;
+    }
+    let runtime = std::env::temp_dir().join(format!("phantogram-xdg-{}", std::process::id()));
+    std::fs::create_dir_all(&runtime).unwrap();
+    let out = Command::new("timeout")
+        .args(["300", "xvfb-run", "-a", "-s", "-screen 0 800x1280x24"])
+        .arg(env!("CARGO_BIN_EXE_phantogram"))
+        .args(["view", "--frames", "20", "--lifecycle-test"])
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let line = stderr
+        .lines()
+        .find(|l| l.starts_with("presented"))
+        .unwrap_or_else(|| panic!("{stderr}"));
+    let number = |key: &str| -> u64 {
+        let i = line.find(key).unwrap_or_else(|| panic!("{line}"));
+        line[..i]
+            .split_whitespace()
+            .last()
+            .unwrap()
+            .trim_start_matches('(')
+            .parse()
+            .unwrap()
+    };
+    assert_eq!(number(" frames"), 20, "{line}");
+    assert!(
+        number(" skipped") >= 1,
+        "the draw while suspended must be skipped: {line}"
+    );
+    let after = |key: &str| -> u64 {
+        let i = line.find(key).unwrap_or_else(|| panic!("{line}")) + key.len();
+        line[i..]
+            .split(|c: char| !c.is_ascii_digit())
+            .find(|s| !s.is_empty())
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    assert_eq!(after("resumed "), 2, "{line}");
+    assert_eq!(after("suspended "), 1, "{line}");
+    assert!(after("reconfigured ") >= 4, "{line}");
+}

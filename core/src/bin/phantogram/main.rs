@@ -9,6 +9,8 @@
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
+mod viewer;
+
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use phantogram::attitude::{LowPassAttitude, OrientationEstimator};
@@ -59,6 +61,23 @@ enum Command {
         /// w x y z) after each input sample time, as estimated by NAME.
         #[arg(long, value_name = "NAME")]
         estimator: Option<EstimatorName>,
+    },
+    /// Open a window showing the phantogram; drag to tilt the virtual phone, or replay a log.
+    View {
+        /// A glTF 2.0 model (.gltf or .glb); the default artifact when omitted.
+        model: Option<PathBuf>,
+        /// Replay this sensor log in real time instead of tilting with the mouse.
+        #[arg(long)]
+        log: Option<PathBuf>,
+        /// Anaglyph method (keys 1-8 switch while running).
+        #[arg(long, default_value = "dubois")]
+        anaglyph: phantogram::anaglyph::Method,
+        /// Close after presenting this many frames.
+        #[arg(long)]
+        frames: Option<u64>,
+        /// Exercise suspend, resume and resize while running (a self-test of the surface lifecycle).
+        #[arg(long)]
+        lifecycle_test: bool,
     },
     /// Render a sensor log as phantogram frames (PNG), headless.
     Render {
@@ -168,6 +187,31 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Info { log } => info_command(&log),
+        Command::View {
+            model,
+            log,
+            anaglyph,
+            frames,
+            lifecycle_test,
+        } => {
+            let screen = SessionConfig::default().screen;
+            let model = load_for_display(model.as_deref(), &screen, &phantogram::model::DioramaFit::default())?;
+            let bounds = model.bounds().context("the model is empty")?;
+            let mut model = model;
+            model.add_floor(&screen, 2.5);
+            let log = match log {
+                Some(path) => Some(open_events(&path)?.collect::<Result<Vec<_>, _>>()?),
+                None => None,
+            };
+            viewer::run(viewer::ViewerArgs {
+                model,
+                bounds,
+                log,
+                method: anaglyph,
+                frames,
+                lifecycle_test,
+            })
+        }
         Command::Render {
             model,
             log,
@@ -559,29 +603,12 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let interval_ns = (every_ms * 1e6).round().max(1.0) as i64;
     let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
 
-    let model = match model_path {
-        Some(path) => {
-            let mut model = phantogram::model::load_model(path)?;
-            for w in &model.warnings {
-                eprintln!("warning: {}: {w}", path.display());
-            }
-            let fit = DioramaFit {
-                placement,
-                protrude_fraction: protrude,
-                ..DioramaFit::default()
-            };
-            model.fit_to_diorama(&screen, &fit);
-            eprintln!(
-                "{}: {} triangles, {} materials, {} images",
-                path.display(),
-                model.triangle_count(),
-                model.materials.len(),
-                model.images.len()
-            );
-            model
-        }
-        None => phantogram::artifact::default_model(),
+    let fit = DioramaFit {
+        placement,
+        protrude_fraction: protrude,
+        ..DioramaFit::default()
     };
+    let model = load_for_display(model_path, &screen, &fit)?;
     // Containment concerns the artifact, not the floor under it.
     let bounds = model.bounds().context("the model is empty")?;
     let mut model = model;
@@ -650,4 +677,29 @@ fn render_command(args: RenderArgs) -> Result<()> {
         out_dir.display()
     );
     Ok(())
+}
+
+/// The model to show: a glTF file fitted to the diorama (its warnings printed), or the default
+/// artifact.
+fn load_for_display(
+    path: Option<&std::path::Path>,
+    screen: &phantogram::screen::Screen,
+    fit: &phantogram::model::DioramaFit,
+) -> Result<phantogram::model::Model> {
+    let Some(path) = path else {
+        return Ok(phantogram::artifact::default_model());
+    };
+    let mut model = phantogram::model::load_model(path)?;
+    for w in &model.warnings {
+        eprintln!("warning: {}: {w}", path.display());
+    }
+    model.fit_to_diorama(screen, fit);
+    eprintln!(
+        "{}: {} triangles, {} materials, {} images",
+        path.display(),
+        model.triangle_count(),
+        model.materials.len(),
+        model.images.len()
+    );
+    Ok(model)
 }
