@@ -11,14 +11,17 @@ struct Eye {
     eye_pos: vec4<f32>,
     // Unit vector towards the light (w unused).
     toward_light: vec4<f32>,
-    // Light radiance (rgb, linear) and, in w, the ambient level.
+    // Light radiance (rgb, linear) and, in w, the environment's intensity.
     light: vec4<f32>,
-    // "Up" in the device frame, for the hemispherical ambient (w unused).
-    up: vec4<f32>,
+    // Rows of the device → world rotation: the environment is fixed in the room.
+    world_from_device: array<vec4<f32>, 3>,
     // Mesh coordinates → shadow-map clip space (orthographic, from the light).
     light_view_proj: mat4x4<f32>,
     // x: shadow-map texel size in metres; y: 1 if shadows are on.
     shadow: vec4<f32>,
+    // The environment's irradiance as nine RGB spherical-harmonic terms, pre-multiplied by the
+    // cosine-lobe band weights and basis constants (see ibl.rs).
+    sh: array<vec4<f32>, 9>,
 };
 
 struct Material {
@@ -127,6 +130,19 @@ fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     return lit / 9.0;
 }
 
+fn to_world(v: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(eye.world_from_device[0].xyz, v), dot(eye.world_from_device[1].xyz, v), dot(eye.world_from_device[2].xyz, v));
+}
+
+// Irradiance E(n) of the environment for world normal n (Ramamoorthi & Hanrahan 2001).
+fn irradiance(n: vec3<f32>) -> vec3<f32> {
+    var e = eye.sh[0].rgb;
+    e = e + eye.sh[1].rgb * n.y + eye.sh[2].rgb * n.z + eye.sh[3].rgb * n.x;
+    e = e + eye.sh[4].rgb * (n.x * n.y) + eye.sh[5].rgb * (n.y * n.z) + eye.sh[6].rgb * (3.0 * n.z * n.z - 1.0);
+    e = e + eye.sh[7].rgb * (n.x * n.z) + eye.sh[8].rgb * (n.x * n.x - n.y * n.y);
+    return max(e, vec3<f32>(0.0));
+}
+
 fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
@@ -191,11 +207,15 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     let geometric_n = normalize(select(-in.normal, in.normal, front));
     let direct = (diffuse + specular) * eye.light.rgb * n_dot_l * light_visibility(in.world, geometric_n, l);
 
-    // Hemispherical ambient: brighter from above; metals reflect it tinted by their colour.
+    // Image-based light, world-fixed: diffuse from the environment's irradiance; specular, until
+    // the prefiltered map exists, from the irradiance in the reflection direction with a
+    // roughness-aware Fresnel (TODO(issue #3): split-sum prefiltered specular).
     let occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);
-    let sky = 0.5 + 0.5 * dot(n, normalize(eye.up.xyz));
-    let ambient_light = eye.light.w * mix(0.35, 1.0, sky) * occlusion;
-    let ambient = ambient_light * mix(base * (1.0 - metallic), f0 * 0.8, metallic);
+    let env = eye.light.w * occlusion / PI;
+    let fresnel_ambient = f0 + (max(vec3<f32>(1.0 - roughness), f0) - f0) * pow(1.0 - n_dot_v, 5.0);
+    let diffuse_ambient = irradiance(to_world(n)) * base * (1.0 - metallic) * (vec3<f32>(1.0) - fresnel_ambient);
+    let specular_ambient = irradiance(to_world(reflect(-v, n))) * fresnel_ambient;
+    let ambient = env * (diffuse_ambient + specular_ambient);
     let emissive = material.emissive.rgb * emissive_sample.rgb;
 
     var out_alpha = 1.0;

@@ -56,6 +56,7 @@ pub mod attitude;
 pub mod containment;
 pub mod eyes;
 pub mod fusion;
+pub mod ibl;
 pub mod light;
 pub mod lowpass;
 pub mod model;

@@ -162,9 +162,10 @@ struct EyeUniform {
     eye_pos: [f32; 4],
     toward_light: [f32; 4],
     light: [f32; 4],
-    up: [f32; 4],
+    world_from_device: [[f32; 4]; 3],
     light_view_proj: [[f32; 4]; 4],
     shadow: [f32; 4],
+    sh: [[f32; 4]; 9],
 }
 
 /// Matches `Compose` in `compose.wgsl`.
@@ -238,8 +239,8 @@ impl MaterialUniform {
 pub struct Lighting {
     /// Radiance of the directional light, linear RGB.
     pub light_rgb: Vec3,
-    /// Ambient level.
-    pub ambient: f32,
+    /// Scale of the environment's light ([`crate::ibl`]).
+    pub environment_intensity: f32,
     /// Linear exposure multiplier before tone mapping.
     pub exposure: f32,
     /// Shadows from the directional light (one shadow map per frame, shared by both eyes).
@@ -250,7 +251,7 @@ impl Default for Lighting {
     fn default() -> Self {
         Self {
             light_rgb: Vec3::new(3.2, 3.05, 2.85),
-            ambient: 0.22,
+            environment_intensity: 1.0,
             exposure: 1.0,
             shadows: true,
         }
@@ -264,8 +265,8 @@ pub struct FrameInput<'a> {
     pub right: &'a OffAxisProjection,
     pub mono: &'a OffAxisProjection,
     pub toward_light: Vec3,
-    /// "Up" in the device frame (for the ambient term); +z if unknown.
-    pub up: Vec3,
+    /// Device → world orientation: the environment light is fixed in the room.
+    pub device_to_world: glam::Quat,
     /// Translation applied to the mesh this frame (containment's push-back).
     pub offset: Vec3,
 }
@@ -280,13 +281,15 @@ impl<'a> FrameInput<'a> {
         }
     }
 
-    pub fn from_view(view: &'a FrameView, up: Option<Vec3>, offset: Vec3) -> Self {
+    /// The frame a session computed, with the mesh moved by `offset` (containment's push-back).
+    /// Without any orientation yet, the device is taken as lying flat facing north.
+    pub fn from_view(view: &'a FrameView, offset: Vec3) -> Self {
         Self {
             left: &view.left,
             right: &view.right,
             mono: &view.mono,
             toward_light: view.toward_light_device,
-            up: up.unwrap_or(Vec3::Z),
+            device_to_world: view.device_to_world.unwrap_or(glam::Quat::IDENTITY),
             offset,
         }
     }
@@ -382,6 +385,8 @@ pub struct Renderer {
     shadow_pipeline: wgpu::RenderPipeline,
     shadow_bind: wgpu::BindGroup,
     shadow_view: wgpu::TextureView,
+    /// The environment's irradiance, as the shader takes it.
+    environment_sh: [[f32; 4]; 9],
     targets: Option<Targets>,
     pub lighting: Lighting,
 }
@@ -662,6 +667,8 @@ impl Renderer {
             shadow_pipeline,
             shadow_bind,
             shadow_view,
+            environment_sh: crate::ibl::IrradianceSh::from_environment(&crate::ibl::Environment::studio())
+                .shader_coefficients(),
             targets: None,
             lighting: Lighting::default(),
             gpu,
@@ -670,6 +677,11 @@ impl Renderer {
 
     pub fn gpu(&self) -> &Gpu {
         &self.gpu
+    }
+
+    /// Lights the scene with `env` (world frame) instead of the generated studio.
+    pub fn set_environment(&mut self, env: &crate::ibl::Environment) {
+        self.environment_sh = crate::ibl::IrradianceSh::from_environment(env).shader_coefficients();
     }
 
     /// Replaces the model drawn (keeps pipelines and targets).
@@ -780,10 +792,18 @@ impl Renderer {
             // Shading happens in mesh coordinates, so the eye moves the other way.
             eye_pos: (proj.eye_m - input.offset).extend(1.0).to_array(),
             toward_light: input.toward_light.normalize_or(Vec3::Z).extend(0.0).to_array(),
-            light: l.light_rgb.extend(l.ambient).to_array(),
-            up: input.up.normalize_or(Vec3::Z).extend(0.0).to_array(),
+            light: l.light_rgb.extend(l.environment_intensity).to_array(),
+            world_from_device: {
+                let m = glam::Mat3::from_quat(input.device_to_world.normalize());
+                [
+                    m.row(0).extend(0.0).to_array(),
+                    m.row(1).extend(0.0).to_array(),
+                    m.row(2).extend(0.0).to_array(),
+                ]
+            },
             light_view_proj: shadow.0.to_cols_array_2d(),
             shadow: [shadow.1, f32::from(u8::from(l.shadows)), 0.0, 0.0],
+            sh: self.environment_sh,
         }
     }
 
@@ -1362,8 +1382,8 @@ mod tests {
 
     #[test]
     fn uniform_layouts_match_the_shaders() {
-        // WGSL sizes: Eye = mat4 + 4 × vec4 + mat4 + vec4; Compose = 7 × vec4.
-        assert_eq!(std::mem::size_of::<EyeUniform>(), 208);
+        // WGSL sizes: Eye = mat4 + 3 × vec4 + 3 × vec4 + mat4 + vec4 + 9 × vec4; Compose = 7 × vec4.
+        assert_eq!(std::mem::size_of::<EyeUniform>(), 384);
         assert_eq!(std::mem::size_of::<ComposeUniform>(), 112);
         // Material = 5 × vec4 + array<vec4, 10>.
         assert_eq!(std::mem::size_of::<MaterialUniform>(), 240);

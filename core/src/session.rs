@@ -95,6 +95,9 @@ pub struct FrameView {
     /// Unit vector towards the world-fixed light.
     pub toward_light_device: Vec3,
     pub light_anchored: bool,
+    /// The device → world orientation this frame used (predicted where asked), if known; world-
+    /// fixed things (the environment light) turn with it.
+    pub device_to_world: Option<Quat>,
 }
 
 impl FrameView {
@@ -251,6 +254,7 @@ impl Session {
             Some(q) => Some(q.inverse() * Vec3::Z),
             None => self.estimator.up_device(),
         };
+        let device_to_world = predicted.or_else(|| self.device_to_world());
         let cfg = &self.config;
         let cyclopean = self.viewpoint.cyclopean_eye_m(up, cfg.eyes.viewing_distance_m);
         let eyes = cfg.eyes.stereo_pair(&cfg.screen, cyclopean);
@@ -261,10 +265,9 @@ impl Session {
             right: project(eyes.right_m)?,
             mono: project(eyes.cyclopean_m)?,
             eyes,
-            toward_light_device: self
-                .light
-                .toward_light_device(predicted.or_else(|| self.device_to_world())),
+            toward_light_device: self.light.toward_light_device(device_to_world),
             light_anchored: self.light.is_anchored(),
+            device_to_world,
         })
     }
 }

@@ -79,7 +79,7 @@ fn every_shared_model_loads_and_renders() {
         };
         let pixels = r
             .render(
-                &FrameInput::from_view(&view, None, Vec3::ZERO),
+                &FrameInput::from_view(&view, Vec3::ZERO),
                 phantogram::anaglyph::Method::Mono,
                 90,
                 200,
@@ -224,4 +224,34 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
         text.contains("volume.gltf") && text.contains("KHR_materials_volume"),
         "{text}"
     );
+}
+
+#[test]
+fn every_shared_environment_map_loads_into_finite_irradiance() {
+    let Some(dir) = data_dir().map(|d| d.join("env")) else {
+        return;
+    };
+    let mut n = 0;
+    for entry in std::fs::read_dir(&dir).unwrap() {
+        let path = entry.unwrap().path();
+        if !path.extension().is_some_and(|e| e == "hdr" || e == "exr") {
+            continue;
+        }
+        let env = phantogram::ibl::Environment::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let sh = phantogram::ibl::IrradianceSh::from_environment(&env);
+        let up = sh.irradiance(Vec3::Z);
+        println!(
+            "{}: {}x{}, irradiance from above {up:?}",
+            path.display(),
+            env.width,
+            env.height
+        );
+        assert!(
+            up.iter().all(|c| c.is_finite() && *c > 0.0),
+            "{}: {up:?}",
+            path.display()
+        );
+        n += 1;
+    }
+    assert!(n >= 9, "found {n} environment maps");
 }

@@ -36,13 +36,13 @@ const H: u32 = 400;
 
 /// The view of a phone held 35° from horizontal, uncalibrated (the viewer looks obliquely, the
 /// classic phantogram view).
-fn oblique_view() -> (FrameView, Vec3) {
+fn oblique_view() -> FrameView {
     let mut s = Session::new(SessionConfig::default()).unwrap();
     let tilt = 35f32.to_radians();
     let up = Vec3::new(0.0, tilt.sin(), tilt.cos());
     s.push(phantogram::sensors::SensorEvent::accelerometer(1, up * 9.81))
         .unwrap();
-    (s.frame().unwrap(), up)
+    s.frame().unwrap()
 }
 
 fn luminance(px: &[u8]) -> f32 {
@@ -74,7 +74,7 @@ fn marker_model(at: Vec3) -> Model {
 fn markers_land_on_the_predicted_pixel_in_each_eye() {
     let Some(gpu) = gpu() else { return };
     let screen = Screen::default();
-    let (view, up) = oblique_view();
+    let view = oblique_view();
     let scale = W as f32 / screen.width_px() as f32;
     let points = [
         Vec3::new(0.012, -0.02, 0.025), // in front of the glass
@@ -86,7 +86,7 @@ fn markers_land_on_the_predicted_pixel_in_each_eye() {
         renderer.set_model(&marker_model(p)).unwrap();
         let input = FrameInput {
             toward_light: Vec3::new(0.2, -0.3, 1.0),
-            ..FrameInput::from_view(&view, Some(up), Vec3::ZERO)
+            ..FrameInput::from_view(&view, Vec3::ZERO)
         };
         let mut centroids = Vec::new();
         for (name, proj) in [("left", &view.left), ("right", &view.right)] {
@@ -164,9 +164,9 @@ fn check_golden(name: &str, pixels: &[u8], tolerance: u8, max_fraction: f64) {
 #[test]
 fn default_artifact_matches_its_golden_images() {
     let Some(gpu) = gpu() else { return };
-    let (view, up) = oblique_view();
+    let view = oblique_view();
     let mut renderer = Renderer::new(gpu, &default_model()).unwrap();
-    let input = FrameInput::from_view(&view, Some(up), Vec3::ZERO);
+    let input = FrameInput::from_view(&view, Vec3::ZERO);
     for (name, method) in [
         ("amphora-mono", Method::Mono),
         ("amphora-dubois", Method::DuboisRedCyan),
@@ -191,8 +191,8 @@ fn shared_models_match_their_golden_images() {
         return;
     };
     let Some(gpu) = gpu() else { return };
-    let (view, up) = oblique_view();
-    let input = FrameInput::from_view(&view, Some(up), Vec3::ZERO);
+    let view = oblique_view();
+    let input = FrameInput::from_view(&view, Vec3::ZERO);
     let screen = Screen::default();
     let cases = [
         ("duck-mono", "khronos/Duck/glTF-Binary/Duck.glb", Method::Mono),
@@ -243,7 +243,7 @@ fn gpu_composition_matches_the_cpu_reference() {
         right: &right,
         mono: &left,
         toward_light: Vec3::Z,
-        up: Vec3::Y,
+        device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
     };
     let centre = ((H / 2) * W + W / 2) as usize * 4;
@@ -298,7 +298,7 @@ fn shadow_scene(cube_centre: Vec3, half: f32, shadows: bool) -> Option<(Vec<u8>,
         right: &mono,
         mono: &mono,
         toward_light: Vec3::new(0.5, 0.0, 1.0),
-        up: Vec3::Z,
+        device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
     };
     Some((renderer.render(&input, Method::Mono, W, H).unwrap(), mono))
@@ -360,4 +360,45 @@ fn lit_floor_has_no_acne_and_resting_objects_no_gap() {
         near_l < 0.6 * far_l,
         "shadow detached from a resting object: {near_l} vs {far_l}"
     );
+}
+
+/// The environment is fixed in the room: with a sky-only environment (no directional light), the
+/// glass-facing side of a cube is bright while the device lies face up, and dark once the device
+/// is turned face down, although nothing moved in the device frame.
+#[test]
+fn environment_light_turns_with_the_device() {
+    let Some(gpu) = gpu() else { return };
+    let screen = Screen::default();
+    let mut mesh = Mesh::default();
+    mesh.push_cube(Vec3::new(0.0, 0.0, -0.02), 0.01, [0.8, 0.8, 0.8, 1.0]);
+    let mut renderer = Renderer::new(gpu, &Model::from_painted_mesh("cube", mesh)).unwrap();
+    let mut sky = phantogram::ibl::Environment::studio();
+    for (i, t) in sky.texels.iter_mut().enumerate() {
+        let above = i / sky.width < sky.height / 2;
+        *t = if above { [1.0; 3] } else { [0.0; 3] };
+    }
+    renderer.set_environment(&sky);
+    renderer.lighting.light_rgb = Vec3::ZERO;
+    renderer.lighting.shadows = false;
+    let eye = Vec3::new(0.0, 0.0, 0.3);
+    let mono = OffAxisProjection::new(&screen, eye, DepthRange::default()).unwrap();
+    let brightness = |renderer: &mut Renderer, q: phantogram::glam::Quat| {
+        let input = FrameInput {
+            left: &mono,
+            right: &mono,
+            mono: &mono,
+            toward_light: Vec3::Z,
+            device_to_world: q,
+            offset: Vec3::ZERO,
+        };
+        let px = renderer.render(&input, Method::Mono, W, H).unwrap();
+        luminance_at(&px, &mono, Vec3::new(0.0, 0.0, -0.01))
+    };
+    let face_up = brightness(&mut renderer, phantogram::glam::Quat::IDENTITY);
+    let face_down = brightness(
+        &mut renderer,
+        phantogram::glam::Quat::from_rotation_x(std::f32::consts::PI),
+    );
+    println!("cube top under a sky: device face up {face_up}, face down {face_down}");
+    assert!(face_up > 2.0 * face_down, "{face_up} vs {face_down}");
 }

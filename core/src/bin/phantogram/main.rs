@@ -111,6 +111,10 @@ enum Command {
         /// Leave out the diorama floor under the model (and the shadow cast on it).
         #[arg(long)]
         no_floor: bool,
+        /// An equirectangular HDR environment (.hdr or .exr, world frame) to light the artifact;
+        /// a generated neutral studio when omitted.
+        #[arg(long)]
+        environment: Option<PathBuf>,
     },
     /// Convert a recording into the phantogram log format (gzip when OUT ends in .gz).
     Import {
@@ -223,6 +227,7 @@ fn run(cli: Cli) -> Result<()> {
             protrude,
             placement,
             no_floor,
+            environment,
         } => render_command(RenderArgs {
             model: model.as_deref(),
             log: &log,
@@ -238,6 +243,7 @@ fn run(cli: Cli) -> Result<()> {
                 PlacementArg::Facing => phantogram::model::Placement::Facing,
             },
             floor: !no_floor,
+            environment: environment.as_deref(),
         }),
         Command::Eval {
             what: EvalWhat::Orientation { paths },
@@ -559,6 +565,7 @@ struct RenderArgs<'a> {
     protrude: f32,
     placement: phantogram::model::Placement,
     floor: bool,
+    environment: Option<&'a std::path::Path>,
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
@@ -577,6 +584,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         protrude,
         placement,
         floor,
+        environment,
     } = args;
     if !(0.0..=1.0).contains(&protrude) {
         bail!("--protrude must be a fraction between 0 and 1, got {protrude}");
@@ -619,6 +627,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
     let mut renderer = Renderer::new(gpu, &model)?;
+    if let Some(path) = environment {
+        renderer.set_environment(&phantogram::ibl::Environment::load(path)?);
+    }
     let mut session = Session::new(config).context("invalid settings")?;
     let mut smoother = ContainmentSmoother::default();
 
@@ -649,7 +660,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
             }
             let required = required_push_back_m(&bounds, &view.stereo_eyes_m(), &session.config().screen);
             let push = smoother.update(required, interval_ns as f32 * 1e-9);
-            let input = FrameInput::from_view(view, session.up_device(), phantogram::glam::Vec3::Z * -push);
+            let input = FrameInput::from_view(view, phantogram::glam::Vec3::Z * -push);
             let result = renderer
                 .render(&input, method, width, height)
                 .map_err(anyhow::Error::from)

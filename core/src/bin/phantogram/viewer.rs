@@ -121,7 +121,7 @@ impl App {
         let view = self.session.frame()?;
         let required = required_push_back_m(&self.args.bounds, &view.stereo_eyes_m(), &self.session.config().screen);
         let push = self.smoother.update(required, dt);
-        let input = FrameInput::from_view(&view, self.session.up_device(), Vec3::Z * -push);
+        let input = FrameInput::from_view(&view, Vec3::Z * -push);
         let Some(renderer) = self.renderer.as_mut() else {
             return Ok(());
         };

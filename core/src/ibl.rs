@@ -1,0 +1,254 @@
+//! Image-based light: an environment of radiance around the artifact, fixed in the room like the
+//! directional light, reduced to the nine spherical-harmonic coefficients of its irradiance
+//! (Ramamoorthi & Hanrahan, "An efficient representation for irradiance environment maps",
+//! SIGGRAPH 2001) for diffuse lighting.
+//!
+//! * Environments are equirectangular, linear radiance, in the **world frame** (x east, y north,
+//!   z up): column `u ∈ [0, 1)` is the azimuth `φ = 2π·u` measured from east towards north, row
+//!   `v ∈ [0, 1)` the polar angle `θ = π·v` from the zenith. Files: Radiance `.hdr` and OpenEXR
+//!   (feature `models`, through the `image` crate); [`Environment::studio`] generates the default.
+//! * [`IrradianceSh`] holds `L_lm` (RGB) of the environment's radiance; [`IrradianceSh::irradiance`]
+//!   evaluates `E(n)`, so a Lambertian surface of albedo `ρ` reflects `ρ/π · E(n)`.
+//!
+//! TODO(issue #3): specular image-based light (prefiltered environment and split-sum BRDF lookup);
+//! the renderer approximates it with the irradiance in the reflection direction.
+
+use glam::Vec3;
+
+/// An equirectangular environment, linear RGB radiance, world frame (see the module docs).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Environment {
+    pub width: usize,
+    pub height: usize,
+    pub texels: Vec<[f32; 3]>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum EnvironmentError {
+    #[error("{}: {message}", path.display())]
+    Load { path: std::path::PathBuf, message: String },
+    #[error("{}: environment maps must be equirectangular (width = 2 × height), got {width}×{height}", path.display())]
+    NotEquirectangular {
+        path: std::path::PathBuf,
+        width: usize,
+        height: usize,
+    },
+}
+
+impl Environment {
+    /// The world direction of texel centre `(x, y)`.
+    pub fn direction(&self, x: usize, y: usize) -> Vec3 {
+        let phi = std::f32::consts::TAU * (x as f32 + 0.5) / self.width as f32;
+        let theta = std::f32::consts::PI * (y as f32 + 0.5) / self.height as f32;
+        Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
+    }
+
+    /// A neutral studio, made here: a soft overhead key panel towards the north-west, a dimmer fill
+    /// from the south-east, a grey horizon and a darker floor. Values are linear radiance, tuned so
+    /// that a white surface facing up receives about the same irradiance as from the directional
+    /// light's ambient share.
+    pub fn studio() -> Self {
+        let (width, height) = (64usize, 32usize);
+        let key = Vec3::new(-0.4, 0.4, 0.82).normalize();
+        let fill = Vec3::new(0.5, -0.6, 0.62).normalize();
+        let mut env = Self {
+            width,
+            height,
+            texels: vec![[0.0; 3]; width * height],
+        };
+        for y in 0..height {
+            for x in 0..width {
+                let d = env.direction(x, y);
+                // Horizon band and floor: neutral grey, slightly warm above, darker below.
+                let base = if d.z >= 0.0 { 0.10 + 0.06 * d.z } else { 0.045 };
+                let soft = |centre: Vec3, width: f32, power: f32| power * ((d.dot(centre) - 1.0) / width).exp();
+                let k = soft(key, 0.08, 1.6);
+                let f = soft(fill, 0.15, 0.35);
+                env.texels[y * width + x] = [
+                    base + k + f * 0.95,
+                    base + k * 0.98 + f * 0.97,
+                    base * 1.04 + k * 0.95 + f,
+                ];
+            }
+        }
+        env
+    }
+
+    /// Loads a Radiance `.hdr` or OpenEXR file.
+    #[cfg(feature = "models")]
+    pub fn load(path: &std::path::Path) -> Result<Self, EnvironmentError> {
+        let err = |message: String| EnvironmentError::Load {
+            path: path.to_path_buf(),
+            message,
+        };
+        let img = image::ImageReader::open(path)
+            .map_err(|e| err(e.to_string()))?
+            .with_guessed_format()
+            .map_err(|e| err(e.to_string()))?
+            .decode()
+            .map_err(|e| err(e.to_string()))?
+            .into_rgb32f();
+        let (width, height) = (img.width() as usize, img.height() as usize);
+        if width != 2 * height || height == 0 {
+            return Err(EnvironmentError::NotEquirectangular {
+                path: path.to_path_buf(),
+                width,
+                height,
+            });
+        }
+        let texels = img
+            .pixels()
+            .map(|p| p.0.map(|c| if c.is_finite() { c.max(0.0) } else { 0.0 }))
+            .collect();
+        Ok(Self { width, height, texels })
+    }
+}
+
+/// Nine RGB spherical-harmonic coefficients of an environment's radiance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct IrradianceSh {
+    pub coefficients: [[f32; 3]; 9],
+}
+
+/// The real SH basis up to l = 2 at unit direction `d`.
+fn basis(d: Vec3) -> [f32; 9] {
+    let (x, y, z) = (d.x, d.y, d.z);
+    [
+        0.282_095,
+        0.488_603 * y,
+        0.488_603 * z,
+        0.488_603 * x,
+        1.092_548 * x * y,
+        1.092_548 * y * z,
+        0.315_392 * (3.0 * z * z - 1.0),
+        1.092_548 * x * z,
+        0.546_274 * (x * x - y * y),
+    ]
+}
+
+/// Convolution of radiance with the clamped cosine, per band (Ramamoorthi & Hanrahan):
+/// `Â_0 = π`, `Â_1 = 2π/3`, `Â_2 = π/4`.
+const BAND_WEIGHTS: [f32; 9] = {
+    use std::f32::consts::{FRAC_PI_4, PI};
+    const A1: f32 = 2.0 * PI / 3.0;
+    [PI, A1, A1, A1, FRAC_PI_4, FRAC_PI_4, FRAC_PI_4, FRAC_PI_4, FRAC_PI_4]
+};
+
+impl IrradianceSh {
+    /// Projects the environment onto the SH basis, each texel weighted by its solid angle.
+    pub fn from_environment(env: &Environment) -> Self {
+        let mut c = [[0.0f64; 3]; 9];
+        let d_phi = std::f64::consts::TAU / env.width as f64;
+        let d_theta = std::f64::consts::PI / env.height as f64;
+        for y in 0..env.height {
+            let theta = (y as f64 + 0.5) * d_theta;
+            let solid_angle = theta.sin() * d_theta * d_phi;
+            for x in 0..env.width {
+                let b = basis(env.direction(x, y));
+                let l = env.texels[y * env.width + x];
+                for (k, bk) in b.iter().enumerate() {
+                    for ch in 0..3 {
+                        c[k][ch] += (l[ch] as f64) * (*bk as f64) * solid_angle;
+                    }
+                }
+            }
+        }
+        Self {
+            coefficients: c.map(|v| v.map(|x| x as f32)),
+        }
+    }
+
+    /// Irradiance `E(n)` (RGB) on a surface with world normal `n`.
+    pub fn irradiance(&self, n: Vec3) -> [f32; 3] {
+        let b = basis(n.normalize_or(Vec3::Z));
+        let mut e = [0.0f32; 3];
+        for k in 0..9 {
+            for (ch, ek) in e.iter_mut().enumerate() {
+                *ek += BAND_WEIGHTS[k] * self.coefficients[k][ch] * b[k];
+            }
+        }
+        e.map(|v| v.max(0.0))
+    }
+
+    /// The coefficients pre-multiplied by the band weights and basis constants, as the shader
+    /// evaluates them: `E(n) = Σ k_i · c_i · poly_i(n)` with the polynomial parts of [`basis`].
+    pub fn shader_coefficients(&self) -> [[f32; 4]; 9] {
+        let constants = [
+            0.282_095, 0.488_603, 0.488_603, 0.488_603, 1.092_548, 1.092_548, 0.315_392, 1.092_548, 0.546_274,
+        ];
+        let mut out = [[0.0f32; 4]; 9];
+        for (k, row) in out.iter_mut().enumerate() {
+            for (ch, v) in row.iter_mut().take(3).enumerate() {
+                *v = BAND_WEIGHTS[k] * constants[k] * self.coefficients[k][ch];
+            }
+        }
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn uniform(value: f32) -> Environment {
+        Environment {
+            width: 128,
+            height: 64,
+            texels: vec![[value; 3]; 128 * 64],
+        }
+    }
+
+    #[test]
+    fn constant_radiance_gives_pi_times_radiance_everywhere() {
+        let sh = IrradianceSh::from_environment(&uniform(0.5));
+        for n in [Vec3::Z, -Vec3::Z, Vec3::X, Vec3::new(0.3, -0.7, 0.2)] {
+            let e = sh.irradiance(n);
+            assert!((e[0] - std::f32::consts::PI * 0.5).abs() < 0.01, "{n}: {e:?}");
+        }
+    }
+
+    #[test]
+    fn sky_lights_upward_faces_and_the_direction_convention_holds() {
+        // Radiance 1 above the horizon, 0 below: E(up) = π, E(down) ≈ 0, sideways ≈ π/2.
+        let mut env = uniform(0.0);
+        for y in 0..env.height / 2 {
+            for x in 0..env.width {
+                env.texels[y * env.width + x] = [1.0; 3];
+            }
+        }
+        let sh = IrradianceSh::from_environment(&env);
+        let pi = std::f32::consts::PI;
+        assert!((sh.irradiance(Vec3::Z)[0] - pi).abs() < 0.12 * pi);
+        assert!(sh.irradiance(-Vec3::Z)[0] < 0.12 * pi);
+        assert!((sh.irradiance(Vec3::X)[0] - pi / 2.0).abs() < 0.05 * pi);
+        // Column 0 is east (φ = 0), a quarter turn later north.
+        assert!(env.direction(0, env.height / 2).distance(Vec3::X) < 0.1);
+        assert!(env.direction(env.width / 4, env.height / 2).distance(Vec3::Y) < 0.1);
+    }
+
+    #[test]
+    fn studio_is_brighter_from_above_and_towards_its_key_light() {
+        let sh = IrradianceSh::from_environment(&Environment::studio());
+        let up = sh.irradiance(Vec3::Z)[0];
+        assert!(up > 2.0 * sh.irradiance(-Vec3::Z)[0]);
+        let towards_key = sh.irradiance(Vec3::new(-0.4, 0.4, 0.82))[0];
+        let away = sh.irradiance(Vec3::new(0.4, -0.4, 0.82))[0];
+        assert!(towards_key > away);
+        // The shader's pre-multiplied form evaluates to the same irradiance.
+        let k = sh.shader_coefficients();
+        let n = Vec3::new(0.2, 0.5, 0.84).normalize();
+        let poly = [
+            1.0,
+            n.y,
+            n.z,
+            n.x,
+            n.x * n.y,
+            n.y * n.z,
+            3.0 * n.z * n.z - 1.0,
+            n.x * n.z,
+            n.x * n.x - n.y * n.y,
+        ];
+        let e: f32 = (0..9).map(|i| k[i][0] * poly[i]).sum();
+        assert!((e - sh.irradiance(n)[0]).abs() < 1e-4);
+    }
+}
