@@ -232,6 +232,19 @@ fn rotation_onto_z(v: DVec3) -> DQuat {
     }
 }
 
+/// Seconds since a stream's previous sample (0 for its first); `None`, counted as stale, when the
+/// time stamp does not advance.
+fn interval_s(last_t_ns: Option<i64>, t_ns: i64, stats: &mut FusionStats) -> Option<f64> {
+    match last_t_ns {
+        Some(last) if t_ns <= last => {
+            stats.ignored_stale_time += 1;
+            None
+        }
+        Some(last) => Some((t_ns - last) as f64 * 1e-9),
+        None => Some(0.0),
+    }
+}
+
 fn wrap_pi(a: f64) -> f64 {
     let t = (a + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU);
     t - std::f64::consts::PI
@@ -459,13 +472,8 @@ impl FusedOrientation {
             self.stats.ignored_accel_shock += 1;
             return;
         }
-        let dt = match self.last_acc_t_ns {
-            Some(last) if t_ns <= last => {
-                self.stats.ignored_stale_time += 1;
-                return;
-            }
-            Some(last) => (t_ns - last) as f64 * 1e-9,
-            None => 0.0,
+        let Some(dt) = interval_s(self.last_acc_t_ns, t_ns, &mut self.stats) else {
+            return;
         };
         // A gap in this stream alone needs no restart: the gyroscope carried the frame, so the
         // filter's memory of gravity is still valid (long gyroscope gaps restart it there).
@@ -496,13 +504,8 @@ impl FusedOrientation {
     }
 
     fn push_mag(&mut self, t_ns: i64, m: DVec3) {
-        let dt = match self.last_mag_t_ns {
-            Some(last) if t_ns <= last => {
-                self.stats.ignored_stale_time += 1;
-                return;
-            }
-            Some(last) => (t_ns - last) as f64 * 1e-9,
-            None => 0.0,
+        let Some(dt) = interval_s(self.last_mag_t_ns, t_ns, &mut self.stats) else {
+            return;
         };
         self.last_mag_t_ns = Some(t_ns);
         let dt = dt.min(self.params.max_gap_s);

@@ -44,11 +44,25 @@
 //! [`sensorlog::LogError`] naming file and line, bad sensor samples are rejected and counted
 //! ([`sensors::SensorStats`]), bad configuration yields typed errors. Panics would indicate a bug.
 //!
-//! ## Dependencies
+//! ## Features and dependencies (and why each)
 //!
-//! `glam` for small-vector maths (the chosen stack), `thiserror` for error types, `flate2` for the
-//! gzip-compressed recordings and logs. The `cli` feature (on by default, off for the phone crates)
-//! adds `clap` and `anyhow` for the `phantogram` binary.
+//! * always: `glam` for small-vector maths (the chosen stack), `thiserror` for error types,
+//!   `flate2` for the gzip-compressed recordings and logs.
+//! * `models`: `gltf` (gltf-rs, the chosen stack) for the glTF document model; `draco-core`
+//!   because museums publish Draco-compressed scans and it decodes them in pure Rust (no C++
+//!   toolchain in the phone builds); `bevy_mikktspace`, the reference tangent algorithm normal
+//!   maps are baked against; `image` for PNG/JPEG textures and HDR/EXR environments; `base64` for
+//!   data URIs; `serde_json` for Voyager scenes and extension blocks.
+//! * `render` (implies `models`): `wgpu` (the chosen stack), `pollster` to wait on its few
+//!   futures, `bytemuck` for uniform and vertex layouts.
+//! * `cli` (implies `render`; on by default, off for the phone crates): `clap`, `anyhow` and
+//!   `indicatif` (progress bars) for the `phantogram` binary, `winit` (the chosen stack) for its
+//!   window.
+//!
+//! Modules: [`screen`], [`eyes`], [`viewpoint`], [`projection`], [`containment`], [`light`],
+//! [`lowpass`], [`attitude`], [`fusion`], [`sensors`], [`sensorlog`], [`replay`], [`session`],
+//! [`synthetic`], [`orientation_eval`], [`anaglyph`], [`artifact`], [`model`], [`ibl`], and with
+//! `render`, `render` and `surface`.
 
 pub mod anaglyph;
 pub mod artifact;

@@ -18,6 +18,17 @@ pub fn data_dir() -> Option<PathBuf> {
     Some(dir)
 }
 
+/// `$PHANTOGRAM_DATA/name`, or `None` after printing that the tests needing it are skipped.
+pub fn data_subdir(name: &str) -> Option<PathBuf> {
+    match data_dir() {
+        Some(d) => Some(d.join(name)),
+        None => {
+            eprintln!("{DATA_ENV} is not set: skipping the tests on {name}");
+            None
+        }
+    }
+}
+
 /// A scratch folder unique to this process and `name`, emptied first.
 pub fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("phantogram-it-{}-{name}", std::process::id()));

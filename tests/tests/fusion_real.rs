@@ -10,24 +10,23 @@ use phantogram::sensorlog::import::import;
 use phantogram::sensors::{SensorEvent, SensorKind};
 use phantogram::synthetic::{ImuSpec, tilt_sweep};
 use phantogram::{Session, SessionConfig};
-use phantogram_integration::{DATA_ENV, data_dir};
+use phantogram_integration::data_subdir;
 
-fn phone_trial(name: &str) -> Option<Vec<SensorEvent>> {
-    let Some(dir) = data_dir() else {
-        eprintln!("{DATA_ENV} is not set: skipping the tests on recorded data");
-        return None;
-    };
-    let log = import(&dir.join("imu/phone").join(name)).unwrap_or_else(|e| panic!("{e}"));
-    Some(log.events)
-}
-
-fn broad_trial(name: &str) -> Option<Vec<SensorEvent>> {
-    let dir = data_dir()?;
+fn trial(group: &str, name: &str) -> Option<Vec<SensorEvent>> {
+    let dir = data_subdir("imu")?;
     Some(
-        import(&dir.join("imu/broad").join(name))
+        import(&dir.join(group).join(name))
             .unwrap_or_else(|e| panic!("{e}"))
             .events,
     )
+}
+
+fn phone_trial(name: &str) -> Option<Vec<SensorEvent>> {
+    trial("phone", name)
+}
+
+fn broad_trial(name: &str) -> Option<Vec<SensorEvent>> {
+    trial("broad", name)
 }
 
 const S: i64 = 1_000_000_000;

@@ -8,16 +8,10 @@ use phantogram::model::{ModelError, load_gltf, load_model};
 use phantogram::render::{FrameInput, Gpu, Renderer};
 use phantogram::screen::Screen;
 use phantogram::{Session, SessionConfig};
-use phantogram_integration::{DATA_ENV, data_dir, scratch};
+use phantogram_integration::{data_subdir, scratch};
 
 fn models_dir() -> Option<PathBuf> {
-    match data_dir() {
-        Some(d) => Some(d.join("models")),
-        None => {
-            eprintln!("{DATA_ENV} is not set: skipping the tests on the shared models");
-            None
-        }
-    }
+    data_subdir("models")
 }
 
 fn gltf_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -228,7 +222,7 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
 
 #[test]
 fn every_shared_environment_map_loads_into_finite_irradiance() {
-    let Some(dir) = data_dir().map(|d| d.join("env")) else {
+    let Some(dir) = data_subdir("env") else {
         return;
     };
     let mut n = 0;

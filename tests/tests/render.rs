@@ -186,8 +186,7 @@ fn default_artifact_matches_its_golden_images() {
 
 #[test]
 fn shared_models_match_their_golden_images() {
-    let Some(data) = phantogram_integration::data_dir() else {
-        eprintln!("PHANTOGRAM_DATA is not set: skipping golden images of the shared models");
+    let Some(models) = phantogram_integration::data_subdir("models") else {
         return;
     };
     let Some(gpu) = gpu() else { return };
@@ -210,7 +209,7 @@ fn shared_models_match_their_golden_images() {
     let mut renderer: Option<Renderer> = None;
     let mut gpu = Some(gpu);
     for (name, file, method) in cases {
-        let mut model = phantogram::model::load_model(&data.join("models").join(file)).unwrap();
+        let mut model = phantogram::model::load_model(&models.join(file)).unwrap();
         model.fit_to_diorama(&screen, &Default::default());
         let r = match (&mut renderer, gpu.take()) {
             (Some(r), _) => {

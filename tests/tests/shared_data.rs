@@ -12,7 +12,7 @@ use phantogram::replay::{Pace, replay};
 use phantogram::sensorlog::import::{ImportedLog, import};
 use phantogram::sensors::SensorKind;
 use phantogram::{Session, SessionConfig};
-use phantogram_integration::{DATA_ENV, data_dir, scratch};
+use phantogram_integration::{data_subdir, scratch};
 
 /// Files in the data folders that are not sensor streams, with the reason they are not read.
 const NOT_SENSOR_DATA: &[(&str, &str)] = &[
@@ -27,13 +27,7 @@ const NOT_SENSOR_DATA: &[(&str, &str)] = &[
 ];
 
 fn imu_dir() -> Option<PathBuf> {
-    match data_dir() {
-        Some(d) => Some(d.join("imu")),
-        None => {
-            eprintln!("{DATA_ENV} is not set: skipping the tests on recorded data");
-            None
-        }
-    }
+    data_subdir("imu")
 }
 
 fn sorted_entries(dir: &Path) -> Vec<PathBuf> {
