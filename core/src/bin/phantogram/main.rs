@@ -159,10 +159,39 @@ enum EvalWhat {
 }
 
 fn main() {
-    if let Err(e) = run(Cli::parse()) {
+    let runtime_dir = ensure_runtime_dir();
+    let result = run(Cli::parse());
+    if let Some(dir) = runtime_dir {
+        let _ = std::fs::remove_dir_all(dir);
+    }
+    if let Err(e) = result {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
+}
+
+/// Without `XDG_RUNTIME_DIR` (containers, CI, ssh sessions) the Vulkan loader's window-system
+/// probe prints "error: XDG_RUNTIME_DIR is invalid or not set", which reads like a failure of
+/// ours. Point it at a private folder of our own instead; returns it, for removal at exit.
+fn ensure_runtime_dir() -> Option<PathBuf> {
+    if std::env::var_os("XDG_RUNTIME_DIR").is_some_and(|d| std::path::Path::new(&d).is_dir()) {
+        return None;
+    }
+    let dir = std::env::temp_dir().join(format!("phantogram-runtime-{}", std::process::id()));
+    #[cfg(unix)]
+    let created = {
+        use std::os::unix::fs::DirBuilderExt;
+        std::fs::DirBuilder::new().mode(0o700).create(&dir).is_ok()
+    };
+    #[cfg(not(unix))]
+    let created = false;
+    if created {
+        // SAFETY: called first thing in `main`, before any other thread exists, so nothing can
+        // read the environment concurrently.
+        unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
+        return Some(dir);
+    }
+    None
 }
 
 fn run(cli: Cli) -> Result<()> {
