@@ -61,12 +61,14 @@
 //!
 //! Modules: [`screen`], [`eyes`], [`viewpoint`], [`projection`], [`containment`], [`light`],
 //! [`lowpass`], [`attitude`], [`fusion`], [`sensors`], [`sensorlog`], [`replay`], [`session`],
-//! [`synthetic`], [`orientation_eval`], [`anaglyph`], [`artifact`], [`model`], [`ibl`], and with
+//! [`synthetic`], [`orientation_eval`], [`calibration`], [`anaglyph`], [`artifact`], [`model`],
+//! [`ibl`], and with
 //! `render`, `render` and `surface`.
 
 pub mod anaglyph;
 pub mod artifact;
 pub mod attitude;
+pub mod calibration;
 pub mod containment;
 pub mod eyes;
 pub mod fusion;
