@@ -171,6 +171,12 @@ impl ContainmentSmoother {
         self.current_m
     }
 
+    /// Advances by one frame towards the push-back `bounds` needs for `eyes` (the frame's stereo
+    /// pair) on `screen`, and returns it.
+    pub fn follow(&mut self, bounds: &Aabb, eyes: &[Vec3], screen: &Screen, dt_s: f32) -> f32 {
+        self.update(required_push_back_m(bounds, eyes, screen), dt_s)
+    }
+
     /// Advances by one frame of `dt_s` seconds towards `required_m` and returns the push-back.
     pub fn update(&mut self, required_m: f32, dt_s: f32) -> f32 {
         if !required_m.is_finite() {

@@ -83,10 +83,6 @@ impl Mesh {
         }
     }
 
-    pub fn translate(&mut self, by: Vec3) {
-        self.transform(Mat4::from_translation(by));
-    }
-
     /// Appends a small axis-aligned cube (markers, tests).
     pub fn push_cube(&mut self, centre: Vec3, half: f32, color: [f32; 4]) {
         let faces = [

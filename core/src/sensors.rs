@@ -283,6 +283,19 @@ mod tests {
     }
 
     #[test]
+    fn reset_clock_accepts_a_restarted_sensor_clock() {
+        let inbox = SensorInbox::default();
+        inbox.push(SensorEvent::gyroscope(1_000, Vec3::ZERO)).unwrap();
+        assert_eq!(
+            inbox.push(SensorEvent::gyroscope(10, Vec3::ZERO)),
+            Err(Rejection::BackwardTimestamp)
+        );
+        inbox.reset_clock();
+        assert!(inbox.push(SensorEvent::gyroscope(10, Vec3::ZERO)).is_ok());
+        assert_eq!(inbox.stats().rejected_backward, 1, "counters survive the reset");
+    }
+
+    #[test]
     fn overflow_drops_the_oldest() {
         let inbox = SensorInbox::with_capacity(3);
         for t in 0..5 {

@@ -228,10 +228,7 @@ fn run(cli: Cli) -> Result<()> {
             lifecycle_test,
         } => {
             let screen = SessionConfig::default().screen;
-            let model = load_for_display(model.as_deref(), &screen, &phantogram::model::DioramaFit::default())?;
-            let bounds = model.bounds().context("the model is empty")?;
-            let mut model = model;
-            model.add_floor(&screen, 2.5);
+            let (model, bounds) = load_for_display(model.as_deref(), &screen, &Default::default(), true)?;
             let log = match log {
                 Some(path) => Some(open_events(&path)?.collect::<Result<Vec<_>, _>>()?),
                 None => None,
@@ -598,7 +595,7 @@ struct RenderArgs<'a> {
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
-    use phantogram::containment::{ContainmentSmoother, required_push_back_m};
+    use phantogram::containment::ContainmentSmoother;
     use phantogram::model::DioramaFit;
     use phantogram::render::{FrameInput, Gpu, Renderer};
 
@@ -645,13 +642,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         protrude_fraction: protrude,
         ..DioramaFit::default()
     };
-    let model = load_for_display(model_path, &screen, &fit)?;
-    // Containment concerns the artifact, not the floor under it.
-    let bounds = model.bounds().context("the model is empty")?;
-    let mut model = model;
-    if floor {
-        model.add_floor(&screen, 2.5);
-    }
+    let (model, bounds) = load_for_display(model_path, &screen, &fit, floor)?;
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
@@ -687,8 +678,12 @@ fn render_command(args: RenderArgs) -> Result<()> {
                     return;
                 }
             }
-            let required = required_push_back_m(&bounds, &view.stereo_eyes_m(), &session.config().screen);
-            let push = smoother.update(required, interval_ns as f32 * 1e-9);
+            let push = smoother.follow(
+                &bounds,
+                &view.stereo_eyes_m(),
+                &session.config().screen,
+                interval_ns as f32 * 1e-9,
+            );
             let input = FrameInput::from_view(view, phantogram::glam::Vec3::Z * -push);
             let result = renderer
                 .render(&input, method, width, height)
@@ -719,16 +714,31 @@ fn render_command(args: RenderArgs) -> Result<()> {
     Ok(())
 }
 
-/// The model to show: a glTF file fitted to the diorama (its warnings printed), or the default
-/// artifact.
+/// The model to show, with the artifact's bounds for containment (the floor, when asked for, is
+/// added after them: containment concerns the artifact, not what it stands on). A glTF file is
+/// fitted to the diorama and its warnings printed; without one, the default artifact.
 fn load_for_display(
     path: Option<&std::path::Path>,
     screen: &phantogram::screen::Screen,
     fit: &phantogram::model::DioramaFit,
-) -> Result<phantogram::model::Model> {
-    let Some(path) = path else {
-        return Ok(phantogram::artifact::default_model());
+    floor: bool,
+) -> Result<(phantogram::model::Model, phantogram::containment::Aabb)> {
+    let mut model = match path {
+        Some(path) => load_fitted(path, screen, fit)?,
+        None => phantogram::artifact::default_model(),
     };
+    let bounds = model.bounds().context("the model is empty")?;
+    if floor {
+        model.add_floor(screen, 2.5);
+    }
+    Ok((model, bounds))
+}
+
+fn load_fitted(
+    path: &std::path::Path,
+    screen: &phantogram::screen::Screen,
+    fit: &phantogram::model::DioramaFit,
+) -> Result<phantogram::model::Model> {
     let mut model = phantogram::model::load_model(path)?;
     for w in &model.warnings {
         eprintln!("warning: {}: {w}", path.display());

@@ -12,7 +12,7 @@ use std::time::Instant;
 
 use anyhow::{Context, Result, anyhow};
 use phantogram::anaglyph::Method;
-use phantogram::containment::{Aabb, ContainmentSmoother, required_push_back_m};
+use phantogram::containment::{Aabb, ContainmentSmoother};
 use phantogram::glam::{Quat, Vec3};
 use phantogram::model::Model;
 use phantogram::render::{FrameInput, Gpu, Renderer};
@@ -119,8 +119,12 @@ impl App {
         self.last_frame_s = now_s;
         self.feed_sensors(now_s);
         let view = self.session.frame()?;
-        let required = required_push_back_m(&self.args.bounds, &view.stereo_eyes_m(), &self.session.config().screen);
-        let push = self.smoother.update(required, dt);
+        let push = self.smoother.follow(
+            &self.args.bounds,
+            &view.stereo_eyes_m(),
+            &self.session.config().screen,
+            dt,
+        );
         let input = FrameInput::from_view(&view, Vec3::Z * -push);
         let Some(renderer) = self.renderer.as_mut() else {
             return Ok(());
