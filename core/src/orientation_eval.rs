@@ -254,7 +254,11 @@ impl OrientationEstimator for PlatformRotationVector {
     }
 }
 
-/// The paper's low-pass coefficients tried when searching for the best `c` of a trial.
+/// The paper's coefficient.
+pub const PAPER_C: f32 = 0.1;
+
+/// The paper's low-pass coefficients tried when searching for the best `c` of a trial (the
+/// paper's own among them).
 pub const LOW_PASS_C_GRID: [f32; 10] = [0.002, 0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5];
 
 /// All scores for one trial: low-pass at c = 0.1, low-pass at its best c (lowest main
@@ -267,12 +271,19 @@ pub fn score_all(trial: &Trial) -> Vec<Score> {
         let mut est = LowPassAttitude::new(tau, tau);
         score(trial, &format!("low-pass c={c}"), &mut est)
     };
-    let mut out = vec![low_pass(0.1)];
-    let best = LOW_PASS_C_GRID
+    // Each coefficient of the grid once; the paper's c = 0.1 is one of them.
+    let grid: Vec<Score> = LOW_PASS_C_GRID.iter().map(|&c| low_pass(c)).collect();
+    let paper = grid
         .iter()
-        .map(|&c| low_pass(c))
-        .min_by(|a, b| a.main.inclination_deg.total_cmp(&b.main.inclination_deg));
-    if let Some(mut best) = best {
+        .zip(LOW_PASS_C_GRID)
+        .find(|(_, c)| *c == PAPER_C)
+        .map(|(s, _)| s.clone())
+        .expect("the grid holds the paper's coefficient");
+    let mut out = vec![paper];
+    if let Some(mut best) = grid
+        .into_iter()
+        .min_by(|a, b| a.main.inclination_deg.total_cmp(&b.main.inclination_deg))
+    {
         best.estimator = format!("{} (best)", best.estimator);
         out.push(best);
     }

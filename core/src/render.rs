@@ -300,11 +300,50 @@ struct Targets {
     height: u32,
     hdr: [wgpu::TextureView; 2],
     depth: wgpu::TextureView,
+    compose_bind: [wgpu::BindGroup; 2],
+    /// Only when rendering headless: drawing to a window composes into its swapchain image.
+    offscreen: Option<Offscreen>,
+}
+
+/// The composed frame's texture and the buffer it is read back through.
+struct Offscreen {
     output: wgpu::Texture,
     output_view: wgpu::TextureView,
     readback: wgpu::Buffer,
     padded_row: u32,
-    compose_bind: [wgpu::BindGroup; 2],
+}
+
+impl Offscreen {
+    fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
+        let output = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("output"),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: OUTPUT_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        });
+        let output_view = output.create_view(&Default::default());
+        let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        let readback = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("readback"),
+            size: padded_row as u64 * height as u64,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        Self {
+            output,
+            output_view,
+            readback,
+            padded_row,
+        }
+    }
 }
 
 struct GpuPrimitive {
@@ -736,19 +775,6 @@ impl Renderer {
         ];
         let depth =
             texture("depth", DEPTH_FORMAT, wgpu::TextureUsages::RENDER_ATTACHMENT).create_view(&Default::default());
-        let output = texture(
-            "output",
-            OUTPUT_FORMAT,
-            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        );
-        let output_view = output.create_view(&Default::default());
-        let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-        let readback = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("readback"),
-            size: padded_row as u64 * height as u64,
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
         // Bind group 0 composes left with right; bind group 1 reads the left image twice (mono).
         let compose_bind = [(0usize, 1usize), (0, 0)].map(|(a, b)| {
             device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -775,10 +801,7 @@ impl Renderer {
             height,
             hdr,
             depth,
-            output,
-            output_view,
-            readback,
-            padded_row,
+            offscreen: None,
             compose_bind,
         }
     }
@@ -839,28 +862,35 @@ impl Renderer {
         height: u32,
     ) -> Result<Vec<u8>, RenderError> {
         self.targets(width, height)?;
-        let output_view = self.targets.as_ref().expect("created above").output_view.clone();
+        let device = self.gpu.device.clone();
+        let targets = self.targets.as_mut().expect("created above");
+        let output_view = targets
+            .offscreen
+            .get_or_insert_with(|| Offscreen::new(&device, width, height))
+            .output_view
+            .clone();
         let mut encoder = self.encode_frame(eyes, input, method, &output_view, OUTPUT_FORMAT)?;
         let targets = self.targets.as_ref().expect("created above");
+        let offscreen = targets.offscreen.as_ref().expect("created above");
         encoder.copy_texture_to_buffer(
-            targets.output.as_image_copy(),
+            offscreen.output.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
-                buffer: &targets.readback,
+                buffer: &offscreen.readback,
                 layout: wgpu::TexelCopyBufferLayout {
                     offset: 0,
-                    bytes_per_row: Some(targets.padded_row),
-                    rows_per_image: Some(targets.height),
+                    bytes_per_row: Some(offscreen.padded_row),
+                    rows_per_image: Some(height),
                 },
             },
             wgpu::Extent3d {
-                width: targets.width,
-                height: targets.height,
+                width,
+                height,
                 depth_or_array_layers: 1,
             },
         );
         let queue = &self.gpu.queue;
         checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()]))?;
-        read_back(&self.gpu.device, targets)
+        read_back(&self.gpu.device, offscreen, width, height)
     }
 
     /// Renders one frame into `target` (e.g. a surface's current texture) of `format` and
@@ -1307,7 +1337,7 @@ fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     }
 }
 
-fn read_back(device: &wgpu::Device, targets: &Targets) -> Result<Vec<u8>, RenderError> {
+fn read_back(device: &wgpu::Device, targets: &Offscreen, width: u32, height: u32) -> Result<Vec<u8>, RenderError> {
     let slice = targets.readback.slice(..);
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
@@ -1319,13 +1349,13 @@ fn read_back(device: &wgpu::Device, targets: &Targets) -> Result<Vec<u8>, Render
     rx.recv()
         .map_err(|e| RenderError::Readback(e.to_string()))?
         .map_err(|e| RenderError::Readback(e.to_string()))?;
-    let row_bytes = (targets.width * 4) as usize;
-    let mut pixels = Vec::with_capacity(row_bytes * targets.height as usize);
+    let row_bytes = (width * 4) as usize;
+    let mut pixels = Vec::with_capacity(row_bytes * height as usize);
     {
         let data = slice
             .get_mapped_range()
             .map_err(|e| RenderError::Readback(e.to_string()))?;
-        for row in data.chunks(targets.padded_row as usize).take(targets.height as usize) {
+        for row in data.chunks(targets.padded_row as usize).take(height as usize) {
             pixels.extend_from_slice(&row[..row_bytes]);
         }
     }
