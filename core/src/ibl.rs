@@ -171,7 +171,8 @@ impl IrradianceSh {
     }
 
     /// The coefficients pre-multiplied by the band weights and basis constants, as the shader
-    /// evaluates them: `E(n) = Σ k_i · c_i · poly_i(n)` with the polynomial parts of [`basis`].
+    /// evaluates them: `E(n) = Σ k_i · c_i · poly_i(n)` with the polynomial parts of the real SH
+    /// basis up to l = 2.
     pub fn shader_coefficients(&self) -> [[f32; 4]; 9] {
         let constants = [
             0.282_095, 0.488_603, 0.488_603, 0.488_603, 1.092_548, 1.092_548, 0.315_392, 1.092_548, 0.546_274,

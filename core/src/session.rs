@@ -5,7 +5,9 @@
 //! [`SensorInbox`] returned by [`Session::inbox`] (an `Arc`, `Send + Sync`); [`Session::frame`]
 //! drains it. Nothing blocks.
 //!
-//! **Order of work per frame**: drain the inbox (sorted by time) → feed the orientation estimator →
+//! **Order of work per frame**: drain the inbox (sorted by time) → feed the orientation estimator
+//! (the gyroscope/accelerometer/magnetometer fusion by default, the paper's low-pass on request:
+//! [`EstimatorChoice`]) →
 //! anchor the light the first time a full orientation is known → cyclopean eye from "up" and the
 //! flat-angle reference → stereo pair → three projections (left, right, and the cyclopean one for
 //! mono rendering).
