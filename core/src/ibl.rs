@@ -10,8 +10,15 @@
 //! * [`IrradianceSh`] holds `L_lm` (RGB) of the environment's radiance; [`IrradianceSh::irradiance`]
 //!   evaluates `E(n)`, so a Lambertian surface of albedo `ρ` reflects `ρ/π · E(n)`.
 //!
-//! TODO(issue #3): specular image-based light (prefiltered environment and split-sum BRDF lookup);
-//! the renderer approximates it with the irradiance in the reflection direction.
+//! * Specular: the split-sum approximation (Karis, "Real Shading in Unreal Engine 4", 2013):
+//!   [`prefiltered_levels`] convolves the environment with the GGX lobe for a ladder of
+//!   roughnesses (one equirectangular mip level each, assuming n = v = r), and [`brdf_lut`]
+//!   tabulates the scale and bias applied to F0 as a function of n·v and roughness.
+//!
+//! TODO(issue #3): the renderer does not sample these yet (it needs the levels as an Rgba16Float
+//! mip chain and the LUT as a texture in the eye bind group); until then it approximates specular
+//! image-based light with the irradiance in the reflection direction. Both are tested here so the
+//! wiring is the only step left.
 
 use glam::Vec3;
 
@@ -187,9 +194,199 @@ impl IrradianceSh {
     }
 }
 
+impl Environment {
+    /// Bilinear lookup in the direction `d` (world frame), wrapping in azimuth.
+    pub fn sample(&self, d: Vec3) -> [f32; 3] {
+        let d = d.normalize_or(Vec3::Z);
+        let u = (d.y.atan2(d.x) / std::f32::consts::TAU).rem_euclid(1.0) * self.width as f32 - 0.5;
+        let v = (d.z.clamp(-1.0, 1.0).acos() / std::f32::consts::PI) * self.height as f32 - 0.5;
+        let (x0, y0) = (u.floor(), v.floor());
+        let (fx, fy) = (u - x0, v - y0);
+        let texel = |x: f32, y: f32| {
+            let xi = (x as i64).rem_euclid(self.width as i64) as usize;
+            let yi = (y as i64).clamp(0, self.height as i64 - 1) as usize;
+            self.texels[yi * self.width + xi]
+        };
+        let mut out = [0.0f32; 3];
+        for (dx, dy, w) in [
+            (0.0, 0.0, (1.0 - fx) * (1.0 - fy)),
+            (1.0, 0.0, fx * (1.0 - fy)),
+            (0.0, 1.0, (1.0 - fx) * fy),
+            (1.0, 1.0, fx * fy),
+        ] {
+            let t = texel(x0 + dx, y0 + dy);
+            for c in 0..3 {
+                out[c] += t[c] * w;
+            }
+        }
+        out
+    }
+
+    /// Half the resolution, each texel the mean of four (keeps the integral for prefiltering).
+    fn downsampled(&self) -> Self {
+        let (w, h) = ((self.width / 2).max(2), (self.height / 2).max(1));
+        let mut texels = vec![[0.0f32; 3]; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                let mut acc = [0.0f32; 3];
+                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                    let t = self.texels
+                        [((2 * y + dy).min(self.height - 1)) * self.width + (2 * x + dx).min(self.width - 1)];
+                    for c in 0..3 {
+                        acc[c] += t[c] * 0.25;
+                    }
+                }
+                texels[y * w + x] = acc;
+            }
+        }
+        Self {
+            width: w,
+            height: h,
+            texels,
+        }
+    }
+}
+
+/// Number of roughness levels in the prefiltered environment (roughness `k / (LEVELS − 1)`).
+pub const PREFILTER_LEVELS: usize = 6;
+
+/// The `i`-th point of the Hammersley set of `n`.
+fn hammersley(i: u32, n: u32) -> (f32, f32) {
+    (i as f32 / n as f32, (i.reverse_bits() as f64 / 4_294_967_296.0) as f32)
+}
+
+/// A GGX half vector about `n` for the sample `(u1, u2)` and `alpha = roughness²`.
+fn ggx_half_vector(u1: f32, u2: f32, alpha: f32, n: Vec3) -> Vec3 {
+    let phi = std::f32::consts::TAU * u1;
+    let cos_theta = ((1.0 - u2) / (1.0 + (alpha * alpha - 1.0) * u2)).max(0.0).sqrt();
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let up = if n.z.abs() < 0.999 { Vec3::Z } else { Vec3::X };
+    let t = up.cross(n).normalize();
+    let b = n.cross(t);
+    (t * (sin_theta * phi.cos()) + b * (sin_theta * phi.sin()) + n * cos_theta).normalize()
+}
+
+/// The environment convolved with the GGX lobe: level `k` (roughness `k / (LEVELS − 1)`) at
+/// `base_width / 2^k` × `base_width / 2^(k+1)`. Level 0 is the (downsampled) environment itself.
+pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environment> {
+    // Sample from a source a little coarser than each level, so few samples suffice.
+    let mut source = env.clone();
+    while source.width > base_width {
+        source = source.downsampled();
+    }
+    let mut levels = vec![source.clone()];
+    let samples = 96u32;
+    for k in 1..PREFILTER_LEVELS {
+        let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
+        let alpha = roughness * roughness;
+        let (w, h) = ((base_width >> k).max(4), (base_width >> (k + 1)).max(2));
+        while source.width > 2 * w && source.width > 8 {
+            source = source.downsampled();
+        }
+        let mut level = Environment {
+            width: w,
+            height: h,
+            texels: vec![[0.0; 3]; w * h],
+        };
+        for y in 0..h {
+            for x in 0..w {
+                let n = level.direction(x, y);
+                let mut acc = [0.0f32; 3];
+                let mut weight = 0.0f32;
+                for i in 0..samples {
+                    let (u1, u2) = hammersley(i, samples);
+                    let hv = ggx_half_vector(u1, u2, alpha, n);
+                    let l = (hv * 2.0 * n.dot(hv) - n).normalize();
+                    let n_dot_l = n.dot(l);
+                    if n_dot_l > 0.0 {
+                        let c = source.sample(l);
+                        for ch in 0..3 {
+                            acc[ch] += c[ch] * n_dot_l;
+                        }
+                        weight += n_dot_l;
+                    }
+                }
+                level.texels[y * w + x] = acc.map(|a| a / weight.max(1e-6));
+            }
+        }
+        levels.push(level);
+    }
+    levels
+}
+
+/// The split-sum BRDF table: `size × size` entries of `(scale, bias)` with n·v along x (0 → 1)
+/// and roughness along y (0 → 1), so that the specular image-based light is
+/// `prefiltered(r, roughness) · (F0 · scale + bias)`.
+pub fn brdf_lut(size: usize) -> Vec<[f32; 2]> {
+    let samples = 256u32;
+    let mut out = Vec::with_capacity(size * size);
+    for j in 0..size {
+        let roughness = (j as f32 + 0.5) / size as f32;
+        let alpha = roughness * roughness;
+        // Schlick–GGX geometry with k = α/2 for image-based light (Karis 2013).
+        let k = alpha / 2.0;
+        let g1 = |c: f32| c / (c * (1.0 - k) + k);
+        for i in 0..size {
+            let n_dot_v = ((i as f32 + 0.5) / size as f32).max(1e-3);
+            let v = Vec3::new((1.0 - n_dot_v * n_dot_v).sqrt(), 0.0, n_dot_v);
+            let (mut a, mut b) = (0.0f32, 0.0f32);
+            for s in 0..samples {
+                let (u1, u2) = hammersley(s, samples);
+                let h = ggx_half_vector(u1, u2, alpha, Vec3::Z);
+                let l = h * 2.0 * v.dot(h) - v;
+                let (n_dot_l, n_dot_h, v_dot_h) = (l.z, h.z.max(0.0), v.dot(h).max(0.0));
+                if n_dot_l > 0.0 {
+                    let g_vis = g1(n_dot_l) * g1(n_dot_v) * v_dot_h / (n_dot_h * n_dot_v).max(1e-6);
+                    let fc = (1.0 - v_dot_h).powi(5);
+                    a += (1.0 - fc) * g_vis;
+                    b += fc * g_vis;
+                }
+            }
+            out.push([a / samples as f32, b / samples as f32]);
+        }
+    }
+    out
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn split_sum_table_matches_known_values() {
+        let lut = brdf_lut(32);
+        let at = |nv: f32, r: f32| lut[((r * 32.0) as usize).min(31) * 32 + ((nv * 32.0) as usize).min(31)];
+        // Smooth surface seen head-on: all of F0, no bias.
+        let smooth = at(0.99, 0.0);
+        assert!((smooth[0] - 1.0).abs() < 0.05 && smooth[1] < 0.02, "{smooth:?}");
+        // Rough and grazing: the reflectance drops well below 1.
+        let rough = at(0.5, 0.99);
+        assert!(rough[0] + rough[1] < 0.8 && rough[0] > 0.2, "{rough:?}");
+        // Every entry is a reflectance in [0, 1].
+        assert!(lut.iter().all(|[a, b]| *a >= 0.0 && *b >= 0.0 && a + b <= 1.05));
+    }
+
+    #[test]
+    fn prefiltering_keeps_constant_light_and_blurs_a_sun() {
+        let levels = prefiltered_levels(&uniform(0.7), 64);
+        assert_eq!(levels.len(), PREFILTER_LEVELS);
+        for l in &levels {
+            assert!(
+                l.texels.iter().all(|t| (t[0] - 0.7).abs() < 0.01),
+                "{}x{}",
+                l.width,
+                l.height
+            );
+        }
+        // A small bright patch: the rough levels spread it (lower peak, light further away).
+        let mut sun = uniform(0.0);
+        sun.texels[10 * sun.width + 40] = [1000.0; 3];
+        let levels = prefiltered_levels(&sun, 64);
+        let peak = |e: &Environment| e.texels.iter().map(|t| t[0]).fold(0.0, f32::max);
+        assert!(peak(&levels[5]) < peak(&levels[1]));
+        let lit = |e: &Environment| e.texels.iter().filter(|t| t[0] > 1e-3).count() as f32 / e.texels.len() as f32;
+        assert!(lit(&levels[5]) > lit(&levels[1]));
+    }
 
     fn uniform(value: f32) -> Environment {
         Environment {
