@@ -388,6 +388,21 @@ mod tests {
         assert!(lit(&levels[5]) > lit(&levels[1]));
     }
 
+    #[test]
+    fn sampling_a_texel_centre_direction_returns_that_texel() {
+        let env = Environment::studio();
+        for (x, y) in [(0, 0), (13, 5), (40, 16), (63, 31)] {
+            let got = env.sample(env.direction(x, y));
+            let want = env.texels[y * env.width + x];
+            for c in 0..3 {
+                assert!(
+                    (got[c] - want[c]).abs() < 1e-4 * (1.0 + want[c]),
+                    "({x},{y}): {got:?} vs {want:?}"
+                );
+            }
+        }
+    }
+
     fn uniform(value: f32) -> Environment {
         Environment {
             width: 128,
