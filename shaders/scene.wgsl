@@ -1,6 +1,7 @@
 // Scene pass: one eye's view, lit by the world-fixed directional light, written as linear HDR
 // radiance. glTF metallic–roughness shading: Lambert diffuse + GGX / Smith / Schlick specular,
-// normal, occlusion and emissive maps, alpha mask and blend, and a small hemispherical ambient.
+// normal, occlusion and emissive maps, alpha mask and blend, and image-based light from a
+// world-fixed environment (SH irradiance for diffuse, split-sum prefiltered map for specular).
 //
 // Coordinates: positions, normals and tangents are in the device frame (metres); `eye.view_proj`
 // is the core's off-axis projection (reverse-Z, wgpu clip space).
@@ -41,6 +42,12 @@ struct Material {
 @group(0) @binding(0) var<uniform> eye: Eye;
 @group(0) @binding(1) var shadow_map: texture_depth_2d;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
+// Specular image-based light (split sum, see ibl.rs): the environment prefiltered with the GGX
+// lobe, one roughness per mip level (roughness k/5 at level k), equirectangular in the world
+// frame; and the BRDF's scale and bias on F0 by (n·v, roughness).
+@group(0) @binding(3) var prefiltered_env: texture_2d<f32>;
+@group(0) @binding(4) var brdf_lut: texture_2d<f32>;
+@group(0) @binding(5) var env_sampler: sampler;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_texture: texture_2d<f32>;
@@ -143,6 +150,16 @@ fn irradiance(n: vec3<f32>) -> vec3<f32> {
     return max(e, vec3<f32>(0.0));
 }
 
+const PREFILTERED_MAX_LEVEL: f32 = 5.0;
+
+// Equirectangular coordinates of world direction d: u = azimuth from east towards north / 2π,
+// v = polar angle from the zenith / π (the convention of ibl.rs).
+fn equirect_uv(d: vec3<f32>) -> vec2<f32> {
+    let u = fract(atan2(d.y, d.x) / (2.0 * PI) + 1.0);
+    let v = acos(clamp(d.z, -1.0, 1.0)) / PI;
+    return vec2<f32>(u, v);
+}
+
 fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
@@ -207,15 +224,19 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     let geometric_n = normalize(select(-in.normal, in.normal, front));
     let direct = (diffuse + specular) * eye.light.rgb * n_dot_l * light_visibility(in.world, geometric_n, l);
 
-    // Image-based light, world-fixed: diffuse from the environment's irradiance; specular, until
-    // the prefiltered map exists, from the irradiance in the reflection direction with a
-    // roughness-aware Fresnel (TODO(issue #3): split-sum prefiltered specular).
+    // Image-based light, world-fixed: diffuse from the environment's irradiance (ρ/π·E), specular
+    // by the split sum: the prefiltered radiance around the reflection direction at this
+    // roughness, times F0·scale + bias from the BRDF table (Karis 2013). Explicit levels: no
+    // derivatives, so the azimuth seam of the equirectangular map leaves no line.
     let occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);
-    let env = eye.light.w * occlusion / PI;
     let fresnel_ambient = f0 + (max(vec3<f32>(1.0 - roughness), f0) - f0) * pow(1.0 - n_dot_v, 5.0);
-    let diffuse_ambient = irradiance(to_world(n)) * base * (1.0 - metallic) * (vec3<f32>(1.0) - fresnel_ambient);
-    let specular_ambient = irradiance(to_world(reflect(-v, n))) * fresnel_ambient;
-    let ambient = env * (diffuse_ambient + specular_ambient);
+    let diffuse_ambient = irradiance(to_world(n)) / PI * base * (1.0 - metallic) * (vec3<f32>(1.0) - fresnel_ambient);
+    let lut_size = vec2<f32>(textureDimensions(brdf_lut));
+    let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+    let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
+    let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(to_world(reflect(-v, n))), roughness * PREFILTERED_MAX_LEVEL).rgb;
+    let specular_ambient = prefiltered * (f0 * scale_bias.x + vec3<f32>(scale_bias.y));
+    let ambient = eye.light.w * occlusion * (diffuse_ambient + specular_ambient);
     let emissive = material.emissive.rgb * emissive_sample.rgb;
 
     var out_alpha = 1.0;

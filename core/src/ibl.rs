@@ -15,10 +15,8 @@
 //!   roughnesses (one equirectangular mip level each, assuming n = v = r), and [`brdf_lut`]
 //!   tabulates the scale and bias applied to F0 as a function of n·v and roughness.
 //!
-//! TODO(issue #3): the renderer does not sample these yet (it needs the levels as an Rgba16Float
-//! mip chain and the LUT as a texture in the eye bind group); until then it approximates specular
-//! image-based light with the irradiance in the reflection direction. Both are tested here so the
-//! wiring is the only step left.
+//!   The renderer uploads the levels as an `Rgba16Float` mip chain and the table as an `Rg16Float`
+//!   texture and samples them with the roughness as the level of detail.
 
 use glam::Vec3;
 
@@ -267,19 +265,37 @@ fn ggx_half_vector(u1: f32, u2: f32, alpha: f32, n: Vec3) -> Vec3 {
 }
 
 /// The environment convolved with the GGX lobe: level `k` (roughness `k / (LEVELS − 1)`) at
-/// `base_width / 2^k` × `base_width / 2^(k+1)`. Level 0 is the (downsampled) environment itself.
+/// `base_width / 2^k` × `base_width / 2^(k+1)`, so the levels form the first [`PREFILTER_LEVELS`]
+/// levels of a texture mip chain. Level 0 is the environment itself, resampled to
+/// `base_width × base_width / 2`.
+///
+/// `base_width` is rounded up to a power of two of at least `2^PREFILTER_LEVELS` so that every
+/// level has whole texels.
 pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environment> {
+    let base_width = base_width.max(1 << PREFILTER_LEVELS).next_power_of_two();
     // Sample from a source a little coarser than each level, so few samples suffice.
     let mut source = env.clone();
-    while source.width > base_width {
+    while source.width >= 2 * base_width && source.width > 8 {
         source = source.downsampled();
+    }
+    if source.width != base_width || source.height != base_width / 2 {
+        let mut level0 = Environment {
+            width: base_width,
+            height: base_width / 2,
+            texels: Vec::new(),
+        };
+        level0.texels = (0..level0.height)
+            .flat_map(|y| (0..level0.width).map(move |x| (x, y)))
+            .map(|(x, y)| source.sample(level0.direction(x, y)))
+            .collect();
+        source = level0;
     }
     let mut levels = vec![source.clone()];
     let samples = 96u32;
     for k in 1..PREFILTER_LEVELS {
         let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
         let alpha = roughness * roughness;
-        let (w, h) = ((base_width >> k).max(4), (base_width >> (k + 1)).max(2));
+        let (w, h) = (base_width >> k, base_width >> (k + 1));
         while source.width > 2 * w && source.width > 8 {
             source = source.downsampled();
         }
@@ -370,6 +386,17 @@ mod tests {
     fn prefiltering_keeps_constant_light_and_blurs_a_sun() {
         let levels = prefiltered_levels(&uniform(0.7), 64);
         assert_eq!(levels.len(), PREFILTER_LEVELS);
+        // A mip chain: each level halves both sizes (a 64-wide request is already the minimum).
+        for (k, l) in levels.iter().enumerate() {
+            assert_eq!((l.width, l.height), (64 >> k, 32 >> k));
+        }
+        // A small environment is resampled up to the requested base.
+        let small = Environment {
+            width: 16,
+            height: 8,
+            texels: vec![[0.7; 3]; 128],
+        };
+        assert_eq!(prefiltered_levels(&small, 100)[0].width, 128);
         for l in &levels {
             assert!(
                 l.texels.iter().all(|t| (t[0] - 0.7).abs() < 0.01),

@@ -417,6 +417,10 @@ pub struct Renderer {
     compose_pipeline_layout: wgpu::PipelineLayout,
     eye_buffers: [wgpu::Buffer; 2],
     eye_bind: [wgpu::BindGroup; 2],
+    eye_layout: wgpu::BindGroupLayout,
+    shadow_sampler: wgpu::Sampler,
+    /// Specular image-based light: the prefiltered environment and the split-sum table.
+    ibl: IblTextures,
     compose_buffer: wgpu::Buffer,
     compose_layout: wgpu::BindGroupLayout,
     material_layout: wgpu::BindGroupLayout,
@@ -472,6 +476,14 @@ impl Renderer {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison),
                     count: None,
                 },
+                filterable_texture_entry(3),
+                filterable_texture_entry(4),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 5,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
             ],
         });
         let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -504,26 +516,8 @@ impl Renderer {
                 mapped_at_creation: false,
             })
         });
-        let eye_bind = [0, 1].map(|i| {
-            device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("eye"),
-                layout: &eye_layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: eye_buffers[i].as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: wgpu::BindingResource::TextureView(&shadow_view),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: wgpu::BindingResource::Sampler(&shadow_sampler),
-                    },
-                ],
-            })
-        });
+        let ibl = IblTextures::new(&gpu, default_prefiltered_environment());
+        let eye_bind = eye_bind_groups(device, &eye_layout, &eye_buffers, &shadow_view, &shadow_sampler, &ibl);
         // The shadow pass reads only the light's matrix (the same in both eye blocks) and must
         // not bind the shadow map it writes.
         let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -699,6 +693,9 @@ impl Renderer {
             compose_pipeline_layout,
             eye_buffers,
             eye_bind,
+            eye_layout,
+            shadow_sampler,
+            ibl,
             compose_buffer,
             compose_layout,
             material_layout,
@@ -719,8 +716,24 @@ impl Renderer {
     }
 
     /// Lights the scene with `env` (world frame) instead of the generated studio.
-    pub fn set_environment(&mut self, env: &crate::ibl::Environment) {
+    ///
+    /// Prefilters the environment for specular light on the CPU (a few tens of milliseconds in
+    /// release builds for the default 256-wide base level).
+    pub fn set_environment(&mut self, env: &crate::ibl::Environment) -> Result<(), RenderError> {
         self.environment_sh = crate::ibl::IrradianceSh::from_environment(env).shader_coefficients();
+        let levels = crate::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
+        let device = self.gpu.device.clone();
+        checked(&device, "the environment map", || {
+            self.ibl = IblTextures::new(&self.gpu, &levels);
+            self.eye_bind = eye_bind_groups(
+                &device,
+                &self.eye_layout,
+                &self.eye_buffers,
+                &self.shadow_view,
+                &self.shadow_sampler,
+                &self.ibl,
+            );
+        })
     }
 
     /// Replaces the model drawn (keeps pipelines and targets).
@@ -1321,6 +1334,190 @@ fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> Gpu
         primitives,
         materials,
         bounds,
+    }
+}
+
+/// Width of the prefiltered environment's sharpest level (mirror-like reflections).
+const PREFILTERED_BASE_WIDTH: usize = 256;
+/// Size of the split-sum BRDF table (n·v × roughness).
+const BRDF_LUT_SIZE: usize = 64;
+
+/// The generated studio's prefiltered levels, computed once per process: every renderer starts
+/// with them.
+fn default_prefiltered_environment() -> &'static [crate::ibl::Environment] {
+    static LEVELS: std::sync::OnceLock<Vec<crate::ibl::Environment>> = std::sync::OnceLock::new();
+    LEVELS.get_or_init(|| crate::ibl::prefiltered_levels(&crate::ibl::Environment::studio(), PREFILTERED_BASE_WIDTH))
+}
+
+/// The split-sum table as `Rg16Float` texels, computed once per process (it depends on nothing).
+fn brdf_lut_texels() -> &'static [u8] {
+    static TEXELS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    TEXELS.get_or_init(|| {
+        crate::ibl::brdf_lut(BRDF_LUT_SIZE)
+            .into_iter()
+            .flat_map(|[a, b]| [half::f16::from_f32(a), half::f16::from_f32(b)])
+            .flat_map(|h| h.to_le_bytes())
+            .collect()
+    })
+}
+
+/// The GPU side of the specular image-based light.
+struct IblTextures {
+    environment: wgpu::TextureView,
+    brdf_lut: wgpu::TextureView,
+    sampler: wgpu::Sampler,
+}
+
+impl IblTextures {
+    /// Uploads `levels` (from [`crate::ibl::prefiltered_levels`], a mip chain) and the BRDF table.
+    fn new(gpu: &Gpu, levels: &[crate::ibl::Environment]) -> Self {
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("prefiltered environment"),
+            size: wgpu::Extent3d {
+                width: levels[0].width as u32,
+                height: levels[0].height as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: levels.len() as u32,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        for (k, level) in levels.iter().enumerate() {
+            let bytes: Vec<u8> = level
+                .texels
+                .iter()
+                .flat_map(|t| [t[0], t[1], t[2], 1.0])
+                // f16 saturates at 65504: clamp so a very bright sun stays finite.
+                .map(|c| half::f16::from_f32(c.min(65_000.0)))
+                .flat_map(|h| h.to_le_bytes())
+                .collect();
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: k as u32,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &bytes,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(8 * level.width as u32),
+                    rows_per_image: Some(level.height as u32),
+                },
+                wgpu::Extent3d {
+                    width: level.width as u32,
+                    height: level.height as u32,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        let lut = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("split-sum BRDF table"),
+            size: wgpu::Extent3d {
+                width: BRDF_LUT_SIZE as u32,
+                height: BRDF_LUT_SIZE as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rg16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &lut,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            brdf_lut_texels(),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * BRDF_LUT_SIZE as u32),
+                rows_per_image: Some(BRDF_LUT_SIZE as u32),
+            },
+            wgpu::Extent3d {
+                width: BRDF_LUT_SIZE as u32,
+                height: BRDF_LUT_SIZE as u32,
+                depth_or_array_layers: 1,
+            },
+        );
+        // Azimuth wraps; the shader keeps the table's coordinates inside its texel centres.
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        Self {
+            environment: texture.create_view(&Default::default()),
+            brdf_lut: lut.create_view(&Default::default()),
+            sampler,
+        }
+    }
+}
+
+fn eye_bind_groups(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[wgpu::Buffer; 2],
+    shadow_view: &wgpu::TextureView,
+    shadow_sampler: &wgpu::Sampler,
+    ibl: &IblTextures,
+) -> [wgpu::BindGroup; 2] {
+    [0, 1].map(|i| {
+        device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("eye"),
+            layout,
+            entries: &[
+                wgpu::BindGroupEntry {
+                    binding: 0,
+                    resource: buffers[i].as_entire_binding(),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 1,
+                    resource: wgpu::BindingResource::TextureView(shadow_view),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 2,
+                    resource: wgpu::BindingResource::Sampler(shadow_sampler),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 3,
+                    resource: wgpu::BindingResource::TextureView(&ibl.environment),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 4,
+                    resource: wgpu::BindingResource::TextureView(&ibl.brdf_lut),
+                },
+                wgpu::BindGroupEntry {
+                    binding: 5,
+                    resource: wgpu::BindingResource::Sampler(&ibl.sampler),
+                },
+            ],
+        })
+    })
+}
+
+fn filterable_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
     }
 }
 

@@ -376,7 +376,7 @@ fn environment_light_turns_with_the_device() {
         let above = i / sky.width < sky.height / 2;
         *t = if above { [1.0; 3] } else { [0.0; 3] };
     }
-    renderer.set_environment(&sky);
+    renderer.set_environment(&sky).unwrap();
     renderer.lighting.light_rgb = Vec3::ZERO;
     renderer.lighting.shadows = false;
     let eye = Vec3::new(0.0, 0.0, 0.3);
@@ -400,4 +400,68 @@ fn environment_light_turns_with_the_device() {
     );
     println!("cube top under a sky: device face up {face_up}, face down {face_down}");
     assert!(face_up > 2.0 * face_down, "{face_up} vs {face_down}");
+}
+
+/// Specular image-based light comes from the prefiltered environment in the reflection direction
+/// (split sum), not from the irradiance: under a small bright disc at the zenith and nothing
+/// else, a mirror-smooth metal top seen from straight above reflects the disc (≈ F0 × its
+/// radiance), while a fully rough one spreads it over the hemisphere and stays dark. Irradiance
+/// alone would make both dark (the disc covers 1.5 % of the sky).
+#[test]
+fn mirror_metal_reflects_the_environment_and_rough_metal_blurs_it() {
+    let Some(gpu) = gpu() else { return };
+    let screen = Screen::default();
+    let mut disc = phantogram::ibl::Environment::studio();
+    disc.width = 256;
+    disc.height = 128;
+    disc.texels = (0..disc.height)
+        .flat_map(|y| (0..256).map(move |x| (x, y)))
+        .map(|(x, y)| {
+            let d = phantogram::ibl::Environment {
+                width: 256,
+                height: 128,
+                texels: Vec::new(),
+            }
+            .direction(x, y);
+            if d.z > 10f32.to_radians().cos() {
+                [1.0; 3]
+            } else {
+                [0.0; 3]
+            }
+        })
+        .collect();
+    let eye = Vec3::new(0.0, 0.0, 0.3);
+    let mono = OffAxisProjection::new(&screen, eye, DepthRange::default()).unwrap();
+    let cube = |roughness: f32| {
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::new(0.0, 0.0, -0.02), 0.01, [0.9, 0.9, 0.9, 1.0]);
+        for v in &mut mesh.vertices {
+            v.material = [1.0, 1.0];
+        }
+        let mut model = Model::from_painted_mesh("metal cube", mesh);
+        model.materials[0].metallic = 1.0;
+        model.materials[0].roughness = roughness;
+        model
+    };
+    let mut renderer = Renderer::new(gpu, &cube(0.05)).unwrap();
+    renderer.set_environment(&disc).unwrap();
+    renderer.lighting.light_rgb = Vec3::ZERO;
+    renderer.lighting.shadows = false;
+    let mut top = |model: &Model| {
+        renderer.set_model(model).unwrap();
+        let input = FrameInput {
+            left: &mono,
+            right: &mono,
+            mono: &mono,
+            toward_light: Vec3::Z,
+            device_to_world: phantogram::glam::Quat::IDENTITY,
+            offset: Vec3::ZERO,
+        };
+        let px = renderer.render(&input, Method::Mono, W, H).unwrap();
+        luminance_at(&px, &mono, Vec3::new(0.0, 0.0, -0.01))
+    };
+    let (mirror, rough) = (top(&cube(0.05)), top(&cube(1.0)));
+    println!("metal top under a zenith disc: mirror {mirror}, rough {rough}");
+    assert!(mirror > 150.0, "the mirror should show the disc: {mirror}");
+    assert!(mirror > 3.0 * rough, "{mirror} vs {rough}");
 }

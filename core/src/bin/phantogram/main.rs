@@ -648,7 +648,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     eprintln!("rendering on {}", gpu.describe());
     let mut renderer = Renderer::new(gpu, &model)?;
     if let Some(path) = environment {
-        renderer.set_environment(&phantogram::ibl::Environment::load(path)?);
+        renderer.set_environment(&phantogram::ibl::Environment::load(path)?)?;
     }
     let mut session = Session::new(config).context("invalid settings")?;
     let mut smoother = ContainmentSmoother::default();
