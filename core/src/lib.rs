@@ -58,12 +58,14 @@
 //! * `cli` (implies `render`; on by default, off for the phone crates): `clap`, `anyhow` and
 //!   `indicatif` (progress bars) for the `phantogram` binary, `winit` (the chosen stack) for its
 //!   window.
+//! * `face` (on by default; implies `models`): `tract-onnx` runs MediaPipe's face, landmark and
+//!   iris networks in pure Rust (no native inference runtime to cross-build for the phones), and
+//!   `half` packs the renderer's f16 textures.
 //!
 //! Modules: [`screen`], [`eyes`], [`viewpoint`], [`projection`], [`containment`], [`light`],
 //! [`lowpass`], [`attitude`], [`fusion`], [`sensors`], [`sensorlog`], [`replay`], [`session`],
 //! [`synthetic`], [`orientation_eval`], [`calibration`], [`anaglyph`], [`artifact`], [`model`],
-//! [`ibl`], and with
-//! `render`, `render` and `surface`.
+//! [`ibl`], [`eyetrack`], and with `render`, `render` and `surface`; with `face`, `face`.
 
 pub mod anaglyph;
 pub mod artifact;
@@ -71,6 +73,9 @@ pub mod attitude;
 pub mod calibration;
 pub mod containment;
 pub mod eyes;
+pub mod eyetrack;
+#[cfg(feature = "face")]
+pub mod face;
 pub mod fusion;
 pub mod ibl;
 pub mod light;
@@ -92,3 +97,17 @@ pub mod viewpoint;
 
 pub use glam;
 pub use session::{FrameView, Session, SessionConfig, SessionError};
+
+/// Where `cargo xtask models` puts the face-tracking models and where [`face::FaceModels`] looks
+/// for them: `$PHANTOGRAM_MODELS` if set, else `$XDG_CACHE_HOME/phantogram/models`, else
+/// `~/.cache/phantogram/models`. `None` only without any of those variables.
+pub fn face_models_dir() -> Option<std::path::PathBuf> {
+    use std::path::PathBuf;
+    if let Some(dir) = std::env::var_os("PHANTOGRAM_MODELS") {
+        return Some(PathBuf::from(dir));
+    }
+    let cache = std::env::var_os("XDG_CACHE_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
+    Some(cache.join("phantogram").join("models"))
+}

@@ -11,6 +11,11 @@
 //! anchor the light the first time a full orientation is known → cyclopean eye from "up" and the
 //! flat-angle reference → stereo pair → three projections (left, right, and the cyclopean one for
 //! mono rendering).
+//!
+//! **Face tracking**: camera results given to [`Session::observe_face`] replace the tilt
+//! approximation's eyes while a face is seen, carried to the frame's time by the phone's rotation
+//! and blended without jumps when the face is lost or found ([`crate::eyetrack`]). Without any
+//! camera result the eyes are exactly the tilt approximation's.
 
 use std::sync::Arc;
 
@@ -19,6 +24,7 @@ use thiserror::Error;
 
 use crate::attitude::{LowPassAttitude, OrientationEstimator, device_to_world_from_up};
 use crate::eyes::{EyeModel, EyeModelError, StereoEyes};
+use crate::eyetrack::{EyeSource, EyeTrackParams, EyeTracker, FaceObservation};
 use crate::fusion::{FusedOrientation, FusionParams};
 use crate::light::WorldLight;
 use crate::projection::{DepthRange, OffAxisProjection, ProjectionError};
@@ -116,6 +122,10 @@ pub struct Session {
     light: WorldLight,
     batch: Vec<SensorEvent>,
     newest_t_ns: Option<i64>,
+    eye_tracker: EyeTracker,
+    /// Whether any camera result has been observed (until then the eyes are the tilt model's).
+    face_observed: bool,
+    eye_source: EyeSource,
 }
 
 impl std::fmt::Debug for Session {
@@ -150,6 +160,9 @@ impl Session {
             viewpoint: Viewpoint::default(),
             batch: Vec::new(),
             newest_t_ns: None,
+            eye_tracker: EyeTracker::new(EyeTrackParams::default(), config.eyes.viewing_distance_m),
+            face_observed: false,
+            eye_source: EyeSource::Tilt,
         })
     }
 
@@ -186,7 +199,23 @@ impl Session {
                 self.light.anchor(q);
             }
         }
+        // The orientation history that carries late camera results to the frame's time.
+        if let (Some(t), Some(q)) = (self.newest_t_ns, self.device_to_world()) {
+            self.eye_tracker.record_orientation(t, q);
+        }
         self.batch.len()
+    }
+
+    /// Takes a face-tracking result (from [`crate::face`] or any other tracker): the eyes in the
+    /// device frame at the frame's capture time, on the sensor clock.
+    pub fn observe_face(&mut self, observation: FaceObservation) {
+        self.face_observed = true;
+        self.eye_tracker.observe(observation);
+    }
+
+    /// Where the last frame's eyes came from.
+    pub fn eye_source(&self) -> EyeSource {
+        self.eye_source
     }
 
     /// The orientation used for the light: the estimator's, or from gravity alone (arbitrary but
@@ -232,6 +261,9 @@ impl Session {
     pub fn set_eye_model(&mut self, eyes: EyeModel) -> Result<(), SessionError> {
         eyes.validate()?;
         self.config.eyes = eyes;
+        if !self.face_observed {
+            self.eye_tracker = EyeTracker::new(EyeTrackParams::default(), eyes.viewing_distance_m);
+        }
         Ok(())
     }
 
@@ -258,8 +290,28 @@ impl Session {
         };
         let device_to_world = predicted.or_else(|| self.device_to_world());
         let cfg = &self.config;
-        let cyclopean = self.viewpoint.cyclopean_eye_m(up, cfg.eyes.viewing_distance_m);
-        let eyes = cfg.eyes.stereo_pair(&cfg.screen, cyclopean);
+        let tilt = |distance_m: f32| {
+            let pair = cfg
+                .eyes
+                .stereo_pair(&cfg.screen, self.viewpoint.cyclopean_eye_m(up, distance_m));
+            [pair.left_m, pair.right_m]
+        };
+        // Always through the tracker, so that a first camera result blends in from the tilt
+        // model's eyes; without one its output is exactly the tilt model's.
+        let t_ns = display_t_ns.or(self.newest_t_ns).unwrap_or(0);
+        let tracked = self.eye_tracker.eyes_at(t_ns, device_to_world, tilt);
+        self.eye_source = tracked.source;
+        let eyes = match tracked.source {
+            EyeSource::Tilt if !tracked.blending => {
+                let cyclopean = self.viewpoint.cyclopean_eye_m(up, tracked.distance_m);
+                cfg.eyes.stereo_pair(&cfg.screen, cyclopean)
+            }
+            _ => StereoEyes {
+                cyclopean_m: tracked.cyclopean_m(),
+                left_m: tracked.left_m,
+                right_m: tracked.right_m,
+            },
+        };
         let project = |eye| OffAxisProjection::new(&cfg.screen, eye, cfg.depth);
         Ok(FrameView {
             sensor_t_ns: self.newest_t_ns,
@@ -277,6 +329,39 @@ impl Session {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn camera_eyes_replace_the_tilt_eyes_and_blend_in() {
+        let mut s = Session::new(SessionConfig::default()).unwrap();
+        s.push(SensorEvent::accelerometer(0, Vec3::Z * 9.81)).unwrap();
+        let before = s.frame_at(Some(0)).unwrap();
+        assert_eq!(s.eye_source(), EyeSource::Tilt);
+        // The viewer is 10 cm to the right of and 40 cm from the glass, eyes 60 mm apart.
+        let seen = [Vec3::new(0.07, 0.0, 0.4), Vec3::new(0.13, 0.0, 0.4)];
+        s.observe_face(FaceObservation {
+            capture_t_ns: 0,
+            eyes_m: Some(seen),
+            confidence: 0.9,
+        });
+        let first = s.frame_at(Some(10_000_000)).unwrap();
+        assert_eq!(s.eye_source(), EyeSource::Camera);
+        // No jump on the first camera frame: the output starts where the tilt eyes were.
+        assert!(first.eyes.left_m.distance(before.eyes.left_m) < 0.01);
+        let mut last = first;
+        for k in 2..200 {
+            s.push(SensorEvent::accelerometer(k * 10_000_000, Vec3::Z * 9.81))
+                .unwrap();
+            s.observe_face(FaceObservation {
+                capture_t_ns: k * 10_000_000,
+                eyes_m: Some(seen),
+                confidence: 0.9,
+            });
+            last = s.frame_at(Some(k * 10_000_000)).unwrap();
+        }
+        assert!(last.eyes.left_m.distance(seen[0]) < 1e-4 && last.eyes.right_m.distance(seen[1]) < 1e-4);
+        // The stereo pair follows the tracked eyes, and the projection is built from them.
+        assert!(last.left.eye_m.distance(seen[0]) < 1e-4, "{:?}", last.left.eye_m);
+    }
 
     #[test]
     fn frame_before_any_sensor_data_is_straight_on() {

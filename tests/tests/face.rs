@@ -1,0 +1,339 @@
+//! Face and eye tracking on real photographs (`$PHANTOGRAM_DATA/faces`) with MediaPipe's models
+//! (`$PHANTOGRAM_MODELS`, written by `cargo xtask models`). Both variables unset: skipped with a
+//! notice; set but wrong: the tests fail.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use phantogram::face::{
+    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, PixelFormat, TrackingMode, UprightImage,
+};
+use phantogram::glam::{Vec2, Vec3};
+use phantogram_integration::data_subdir;
+
+fn models() -> Option<Arc<FaceModels>> {
+    let Some(dir) = std::env::var_os("PHANTOGRAM_MODELS") else {
+        eprintln!("PHANTOGRAM_MODELS is not set: skipping the face tests (run `cargo xtask models`)");
+        return None;
+    };
+    Some(Arc::new(
+        FaceModels::load(Path::new(&dir)).expect("PHANTOGRAM_MODELS is set: the models must load"),
+    ))
+}
+
+fn setup() -> Option<(Arc<FaceModels>, PathBuf)> {
+    let faces = data_subdir("faces")?;
+    Some((models()?, faces))
+}
+
+fn rgba(path: &Path) -> image::RgbaImage {
+    image::open(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+        .to_rgba8()
+}
+
+fn frame(img: &image::RgbaImage, intrinsics: Intrinsics) -> CameraFrame<'_> {
+    CameraFrame {
+        width: img.width(),
+        height: img.height(),
+        row_stride: 4 * img.width() as usize,
+        format: PixelFormat::Rgba8,
+        data: img.as_raw(),
+        rotation_cw_deg: 0,
+        intrinsics,
+        capture_t_ns: 0,
+    }
+}
+
+fn default_intrinsics(img: &image::RgbaImage) -> Intrinsics {
+    Intrinsics::from_horizontal_fov(img.width(), img.height(), 60f32.to_radians())
+}
+
+/// `(file, [(left, top, width, height)])` from dlib's imglab XML, for the files present.
+fn labelled_boxes(dir: &Path) -> Vec<(PathBuf, Vec<[f32; 4]>)> {
+    let mut out = Vec::new();
+    for xml in ["training.xml", "testing.xml"] {
+        let text = std::fs::read_to_string(dir.join(xml)).expect("the face data's XML");
+        let attr = |tag: &str, name: &str| -> Option<String> {
+            let start = tag.find(&format!("{name}='"))? + name.len() + 2;
+            Some(tag[start..].split('\'').next()?.to_owned())
+        };
+        let mut current: Option<(PathBuf, Vec<[f32; 4]>)> = None;
+        for line in text.lines().map(str::trim) {
+            if line.starts_with("<image ") {
+                current = attr(line, "file").map(|f| (dir.join(f), Vec::new()));
+            } else if line.starts_with("<box ") {
+                if let Some((_, boxes)) = current.as_mut() {
+                    let n = |k| {
+                        attr(line, k)
+                            .and_then(|v| v.parse::<f32>().ok())
+                            .expect("box attribute")
+                    };
+                    boxes.push([n("left"), n("top"), n("width"), n("height")]);
+                }
+            } else if line.starts_with("</image>") {
+                if let Some(entry) = current.take() {
+                    if entry.0.is_file() {
+                        out.push(entry);
+                    }
+                }
+            }
+        }
+    }
+    out
+}
+
+fn inside(p: Vec2, b: &[f32; 4]) -> bool {
+    p.x >= b[0] && p.x <= b[0] + b[2] && p.y >= b[1] && p.y <= b[1] + b[3]
+}
+
+#[test]
+fn found_faces_have_both_eyes_inside_a_human_labelled_box() {
+    let Some((models, dir)) = setup() else { return };
+    let labelled = labelled_boxes(&dir);
+    assert!(!labelled.is_empty(), "no labelled photo present in {}", dir.display());
+    let (mut boxes_total, mut boxes_found, mut faces_total) = (0, 0, 0);
+    for (path, boxes) in &labelled {
+        let img = rgba(path);
+        let faces = models
+            .find_faces(&UprightImage::new(frame(&img, default_intrinsics(&img))).unwrap())
+            .unwrap();
+        let mut matched = vec![false; boxes.len()];
+        for f in &faces {
+            let hit = boxes
+                .iter()
+                .position(|b| inside(f.left_eye_px, b) && inside(f.right_eye_px, b));
+            assert!(
+                hit.is_some(),
+                "{}: a face with eyes at {} and {} is in no labelled box",
+                path.display(),
+                f.left_eye_px,
+                f.right_eye_px
+            );
+            if let Some(i) = hit {
+                matched[i] = true;
+            }
+            assert!(f.left_eye_px.x < f.right_eye_px.x, "left/right as seen in the image");
+        }
+        let found = matched.iter().filter(|m| **m).count();
+        println!(
+            "{}: {} labelled, {} found ({} faces reported)",
+            path.file_name().unwrap().to_string_lossy(),
+            boxes.len(),
+            found,
+            faces.len()
+        );
+        boxes_total += boxes.len();
+        boxes_found += found;
+        faces_total += faces.len();
+    }
+    println!("recall {boxes_found}/{boxes_total}; every one of {faces_total} reported faces lies in a labelled box");
+    // Group photos with 37-px faces are far from the selfie use the short-range detector is for;
+    // it must still find a good share of them (and never report a non-face, asserted above).
+    assert!(
+        boxes_found * 2 >= boxes_total,
+        "recall {boxes_found}/{boxes_total} below one half"
+    );
+}
+
+#[test]
+fn a_single_portrait_gives_one_face_with_plausible_eyes_and_distance() {
+    let Some((models, dir)) = setup() else { return };
+    let img = rgba(&dir.join("astronaut.png"));
+    let k = default_intrinsics(&img);
+    let faces = models.find_faces(&UprightImage::new(frame(&img, k)).unwrap()).unwrap();
+    assert_eq!(faces.len(), 1, "{} faces", faces.len());
+    let f = &faces[0];
+    let ipd_px = f.left_eye_px.distance(f.right_eye_px);
+    println!(
+        "astronaut: eyes {} {}, IPD {ipd_px:.1} px, iris {:.1} px, distance {:.0} mm, confidence {:.2}",
+        f.left_eye_px,
+        f.right_eye_px,
+        f.iris_diameter_px,
+        f.distance_m(&k, None).unwrap() * 1000.0,
+        f.confidence
+    );
+    // Anatomy: the iris is about 11.7 / 63 of the interpupillary distance (± a generous 35 %
+    // for the head's turn and the landmark noise); the eyes are level and in the upper half.
+    let ratio = f.iris_diameter_px / ipd_px;
+    assert!((ratio - 11.7 / 63.0).abs() < 0.35 * 11.7 / 63.0, "iris/IPD {ratio}");
+    assert!((f.left_eye_px.y - f.right_eye_px.y).abs() < 0.2 * ipd_px);
+    assert!(f.left_eye_px.y < img.height() as f32 * 0.5);
+    assert!(f.confidence > 0.5);
+}
+
+#[test]
+fn rescaling_the_image_by_s_changes_the_distance_by_one_over_s() {
+    let Some((models, dir)) = setup() else { return };
+    let img = rgba(&dir.join("astronaut.png"));
+    // The same camera (same focal length in pixels) seeing the face s times larger.
+    let k = Intrinsics {
+        fx_px: 600.0,
+        fy_px: 600.0,
+        cx_px: 256.0,
+        cy_px: 256.0,
+    };
+    let distance = |img: &image::RgbaImage| {
+        let faces = models.find_faces(&UprightImage::new(frame(img, k)).unwrap()).unwrap();
+        assert_eq!(faces.len(), 1);
+        (faces[0].distance_m(&k, None).unwrap(), faces[0].iris_diameter_px)
+    };
+    let (d1, iris1) = distance(&img);
+    let mut asserted = 0;
+    for s in [0.5f32, 0.75, 1.25, 1.5, 2.0] {
+        let size = (img.width() as f32 * s).round() as u32;
+        let scaled = image::imageops::resize(&img, size, size, image::imageops::FilterType::Triangle);
+        let (ds, iris) = distance(&scaled);
+        let ratio = ds / d1;
+        // Below 5 px across, a tenth of a pixel of landmark error is over 2 % of the distance:
+        // printed, not asserted (the phone's face at arm's length spans 10-20 px of iris).
+        let precise = iris1 * s >= 5.0;
+        println!(
+            "scale {s}: iris {iris:.1} px, distance {:.0} mm vs {:.0} mm, ratio {ratio:.3} (want {:.3}){}",
+            ds * 1e3,
+            d1 * 1e3,
+            1.0 / s,
+            if precise {
+                ""
+            } else {
+                " — iris under 5 px, not asserted"
+            }
+        );
+        if precise {
+            assert!((ratio * s - 1.0).abs() < 0.05, "scale {s}: ratio {ratio}");
+            asserted += 1;
+        }
+    }
+    assert!(asserted >= 4);
+}
+
+#[test]
+fn no_face_gives_no_eyes_and_no_panic() {
+    let Some((models, dir)) = setup() else { return };
+    let dogs = rgba(&dir.join("dogs.jpg"));
+    let faces = models
+        .find_faces(&UprightImage::new(frame(&dogs, default_intrinsics(&dogs))).unwrap())
+        .unwrap();
+    let summary: Vec<_> = faces
+        .iter()
+        .map(|f| (f.left_eye_px, f.right_eye_px, f.confidence))
+        .collect();
+    assert!(faces.is_empty(), "dogs.jpg: faces (eyes, confidence) {summary:?}");
+    // Flat grey and noise through the tracker: no eyes, confidence 0, detector every time.
+    let mut tracker = FaceTracker::new(models, CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
+    let mut noise = image::RgbaImage::new(640, 480);
+    let mut state = 12345u32;
+    for p in noise.pixels_mut() {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        *p = image::Rgba([(state >> 24) as u8, (state >> 16) as u8, (state >> 8) as u8, 255]);
+    }
+    let grey = image::RgbaImage::from_pixel(640, 480, image::Rgba([128, 128, 128, 255]));
+    for img in [&grey, &noise] {
+        let obs = tracker.process(frame(img, default_intrinsics(img))).unwrap();
+        assert_eq!(obs.eyes_m, None);
+        assert_eq!(obs.confidence, 0.0);
+        assert_eq!(tracker.last_mode(), TrackingMode::Detecting);
+    }
+}
+
+#[test]
+fn tracking_follows_the_face_from_its_landmarks_and_gives_metric_device_eyes() {
+    let Some((models, dir)) = setup() else { return };
+    let img = rgba(&dir.join("astronaut.png"));
+    let k = default_intrinsics(&img);
+    let mut tracker = FaceTracker::new(models, CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
+    let first = tracker.process(frame(&img, k)).unwrap();
+    assert_eq!(tracker.last_mode(), TrackingMode::Detecting);
+    let second = tracker.process(frame(&img, k)).unwrap();
+    assert_eq!(tracker.last_mode(), TrackingMode::Tracking);
+    let (Some(a), Some(b)) = (first.eyes_m, second.eyes_m) else {
+        panic!("the astronaut's eyes: {first:?} {second:?}")
+    };
+    for i in 0..2 {
+        // The same image through a different crop: within 3 % of the distance (the iris-based
+        // scale's repeatability).
+        assert!(a[i].distance(b[i]) < 0.03 * a[i].length(), "{} vs {}", a[i], b[i]);
+    }
+    // Device frame: the viewer's left eye towards −x, both in front of the glass, 63 ± 15 mm
+    // apart (the iris-based scale).
+    assert!(a[0].x < a[1].x && a[0].z > 0.0 && a[1].z > 0.0);
+    let ipd = a[0].distance(a[1]);
+    assert!((0.048..0.078).contains(&ipd), "IPD {ipd} m");
+    // With a calibrated IPD the eyes are exactly that far apart.
+    tracker.ipd_m = Some(0.060);
+    tracker.reset();
+    let c = tracker.process(frame(&img, k)).unwrap().eyes_m.unwrap();
+    assert!((c[0].distance(c[1]) - 0.060).abs() < 1e-4);
+    // The same frame turned as a sensor would deliver it (90° clockwise needed to be upright)
+    // gives the same eyes: a quarter turn is lossless, so the same pixels reach the networks.
+    let turned = image::imageops::rotate270(&img);
+    let mut f = frame(&turned, k);
+    f.rotation_cw_deg = 90;
+    f.intrinsics = Intrinsics {
+        fx_px: k.fy_px,
+        fy_px: k.fx_px,
+        cx_px: k.cy_px,
+        cy_px: img.width() as f32 - k.cx_px,
+    };
+    tracker.reset();
+    let d = tracker.process(f).unwrap().eyes_m.unwrap();
+    for i in 0..2 {
+        assert!(c[i].distance(d[i]) < 1e-4, "turned: {} vs {}", c[i], d[i]);
+    }
+}
+
+#[test]
+fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
+    use phantogram::face::{FaceWorker, OwnedFrame};
+    let Some((models, dir)) = setup() else { return };
+    let img = rgba(&dir.join("astronaut.png"));
+    let k = default_intrinsics(&img);
+    let worker = FaceWorker::spawn(FaceTracker::new(models, CameraPose::front(Vec3::ZERO)));
+    assert!(worker.is_running());
+    assert_eq!(worker.newest(), None);
+    // A burst of 20 frames submitted at once: the worker cannot keep up, so most are replaced
+    // (dropped) before it starts them, and the newest one is processed last.
+    for i in 0..20i64 {
+        worker.submit(OwnedFrame {
+            width: img.width(),
+            height: img.height(),
+            row_stride: 4 * img.width() as usize,
+            format: PixelFormat::Rgba8,
+            data: img.as_raw().clone(),
+            rotation_cw_deg: 0,
+            intrinsics: k,
+            capture_t_ns: i,
+        });
+    }
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while worker.newest().is_none_or(|o| o.capture_t_ns != 19) {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the newest frame was never processed"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert!(worker.newest().unwrap().eyes_m.is_some());
+    assert!(worker.dropped_frames() >= 10, "dropped {}", worker.dropped_frames());
+    // A malformed frame is reported as an error, and the worker goes on.
+    worker.submit(OwnedFrame {
+        width: 10,
+        height: 10,
+        row_stride: 40,
+        format: PixelFormat::Rgba8,
+        data: vec![0; 12],
+        rotation_cw_deg: 0,
+        intrinsics: k,
+        capture_t_ns: 20,
+    });
+    while worker.last_error().is_none() {
+        assert!(std::time::Instant::now() < deadline, "no error reported");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    println!(
+        "worker: {} frames dropped; error reported: {:?}",
+        worker.dropped_frames(),
+        worker.last_error()
+    );
+    drop(worker); // joins the thread
+}
