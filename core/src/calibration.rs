@@ -238,9 +238,26 @@ impl Calibration {
         }
     }
 
+    /// Where the desktop tools keep it: `$PHANTOGRAM_CALIBRATION` if set, else
+    /// `$XDG_CONFIG_HOME/phantogram/calibration.txt`, else `~/.config/phantogram/calibration.txt`.
+    /// The phone shells pass their app-private folder instead.
+    pub fn default_path() -> Option<std::path::PathBuf> {
+        use std::path::PathBuf;
+        if let Some(p) = std::env::var_os("PHANTOGRAM_CALIBRATION") {
+            return Some(PathBuf::from(p));
+        }
+        let config = std::env::var_os("XDG_CONFIG_HOME")
+            .map(PathBuf::from)
+            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
+        Some(config.join("phantogram").join("calibration.txt"))
+    }
+
     /// Writes the file atomically (a temporary file renamed over it), so a crash mid-write cannot
-    /// leave a corrupt calibration.
+    /// leave a corrupt calibration. Creates the folder if needed.
     pub fn save(&self, path: &Path) -> std::io::Result<()> {
+        if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir)?;
+        }
         let tmp = path.with_extension("tmp");
         std::fs::write(&tmp, self.to_text())?;
         std::fs::rename(&tmp, path)

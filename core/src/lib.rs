@@ -61,16 +61,21 @@
 //! * `face` (on by default; implies `models`): `tract-onnx` runs MediaPipe's face, landmark and
 //!   iris networks in pure Rust (no native inference runtime to cross-build for the phones), and
 //!   `half` packs the renderer's f16 textures.
+//! * `ui` (on by default; implies `render`): `egui` and `egui-wgpu` draw the calibration screens
+//!   with the renderer's own device ([`calibration_ui`]); the CLI adds `egui-winit` for mouse input.
 //!
 //! Modules: [`screen`], [`eyes`], [`viewpoint`], [`projection`], [`containment`], [`light`],
 //! [`lowpass`], [`attitude`], [`fusion`], [`sensors`], [`sensorlog`], [`replay`], [`session`],
 //! [`synthetic`], [`orientation_eval`], [`calibration`], [`anaglyph`], [`artifact`], [`model`],
-//! [`ibl`], [`eyetrack`], and with `render`, `render` and `surface`; with `face`, `face`.
+//! [`ibl`], [`eyetrack`], and with `render`, `render` and `surface`; with `face`, `face`; with `ui`,
+//! `calibration_ui`.
 
 pub mod anaglyph;
 pub mod artifact;
 pub mod attitude;
 pub mod calibration;
+#[cfg(feature = "ui")]
+pub mod calibration_ui;
 pub mod containment;
 pub mod eyes;
 pub mod eyetrack;

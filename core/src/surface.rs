@@ -164,6 +164,20 @@ impl SurfaceHost {
         input: &FrameInput,
         method: Method,
     ) -> Result<DrawOutcome, RenderError> {
+        self.draw_with(renderer, input, method, |_, _, _, _| {})
+    }
+
+    /// As [`Self::draw`], calling `overlay(gpu, target, format, [width, height])` after the frame
+    /// is drawn and before it is presented (the calibration screens paint there). Not called when
+    /// the draw is skipped.
+    pub fn draw_with(
+        &mut self,
+        renderer: &mut Renderer,
+        input: &FrameInput,
+        method: Method,
+        overlay: impl FnOnce(&crate::render::Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]),
+    ) -> Result<DrawOutcome, RenderError> {
+        let mut overlay = Some(overlay);
         let Some(config) = self.config.clone() else {
             self.stats.skipped += 1;
             return Ok(DrawOutcome::Skipped("suspended"));
@@ -210,6 +224,9 @@ impl SurfaceHost {
             };
             let view = texture.texture.create_view(&Default::default());
             renderer.render_to_view(input, method, &view, config.format, config.width, config.height)?;
+            if let Some(paint) = overlay.take() {
+                paint(renderer.gpu(), &view, config.format, [config.width, config.height]);
+            }
             renderer.gpu().queue.present(texture);
             self.stats.presented += 1;
             if suboptimal {

@@ -81,6 +81,10 @@ enum Command {
         /// Exercise suspend, resume and resize while running (a self-test of the surface lifecycle).
         #[arg(long)]
         lifecycle_test: bool,
+        /// Open the calibration screens at start (also key `c`): eye distance by the mirror,
+        /// viewing distance by the blind spot, screen size by a bank card, flat angle, light.
+        #[arg(long)]
+        calibration: bool,
     },
     /// Render a sensor log as phantogram frames (PNG), headless.
     Render {
@@ -245,6 +249,7 @@ fn run(cli: Cli) -> Result<()> {
             anaglyph,
             frames,
             lifecycle_test,
+            calibration,
         } => {
             let screen = SessionConfig::default().screen;
             let (model, bounds) = load_for_display(model.as_deref(), &screen, &Default::default(), true)?;
@@ -259,6 +264,7 @@ fn run(cli: Cli) -> Result<()> {
                 method: anaglyph,
                 frames,
                 lifecycle_test,
+                calibration,
             })
         }
         Command::Render {

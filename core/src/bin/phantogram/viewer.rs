@@ -35,6 +35,8 @@ pub struct ViewerArgs {
     pub frames: Option<u64>,
     /// Exercise suspend, resume and resize while running (a self-test of the surface lifecycle).
     pub lifecycle_test: bool,
+    /// Open the calibration screens at start.
+    pub calibration: bool,
 }
 
 /// A phone tilted by the mouse: pitch about the screen's horizontal, roll about its vertical.
@@ -84,7 +86,17 @@ struct App {
     cursor: Option<(f64, f64)>,
     presented: u64,
     error: Option<anyhow::Error>,
+    /// The calibration screens, while open (key `c`).
+    calibration_ui: Option<phantogram::calibration_ui::CalibrationUi>,
+    calibration: phantogram::calibration::Calibration,
+    calibration_path: Option<std::path::PathBuf>,
+    egui_ctx: egui::Context,
+    egui_input: Option<egui_winit::State>,
+    overlay: Option<phantogram::calibration_ui::Overlay>,
 }
+
+/// The phone's density scale (pixels per point) the calibration screens are laid out for.
+const PHONE_PIXELS_PER_POINT: f32 = 2.75;
 
 impl App {
     fn size(&self) -> (u32, u32) {
@@ -129,8 +141,52 @@ impl App {
         let Some(renderer) = self.renderer.as_mut() else {
             return Ok(());
         };
-        if self.host.draw(renderer, &input, self.method)? == DrawOutcome::Presented {
+        let mut actions = Vec::new();
+        let painted = match (
+            self.calibration_ui.as_mut(),
+            self.egui_input.as_mut(),
+            self.window.clone(),
+        ) {
+            (Some(ui_state), Some(egui_input), Some(window)) => {
+                let screen = self.session.config().screen;
+                // Display pixels of the virtual phone → window pixels; egui's points are laid
+                // out as on the phone.
+                let k = window.inner_size().width as f32 / screen.width_px() as f32;
+                self.egui_ctx
+                    .set_zoom_factor(PHONE_PIXELS_PER_POINT * k / window.scale_factor() as f32);
+                let raw = egui_input.take_egui_input(&window);
+                let mut output = self
+                    .egui_ctx
+                    .run_ui(raw, |ui| actions = ui_state.show(ui, &screen, PHONE_PIXELS_PER_POINT));
+                egui_input.handle_platform_output(&window, std::mem::take(&mut output.platform_output));
+                Some(output)
+            }
+            _ => None,
+        };
+        let outcome = match painted {
+            Some(mut output) => {
+                let ctx = self.egui_ctx.clone();
+                let overlay = &mut self.overlay;
+                let outcome = self
+                    .host
+                    .draw_with(renderer, &input, self.method, |gpu, view, format, size| {
+                        let o = match overlay {
+                            Some(o) if o.format() == format => o,
+                            _ => overlay.insert(phantogram::calibration_ui::Overlay::new(gpu, format)),
+                        };
+                        o.paint(gpu, &ctx, std::mem::take(&mut output), view, size);
+                    })?;
+                // A skipped frame did not paint: egui's texture changes must still be dropped.
+                output.textures_delta.clear();
+                outcome
+            }
+            None => self.host.draw(renderer, &input, self.method)?,
+        };
+        if outcome == DrawOutcome::Presented {
             self.presented += 1;
+        }
+        for action in actions {
+            self.apply(action);
         }
         if self.args.lifecycle_test {
             self.lifecycle_step(&input)?;
@@ -164,6 +220,54 @@ impl App {
         Ok(())
     }
 
+    fn apply(&mut self, action: phantogram::calibration_ui::CalibrationAction) {
+        use phantogram::calibration_ui::CalibrationAction as A;
+        match action {
+            A::FlatAngleHere => match self.session.calibrate_flat_angle() {
+                Ok(()) => eprintln!("flat angle: this pose is now straight on"),
+                Err(e) => eprintln!("flat angle: {e}"),
+            },
+            A::ResetLight => match self.session.recalibrate_light() {
+                Ok(()) => eprintln!("light re-tied to the room at this pose"),
+                Err(e) => eprintln!("light: {e}"),
+            },
+            A::Changed(c) => {
+                self.calibration = c;
+                self.apply_calibration();
+                if let Some(path) = &self.calibration_path {
+                    match c.save(path) {
+                        Ok(()) => eprintln!("calibration saved to {}", path.display()),
+                        Err(e) => eprintln!("warning: could not save the calibration to {}: {e}", path.display()),
+                    }
+                }
+            }
+            A::Closed => self.calibration_ui = None,
+        }
+    }
+
+    /// Puts the calibrated IPD, distance and pixel density into the session.
+    fn apply_calibration(&mut self) {
+        let c = self.calibration;
+        let mut eyes = self.session.config().eyes;
+        eyes.ipd_m = c.ipd_m.unwrap_or(eyes.ipd_m);
+        eyes.viewing_distance_m = c.viewing_distance_m.unwrap_or(eyes.viewing_distance_m);
+        if let Err(e) = self.session.set_eye_model(eyes) {
+            eprintln!("warning: calibration not applied: {e}");
+        }
+        if let Some(d) = c.density_dpi {
+            let screen = self.session.config().screen;
+            let panel = phantogram::screen::PanelSpec {
+                xdpi: d.x,
+                ydpi: d.y,
+                ..screen.panel()
+            };
+            match phantogram::screen::Screen::new(panel, screen.rotation()) {
+                Ok(s) => self.session.set_screen(s),
+                Err(e) => eprintln!("warning: calibrated density not applied: {e}"),
+            }
+        }
+    }
+
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
         self.error.get_or_insert(e);
         event_loop.exit();
@@ -187,6 +291,16 @@ impl ApplicationHandler for App {
                 eprintln!("viewing on {}", gpu.describe());
                 self.renderer = Some(Renderer::new(gpu, &self.args.model)?);
             }
+            if self.egui_input.is_none() {
+                self.egui_input = Some(egui_winit::State::new(
+                    self.egui_ctx.clone(),
+                    egui::ViewportId::ROOT,
+                    &window,
+                    Some(window.scale_factor() as f32),
+                    None,
+                    None,
+                ));
+            }
             let (w, h) = self.size();
             let renderer = self.renderer.as_ref().expect("created above");
             self.host.resume(renderer.gpu(), window.clone(), w, h)?;
@@ -203,6 +317,19 @@ impl ApplicationHandler for App {
     }
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
+        // While the calibration screens are open, the mouse and keys drive them.
+        if self.calibration_ui.is_some() {
+            if let (Some(state), Some(window)) = (self.egui_input.as_mut(), self.window.as_ref()) {
+                let consumed = state.on_window_event(window, &event).consumed;
+                let passes = matches!(
+                    event,
+                    WindowEvent::CloseRequested | WindowEvent::Resized(_) | WindowEvent::RedrawRequested
+                );
+                if consumed || !passes {
+                    return;
+                }
+            }
+        }
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
@@ -257,6 +384,11 @@ impl ApplicationHandler for App {
                             Ok(()) => eprintln!("light re-tied to the room at this pose"),
                             Err(e) => eprintln!("light: {e}"),
                         },
+                        "c" => {
+                            self.calibration_ui = Some(phantogram::calibration_ui::CalibrationUi::with_calibration(
+                                self.calibration,
+                            ));
+                        }
                         _ => {}
                     },
                     _ => {}
@@ -284,9 +416,23 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         EventLoop::new().context("no display to open a window on (set DISPLAY, or use `phantogram render`)")?;
     event_loop.set_control_flow(ControlFlow::Poll);
     eprintln!(
-        "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, Esc quit"
+        "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, c calibration screens, Esc quit"
     );
+    let calibration_path = phantogram::calibration::Calibration::default_path();
+    let calibration = match &calibration_path {
+        Some(path) => {
+            let (c, warning) = phantogram::calibration::Calibration::load(path);
+            if let Some(w) = warning {
+                eprintln!("warning: {w}");
+            }
+            c
+        }
+        None => Default::default(),
+    };
     let method = args.method;
+    let args_calibration_open = args
+        .calibration
+        .then(|| phantogram::calibration_ui::CalibrationUi::with_calibration(calibration));
     let mut app = App {
         args,
         window: None,
@@ -308,7 +454,14 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         cursor: None,
         presented: 0,
         error: None,
+        calibration_ui: args_calibration_open,
+        calibration,
+        calibration_path,
+        egui_ctx: egui::Context::default(),
+        egui_input: None,
+        overlay: None,
     };
+    app.apply_calibration();
     event_loop.run_app(&mut app).context("the window's event loop failed")?;
     let s = app.host.stats();
     eprintln!(

@@ -1,0 +1,154 @@
+//! The calibration screens drawn by the GPU (lavapipe): the eye-reflection targets land on the
+//! pixels the geometry puts them at, on a window half the phone's size (so egui's scale is
+//! exercised too).
+
+use phantogram::calibration_ui::{CalibrationUi, Overlay, Page, reflection_targets_px};
+use phantogram::glam::Vec2;
+use phantogram::render::Gpu;
+use phantogram::screen::{DisplayRotation, PanelSpec, Screen};
+
+const PHONE_PPP: f32 = 2.75;
+
+#[test]
+fn eye_reflection_targets_are_drawn_where_the_geometry_puts_them() {
+    let gpu = match Gpu::headless() {
+        Ok(g) => g,
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no GPU adapter ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    };
+    // Sideways, as the screens ask: a portrait phone (68 mm) is barely wider than an IPD.
+    let screen = Screen::new(PanelSpec::TYPICAL_PHONE, DisplayRotation::Deg90).unwrap();
+    let (w, h) = (screen.width_px() / 2, screen.height_px() / 2);
+    let k = w as f32 / screen.width_px() as f32;
+    let format = wgpu::TextureFormat::Rgba8UnormSrgb;
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("calibration test"),
+        size: wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view = texture.create_view(&Default::default());
+    // The frame underneath: black.
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: None,
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: &view,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: None,
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    gpu.queue.submit([encoder.finish()]);
+
+    let ctx = egui::Context::default();
+    let mut ui_state = CalibrationUi::default();
+    ui_state.page = Page::EyeReflection;
+    ui_state.target_separation_mm = 64.0;
+    ui_state.target_offset_mm = Vec2::new(3.0, 10.0);
+    let ppp = PHONE_PPP * k;
+    ctx.set_pixels_per_point(ppp);
+    let input = || egui::RawInput {
+        screen_rect: Some(egui::Rect::from_min_size(
+            egui::Pos2::ZERO,
+            egui::vec2(w as f32 / ppp, h as f32 / ppp),
+        )),
+        ..Default::default()
+    };
+    // Three frames: the first ones lay out the panel.
+    let mut overlay = Overlay::new(&gpu, format);
+    for _ in 0..2 {
+        let first = ctx.run_ui(input(), |ui| {
+            ui_state.show(ui, &screen, PHONE_PPP);
+        });
+        overlay.paint(&gpu, &ctx, first, &view, [w, h]);
+    }
+    let output = ctx.run_ui(input(), |ui| {
+        ui_state.show(ui, &screen, PHONE_PPP);
+    });
+    overlay.paint(&gpu, &ctx, output, &view, [w, h]);
+
+    let pixels = read_back(&gpu, &texture, w, h);
+    let at = |p: Vec2| {
+        assert!(
+            p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32,
+            "{p} is off the frame"
+        );
+        let (x, y) = (p.x.floor() as u32, p.y.floor() as u32);
+        let i = ((y * w + x) * 4) as usize;
+        pixels[i..i + 3].iter().map(|&c| u32::from(c)).sum::<u32>() / 3
+    };
+    let targets = reflection_targets_px(&screen, 64.0, Vec2::new(3.0, 10.0)).map(|p| p * k);
+    for t in targets {
+        // The cross's centre and its arm (beyond the 10-point ring) are lit; between the arms,
+        // inside the ring, it is dark: the cross is centred on the predicted pixel.
+        let arm = 10.0 * ppp;
+        println!(
+            "target at {t}: centre {}, arm {}, beside {}",
+            at(t),
+            at(t + Vec2::new(arm * 1.3, 0.0)),
+            at(t + Vec2::splat(arm * 0.4))
+        );
+        assert!(at(t) > 180, "no target drawn at {t}");
+        assert!(at(t + Vec2::new(arm * 1.3, 0.0)) > 180, "horizontal arm missing at {t}");
+        assert!(at(t + Vec2::splat(arm * 0.4)) < 40, "target not centred at {t}");
+    }
+    if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
+        image::RgbaImage::from_raw(w, h, pixels)
+            .expect("size")
+            .save(std::path::Path::new(&dir).join("calibration-eye.png"))
+            .expect("saving");
+    }
+}
+
+fn read_back(gpu: &Gpu, texture: &wgpu::Texture, w: u32, h: u32) -> Vec<u8> {
+    let row = (w * 4).div_ceil(256) * 256;
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: None,
+        size: u64::from(row * h),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(row),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    gpu.queue.submit([encoder.finish()]);
+    buffer.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping"));
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("polling");
+    let data = buffer.slice(..).get_mapped_range().expect("mapped");
+    (0..h)
+        .flat_map(|y| data[(y * row) as usize..(y * row + w * 4) as usize].to_vec())
+        .collect()
+}
