@@ -189,3 +189,49 @@ fn viewer_runs_its_surface_lifecycle_in_a_window() {
     assert_eq!(after("suspended "), 1, "{line}");
     assert!(after("reconfigured ") >= 4, "{line}");
 }
+
+/// `eval face --json`: one object per image with the documented keys; a missing model folder is a
+/// clear error naming `cargo xtask models`. Needs `PHANTOGRAM_MODELS` and `PHANTOGRAM_DATA` for
+/// the positive part.
+#[test]
+fn eval_face_prints_json_per_image_and_names_the_missing_models() {
+    let missing = bin()
+        .args(["eval", "face", "--models", "/nonexistent-models", "x.png"])
+        .output()
+        .unwrap();
+    assert!(!missing.status.success());
+    let err = String::from_utf8_lossy(&missing.stderr);
+    assert!(err.contains("cargo xtask models"), "{err}");
+
+    let (Some(models), Some(data)) = (
+        std::env::var_os("PHANTOGRAM_MODELS"),
+        std::env::var_os("PHANTOGRAM_DATA"),
+    ) else {
+        eprintln!("PHANTOGRAM_MODELS or PHANTOGRAM_DATA unset: skipping the positive part");
+        return;
+    };
+    let faces = PathBuf::from(data).join("faces");
+    let out = bin()
+        .args(["eval", "face", "--json", "--models"])
+        .arg(&models)
+        .arg(faces.join("astronaut.png"))
+        .arg(faces.join("dogs.jpg"))
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("one JSON object per line"))
+        .collect();
+    assert_eq!(lines.len(), 2);
+    assert!(lines[0]["image"].as_str().unwrap().ends_with("astronaut.png"));
+    let face = &lines[0]["faces"][0];
+    let (l, r) = (&face["left_eye"], &face["right_eye"]);
+    assert!(
+        l[0].as_f64().unwrap() < r[0].as_f64().unwrap(),
+        "left as seen in the image"
+    );
+    assert!(face["distance_mm"].as_f64().unwrap() > 100.0);
+    assert!((0.0..=1.0).contains(&face["confidence"].as_f64().unwrap()));
+    assert_eq!(lines[1]["faces"].as_array().unwrap().len(), 0, "no face among the dogs");
+}
