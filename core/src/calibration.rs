@@ -242,14 +242,12 @@ impl Calibration {
     /// `$XDG_CONFIG_HOME/phantogram/calibration.txt`, else `~/.config/phantogram/calibration.txt`.
     /// The phone shells pass their app-private folder instead.
     pub fn default_path() -> Option<std::path::PathBuf> {
-        use std::path::PathBuf;
-        if let Some(p) = std::env::var_os("PHANTOGRAM_CALIBRATION") {
-            return Some(PathBuf::from(p));
-        }
-        let config = std::env::var_os("XDG_CONFIG_HOME")
-            .map(PathBuf::from)
-            .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
-        Some(config.join("phantogram").join("calibration.txt"))
+        crate::user_path(
+            "PHANTOGRAM_CALIBRATION",
+            "XDG_CONFIG_HOME",
+            ".config",
+            "calibration.txt",
+        )
     }
 
     /// Writes the file atomically (a temporary file renamed over it), so a crash mid-write cannot

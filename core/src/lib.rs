@@ -107,12 +107,17 @@ pub use session::{FrameView, Session, SessionConfig, SessionError};
 /// for them: `$PHANTOGRAM_MODELS` if set, else `$XDG_CACHE_HOME/phantogram/models`, else
 /// `~/.cache/phantogram/models`. `None` only without any of those variables.
 pub fn face_models_dir() -> Option<std::path::PathBuf> {
+    user_path("PHANTOGRAM_MODELS", "XDG_CACHE_HOME", ".cache", "models")
+}
+
+/// `$override_var` if set, else `$xdg_var/phantogram/name`, else `~/home_dir/phantogram/name`.
+pub(crate) fn user_path(override_var: &str, xdg_var: &str, home_dir: &str, name: &str) -> Option<std::path::PathBuf> {
     use std::path::PathBuf;
-    if let Some(dir) = std::env::var_os("PHANTOGRAM_MODELS") {
-        return Some(PathBuf::from(dir));
+    if let Some(p) = std::env::var_os(override_var) {
+        return Some(PathBuf::from(p));
     }
-    let cache = std::env::var_os("XDG_CACHE_HOME")
+    let base = std::env::var_os(xdg_var)
         .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".cache")))?;
-    Some(cache.join("phantogram").join("models"))
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(home_dir)))?;
+    Some(base.join("phantogram").join(name))
 }
