@@ -189,8 +189,7 @@ impl FaceModels {
 
     /// Loads the three models from `dir` (a few tens of milliseconds each).
     pub fn load(dir: &Path) -> Result<Self, FaceError> {
-        let mut plans = Vec::with_capacity(3);
-        for (file, size) in Self::FILES.iter().zip(Self::SIZES) {
+        let load = |file: &str, size: usize| -> Result<Plan, FaceError> {
             let path = dir.join(file);
             if !path.is_file() {
                 return Err(FaceError::ModelMissing {
@@ -198,21 +197,23 @@ impl FaceModels {
                     dir: dir.to_path_buf(),
                 });
             }
-            let model_error = |e: TractError| FaceError::Model {
-                path: path.clone(),
-                message: format!("{e:#}"),
-            };
-            let plan = tract_onnx::onnx()
+            tract_onnx::onnx()
                 .model_for_path(&path)
                 .and_then(|m| m.with_input_fact(0, f32::fact([1, 3, size, size]).into()))
                 .and_then(|m| m.into_optimized())
                 .and_then(|m| m.into_runnable())
-                .map_err(model_error)?;
-            plans.push(plan);
-        }
-        let iris = plans.pop().ok_or_else(|| FaceError::Inference("model list".into()))?;
-        let mesh = plans.pop().ok_or_else(|| FaceError::Inference("model list".into()))?;
-        let detector = plans.pop().ok_or_else(|| FaceError::Inference("model list".into()))?;
+                .map_err(|e| FaceError::Model {
+                    path: path.clone(),
+                    message: format!("{e:#}"),
+                })
+        };
+        let [detector, mesh, iris] = Self::FILES;
+        let [detector_size, mesh_size, iris_size] = Self::SIZES;
+        let (detector, mesh, iris) = (
+            load(detector, detector_size)?,
+            load(mesh, mesh_size)?,
+            load(iris, iris_size)?,
+        );
         Ok(Self { detector, mesh, iris })
     }
 

@@ -301,16 +301,10 @@ impl Session {
         let t_ns = display_t_ns.or(self.newest_t_ns).unwrap_or(0);
         let tracked = self.eye_tracker.eyes_at(t_ns, device_to_world, tilt);
         self.eye_source = tracked.source;
-        let eyes = match tracked.source {
-            EyeSource::Tilt if !tracked.blending => {
-                let cyclopean = self.viewpoint.cyclopean_eye_m(up, tracked.distance_m);
-                cfg.eyes.stereo_pair(&cfg.screen, cyclopean)
-            }
-            _ => StereoEyes {
-                cyclopean_m: tracked.cyclopean_m(),
-                left_m: tracked.left_m,
-                right_m: tracked.right_m,
-            },
+        let eyes = StereoEyes {
+            cyclopean_m: tracked.cyclopean_m(),
+            left_m: tracked.left_m,
+            right_m: tracked.right_m,
         };
         let project = |eye| OffAxisProjection::new(&cfg.screen, eye, cfg.depth);
         Ok(FrameView {
