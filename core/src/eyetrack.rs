@@ -167,6 +167,14 @@ impl EyeTracker {
         self.distance_m
     }
 
+    /// Changes the distance used before the camera has measured one (a new calibration); a
+    /// measured distance is kept.
+    pub fn set_default_distance_m(&mut self, distance_m: f32) {
+        if self.newest.is_none() {
+            self.distance_m = distance_m;
+        }
+    }
+
     /// Records the device → world orientation at `t_ns` (call once per frame or per gyro batch).
     pub fn record_orientation(&mut self, t_ns: i64, device_to_world: Quat) {
         if !device_to_world.is_finite() {

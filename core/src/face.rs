@@ -619,6 +619,14 @@ impl FaceModels {
         }))
     }
 
+    /// The face a detection leads to, its confidence the lower of detector score and face flag.
+    fn face_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<FaceFound>, FaceError> {
+        Ok(self.face_in(image, &roi_from_detection(d))?.map(|mut f| {
+            f.confidence = f.confidence.min(d.score);
+            f
+        }))
+    }
+
     /// Every face in a still image (detection on every call; no tracking).
     ///
     /// BlazeFace short-range is made for selfie distances (faces over a fifth of the frame). For
@@ -665,8 +673,7 @@ impl FaceModels {
         let detections = merge_detections(detections);
         let mut faces: Vec<FaceFound> = Vec::new();
         for d in detections {
-            if let Some(mut face) = self.face_in(image, &roi_from_detection(&d))? {
-                face.confidence = d.score.min(face.confidence);
+            if let Some(face) = self.face_from_detection(image, &d)? {
                 if face.confidence >= MIN_FACE_CONFIDENCE {
                     faces.push(face);
                 }
@@ -787,10 +794,7 @@ impl FaceTracker {
         if found.is_none() {
             self.last_mode = TrackingMode::Detecting;
             if let Some(d) = self.models.detect(&image)?.first() {
-                found = self.models.face_in(&image, &roi_from_detection(d))?.map(|mut f| {
-                    f.confidence = f.confidence.min(d.score);
-                    f
-                });
+                found = self.models.face_from_detection(&image, d)?;
             }
         }
         self.roi = found.as_ref().map(|f| roi_from_landmarks(&f.landmarks));

@@ -123,8 +123,6 @@ pub struct Session {
     batch: Vec<SensorEvent>,
     newest_t_ns: Option<i64>,
     eye_tracker: EyeTracker,
-    /// Whether any camera result has been observed (until then the eyes are the tilt model's).
-    face_observed: bool,
     eye_source: EyeSource,
 }
 
@@ -161,7 +159,6 @@ impl Session {
             batch: Vec::new(),
             newest_t_ns: None,
             eye_tracker: EyeTracker::new(EyeTrackParams::default(), config.eyes.viewing_distance_m),
-            face_observed: false,
             eye_source: EyeSource::Tilt,
         })
     }
@@ -209,7 +206,6 @@ impl Session {
     /// Takes a face-tracking result (from [`crate::face`] or any other tracker): the eyes in the
     /// device frame at the frame's capture time, on the sensor clock.
     pub fn observe_face(&mut self, observation: FaceObservation) {
-        self.face_observed = true;
         self.eye_tracker.observe(observation);
     }
 
@@ -261,9 +257,7 @@ impl Session {
     pub fn set_eye_model(&mut self, eyes: EyeModel) -> Result<(), SessionError> {
         eyes.validate()?;
         self.config.eyes = eyes;
-        if !self.face_observed {
-            self.eye_tracker = EyeTracker::new(EyeTrackParams::default(), eyes.viewing_distance_m);
-        }
+        self.eye_tracker.set_default_distance_m(eyes.viewing_distance_m);
         Ok(())
     }
 
