@@ -67,7 +67,8 @@
 //! Modules: [`screen`], [`eyes`], [`viewpoint`], [`projection`], [`containment`], [`light`],
 //! [`lowpass`], [`attitude`], [`fusion`], [`sensors`], [`sensorlog`], [`replay`], [`session`],
 //! [`synthetic`], [`orientation_eval`], [`calibration`], [`anaglyph`], [`artifact`], [`model`],
-//! [`ibl`], [`eyetrack`], and with `render`, `render` and `surface`; with `face`, `face`; with `ui`,
+//! [`ibl`], [`eyetrack`], [`gesture`], and with `render`, `render`, `surface` and `engine` (the
+//! embedding API the phone shells drive); with `face`, `face`; with `ui`,
 //! `calibration_ui`.
 
 pub mod anaglyph;
@@ -77,11 +78,14 @@ pub mod calibration;
 #[cfg(feature = "ui")]
 pub mod calibration_ui;
 pub mod containment;
+#[cfg(feature = "render")]
+pub mod engine;
 pub mod eyes;
 pub mod eyetrack;
 #[cfg(feature = "face")]
 pub mod face;
 pub mod fusion;
+pub mod gesture;
 pub mod ibl;
 pub mod light;
 pub mod lowpass;
@@ -102,6 +106,9 @@ pub mod viewpoint;
 
 pub use glam;
 pub use session::{FrameView, Session, SessionConfig, SessionError};
+/// The wgpu the renderer is built on, for shells that hand it window handles.
+#[cfg(feature = "render")]
+pub use wgpu;
 
 /// Where `cargo xtask models` puts the face-tracking models and where [`face::FaceModels`] looks
 /// for them: `$PHANTOGRAM_MODELS` if set, else `$XDG_CACHE_HOME/phantogram/models`, else

@@ -1,0 +1,529 @@
+//! The embedding API: everything a platform shell drives, in one object. The Android JNI bridge,
+//! the iOS C ABI and the desktop tests that stand in for both wrap an [`Engine`] (through
+//! [`SharedEngine`]) and only translate platform events into its calls.
+//!
+//! An engine owns the sensor [`Session`], the [`Renderer`] with its GPU device, the loaded model,
+//! the containment smoother, the optional face tracker and the touch [`Gestures`]. Its drawing
+//! target follows the surface lifecycle of [`crate::surface`]:
+//!
+//! * [`Engine::resume_window`] — a drawable exists (Android `surfaceCreated`, iOS view in a
+//!   window); [`Engine::resume_offscreen`] — an offscreen target instead (desktop tests, the C
+//!   and JVM bridge tests);
+//! * [`Engine::resize`] — physical pixels changed (rotation, split screen);
+//! * [`Engine::suspend`] — the drawable is going away. **Important:** only the target goes; the
+//!   device, the model and the sensor state stay, so resuming is cheap and nothing is reloaded.
+//!
+//! [`Engine::draw`] makes one frame for the time it will be on screen: drains the sensors, takes
+//! the newest face-tracking result, predicts the orientation, keeps the artifact in the front
+//! frustum, renders both eyes and composes them with the anaglyph method (or mono), and presents
+//! (or keeps the pixels, offscreen). Drawing while suspended is a skipped frame, not an error.
+//!
+//! ## Threading
+//! **Important:** sensor events and camera frames arrive on platform threads (Android's sensor
+//! looper and CameraX executor, Core Motion's and AVFoundation's queues) while the render thread
+//! draws. [`SharedEngine`] makes that safe without making producers wait for a frame: sensor
+//! events go straight into the session's lock-protected inbox and camera frames into the face
+//! worker's one-slot mailbox; everything else (lifecycle, touch, drawing) takes the engine's
+//! mutex, so a `surfaceDestroyed` on the UI thread waits for a frame in progress and returns
+//! only when the surface is gone, as Android requires. The face tracker runs on its own thread.
+//!
+//! ## Panics and errors
+//! Bad input (sizes, unknown methods, files) yields [`EngineError`]; nothing here panics on data
+//! from outside. The bridges still catch panics at every entry point; a poisoned mutex (a panic
+//! while drawing) is recovered, since the engine's state stays consistent between calls.
+
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+
+use glam::Vec3;
+use thiserror::Error;
+
+use crate::anaglyph::Method;
+use crate::containment::{Aabb, ContainmentSmoother};
+use crate::gesture::{Gesture, Gestures, TouchPhase};
+use crate::render::{FrameInput, Gpu, RenderError, Renderer};
+use crate::screen::{DisplayRotation, PanelSpec, Screen, ScreenError};
+use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorStats};
+use crate::surface::{DrawOutcome, SurfaceHost, SurfaceStats};
+use crate::{Session, SessionConfig, SessionError};
+
+/// Largest offscreen or surface side accepted (wgpu's downlevel limit).
+pub const MAX_SIDE_PX: u32 = 8192;
+
+/// How a shell starts an engine.
+#[derive(Clone, Debug)]
+pub struct EngineConfig {
+    /// The display panel in its natural orientation (Android `DisplayMetrics`, iOS `UIScreen`).
+    pub panel: PanelSpec,
+    pub rotation: DisplayRotation,
+    pub method: Method,
+    /// A glTF 2.0 file to show; `None`: the default artifact.
+    pub model_path: Option<PathBuf>,
+    /// An equirectangular HDR/EXR environment; `None`: the generated studio.
+    pub environment_path: Option<PathBuf>,
+    /// The folder with the face-tracking models; `None`: tilt only (no camera, or permission
+    /// refused).
+    pub face_models_dir: Option<PathBuf>,
+    /// The front camera's position in the device frame, metres; `None`: centred 4 mm above the
+    /// panel's top edge (typical of phones).
+    pub camera_position_m: Option<Vec3>,
+    /// Draw the diorama's floor under the artifact.
+    pub floor: bool,
+}
+
+impl Default for EngineConfig {
+    fn default() -> Self {
+        Self {
+            panel: PanelSpec::TYPICAL_PHONE,
+            rotation: DisplayRotation::Deg0,
+            method: Method::default(),
+            model_path: None,
+            environment_path: None,
+            face_models_dir: None,
+            camera_position_m: None,
+            floor: true,
+        }
+    }
+}
+
+#[derive(Debug, Error)]
+pub enum EngineError {
+    #[error(transparent)]
+    Render(#[from] RenderError),
+    #[error(transparent)]
+    Model(#[from] crate::model::ModelError),
+    #[error(transparent)]
+    Environment(#[from] crate::ibl::EnvironmentError),
+    #[error(transparent)]
+    Session(#[from] SessionError),
+    #[error(transparent)]
+    Screen(#[from] ScreenError),
+    #[cfg(feature = "face")]
+    #[error(transparent)]
+    Face(#[from] crate::face::FaceError),
+    #[error("face tracking needs the `face` feature, which this build does not have")]
+    NoFaceSupport,
+    #[error("{0}")]
+    InvalidArgument(String),
+    #[error("no offscreen frame to read: resume an offscreen target and draw first")]
+    NoFrame,
+}
+
+/// Where frames go.
+enum Target {
+    Detached,
+    Window(Box<SurfaceHost>),
+    Offscreen { width: u32, height: u32 },
+}
+
+/// Counters, for logs, the shells' debug overlays and tests.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct EngineStats {
+    pub frames_drawn: u64,
+    pub frames_skipped: u64,
+    pub resumed: u64,
+    pub suspended: u64,
+    pub resized: u64,
+    pub sensors: SensorStats,
+    pub surface: SurfaceStats,
+    /// Camera frames handed to the face tracker, and those it had to drop (busy).
+    pub camera_frames: u64,
+    pub camera_frames_dropped: u64,
+    pub gestures: u64,
+    /// Whether the last frame's eyes came from the camera.
+    pub eyes_from_camera: bool,
+}
+
+/// What a shell embeds; see the module docs.
+pub struct Engine {
+    session: Session,
+    renderer: Renderer,
+    bounds: Aabb,
+    smoother: ContainmentSmoother,
+    method: Method,
+    /// The method to return to when stereo is toggled back on.
+    stereo_method: Method,
+    target: Target,
+    last_display_t_ns: Option<i64>,
+    #[cfg(feature = "face")]
+    face: Option<Arc<crate::face::FaceWorker>>,
+    last_face_t_ns: Option<i64>,
+    gestures: Gestures,
+    last_frame: Option<(u32, u32, Vec<u8>)>,
+    stats: EngineStats,
+}
+
+impl std::fmt::Debug for Engine {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Engine")
+            .field("method", &self.method)
+            .field("stats", &self.stats)
+            .finish_non_exhaustive()
+    }
+}
+
+fn check_size(width: u32, height: u32) -> Result<(), EngineError> {
+    if width > MAX_SIDE_PX || height > MAX_SIDE_PX {
+        return Err(EngineError::InvalidArgument(format!(
+            "size {width}×{height} is too large (at most {MAX_SIDE_PX} pixels per side)"
+        )));
+    }
+    Ok(())
+}
+
+impl Engine {
+    /// Opens the GPU device (hardware first, software fallback), loads and fits the model, the
+    /// environment and (if asked) the face models. Takes from tens of milliseconds (default
+    /// artifact) to about a second (a large scan): call it off the UI thread.
+    pub fn new(config: EngineConfig) -> Result<Self, EngineError> {
+        Self::with_gpu(Gpu::headless()?, config)
+    }
+
+    /// As [`Self::new`] on a given device.
+    pub fn with_gpu(gpu: Gpu, config: EngineConfig) -> Result<Self, EngineError> {
+        let screen = Screen::new(config.panel, config.rotation)?;
+        let session_config = SessionConfig {
+            screen,
+            ..SessionConfig::default()
+        };
+        let session = Session::new(session_config)?;
+        let mut model = match &config.model_path {
+            Some(path) => {
+                let mut m = crate::model::load_model(path)?;
+                m.fit_to_diorama(&screen, &crate::model::DioramaFit::default());
+                m
+            }
+            None => crate::artifact::default_model(),
+        };
+        let bounds = model.bounds().ok_or(RenderError::EmptyModel)?;
+        if config.floor {
+            model.add_floor(&screen, 2.5);
+        }
+        let mut renderer = Renderer::new(gpu, &model)?;
+        if let Some(path) = &config.environment_path {
+            renderer.set_environment(&crate::ibl::Environment::load(path)?)?;
+        }
+        #[cfg(feature = "face")]
+        let face = match &config.face_models_dir {
+            Some(dir) => {
+                let models = Arc::new(crate::face::FaceModels::load(dir)?);
+                let camera =
+                    config
+                        .camera_position_m
+                        .unwrap_or(Vec3::new(0.0, screen.panel_height_m() * 0.5 + 0.004, 0.0));
+                let tracker = crate::face::FaceTracker::new(models, crate::face::CameraPose::front(camera));
+                Some(Arc::new(crate::face::FaceWorker::spawn(tracker)))
+            }
+            None => None,
+        };
+        #[cfg(not(feature = "face"))]
+        if config.face_models_dir.is_some() {
+            return Err(EngineError::NoFaceSupport);
+        }
+        Ok(Self {
+            session,
+            renderer,
+            bounds,
+            smoother: ContainmentSmoother::default(),
+            method: config.method,
+            stereo_method: if config.method == Method::Mono {
+                Method::default()
+            } else {
+                config.method
+            },
+            target: Target::Detached,
+            last_display_t_ns: None,
+            #[cfg(feature = "face")]
+            face,
+            last_face_t_ns: None,
+            gestures: Gestures::new(config.panel.xdpi),
+            last_frame: None,
+            stats: EngineStats::default(),
+        })
+    }
+
+    /// The session's sensor inbox: push events from any thread.
+    pub fn inbox(&self) -> Arc<SensorInbox> {
+        self.session.inbox()
+    }
+
+    pub fn session(&self) -> &Session {
+        &self.session
+    }
+
+    pub fn renderer(&self) -> &Renderer {
+        &self.renderer
+    }
+
+    /// The face worker, if face tracking is on: submit camera frames from any thread.
+    #[cfg(feature = "face")]
+    pub fn face_worker(&self) -> Option<Arc<crate::face::FaceWorker>> {
+        self.face.clone()
+    }
+
+    pub fn method(&self) -> Method {
+        self.method
+    }
+
+    pub fn set_method(&mut self, method: Method) {
+        self.method = method;
+        if method != Method::Mono {
+            self.stereo_method = method;
+        }
+    }
+
+    /// A drawable appeared: draw into `window` at `width × height` physical pixels.
+    pub fn resume_window(
+        &mut self,
+        window: Arc<dyn wgpu::WindowHandle>,
+        width: u32,
+        height: u32,
+    ) -> Result<(), EngineError> {
+        check_size(width, height)?;
+        let mut host = SurfaceHost::new();
+        host.resume(self.renderer.gpu(), window, width, height)?;
+        self.target = Target::Window(Box::new(host));
+        self.stats.resumed += 1;
+        Ok(())
+    }
+
+    /// Draw into an offscreen image of `width × height` pixels (read with [`Self::last_frame`]).
+    pub fn resume_offscreen(&mut self, width: u32, height: u32) -> Result<(), EngineError> {
+        check_size(width, height)?;
+        self.target = Target::Offscreen { width, height };
+        self.stats.resumed += 1;
+        Ok(())
+    }
+
+    /// The target's size changed, in physical pixels (zero: minimised; frames are skipped).
+    pub fn resize(&mut self, width: u32, height: u32) -> Result<(), EngineError> {
+        check_size(width, height)?;
+        match &mut self.target {
+            Target::Detached => {}
+            Target::Window(host) => host.resize(self.renderer.gpu(), width, height),
+            Target::Offscreen { width: w, height: h } => {
+                (*w, *h) = (width, height);
+            }
+        }
+        self.stats.resized += 1;
+        Ok(())
+    }
+
+    /// The drawable is going away: drop the target (and with it the surface and the window it
+    /// borrows) before returning. Keeps the device, the model and the sensor state.
+    pub fn suspend(&mut self) {
+        if let Target::Window(host) = &mut self.target {
+            host.suspend();
+            self.stats.surface = add_surface_stats(self.stats.surface, host.stats());
+        }
+        if !matches!(self.target, Target::Detached) {
+            self.stats.suspended += 1;
+        }
+        self.target = Target::Detached;
+        self.last_frame = None;
+    }
+
+    /// The display's panel or rotation changed (Android configuration change, iOS trait change).
+    pub fn set_display(&mut self, panel: PanelSpec, rotation: DisplayRotation) -> Result<(), EngineError> {
+        self.session.set_screen(Screen::new(panel, rotation)?);
+        self.gestures = Gestures::new(panel.xdpi);
+        Ok(())
+    }
+
+    /// One touch event (physical pixels, nanoseconds on a monotonic clock); acts on the gesture
+    /// it completes and returns it.
+    pub fn touch(&mut self, phase: TouchPhase, pointer_id: i32, x_px: f32, y_px: f32, t_ns: i64) -> Option<Gesture> {
+        let g = self.gestures.touch(phase, pointer_id, x_px, y_px, t_ns)?;
+        self.apply_gesture(g);
+        Some(g)
+    }
+
+    fn apply_gesture(&mut self, g: Gesture) {
+        self.stats.gestures += 1;
+        // Without gravity yet the calibrations cannot be done; the gesture is then a no-op, as a
+        // user would expect from tapping a phone that has not measured anything.
+        match g {
+            Gesture::StraightOn => {
+                let _ = self.session.calibrate_flat_angle();
+            }
+            Gesture::AnchorLight => {
+                let _ = self.session.recalibrate_light();
+            }
+            Gesture::ToggleStereo => {
+                self.method = if self.method == Method::Mono {
+                    self.stereo_method
+                } else {
+                    Method::Mono
+                };
+            }
+        }
+    }
+
+    /// Makes the current holding pose count as straight on.
+    pub fn calibrate_flat_angle(&mut self) -> Result<(), EngineError> {
+        Ok(self.session.calibrate_flat_angle()?)
+    }
+
+    /// Draws one frame that will be on screen at `display_t_ns` (sensor clock; `None`: for the
+    /// newest sensor state, no prediction).
+    pub fn draw(&mut self, display_t_ns: Option<i64>) -> Result<DrawOutcome, EngineError> {
+        if let Some(g) = display_t_ns.and_then(|t| self.gestures.poll(t)) {
+            self.apply_gesture(g);
+        }
+        if matches!(self.target, Target::Detached) {
+            self.stats.frames_skipped += 1;
+            return Ok(DrawOutcome::Skipped("suspended"));
+        }
+        self.take_face_result();
+        let view = self.session.frame_at(display_t_ns)?;
+        let dt_s = match (self.last_display_t_ns, display_t_ns) {
+            (Some(a), Some(b)) if b > a => ((b - a) as f32 * 1e-9).min(0.1),
+            _ => 1.0 / 60.0,
+        };
+        if display_t_ns.is_some() {
+            self.last_display_t_ns = display_t_ns;
+        }
+        let push = self
+            .smoother
+            .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s);
+        let input = FrameInput::from_view(&view, Vec3::Z * -push);
+        self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
+        let outcome = match &mut self.target {
+            Target::Detached => DrawOutcome::Skipped("suspended"),
+            Target::Window(host) => host.draw(&mut self.renderer, &input, self.method)?,
+            Target::Offscreen { width, height } => {
+                let (w, h) = (*width, *height);
+                if w == 0 || h == 0 {
+                    DrawOutcome::Skipped("zero-sized")
+                } else {
+                    let pixels = self.renderer.render(&input, self.method, w, h)?;
+                    self.last_frame = Some((w, h, pixels));
+                    DrawOutcome::Presented
+                }
+            }
+        };
+        match outcome {
+            DrawOutcome::Presented => self.stats.frames_drawn += 1,
+            DrawOutcome::Skipped(_) => self.stats.frames_skipped += 1,
+        }
+        Ok(outcome)
+    }
+
+    #[cfg(feature = "face")]
+    fn take_face_result(&mut self) {
+        let newest = self.face.as_ref().and_then(|f| f.newest());
+        if let Some(obs) = newest.filter(|o| self.last_face_t_ns != Some(o.capture_t_ns)) {
+            self.last_face_t_ns = Some(obs.capture_t_ns);
+            self.session.observe_face(obs);
+        }
+    }
+
+    #[cfg(not(feature = "face"))]
+    fn take_face_result(&mut self) {
+        let _ = self.last_face_t_ns;
+    }
+
+    /// The last offscreen frame: width, height and 8-bit sRGB RGBA pixels, rows top to bottom.
+    pub fn last_frame(&self) -> Result<(u32, u32, &[u8]), EngineError> {
+        self.last_frame
+            .as_ref()
+            .map(|(w, h, p)| (*w, *h, p.as_slice()))
+            .ok_or(EngineError::NoFrame)
+    }
+
+    pub fn stats(&self) -> EngineStats {
+        let mut s = self.stats;
+        s.sensors = self.session.stats();
+        if let Target::Window(host) = &self.target {
+            s.surface = add_surface_stats(s.surface, host.stats());
+        }
+        #[cfg(feature = "face")]
+        if let Some(f) = &self.face {
+            s.camera_frames_dropped = f.dropped_frames();
+        }
+        s
+    }
+}
+
+fn add_surface_stats(a: SurfaceStats, b: SurfaceStats) -> SurfaceStats {
+    SurfaceStats {
+        presented: a.presented + b.presented,
+        skipped: a.skipped + b.skipped,
+        reconfigured: a.reconfigured + b.reconfigured,
+        recreated: a.recreated + b.recreated,
+        resumed: a.resumed + b.resumed,
+        suspended: a.suspended + b.suspended,
+    }
+}
+
+/// An [`Engine`] shared between the render thread and the platform's producer threads; what the
+/// bridges hold behind their handles. See the module docs for the threading contract.
+pub struct SharedEngine {
+    inbox: Arc<SensorInbox>,
+    #[cfg(feature = "face")]
+    face: Option<Arc<crate::face::FaceWorker>>,
+    camera_frames: std::sync::atomic::AtomicU64,
+    engine: Mutex<Engine>,
+}
+
+impl SharedEngine {
+    pub fn new(engine: Engine) -> Self {
+        Self {
+            inbox: engine.inbox(),
+            #[cfg(feature = "face")]
+            face: engine.face_worker(),
+            camera_frames: std::sync::atomic::AtomicU64::new(0),
+            engine: Mutex::new(engine),
+        }
+    }
+
+    /// From any thread, without waiting for a frame. Bad samples are rejected and counted.
+    pub fn push_sensor(&self, event: SensorEvent) -> Result<(), Rejection> {
+        self.inbox.push(event)
+    }
+
+    /// From any thread, without waiting for inference: hands the frame to the face tracker
+    /// (replacing one not yet started). `Ok(false)` when face tracking is off.
+    #[cfg(feature = "face")]
+    pub fn camera_frame(&self, frame: crate::face::OwnedFrame) -> Result<bool, EngineError> {
+        crate::face::UprightImage::new(frame.as_frame())?;
+        match &self.face {
+            Some(worker) => {
+                worker.submit(frame);
+                self.camera_frames.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+                Ok(true)
+            }
+            None => Ok(false),
+        }
+    }
+
+    /// The engine, for lifecycle, touch and drawing (waits for a frame in progress).
+    pub fn lock(&self) -> MutexGuard<'_, Engine> {
+        self.engine.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    pub fn stats(&self) -> EngineStats {
+        let mut s = self.lock().stats();
+        s.camera_frames = self.camera_frames.load(std::sync::atomic::Ordering::Relaxed);
+        s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn assert_send_sync<T: Send + Sync>() {}
+
+    #[test]
+    fn the_shared_engine_may_cross_threads() {
+        assert_send_sync::<SharedEngine>();
+    }
+
+    #[test]
+    fn sizes_beyond_the_device_limit_are_refused_with_the_limit() {
+        let e = check_size(9000, 10).unwrap_err().to_string();
+        assert!(e.contains("8192"), "{e}");
+        assert!(check_size(0, 0).is_ok(), "zero is a minimised window, not an error");
+    }
+}
