@@ -1,13 +1,23 @@
-//! The iOS side of the phantogram core: today only the conversion from Core Motion's conventions to
-//! the core's sensor events; the C ABI, cbindgen header and Metal surface come with the shell
-//! (issue #6).
+//! The iOS side of the phantogram core: the C ABI the Swift shell calls ([`ffi`], header
+//! `include/phantogram.h`), the `UIView` surface ([`platform_ios`]), and the conversion from
+//! Core Motion's conventions to the core's sensor events (below).
+//!
+//! Built as a static library (`cargo xtask ios` packs it into an XCFramework on macOS). The
+//! desktop tests link the same static library into a C program (`tests/c/replay.c`).
 //!
 //! Core Motion's device axes are the core's (x right, y up, z out of the screen), but its
 //! accelerometer reports in g with the opposite sign (a phone lying face up reads −1 g on z, where
 //! the core, like Android, reads +9.81 m/s²). Gyroscope (rad/s) and calibrated magnetic field (µT)
 //! pass through. Time stamps are seconds since boot (`CMLogItem.timestamp`).
 
-use phantogram::glam::Vec3;
+use phantogram::glam::{Quat, Vec3};
+
+pub mod ffi;
+pub mod platform_ios;
+
+mod platform {
+    pub use super::platform_ios::view_window;
+}
 use phantogram::sensors::SensorEvent;
 
 /// Standard gravity used by Core Motion's g unit, m/s².
@@ -40,6 +50,24 @@ pub fn magnetometer_event(timestamp_s: f64, field_ut: [f64; 3]) -> Option<Sensor
     Some(SensorEvent::magnetometer(
         timestamp_ns(timestamp_s)?,
         Vec3::from_array(field_ut.map(|v| v as f32)),
+    ))
+}
+
+/// `CMDeviceMotion.attitude.quaternion` (w, x, y, z) in the `xMagneticNorthZVertical` reference
+/// frame (x magnetic north, z up, y west) → a core rotation-vector event (device → ENU world):
+/// a quarter turn about z takes north to the world's y and west to −x. The quaternion is taken
+/// to rotate device vectors into the reference frame; this reading of Apple's documentation has
+/// not been checked on a device (it only feeds the comparison, never the estimators).
+pub fn attitude_event(timestamp_s: f64, wxyz: [f64; 4]) -> Option<SensorEvent> {
+    let q = Quat::from_xyzw(wxyz[1] as f32, wxyz[2] as f32, wxyz[3] as f32, wxyz[0] as f32);
+    if !q.is_finite() || q.length_squared() < 0.5 {
+        return None;
+    }
+    let enu_from_reference = Quat::from_rotation_z(std::f32::consts::FRAC_PI_2);
+    Some(SensorEvent::orientation(
+        phantogram::sensors::SensorKind::RotationVector,
+        timestamp_ns(timestamp_s)?,
+        (enu_from_reference * q.normalize()).normalize(),
     ))
 }
 

@@ -1,0 +1,161 @@
+/*
+ * Desktop test of the C ABI (run by ios/tests/c_abi.rs): compiled with a C compiler against the
+ * generated include/phantogram.h and linked with the static library the XCFramework packs.
+ * Replays a sensor log through the Core Motion entry points exactly as the Swift shell would
+ * (g with Core Motion's sign, seconds since boot), draws offscreen every 100 ms of log time and
+ * writes the last frame's RGBA bytes. Also checks the error contract (status codes, messages).
+ *
+ * Usage: replay LOG OUT WIDTH HEIGHT
+ */
+#include "phantogram.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void check(PgStatus got, PgStatus want, const char *what, const char *fragment) {
+    char message[512];
+    pg_last_error(message, sizeof message);
+    if (got != want || (fragment && !strstr(message, fragment))) {
+        fprintf(stderr, "%s: status %d (want %d), message \"%s\" (want \"%s\")\n", what, (int)got, (int)want,
+                message, fragment ? fragment : "");
+        exit(1);
+    }
+    if (fragment) {
+        printf("ok: %s -> %d: %s\n", what, (int)got, message);
+    }
+}
+
+int main(int argc, char **argv) {
+    if (argc != 5) {
+        fprintf(stderr, "usage: replay LOG OUT WIDTH HEIGHT\n");
+        return 2;
+    }
+    const char *log_path = argv[1];
+    const char *out_path = argv[2];
+    uint32_t width = (uint32_t)atoi(argv[3]);
+    uint32_t height = (uint32_t)atoi(argv[4]);
+
+    /* The error contract. */
+    check(pg_draw(NULL, 0.0, NULL), PG_STATUS_NULL_POINTER, "pg_draw(NULL)", "null");
+    PgConfig config = pg_config_default();
+    config.anaglyph = "sepia";
+    PgEngine *engine = (PgEngine *)1;
+    check(pg_engine_create(&config, &engine), PG_STATUS_INVALID_ARGUMENT, "create with anaglyph sepia", "sepia");
+    if (engine != NULL) {
+        fprintf(stderr, "a failed create must leave the handle null\n");
+        return 1;
+    }
+    config.anaglyph = "dubois";
+    config.rotation_quarter_turns = 5;
+    check(pg_engine_create(&config, &engine), PG_STATUS_INVALID_ARGUMENT, "create with rotation 5", "rotation");
+    config.rotation_quarter_turns = 0;
+    check(pg_engine_create(&config, &engine), PG_STATUS_OK, "create", NULL);
+    if (pg_last_error(NULL, 0) != 1) {
+        fprintf(stderr, "success must clear the error message\n");
+        return 1;
+    }
+    uint32_t w = 0, h = 0;
+    check(pg_read_frame(engine, NULL, 0, &w, &h), PG_STATUS_NO_FRAME, "read before drawing", "no offscreen frame");
+    check(pg_resume_view(engine, NULL, 10, 10), PG_STATUS_NULL_POINTER, "resume a null view", "ui_view");
+    check(pg_set_anaglyph(engine, "sepia"), PG_STATUS_INVALID_ARGUMENT, "set anaglyph sepia", "sepia");
+    uint8_t presented = 9;
+    check(pg_draw(engine, -1.0, &presented), PG_STATUS_OK, "draw while suspended", NULL);
+    if (presented != 0) {
+        fprintf(stderr, "drawing without a target must be a skipped frame\n");
+        return 1;
+    }
+    check(pg_resume_offscreen(engine, width, height), PG_STATUS_OK, "resume offscreen", NULL);
+
+    FILE *log = fopen(log_path, "r");
+    if (!log) {
+        perror(log_path);
+        return 1;
+    }
+    const double g = STANDARD_GRAVITY_M_S2;
+    const long long step_ns = 100000000LL;
+    long long next = 0, last = 0;
+    int have_next = 0, frames = 0, rejected = 0;
+    char line[256];
+    while (fgets(line, sizeof line, log)) {
+        char kind[8];
+        long long t;
+        double x, y, z;
+        if (sscanf(line, "%7s %lld %lf %lf %lf", kind, &t, &x, &y, &z) != 5) {
+            continue;
+        }
+        int which = strcmp(kind, "acc") == 0 ? 1 : strcmp(kind, "gyr") == 0 ? 2 : strcmp(kind, "mag") == 0 ? 3 : 0;
+        if (!which) {
+            continue;
+        }
+        if (!have_next) {
+            next = t + step_ns;
+            have_next = 1;
+        }
+        while (t > next) {
+            check(pg_draw(engine, (double)next * 1e-9, &presented), PG_STATUS_OK, "draw", NULL);
+            frames += presented;
+            next += step_ns;
+        }
+        double t_s = (double)t * 1e-9;
+        PgStatus s;
+        if (which == 1) {
+            /* Core Motion reports acceleration in g, with gravity negative when face up. */
+            s = pg_push_accelerometer(engine, t_s, -x / g, -y / g, -z / g);
+        } else if (which == 2) {
+            s = pg_push_gyroscope(engine, t_s, x, y, z);
+        } else {
+            s = pg_push_magnetometer(engine, t_s, x, y, z);
+        }
+        if (s == PG_STATUS_REJECTED) {
+            rejected++;
+        } else {
+            check(s, PG_STATUS_OK, "push", NULL);
+        }
+        last = t;
+    }
+    fclose(log);
+    check(pg_draw(engine, (double)last * 1e-9, &presented), PG_STATUS_OK, "last draw", NULL);
+    frames += presented;
+
+    check(pg_read_frame(engine, NULL, 0, &w, &h), PG_STATUS_OK, "frame size", NULL);
+    if (w != width || h != height) {
+        fprintf(stderr, "frame is %ux%u, want %ux%u\n", w, h, width, height);
+        return 1;
+    }
+    size_t size = (size_t)w * h * 4;
+    uint8_t *pixels = malloc(size);
+    check(pg_read_frame(engine, pixels, size - 1, &w, &h), PG_STATUS_BUFFER_TOO_SMALL, "short buffer", "needs");
+    check(pg_read_frame(engine, pixels, size, &w, &h), PG_STATUS_OK, "read frame", NULL);
+    FILE *out = fopen(out_path, "wb");
+    if (!out || fwrite(pixels, 1, size, out) != size) {
+        perror(out_path);
+        return 1;
+    }
+    fclose(out);
+    free(pixels);
+
+    /* The rest of the ABI once: touch, display, camera (face tracking off), lifecycle. */
+    int gesture = -1;
+    check(pg_touch(engine, 0, 0, 10.0f, 10.0f, (double)last * 1e-9, &gesture), PG_STATUS_OK, "touch down", NULL);
+    check(pg_touch(engine, 7, 0, 10.0f, 10.0f, (double)last * 1e-9, &gesture), PG_STATUS_INVALID_ARGUMENT,
+          "touch phase 7", "touch phase");
+    check(pg_set_display(engine, 1080, 2400, 420.0f, 420.0f, 0), PG_STATUS_OK, "set display", NULL);
+    uint8_t luma[64 * 48] = {0};
+    check(pg_camera_frame(engine, luma, 64, 48, 64, 270, 50.0f, 50.0f, 32.0f, 24.0f, (double)last * 1e-9),
+          PG_STATUS_UNSUPPORTED, "camera frame without face tracking", "face tracking is off");
+    check(pg_camera_frame(engine, luma, 64, 48, 64, 45, 50.0f, 50.0f, 32.0f, 24.0f, (double)last * 1e-9),
+          PG_STATUS_INVALID_ARGUMENT, "camera frame turned 45 degrees", "rotation");
+    check(pg_resize(engine, width / 2, height / 2), PG_STATUS_OK, "resize", NULL);
+    check(pg_suspend(engine), PG_STATUS_OK, "suspend", NULL);
+    PgStats stats;
+    check(pg_stats(engine, &stats), PG_STATUS_OK, "stats", NULL);
+    printf("frames %d drawn %llu skipped %llu accepted %llu rejected %llu (driver saw %d)\n", frames,
+           (unsigned long long)stats.frames_drawn, (unsigned long long)stats.frames_skipped,
+           (unsigned long long)stats.sensor_events_accepted, (unsigned long long)stats.sensor_events_rejected,
+           rejected);
+    pg_engine_destroy(engine);
+    pg_engine_destroy(NULL);
+    printf("done\n");
+    return 0;
+}
