@@ -1,6 +1,16 @@
-//! The Android side of the phantogram core: today only the mapping from Android's sensor API to the
-//! core's sensor events; the JNI bridge, surface and lifecycle handling come with the shell
-//! (issue #6).
+//! The Android side of the phantogram core: the JNI bridge the Kotlin shell calls
+//! ([`jni_bridge`]), the `Surface` → `ANativeWindow` step (`platform_android.rs`; elsewhere
+//! `platform_other.rs`), and the mapping from Android's sensor API to the core's sensor events
+//! (below).
+//!
+//! Built as a cdylib (`libphantogram_android.so`, loaded by `System.loadLibrary`); the desktop
+//! JVM test loads the host build of the same library.
+//!
+//! Why a `SurfaceView` with its holder callbacks and `ndk::NativeWindow` rather than GameActivity
+//! through android-activity: the shell stays an ordinary Kotlin Activity (CameraX, the
+//! permission flow and Choreographer are plain Android APIs there), the native side needs only
+//! `ANativeWindow_fromSurface`, and that code type-checks on this Linux host (ndk-sys's `test`
+//! feature), where android-activity stops with a `compile_error!`.
 //!
 //! Android's sensor frame *is* the core's device frame and its units are the core's (m/s² with
 //! gravity, rad/s, µT; `SensorEvent.timestamp` in ns), so values pass through unchanged; only the
@@ -8,6 +18,15 @@
 
 use phantogram::glam::{Quat, Vec3};
 use phantogram::sensors::{SensorEvent, SensorKind};
+
+pub mod jni_bridge;
+
+#[cfg(any(target_os = "android", feature = "android-typecheck"))]
+#[path = "platform_android.rs"]
+mod platform;
+#[cfg(not(any(target_os = "android", feature = "android-typecheck")))]
+#[path = "platform_other.rs"]
+mod platform;
 
 /// `android.hardware.Sensor.TYPE_*` values the shell forwards.
 pub mod sensor_type {

@@ -1,0 +1,85 @@
+package org.phantogram;
+
+import java.nio.ByteBuffer;
+
+/**
+ * The native methods of libphantogram_android.so (android/src/jni_bridge.rs). This file is the
+ * one declaration of them: the app compiles it, and the desktop JVM test compiles it unchanged
+ * against the host build of the same library, so the two cannot drift. It uses no Android class
+ * (the surface is passed as an Object) for that reason.
+ *
+ * Threading: the sensor and camera methods may be called from any thread at any time and never
+ * wait for a frame; the others serialise on the engine. nativeSurfaceDestroyed returns once the
+ * native window is released. nativeDestroy must not race any other call on the same handle.
+ *
+ * Errors: IllegalArgumentException (bad arguments), IllegalStateException (wrong state, e.g. a
+ * destroyed handle), UnsupportedOperationException (not on this platform), RuntimeException
+ * (loading or GPU failures, and internal errors). Native panics never reach the JVM as crashes.
+ *
+ * Times are nanoseconds on the sensor clock (SensorEvent.timestamp, i.e.
+ * SystemClock.elapsedRealtimeNanos()); the shell converts Choreographer and MotionEvent times.
+ */
+public final class NativeBridge {
+    private NativeBridge() {}
+
+    /** Loads the library (the app: by name; the desktop test: by path). */
+    public static void load(String absolutePathOrNull) {
+        if (absolutePathOrNull == null) {
+            System.loadLibrary("phantogram_android");
+        } else {
+            System.load(absolutePathOrNull);
+        }
+    }
+
+    /** Gesture codes returned by nativeTouch. */
+    public static final int GESTURE_NONE = 0;
+    public static final int GESTURE_STRAIGHT_ON = 1;
+    public static final int GESTURE_LIGHT_ANCHORED = 2;
+    public static final int GESTURE_STEREO_TOGGLED = 3;
+
+    /** Touch phases for nativeTouch. */
+    public static final int TOUCH_DOWN = 0;
+    public static final int TOUCH_MOVE = 1;
+    public static final int TOUCH_UP = 2;
+    public static final int TOUCH_CANCEL = 3;
+
+    /** Opens the GPU device and loads the scene; call off the UI thread. Null strings: defaults. */
+    public static native long nativeCreate(String modelPath, String faceModelsDir, int panelWidthPx,
+            int panelHeightPx, float xdpi, float ydpi, int rotation, String anaglyph);
+
+    public static native void nativeDestroy(long handle);
+
+    /** One SensorEvent (Sensor.TYPE_*); w is NaN when the event has three values. */
+    public static native boolean nativePushSensor(long handle, int sensorType, long timestampNs,
+            float x, float y, float z, float w);
+
+    /** A front-camera Y plane (direct buffer, pixel stride 1); copied before returning. */
+    public static native boolean nativeCameraFrame(long handle, ByteBuffer luma, int width, int height,
+            int rowStride, int rotationDegrees, float fx, float fy, float cx, float cy, long timestampNs);
+
+    public static native int nativeTouch(long handle, int phase, int pointerId, float x, float y, long timeNs);
+
+    /** surface is an android.view.Surface. */
+    public static native void nativeSurfaceCreated(long handle, Object surface, int width, int height);
+
+    public static native void nativeResumeOffscreen(long handle, int width, int height);
+
+    public static native void nativeSurfaceChanged(long handle, int width, int height);
+
+    public static native void nativeSurfaceDestroyed(long handle);
+
+    public static native void nativeSetDisplay(long handle, int panelWidthPx, int panelHeightPx,
+            float xdpi, float ydpi, int rotation);
+
+    public static native void nativeSetAnaglyph(long handle, String name);
+
+    /** Draws the frame shown at displayTimeNs (negative: no prediction); false if skipped. */
+    public static native boolean nativeDrawFrame(long handle, long displayTimeNs);
+
+    /** The last offscreen frame: [width, height, ARGB pixels...]. */
+    public static native int[] nativeReadFrame(long handle);
+
+    /** [framesDrawn, framesSkipped, resumed, suspended, sensorsAccepted, sensorsRejected,
+     *  cameraFrames, gestures, eyesFromCamera]. */
+    public static native long[] nativeStats(long handle);
+}

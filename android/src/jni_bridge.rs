@@ -1,0 +1,588 @@
+//! The JNI bridge: the native methods of `org.phantogram.NativeBridge`
+//! (`android/app/src/main/java/org/phantogram/NativeBridge.java`, the one declaration of them,
+//! compiled unchanged by the desktop JVM test).
+//!
+//! * **Handles**: `nativeCreate` returns a `long` owning a [`SharedEngine`]; every other method
+//!   takes it first; `nativeDestroy` frees it. `0` is never a live handle and is reported as an
+//!   `IllegalStateException`.
+//! * **Errors and panics**: every entry point runs inside jni-rs's `with_env`, which catches
+//!   panics; our errors become Java exceptions (`IllegalArgumentException` for bad arguments,
+//!   `IllegalStateException` for calls in the wrong state, `UnsupportedOperationException` for
+//!   what this platform cannot do, `RuntimeException` for load and GPU failures) and a panic a
+//!   `RuntimeException` naming it. Nothing unwinds into the JVM. Rejected sensor samples are not
+//!   errors (a throwing sensor callback would kill the app): `nativePushSensor` returns `false`.
+//! * **Classes** are resolved once, in `JNI_OnLoad` (on the thread that loads the library, whose
+//!   class loader sees them), and kept as global references, so throwing works on any thread.
+//! * **Threads**: the JVM attaches the threads that call native methods (the sensor looper, the
+//!   CameraX executor, the UI thread, the render thread); the bridge never starts threads that
+//!   call into Java. **Important:** sensor and camera methods may run concurrently with drawing
+//!   and never wait for a frame; `nativeSurfaceDestroyed` waits for a frame in progress and
+//!   returns once the native window is released, as `surfaceDestroyed` requires. The caller
+//!   guarantees that `nativeDestroy` races no other call on the same handle.
+
+use std::ffi::c_void;
+use std::sync::OnceLock;
+
+use jni::errors::ThrowRuntimeExAndDefault;
+use jni::objects::{JByteBuffer, JClass, JObject, JString};
+use jni::refs::Global;
+use jni::strings::JNIString;
+use jni::sys::{JNI_VERSION_1_6, jboolean, jfloat, jint, jintArray, jlong, jlongArray};
+use jni::{Env, EnvUnowned, JavaVM, jni_str};
+use phantogram::anaglyph::Method;
+use phantogram::engine::{Engine, EngineConfig, EngineError, SharedEngine};
+use phantogram::face::{Intrinsics, OwnedFrame, PixelFormat};
+use phantogram::gesture::{Gesture, TouchPhase};
+use phantogram::screen::{DisplayRotation, PanelSpec};
+use phantogram::surface::DrawOutcome;
+
+/// Which Java exception an error becomes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Kind {
+    IllegalArgument,
+    IllegalState,
+    Unsupported,
+    Runtime,
+}
+
+/// An error on its way to Java.
+pub(crate) enum Thrown {
+    Java(Kind, String),
+    /// A JNI call failed (usually an exception is already pending).
+    Jni(jni::errors::Error),
+}
+
+impl From<jni::errors::Error> for Thrown {
+    fn from(e: jni::errors::Error) -> Self {
+        Self::Jni(e)
+    }
+}
+
+impl From<EngineError> for Thrown {
+    fn from(e: EngineError) -> Self {
+        let kind = match &e {
+            EngineError::InvalidArgument(_)
+            | EngineError::Screen(_)
+            | EngineError::Session(_)
+            | EngineError::Face(phantogram::face::FaceError::BadFrame(_)) => Kind::IllegalArgument,
+            EngineError::NoFrame => Kind::IllegalState,
+            EngineError::NoFaceSupport => Kind::Unsupported,
+            EngineError::Render(_) | EngineError::Model(_) | EngineError::Environment(_) | EngineError::Face(_) => {
+                Kind::Runtime
+            }
+        };
+        Self::Java(kind, e.to_string())
+    }
+}
+
+pub(crate) fn fail(kind: Kind, message: impl Into<String>) -> Thrown {
+    Thrown::Java(kind, message.into())
+}
+
+/// Exception classes, resolved in `JNI_OnLoad`.
+struct Classes {
+    illegal_argument: Global<JClass<'static>>,
+    illegal_state: Global<JClass<'static>>,
+    unsupported: Global<JClass<'static>>,
+    runtime: Global<JClass<'static>>,
+}
+
+static CLASSES: OnceLock<Classes> = OnceLock::new();
+
+fn cache_classes(env: &mut Env) -> jni::errors::Result<Classes> {
+    let mut global = |name: &jni::strings::JNIStr| -> jni::errors::Result<Global<JClass<'static>>> {
+        let class = env.find_class(name)?;
+        env.new_global_ref(class)
+    };
+    Ok(Classes {
+        illegal_argument: global(jni_str!("java/lang/IllegalArgumentException"))?,
+        illegal_state: global(jni_str!("java/lang/IllegalStateException"))?,
+        unsupported: global(jni_str!("java/lang/UnsupportedOperationException"))?,
+        runtime: global(jni_str!("java/lang/RuntimeException"))?,
+    })
+}
+
+/// Resolves and caches the classes the bridge throws.
+///
+/// # Safety
+/// Called by the JVM with its own `JavaVM` pointer when the library is loaded.
+#[unsafe(no_mangle)]
+pub unsafe extern "system" fn JNI_OnLoad(vm: *mut jni::sys::JavaVM, _reserved: *mut c_void) -> jint {
+    let outcome = std::panic::catch_unwind(|| {
+        // SAFETY: the JVM passes its own, valid `JavaVM` pointer.
+        let vm = unsafe { JavaVM::from_raw(vm) };
+        vm.attach_current_thread(|env| -> jni::errors::Result<()> {
+            let classes = cache_classes(env)?;
+            let _ = CLASSES.set(classes);
+            Ok(())
+        })
+    });
+    match outcome {
+        Ok(Ok(())) => JNI_VERSION_1_6,
+        // Loading fails with an `UnsatisfiedLinkError` rather than later with obscure errors.
+        _ => jni::sys::JNI_ERR,
+    }
+}
+
+fn throw(env: &mut Env, kind: Kind, message: &str) -> jni::errors::Result<()> {
+    let message = JNIString::from(message);
+    match CLASSES.get() {
+        Some(c) => {
+            let class = match kind {
+                Kind::IllegalArgument => &c.illegal_argument,
+                Kind::IllegalState => &c.illegal_state,
+                Kind::Unsupported => &c.unsupported,
+                Kind::Runtime => &c.runtime,
+            };
+            env.throw_new(class, message)
+        }
+        // Only if `JNI_OnLoad` did not run (a host loading the library oddly).
+        None => env.throw_new(jni_str!("java/lang/RuntimeException"), message),
+    }
+}
+
+/// Runs one native method's body: errors become Java exceptions (and `T::default()` the return
+/// value Java ignores), panics are caught by `with_env` and become a `RuntimeException`.
+fn run<'local, T: Default>(
+    unowned: &mut EnvUnowned<'local>,
+    body: impl FnOnce(&mut Env<'local>) -> Result<T, Thrown>,
+) -> T {
+    unowned
+        .with_env(|env| -> jni::errors::Result<T> {
+            match body(env) {
+                Ok(v) => Ok(v),
+                Err(Thrown::Java(kind, message)) => {
+                    throw(env, kind, &message)?;
+                    Ok(T::default())
+                }
+                Err(Thrown::Jni(e)) => Err(e),
+            }
+        })
+        .resolve::<ThrowRuntimeExAndDefault>()
+}
+
+/// The engine behind a handle.
+///
+/// The handle is a `Box<SharedEngine>` leaked by `nativeCreate` and not yet freed (the caller's
+/// contract, see the module docs); it is only ever shared, never mutated through this reference.
+fn engine<'a>(handle: jlong) -> Result<&'a SharedEngine, Thrown> {
+    let ptr = handle as usize as *const SharedEngine;
+    // SAFETY: a non-zero handle is a live `Box<SharedEngine>` from `nativeCreate` that
+    // `nativeDestroy` has not freed (the Java side's contract); `SharedEngine` is `Sync`.
+    unsafe { ptr.as_ref() }.ok_or_else(|| fail(Kind::IllegalState, "the engine was destroyed (handle 0)"))
+}
+
+fn optional_string(env: &Env, s: &JString) -> Result<Option<String>, Thrown> {
+    if s.is_null() {
+        return Ok(None);
+    }
+    Ok(Some(s.try_to_string(env)?))
+}
+
+fn panel(width_px: jint, height_px: jint, xdpi: jfloat, ydpi: jfloat) -> Result<PanelSpec, Thrown> {
+    let px = |v: jint, what: &str| {
+        u32::try_from(v).map_err(|_| fail(Kind::IllegalArgument, format!("{what} must not be negative, got {v}")))
+    };
+    Ok(PanelSpec {
+        width_px: px(width_px, "panel width")?,
+        height_px: px(height_px, "panel height")?,
+        xdpi,
+        ydpi,
+    })
+}
+
+fn rotation(value: jint) -> Result<DisplayRotation, Thrown> {
+    DisplayRotation::from_android_surface_rotation(value).ok_or_else(|| {
+        fail(
+            Kind::IllegalArgument,
+            format!("rotation must be a Surface.ROTATION_* value (0 to 3), got {value}"),
+        )
+    })
+}
+
+fn size(width: jint, height: jint) -> Result<(u32, u32), Thrown> {
+    match (u32::try_from(width), u32::try_from(height)) {
+        (Ok(w), Ok(h)) => Ok((w, h)),
+        _ => Err(fail(
+            Kind::IllegalArgument,
+            format!("size must not be negative, got {width}×{height}"),
+        )),
+    }
+}
+
+fn method(name: &str) -> Result<Method, Thrown> {
+    name.parse::<Method>()
+        .map_err(|e| fail(Kind::IllegalArgument, e.to_string()))
+}
+
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    model_path: JString<'local>,
+    face_models_dir: JString<'local>,
+    panel_width_px: jint,
+    panel_height_px: jint,
+    xdpi: jfloat,
+    ydpi: jfloat,
+    rotation_value: jint,
+    anaglyph: JString<'local>,
+) -> jlong {
+    run(&mut env, |env| {
+        let config = EngineConfig {
+            panel: panel(panel_width_px, panel_height_px, xdpi, ydpi)?,
+            rotation: rotation(rotation_value)?,
+            method: optional_string(env, &anaglyph)?
+                .as_deref()
+                .map(method)
+                .transpose()?
+                .unwrap_or_default(),
+            model_path: optional_string(env, &model_path)?.map(Into::into),
+            environment_path: None,
+            face_models_dir: optional_string(env, &face_models_dir)?.map(Into::into),
+            camera_position_m: None,
+            floor: true,
+        };
+        let engine = Engine::new(config)?;
+        Ok(Box::into_raw(Box::new(SharedEngine::new(engine))) as usize as jlong)
+    })
+}
+
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeDestroy<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) {
+    run(&mut env, |_| {
+        let ptr = handle as usize as *mut SharedEngine;
+        if !ptr.is_null() {
+            // SAFETY: the Box leaked by `nativeCreate`, freed once (the caller's contract).
+            drop(unsafe { Box::from_raw(ptr) });
+        }
+        Ok(())
+    })
+}
+
+/// `SensorEvent` of `android.hardware.Sensor.TYPE_*` `sensor_type` with its `timestamp` and
+/// first values (`w` is NaN when absent). Returns `false` for rejected samples and unused types.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativePushSensor<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    sensor_type: jint,
+    timestamp_ns: jlong,
+    x: jfloat,
+    y: jfloat,
+    z: jfloat,
+    w: jfloat,
+) -> jboolean {
+    run(&mut env, |_| {
+        let engine = engine(handle)?;
+        let values = [x, y, z, w];
+        let n = if w.is_nan() { 3 } else { 4 };
+        Ok(
+            match crate::event_from_android(sensor_type, timestamp_ns, &values[..n]) {
+                Some(event) => engine.push_sensor(event).is_ok(),
+                None => false,
+            },
+        )
+    })
+}
+
+/// A front-camera frame's Y plane (CameraX `ImageProxy.planes[0]`, a direct buffer, pixel
+/// stride 1). Copied before returning, so the caller may close the image at once. Returns
+/// `false` when face tracking is off.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    luma: JByteBuffer<'local>,
+    width: jint,
+    height: jint,
+    row_stride: jint,
+    rotation_degrees: jint,
+    fx_px: jfloat,
+    fy_px: jfloat,
+    cx_px: jfloat,
+    cy_px: jfloat,
+    timestamp_ns: jlong,
+) -> jboolean {
+    run(&mut env, |env| {
+        let engine = engine(handle)?;
+        let (width, height) = size(width, height)?;
+        let row_stride = usize::try_from(row_stride).map_err(|_| {
+            fail(
+                Kind::IllegalArgument,
+                format!("row stride must not be negative, got {row_stride}"),
+            )
+        })?;
+        let rotation_cw_deg = u32::try_from(rotation_degrees).map_err(|_| {
+            fail(
+                Kind::IllegalArgument,
+                format!("rotation must be 0, 90, 180 or 270, got {rotation_degrees}"),
+            )
+        })?;
+        if luma.is_null() {
+            return Err(fail(Kind::IllegalArgument, "the luma buffer is null"));
+        }
+        let address = env.get_direct_buffer_address(&luma)?;
+        let capacity = env.get_direct_buffer_capacity(&luma)?;
+        if address.is_null() {
+            return Err(fail(Kind::IllegalArgument, "the luma buffer is not a direct buffer"));
+        }
+        // SAFETY: a direct buffer's memory is valid for `capacity` bytes while `luma` is alive,
+        // which it is for this call; we copy before returning.
+        let data = unsafe { std::slice::from_raw_parts(address, capacity) }.to_vec();
+        let frame = OwnedFrame {
+            width,
+            height,
+            row_stride,
+            format: PixelFormat::Luma8,
+            data,
+            rotation_cw_deg,
+            intrinsics: Intrinsics {
+                fx_px,
+                fy_px,
+                cx_px,
+                cy_px,
+            },
+            capture_t_ns: timestamp_ns,
+        };
+        Ok(engine.camera_frame(frame)?)
+    })
+}
+
+/// A `MotionEvent` pointer: phase 0 down, 1 move, 2 up, 3 cancel; position in physical pixels;
+/// time on the sensor clock. Returns the gesture completed: 0 none, 1 straight on (double tap),
+/// 2 light re-anchored (long press), 3 stereo toggled (two-finger tap).
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeTouch<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    phase: jint,
+    pointer_id: jint,
+    x_px: jfloat,
+    y_px: jfloat,
+    time_ns: jlong,
+) -> jint {
+    run(&mut env, |_| {
+        let engine = engine(handle)?;
+        let phase = TouchPhase::from_code(phase).ok_or_else(|| {
+            fail(
+                Kind::IllegalArgument,
+                format!("touch phase must be 0 to 3, got {phase}"),
+            )
+        })?;
+        Ok(match engine.lock().touch(phase, pointer_id, x_px, y_px, time_ns) {
+            None => 0,
+            Some(Gesture::StraightOn) => 1,
+            Some(Gesture::AnchorLight) => 2,
+            Some(Gesture::ToggleStereo) => 3,
+        })
+    })
+}
+
+/// `SurfaceHolder.Callback.surfaceCreated`/first `surfaceChanged`: draw into `surface` (an
+/// `android.view.Surface`) at `width × height` physical pixels. Off Android:
+/// `UnsupportedOperationException`.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSurfaceCreated<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    surface: JObject<'local>,
+    width: jint,
+    height: jint,
+) {
+    run(&mut env, |env| {
+        let engine = engine(handle)?;
+        let (width, height) = size(width, height)?;
+        if surface.is_null() {
+            return Err(fail(Kind::IllegalArgument, "the surface is null"));
+        }
+        let window = crate::platform::native_window(env, &surface)?;
+        engine.lock().resume_window(window, width, height)?;
+        Ok(())
+    })
+}
+
+/// Draw into an offscreen image instead (tests, snapshots); read it with `nativeReadFrame`.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeResumeOffscreen<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    width: jint,
+    height: jint,
+) {
+    run(&mut env, |_| {
+        let (width, height) = size(width, height)?;
+        engine(handle)?.lock().resume_offscreen(width, height)?;
+        Ok(())
+    })
+}
+
+/// `surfaceChanged`: new size in physical pixels.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSurfaceChanged<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    width: jint,
+    height: jint,
+) {
+    run(&mut env, |_| {
+        let (width, height) = size(width, height)?;
+        engine(handle)?.lock().resize(width, height)?;
+        Ok(())
+    })
+}
+
+/// `surfaceDestroyed`: returns once the native window is released.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSurfaceDestroyed<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) {
+    run(&mut env, |_| {
+        engine(handle)?.lock().suspend();
+        Ok(())
+    })
+}
+
+/// Display metrics or rotation changed (`DisplayMetrics`, `Display.getRotation()`).
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSetDisplay<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    panel_width_px: jint,
+    panel_height_px: jint,
+    xdpi: jfloat,
+    ydpi: jfloat,
+    rotation_value: jint,
+) {
+    run(&mut env, |_| {
+        let panel = panel(panel_width_px, panel_height_px, xdpi, ydpi)?;
+        let rotation = rotation(rotation_value)?;
+        engine(handle)?.lock().set_display(panel, rotation)?;
+        Ok(())
+    })
+}
+
+/// `dubois` (default), `dubois-green-magenta`, `dubois-amber-blue`, `half-color`, `optimized`,
+/// `gray`, `color` or `mono`.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSetAnaglyph<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    name: JString<'local>,
+) {
+    run(&mut env, |env| {
+        let engine = engine(handle)?;
+        let name =
+            optional_string(env, &name)?.ok_or_else(|| fail(Kind::IllegalArgument, "the method name is null"))?;
+        engine.lock().set_method(method(&name)?);
+        Ok(())
+    })
+}
+
+/// Draws the frame that will be on screen at `display_time_ns` (sensor clock; negative: no
+/// prediction). `true` when drawn, `false` when skipped (no surface, zero size).
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeDrawFrame<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    display_time_ns: jlong,
+) -> jboolean {
+    run(&mut env, |_| {
+        let t = (display_time_ns >= 0).then_some(display_time_ns);
+        Ok(engine(handle)?.lock().draw(t)? == DrawOutcome::Presented)
+    })
+}
+
+/// The last offscreen frame as `[width, height, pixels…]`, pixels as `0xAARRGGBB` (what
+/// `Bitmap.createBitmap(int[], …)` takes), rows top to bottom.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeReadFrame<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jintArray {
+    run(&mut env, |env| {
+        let engine = engine(handle)?;
+        let packed: Vec<jint> = {
+            let guard = engine.lock();
+            let (w, h, rgba) = guard.last_frame()?;
+            let mut packed = Vec::with_capacity(2 + rgba.len() / 4);
+            packed.push(w as jint);
+            packed.push(h as jint);
+            packed.extend(rgba.chunks_exact(4).map(|p| {
+                (u32::from(p[3]) << 24 | u32::from(p[0]) << 16 | u32::from(p[1]) << 8 | u32::from(p[2])) as jint
+            }));
+            packed
+        };
+        let array = jni::objects::JIntArray::new(env, packed.len())?;
+        array.set_region(env, 0, &packed)?;
+        Ok(array.into_raw())
+    })
+}
+
+/// `[framesDrawn, framesSkipped, resumed, suspended, sensorsAccepted, sensorsRejected,
+/// cameraFrames, gestures, eyesFromCamera]`.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeStats<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jlongArray {
+    run(&mut env, |env| {
+        let s = engine(handle)?.stats();
+        let values = [
+            s.frames_drawn,
+            s.frames_skipped,
+            s.resumed,
+            s.suspended,
+            s.sensors.accepted,
+            s.sensors.rejected(),
+            s.camera_frames,
+            s.gestures,
+            u64::from(s.eyes_from_camera),
+        ]
+        .map(|v| v as jlong);
+        let array = jni::objects::JLongArray::new(env, values.len())?;
+        array.set_region(env, 0, &values)?;
+        Ok(array.into_raw())
+    })
+}
+
+/// Names of the native methods this library implements, for the test that keeps them and
+/// `NativeBridge.java` in step.
+pub const NATIVE_METHODS: [&str; 14] = [
+    "nativeCreate",
+    "nativeDestroy",
+    "nativePushSensor",
+    "nativeCameraFrame",
+    "nativeTouch",
+    "nativeSurfaceCreated",
+    "nativeResumeOffscreen",
+    "nativeSurfaceChanged",
+    "nativeSurfaceDestroyed",
+    "nativeSetDisplay",
+    "nativeSetAnaglyph",
+    "nativeDrawFrame",
+    "nativeReadFrame",
+    "nativeStats",
+];

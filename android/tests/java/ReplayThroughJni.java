@@ -1,0 +1,131 @@
+import java.io.BufferedReader;
+import java.io.DataOutputStream;
+import java.io.FileOutputStream;
+import java.io.FileReader;
+import java.io.BufferedOutputStream;
+
+import org.phantogram.NativeBridge;
+
+/**
+ * Desktop JVM test driver (run by android/tests/jvm.rs): loads the host build of the Android
+ * bridge, replays a sensor log through JNI exactly as the app's sensor listener would (Sensor
+ * types, nanosecond time stamps), draws offscreen every 100 ms of log time, and writes the
+ * last frame. Also checks that errors arrive as the documented Java exceptions.
+ *
+ * Usage: ReplayThroughJni LIBRARY LOG OUT WIDTH HEIGHT
+ */
+public final class ReplayThroughJni {
+    static void expect(Class<? extends Throwable> type, String fragment, Runnable call) {
+        try {
+            call.run();
+        } catch (Throwable t) {
+            if (!type.isInstance(t) || t.getMessage() == null || !t.getMessage().contains(fragment)) {
+                throw new AssertionError("expected " + type.getName() + " containing '" + fragment + "', got " + t, t);
+            }
+            System.out.println("ok: " + type.getSimpleName() + ": " + t.getMessage());
+            return;
+        }
+        throw new AssertionError("expected " + type.getName() + " containing '" + fragment + "', nothing thrown");
+    }
+
+    public static void main(String[] args) throws Exception {
+        NativeBridge.load(args[0]);
+        String log = args[1];
+        String out = args[2];
+        int width = Integer.parseInt(args[3]);
+        int height = Integer.parseInt(args[4]);
+
+        expect(IllegalArgumentException.class, "sepia",
+                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "sepia"));
+        expect(IllegalArgumentException.class, "rotation",
+                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 7, null));
+        expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeDrawFrame(0, -1));
+
+        long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois");
+        try {
+            expect(IllegalStateException.class, "no offscreen frame", () -> NativeBridge.nativeReadFrame(h));
+            expect(UnsupportedOperationException.class, "only on Android",
+                    () -> NativeBridge.nativeSurfaceCreated(h, new Object(), 100, 100));
+            expect(IllegalArgumentException.class, "unknown anaglyph method",
+                    () -> NativeBridge.nativeSetAnaglyph(h, "sepia"));
+            if (NativeBridge.nativeDrawFrame(h, -1)) {
+                throw new AssertionError("drawing without a surface must be a skipped frame");
+            }
+            NativeBridge.nativeResumeOffscreen(h, width, height);
+
+            final long stepNs = 100_000_000L;
+            long next = Long.MIN_VALUE;
+            long last = 0;
+            int frames = 0;
+            int rejected = 0;
+            try (BufferedReader r = new BufferedReader(new FileReader(log))) {
+                String line;
+                while ((line = r.readLine()) != null) {
+                    String[] f = line.trim().split("\\s+");
+                    int type;
+                    switch (f[0]) {
+                        case "acc": type = 1; break;   // Sensor.TYPE_ACCELEROMETER
+                        case "mag": type = 2; break;   // Sensor.TYPE_MAGNETIC_FIELD
+                        case "gyr": type = 4; break;   // Sensor.TYPE_GYROSCOPE
+                        default: continue;
+                    }
+                    long t = Long.parseLong(f[1]);
+                    if (next == Long.MIN_VALUE) {
+                        next = t + stepNs;
+                    }
+                    while (t > next) {
+                        if (NativeBridge.nativeDrawFrame(h, next)) {
+                            frames++;
+                        }
+                        next += stepNs;
+                    }
+                    boolean ok = NativeBridge.nativePushSensor(h, type, t,
+                            Float.parseFloat(f[2]), Float.parseFloat(f[3]), Float.parseFloat(f[4]), Float.NaN);
+                    if (!ok) {
+                        rejected++;
+                    }
+                    last = t;
+                }
+            }
+            if (!NativeBridge.nativeDrawFrame(h, last)) {
+                throw new AssertionError("the last frame was skipped");
+            }
+            frames++;
+            int[] frame = NativeBridge.nativeReadFrame(h);
+            if (frame[0] != width || frame[1] != height || frame.length != 2 + width * height) {
+                throw new AssertionError("frame of " + frame[0] + "x" + frame[1] + ", " + frame.length + " ints");
+            }
+            try (DataOutputStream o = new DataOutputStream(new BufferedOutputStream(new FileOutputStream(out)))) {
+                for (int i = 2; i < frame.length; i++) {
+                    o.writeInt(frame[i]);
+                }
+            }
+            final long end = last;
+            // Every other native method once, so that a declaration out of step with the library
+            // fails here (the JVM links native methods at their first call).
+            if (NativeBridge.nativeTouch(h, NativeBridge.TOUCH_DOWN, 0, 10f, 10f, last) != NativeBridge.GESTURE_NONE
+                    || NativeBridge.nativeTouch(h, NativeBridge.TOUCH_UP, 0, 10f, 10f, last + 50_000_000L) != NativeBridge.GESTURE_NONE) {
+                throw new AssertionError("a single tap is no gesture");
+            }
+            expect(IllegalArgumentException.class, "touch phase", () -> NativeBridge.nativeTouch(h, 9, 0, 0f, 0f, end));
+            NativeBridge.nativeSetDisplay(h, 1080, 2400, 420f, 420f, 0);
+            java.nio.ByteBuffer luma = java.nio.ByteBuffer.allocateDirect(64 * 48);
+            if (NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, 270, 50f, 50f, 32f, 24f, last)) {
+                throw new AssertionError("face tracking is off: the frame must not be taken");
+            }
+            expect(IllegalArgumentException.class, "camera frame",
+                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, 45, 50f, 50f, 32f, 24f, end));
+            NativeBridge.nativeSurfaceChanged(h, width / 2, height / 2);
+            NativeBridge.nativeSurfaceDestroyed(h);
+            if (NativeBridge.nativeDrawFrame(h, last)) {
+                throw new AssertionError("drawing after surfaceDestroyed must be a skipped frame");
+            }
+            long[] stats = NativeBridge.nativeStats(h);
+            System.out.println("frames " + frames + " drawn " + stats[0] + " skipped " + stats[1]
+                    + " accepted " + stats[4] + " rejected " + stats[5] + " (driver saw " + rejected + ")");
+        } finally {
+            NativeBridge.nativeDestroy(h);
+        }
+        System.out.println("done");
+    }
+}
