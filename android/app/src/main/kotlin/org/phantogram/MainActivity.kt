@@ -1,0 +1,180 @@
+package org.phantogram
+
+import android.Manifest
+import android.content.pm.PackageManager
+import android.content.res.Configuration
+import android.hardware.SensorManager
+import android.os.Build
+import android.os.Bundle
+import android.util.DisplayMetrics
+import android.util.Log
+import android.view.MotionEvent
+import android.view.Surface
+import android.view.SurfaceHolder
+import android.view.SurfaceView
+import android.view.WindowInsets
+import android.view.WindowInsetsController
+import android.view.WindowManager
+import android.widget.Toast
+import androidx.activity.ComponentActivity
+import androidx.activity.result.contract.ActivityResultContracts
+import java.io.File
+
+/**
+ * The whole Android shell: one full-screen SurfaceView. It forwards the surface (holder
+ * callbacks), sensors, front-camera frames, touches, lifecycle and display metrics to the Rust
+ * core through NativeBridge; everything else happens there.
+ *
+ * Lifecycle: onResume starts sensors and frames, onPause stops them; the surface follows the
+ * holder callbacks (its loss never loses the GPU device); rotation is handled in place
+ * (configChanges), so the engine survives it.
+ */
+class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
+    private val render = RenderLoop { t -> Log.e(TAG, "phantogram", t) }
+    private lateinit var sensors: SensorForwarder
+    private var camera: CameraForwarder? = null
+    private var surfaceReady = false
+
+    private val askCamera = registerForActivityResult(ActivityResultContracts.RequestPermission()) { granted ->
+        if (granted) startCamera() else Toast.makeText(this, R.string.tilt_only, Toast.LENGTH_LONG).show()
+    }
+
+    override fun onCreate(savedInstanceState: Bundle?) {
+        super.onCreate(savedInstanceState)
+        NativeBridge.load(null)
+        window.addFlags(WindowManager.LayoutParams.FLAG_KEEP_SCREEN_ON)
+        immersive()
+        val view = SurfaceView(this)
+        view.holder.addCallback(this)
+        setContentView(view)
+        render.create(extractFaceModels(), panel(), "dubois")
+        sensors = SensorForwarder(getSystemService(SensorManager::class.java)) { render.engine }
+        if (checkSelfPermission(Manifest.permission.CAMERA) == PackageManager.PERMISSION_GRANTED) {
+            startCamera()
+        } else {
+            askCamera.launch(Manifest.permission.CAMERA)
+        }
+    }
+
+    override fun onResume() {
+        super.onResume()
+        sensors.start()
+        render.start()
+    }
+
+    override fun onPause() {
+        render.stop()
+        sensors.stop()
+        super.onPause()
+    }
+
+    override fun onDestroy() {
+        camera?.close()
+        sensors.close()
+        render.destroy()
+        super.onDestroy()
+    }
+
+    override fun onConfigurationChanged(newConfig: Configuration) {
+        super.onConfigurationChanged(newConfig)
+        render.setDisplay(panel())
+    }
+
+    // Surface: created → (changed)+ → destroyed. Sizes are physical pixels, so the image is
+    // drawn at the panel's full density.
+    override fun surfaceCreated(holder: SurfaceHolder) {}
+
+    override fun surfaceChanged(holder: SurfaceHolder, format: Int, width: Int, height: Int) {
+        if (!surfaceReady) {
+            surfaceReady = true
+            render.surfaceCreated(holder.surface, width, height)
+        } else {
+            render.surfaceChanged(width, height)
+        }
+    }
+
+    override fun surfaceDestroyed(holder: SurfaceHolder) {
+        surfaceReady = false
+        render.surfaceDestroyed()
+    }
+
+    override fun onTouchEvent(event: MotionEvent): Boolean {
+        val e = render.engine
+        if (e == 0L) return true
+        val t = Clock.monotonicToSensorNs(event.eventTime * 1_000_000L)
+        val phase = when (event.actionMasked) {
+            MotionEvent.ACTION_DOWN, MotionEvent.ACTION_POINTER_DOWN -> NativeBridge.TOUCH_DOWN
+            MotionEvent.ACTION_MOVE -> NativeBridge.TOUCH_MOVE
+            MotionEvent.ACTION_UP, MotionEvent.ACTION_POINTER_UP -> NativeBridge.TOUCH_UP
+            MotionEvent.ACTION_CANCEL -> NativeBridge.TOUCH_CANCEL
+            else -> return true
+        }
+        if (phase == NativeBridge.TOUCH_MOVE || phase == NativeBridge.TOUCH_CANCEL) {
+            for (i in 0 until event.pointerCount) {
+                NativeBridge.nativeTouch(e, phase, event.getPointerId(i), event.getX(i), event.getY(i), t)
+            }
+        } else {
+            val i = event.actionIndex
+            NativeBridge.nativeTouch(e, phase, event.getPointerId(i), event.getX(i), event.getY(i), t)
+        }
+        return true
+    }
+
+    /** Full screen, bars hidden: the core's screen model is the whole panel, so the surface must
+     *  be too (a surface inset by system bars would show the projection slightly stretched). */
+    private fun immersive() {
+        if (Build.VERSION.SDK_INT >= Build.VERSION_CODES.P) {
+            window.attributes.layoutInDisplayCutoutMode =
+                WindowManager.LayoutParams.LAYOUT_IN_DISPLAY_CUTOUT_MODE_SHORT_EDGES
+        }
+        if (Build.VERSION.SDK_INT >= Build.VERSION_CODES.R) {
+            window.setDecorFitsSystemWindows(false)
+            window.insetsController?.let {
+                it.hide(WindowInsets.Type.systemBars())
+                it.systemBarsBehavior = WindowInsetsController.BEHAVIOR_SHOW_TRANSIENT_BARS_BY_SWIPE
+            }
+        }
+    }
+
+    private fun startCamera() {
+        if (camera == null) camera = CameraForwarder(this) { render.engine }.also { it.start(this) }
+    }
+
+    /** The panel in its natural orientation: the current metrics, turned back by the rotation. */
+    private fun panel(): Panel {
+        @Suppress("DEPRECATION")
+        val display = windowManager.defaultDisplay
+        val metrics = DisplayMetrics()
+        @Suppress("DEPRECATION")
+        display.getRealMetrics(metrics)
+        val rotation = display.rotation
+        val quarter = rotation == Surface.ROTATION_90 || rotation == Surface.ROTATION_270
+        return Panel(
+            widthPx = if (quarter) metrics.heightPixels else metrics.widthPixels,
+            heightPx = if (quarter) metrics.widthPixels else metrics.heightPixels,
+            xdpi = if (quarter) metrics.ydpi else metrics.xdpi,
+            ydpi = if (quarter) metrics.xdpi else metrics.ydpi,
+            rotation = rotation,
+            refreshRateHz = display.refreshRate
+        )
+    }
+
+    /** Copies the face models from the APK's assets to app storage once; null without them. */
+    private fun extractFaceModels(): String? {
+        val names = assets.list("models")?.filter { it.endsWith(".onnx") } ?: return null
+        if (names.size < 3) return null
+        val dir = File(filesDir, "models").apply { mkdirs() }
+        for (name in names) {
+            val target = File(dir, name)
+            if (target.exists()) continue
+            val partial = File(dir, "$name.part")
+            assets.open("models/$name").use { input -> partial.outputStream().use { input.copyTo(it) } }
+            partial.renameTo(target)
+        }
+        return dir.absolutePath
+    }
+
+    private companion object {
+        const val TAG = "Phantogram"
+    }
+}

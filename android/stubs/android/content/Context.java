@@ -1,0 +1,2 @@
+// Host stub of the Android/AndroidX API surface the shell uses; see android/stubs/README.md.
+package android.content; public abstract class Context { public abstract <T> T getSystemService(Class<T> c); public abstract android.content.res.AssetManager getAssets(); public abstract java.io.File getFilesDir(); public abstract int checkSelfPermission(String p); public abstract android.content.res.Resources getResources(); }

@@ -1,0 +1,2 @@
+// Host stub of the Android/AndroidX API surface the shell uses; see android/stubs/README.md.
+package android.hardware; public abstract class SensorManager { public Sensor getDefaultSensor(int type) { return null; } public boolean registerListener(SensorEventListener l, Sensor s, int samplingPeriodUs, android.os.Handler h) { return true; } public void unregisterListener(SensorEventListener l) {} }

@@ -1,0 +1,2 @@
+// Host stub of the Android/AndroidX API surface the shell uses; see android/stubs/README.md.
+package androidx.camera.core; public final class CameraSelector { public static final CameraSelector DEFAULT_FRONT_CAMERA = new CameraSelector(); }
