@@ -1,0 +1,76 @@
+import AVFoundation
+import simd
+import PhantogramCore
+
+/// Front-camera frames (luma plane of 4:2:0 bi-planar buffers) with the camera's intrinsic
+/// matrix, pushed to the core, which tracks the face on its own thread. Without permission the
+/// app runs on tilt alone.
+final class CameraSource: NSObject, AVCaptureVideoDataOutputSampleBufferDelegate {
+    private let session = AVCaptureSession()
+    private let queue = DispatchQueue(label: "phantogram-camera")
+    private let engine: Engine
+
+    private init(engine: Engine) { self.engine = engine }
+
+    /// Asks for permission when needed; returns the running source, or nil (tilt only).
+    static func startIfAllowed(engine: Engine) -> CameraSource? {
+        let source = CameraSource(engine: engine)
+        switch AVCaptureDevice.authorizationStatus(for: .video) {
+        case .authorized:
+            source.queue.async { source.configureAndStart() }
+        case .notDetermined:
+            AVCaptureDevice.requestAccess(for: .video) { granted in
+                if granted { source.queue.async { source.configureAndStart() } }
+            }
+        default:
+            return nil
+        }
+        return source
+    }
+
+    private func configureAndStart() {
+        guard let device = AVCaptureDevice.default(.builtInWideAngleCamera, for: .video, position: .front),
+              let input = try? AVCaptureDeviceInput(device: device) else { return }
+        session.beginConfiguration()
+        session.sessionPreset = .vga640x480
+        let output = AVCaptureVideoDataOutput()
+        output.videoSettings = [kCVPixelBufferPixelFormatTypeKey as String: kCVPixelFormatType_420YpCbCr8BiPlanarFullRange]
+        output.alwaysDiscardsLateVideoFrames = true
+        output.setSampleBufferDelegate(self, queue: queue)
+        guard session.canAddInput(input), session.canAddOutput(output) else { return }
+        session.addInput(input)
+        session.addOutput(output)
+        if let connection = output.connection(with: .video) {
+            // Unmirrored sensor-orientation buffers; the core turns them upright itself.
+            connection.automaticallyAdjustsVideoMirroring = false
+            connection.isVideoMirrored = false
+            if connection.isCameraIntrinsicMatrixDeliverySupported {
+                connection.isCameraIntrinsicMatrixDeliveryEnabled = true
+            }
+        }
+        session.commitConfiguration()
+        session.startRunning()
+    }
+
+    func stop() { queue.async { self.session.stopRunning() } }
+
+    func captureOutput(_ output: AVCaptureOutput, didOutput sampleBuffer: CMSampleBuffer,
+                       from connection: AVCaptureConnection) {
+        guard let pixels = CMSampleBufferGetImageBuffer(sampleBuffer),
+              let data = CMGetAttachment(sampleBuffer, key: kCMSampleBufferAttachmentKey_CameraIntrinsicMatrix,
+                                         attachmentModeOut: nil) as? Data,
+              data.count >= MemoryLayout<matrix_float3x3>.size else { return }
+        let k = data.withUnsafeBytes { $0.load(as: matrix_float3x3.self) }
+        CVPixelBufferLockBaseAddress(pixels, .readOnly)
+        defer { CVPixelBufferUnlockBaseAddress(pixels, .readOnly) }
+        guard let base = CVPixelBufferGetBaseAddressOfPlane(pixels, 0) else { return }
+        let width = CVPixelBufferGetWidthOfPlane(pixels, 0)
+        let height = CVPixelBufferGetHeightOfPlane(pixels, 0)
+        let stride = CVPixelBufferGetBytesPerRowOfPlane(pixels, 0)
+        let time = CMTimeGetSeconds(CMSampleBufferGetPresentationTimeStamp(sampleBuffer))
+        // The front camera's buffers are landscape; a quarter turn counter-clockwise (270° cw)
+        // makes them upright in portrait. Column-major: k[0][0] = fx, k[1][1] = fy, k[2] = (cx, cy).
+        pg_camera_frame(engine.handle, base.assumingMemoryBound(to: UInt8.self), UInt32(width), UInt32(height),
+                        stride, 270, k[0][0], k[1][1], k[2][0], k[2][1], time)
+    }
+}

@@ -1,0 +1,53 @@
+import Foundation
+import PhantogramCore
+
+/// An error from the core: its status code and message.
+public struct PhantogramError: Error, CustomStringConvertible {
+    public let status: PgStatus
+    public let message: String
+    public var description: String { "phantogram error \(status.rawValue): \(message)" }
+}
+
+/// Reads the calling thread's last error message (the core keeps one per thread).
+func lastError() -> String {
+    let needed = pg_last_error(nil, 0)
+    var buffer = [CChar](repeating: 0, count: needed)
+    _ = pg_last_error(&buffer, needed)
+    return String(cString: buffer)
+}
+
+@discardableResult
+func check(_ status: PgStatus) throws -> PgStatus {
+    if status == PG_STATUS_OK || status == PG_STATUS_REJECTED { return status }
+    throw PhantogramError(status: status, message: lastError())
+}
+
+/// Owns the core's engine handle. Sensor and camera calls may come from any queue; lifecycle and
+/// drawing calls from the main thread (where the display link runs).
+public final class Engine {
+    let handle: OpaquePointer
+
+    /// Opens the GPU device and loads the default artifact (and the face models from the app
+    /// bundle's `models` folder when present). Call once, at start.
+    public init(panelWidthPx: UInt32, panelHeightPx: UInt32, pixelsPerInch: Float) throws {
+        var config = pg_config_default()
+        config.panel_width_px = panelWidthPx
+        config.panel_height_px = panelHeightPx
+        config.xdpi = pixelsPerInch
+        config.ydpi = pixelsPerInch
+        let faces = Bundle.main.resourceURL?.appendingPathComponent("models").path
+        let hasFaces = faces.map { FileManager.default.fileExists(atPath: $0) } ?? false
+        var out: OpaquePointer?
+        let status: PgStatus = (hasFaces ? faces! : "").withCString { facesPtr in
+            config.face_models_dir = hasFaces ? facesPtr : nil
+            return pg_engine_create(&config, &out)
+        }
+        try check(status)
+        guard let engine = out else { throw PhantogramError(status: status, message: "no handle") }
+        handle = engine
+    }
+
+    deinit {
+        pg_engine_destroy(handle)
+    }
+}

@@ -1,0 +1,115 @@
+import UIKit
+import QuartzCore
+import PhantogramCore
+
+/// The phantogram on screen: a view backed by a `CAMetalLayer` that the core draws into.
+///
+/// Surface contract (after Filament's UiHelper): in a window → `pg_resume_view`; layout →
+/// `pg_resize` in physical pixels (bounds × native scale, so nothing is drawn blurry); out of the
+/// window or the app in the background → `pg_suspend` (the GPU device and sensor state stay).
+/// Frames come from a `CADisplayLink` on the main run loop, paused in the background.
+public final class PhantogramView: UIView {
+    public override class var layerClass: AnyClass { CAMetalLayer.self }
+
+    private let engine: Engine
+    private let motion: MotionSource
+    private var camera: CameraSource?
+    private var link: CADisplayLink?
+    private var resumed = false
+    private var observers: [NSObjectProtocol] = []
+
+    public init(engine: Engine) {
+        self.engine = engine
+        self.motion = MotionSource(engine: engine)
+        super.init(frame: .zero)
+        isMultipleTouchEnabled = true
+        let center = NotificationCenter.default
+        observers.append(center.addObserver(forName: UIApplication.didEnterBackgroundNotification,
+                                            object: nil, queue: .main) { [weak self] _ in self?.background() })
+        observers.append(center.addObserver(forName: UIApplication.willEnterForegroundNotification,
+                                            object: nil, queue: .main) { [weak self] _ in self?.foreground() })
+    }
+
+    @available(*, unavailable)
+    required init?(coder: NSCoder) { fatalError("PhantogramView is made in code") }
+
+    deinit {
+        observers.forEach(NotificationCenter.default.removeObserver)
+        link?.invalidate()
+        motion.stop()
+        camera?.stop()
+        pg_suspend(engine.handle)
+    }
+
+    private var pixelSize: (UInt32, UInt32) {
+        let s = contentScaleFactor
+        return (UInt32(max(0, bounds.width * s)), UInt32(max(0, bounds.height * s)))
+    }
+
+    public override func didMoveToWindow() {
+        super.didMoveToWindow()
+        if let window = window {
+            contentScaleFactor = window.screen.nativeScale
+            (layer as? CAMetalLayer)?.contentsScale = window.screen.nativeScale
+            foreground()
+            if camera == nil { camera = CameraSource.startIfAllowed(engine: engine) }
+        } else {
+            background()
+        }
+    }
+
+    public override func layoutSubviews() {
+        super.layoutSubviews()
+        let (w, h) = pixelSize
+        if resumed { try? check(pg_resize(engine.handle, w, h)) }
+    }
+
+    private func foreground() {
+        guard window != nil, !resumed else { return }
+        let (w, h) = pixelSize
+        do {
+            try check(pg_resume_view(engine.handle, Unmanaged.passUnretained(self).toOpaque(), w, h))
+            resumed = true
+        } catch {
+            NSLog("phantogram: %@", String(describing: error))
+            return
+        }
+        motion.start()
+        let link = CADisplayLink(target: self, selector: #selector(step(_:)))
+        link.add(to: .main, forMode: .common)
+        self.link = link
+    }
+
+    private func background() {
+        link?.invalidate()
+        link = nil
+        motion.stop()
+        if resumed {
+            pg_suspend(engine.handle)
+            resumed = false
+        }
+    }
+
+    @objc private func step(_ link: CADisplayLink) {
+        var presented: UInt8 = 0
+        // targetTimestamp: when this frame will be on screen (the core predicts the pose to it).
+        do { try check(pg_draw(engine.handle, link.targetTimestamp, &presented)) } catch {
+            NSLog("phantogram: %@", String(describing: error))
+        }
+    }
+
+    // Touches: one call per touch and phase, physical pixels, Core Motion's clock.
+    private func forward(_ touches: Set<UITouch>, phase: Int32) {
+        let s = contentScaleFactor
+        for touch in touches {
+            let p = touch.location(in: self)
+            let id = Int32(truncatingIfNeeded: ObjectIdentifier(touch).hashValue)
+            pg_touch(engine.handle, phase, id, Float(p.x * s), Float(p.y * s), touch.timestamp, nil)
+        }
+    }
+
+    public override func touchesBegan(_ touches: Set<UITouch>, with event: UIEvent?) { forward(touches, phase: 0) }
+    public override func touchesMoved(_ touches: Set<UITouch>, with event: UIEvent?) { forward(touches, phase: 1) }
+    public override func touchesEnded(_ touches: Set<UITouch>, with event: UIEvent?) { forward(touches, phase: 2) }
+    public override func touchesCancelled(_ touches: Set<UITouch>, with event: UIEvent?) { forward(touches, phase: 3) }
+}
