@@ -13,12 +13,20 @@
 //!   0.6.0, Apache-2.0 models) into a private Python virtual environment and convert them to ONNX
 //!   with `tflite2onnx`, into `phantogram::face_models_dir()`. Needs Python 3 with `venv` and
 //!   network access once; says what is missing otherwise. `models --force` redoes it.
+//! * `android` — the native libraries for arm64-v8a, armeabi-v7a and x86_64 (cargo-ndk) and the
+//!   APK (Gradle), with the face models as assets; lists what is missing (SDK, NDK, cargo-ndk,
+//!   Rust targets, Gradle, JDK) and how to get it when it cannot build.
+//! * `ios` — the XCFramework of the C-ABI static library (macOS with Xcode only; says why
+//!   elsewhere).
+//! * `header` — regenerate `ios/include/phantogram.h` with cbindgen (a test fails while stale).
 //! * `ci` — what `.ci/run` runs after installing packages: fmt check, clippy, tests.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use anyhow::{Context, Result, bail};
+
+mod phone;
 
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -31,14 +39,18 @@ fn main() -> Result<()> {
         ["bench", "face"] => cargo(&["bench", "-p", "phantogram", "--bench", "face"]),
         ["models"] => models(false),
         ["models", "--force"] => models(true),
+        ["android"] => phone::android(),
+        ["ios"] => phone::ios(),
+        ["header"] => phone::header(),
         ["ci"] => {
             cargo(&["fmt", "--all", "--check"])?;
             cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"])?;
+            cargo(&["check", "-p", "phantogram-android", "--features", "android-typecheck"])?;
             cargo(&["test", "--workspace"])
         }
         [] | ["help"] | ["--help"] => {
             println!(
-                "usage: cargo xtask <assets | bench core | bench render | bench face | bench orientation | models [--force] | ci>"
+                "usage: cargo xtask <assets | bench core | bench render | bench face | bench orientation | models [--force] | android | ios | header | ci>"
             );
             Ok(())
         }

@@ -1,0 +1,241 @@
+//! `cargo xtask android`, `cargo xtask ios` and `cargo xtask header`: the phone builds. Each
+//! checks what it needs first and, when something is missing, says exactly what and how to get
+//! it, instead of failing halfway.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+
+use crate::{cargo, run, workspace_root};
+
+/// The Android ABIs the APK carries, with their Rust targets.
+const ANDROID_ABIS: [(&str, &str); 3] = [
+    ("arm64-v8a", "aarch64-linux-android"),
+    ("armeabi-v7a", "armv7-linux-androideabi"),
+    ("x86_64", "x86_64-linux-android"),
+];
+
+const IOS_TARGETS: [&str; 3] = ["aarch64-apple-ios", "aarch64-apple-ios-sim", "x86_64-apple-ios"];
+
+fn succeeds(program: &str, args: &[&str]) -> bool {
+    Command::new(program)
+        .args(args)
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
+fn installed_targets() -> Vec<String> {
+    Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).lines().map(str::to_owned).collect())
+        .unwrap_or_default()
+}
+
+fn env_dir(names: &[&str]) -> Option<PathBuf> {
+    names
+        .iter()
+        .filter_map(std::env::var_os)
+        .map(PathBuf::from)
+        .find(|p| p.is_dir())
+}
+
+/// The NDK: `$ANDROID_NDK_HOME`/`$ANDROID_NDK_ROOT`, else the newest under `$ANDROID_HOME/ndk`.
+fn android_ndk(sdk: Option<&Path>) -> Option<PathBuf> {
+    env_dir(&["ANDROID_NDK_HOME", "ANDROID_NDK_ROOT"]).or_else(|| {
+        let mut versions: Vec<PathBuf> = std::fs::read_dir(sdk?.join("ndk"))
+            .ok()?
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .filter(|p| p.is_dir())
+            .collect();
+        versions.sort();
+        versions.pop()
+    })
+}
+
+/// The face models, copied next to the app's resources (tilt-only without them).
+fn copy_face_models(to: &Path) -> Result<()> {
+    let Some(from) = phantogram::face_models_dir().filter(|d| d.is_dir()) else {
+        println!("note: no face models found (run `cargo xtask models`); the app will track tilt only");
+        return Ok(());
+    };
+    std::fs::create_dir_all(to).with_context(|| format!("creating {}", to.display()))?;
+    for name in [
+        "face_detection_short_range.onnx",
+        "face_landmark.onnx",
+        "iris_landmark.onnx",
+    ] {
+        let src = from.join(name);
+        if !src.is_file() {
+            println!("note: {} is missing; the app will track tilt only", src.display());
+            return Ok(());
+        }
+        std::fs::copy(&src, to.join(name)).with_context(|| format!("copying {}", src.display()))?;
+    }
+    println!("face models copied into {}", to.display());
+    Ok(())
+}
+
+pub fn android() -> Result<()> {
+    let root = workspace_root();
+    let sdk = env_dir(&["ANDROID_HOME", "ANDROID_SDK_ROOT"]);
+    let ndk = android_ndk(sdk.as_deref());
+    let targets = installed_targets();
+    let gradle = if root.join("android/gradlew").is_file() {
+        Some(root.join("android/gradlew").display().to_string())
+    } else if succeeds("gradle", &["--version"]) {
+        Some("gradle".to_owned())
+    } else {
+        None
+    };
+    let mut missing = Vec::new();
+    if sdk.is_none() {
+        missing.push(
+            "the Android SDK: install Android Studio or the command-line tools \
+             (https://developer.android.com/studio#command-line-tools-only), then \
+             `sdkmanager \"platforms;android-35\" \"build-tools;35.0.0\"` and set ANDROID_HOME"
+                .to_owned(),
+        );
+    }
+    if ndk.is_none() {
+        missing.push(
+            "the Android NDK: `sdkmanager \"ndk;27.2.12479018\"` (or set ANDROID_NDK_HOME to an NDK r26+)".to_owned(),
+        );
+    }
+    if !succeeds("cargo", &["ndk", "--version"]) {
+        missing.push("cargo-ndk: `cargo install cargo-ndk --locked`".to_owned());
+    }
+    let absent: Vec<&str> = ANDROID_ABIS
+        .iter()
+        .map(|(_, t)| *t)
+        .filter(|t| !targets.iter().any(|i| i == t))
+        .collect();
+    if !absent.is_empty() {
+        missing.push(format!("the Rust targets: `rustup target add {}`", absent.join(" ")));
+    }
+    if gradle.is_none() {
+        missing.push(
+            "Gradle 8.9 or newer on the PATH (https://gradle.org/install/; once present, `gradle wrapper` \
+             in android/ pins it for everyone)"
+                .to_owned(),
+        );
+    }
+    if !succeeds("java", &["-version"]) {
+        missing.push("a JDK 17 (`apt-get install openjdk-17-jdk-headless`)".to_owned());
+    }
+    if !missing.is_empty() {
+        bail!(
+            "cannot build the Android app on this machine; missing:\n  - {}",
+            missing.join("\n  - ")
+        );
+    }
+    let jni_libs = root.join("android/app/src/main/jniLibs");
+    let mut args = vec!["ndk".to_owned()];
+    for (abi, _) in ANDROID_ABIS {
+        args.extend(["-t".to_owned(), abi.to_owned()]);
+    }
+    args.extend([
+        "--platform".to_owned(),
+        "26".to_owned(),
+        "-o".to_owned(),
+        jni_libs.display().to_string(),
+        "build".to_owned(),
+        "--release".to_owned(),
+        "-p".to_owned(),
+        "phantogram-android".to_owned(),
+    ]);
+    let args: Vec<&str> = args.iter().map(String::as_str).collect();
+    cargo(&args)?;
+    copy_face_models(&root.join("android/app/src/main/assets/models"))?;
+    let gradle = gradle.unwrap_or_default();
+    run(Command::new(&gradle)
+        .args(["assembleRelease"])
+        .current_dir(root.join("android")))?;
+    let apk = root.join("android/app/build/outputs/apk/release/app-release.apk");
+    println!(
+        "built {}\ninstall on a phone (USB debugging on): adb install -r {}",
+        apk.display(),
+        apk.display()
+    );
+    Ok(())
+}
+
+pub fn ios() -> Result<()> {
+    if !cfg!(target_os = "macos") {
+        bail!(
+            "`cargo xtask ios` packs the core into an XCFramework with Xcode's `xcodebuild` and Apple's iOS SDKs, \
+             which exist only on macOS (this is {}). Here the C ABI is built and tested as the same static library \
+             instead: `cargo test -p phantogram-ios` (header check, a C program replaying a log, the stress test).",
+            std::env::consts::OS
+        );
+    }
+    let root = workspace_root();
+    let targets = installed_targets();
+    let mut missing = Vec::new();
+    if !succeeds("xcodebuild", &["-version"]) {
+        missing.push("Xcode 15 or newer (App Store), then `sudo xcode-select -s /Applications/Xcode.app`".to_owned());
+    }
+    let absent: Vec<&str> = IOS_TARGETS
+        .iter()
+        .copied()
+        .filter(|t| !targets.iter().any(|i| i == t))
+        .collect();
+    if !absent.is_empty() {
+        missing.push(format!("the Rust targets: `rustup target add {}`", absent.join(" ")));
+    }
+    if !missing.is_empty() {
+        bail!("cannot build for iOS; missing:\n  - {}", missing.join("\n  - "));
+    }
+    for target in IOS_TARGETS {
+        cargo(&["build", "--release", "-p", "phantogram-ios", "--target", target])?;
+    }
+    let lib = |t: &str| root.join("target").join(t).join("release/libphantogram_ios.a");
+    let build = root.join("ios/build");
+    let _ = std::fs::remove_dir_all(&build);
+    let headers = build.join("headers");
+    std::fs::create_dir_all(&headers)?;
+    std::fs::copy(root.join("ios/include/phantogram.h"), headers.join("phantogram.h"))?;
+    std::fs::write(
+        headers.join("module.modulemap"),
+        "module PhantogramCore {\n    header \"phantogram.h\"\n    export *\n}\n",
+    )?;
+    let simulator = build.join("libphantogram_ios-simulator.a");
+    run(Command::new("lipo")
+        .arg("-create")
+        .arg(lib("aarch64-apple-ios-sim"))
+        .arg(lib("x86_64-apple-ios"))
+        .arg("-output")
+        .arg(&simulator))?;
+    run(Command::new("xcodebuild")
+        .arg("-create-xcframework")
+        .arg("-library")
+        .arg(lib("aarch64-apple-ios"))
+        .arg("-headers")
+        .arg(&headers)
+        .arg("-library")
+        .arg(&simulator)
+        .arg("-headers")
+        .arg(&headers)
+        .arg("-output")
+        .arg(build.join("PhantogramCore.xcframework")))?;
+    copy_face_models(&build.join("models"))?;
+    println!(
+        "built {}; open the app with `xcodegen generate` in ios/App (or add the package to an Xcode app target)",
+        build.join("PhantogramCore.xcframework").display()
+    );
+    Ok(())
+}
+
+/// Regenerates `ios/include/phantogram.h` (the header test writes it when blessed).
+pub fn header() -> Result<()> {
+    let cargo_bin = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    run(Command::new(cargo_bin)
+        .args(["test", "-p", "phantogram-ios", "--test", "header"])
+        .env("PHANTOGRAM_BLESS", "1")
+        .current_dir(workspace_root()))?;
+    println!("wrote ios/include/phantogram.h");
+    Ok(())
+}
