@@ -1,7 +1,7 @@
 //! The one piece of Android-only code: an `android.view.Surface` as an `ANativeWindow` that wgpu
 //! can make a Vulkan (or GLES) surface for. Built on Android, and on the desktop only to
-//! type-check it (`cargo check -p phantogram-android --features android-typecheck`, which `.ci/run`
-//! runs): no Android target can be installed on the build machine.
+//! type-check it (`cargo check --workspace --features phantogram-android/android-typecheck`, which
+//! `.ci/run` runs): no Android target can be installed on the build machine.
 
 use std::sync::Arc;
 

@@ -337,3 +337,99 @@ fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
     );
     drop(worker); // joins the thread
 }
+
+/// Through the embedding API the shells use: camera frames handed to a `SharedEngine` from
+/// another thread reach the session, and the frames drawn afterwards take their eyes from the
+/// camera (and differ from the tilt-only frame).
+#[test]
+fn camera_frames_through_the_engine_move_the_eyes_to_the_camera() {
+    use phantogram::engine::{Engine, EngineConfig, SharedEngine};
+    use phantogram::face::OwnedFrame;
+    use phantogram::sensors::SensorEvent;
+    let Some((_, dir)) = setup() else { return };
+    let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
+    let engine = match Engine::new(EngineConfig {
+        face_models_dir: Some(models_dir),
+        ..EngineConfig::default()
+    }) {
+        Ok(e) => e,
+        Err(phantogram::engine::EngineError::Render(e)) => {
+            eprintln!("no GPU ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("engine: {e}"),
+    };
+    let shared = Arc::new(SharedEngine::new(engine));
+    // The phone held at 30° from vertical, still, for one second.
+    let tilt = 30f32.to_radians();
+    for i in 0..=100i64 {
+        let t = i * 10_000_000;
+        shared
+            .push_sensor(SensorEvent::accelerometer(
+                t,
+                Vec3::new(0.0, tilt.cos(), tilt.sin()) * 9.81,
+            ))
+            .expect("a valid sample");
+        shared
+            .push_sensor(SensorEvent::gyroscope(t, Vec3::ZERO))
+            .expect("a valid sample");
+    }
+    let now_ns = 1_000_000_000;
+    shared.lock().resume_offscreen(54, 120).expect("offscreen");
+    shared.lock().draw(Some(now_ns)).expect("drawing");
+    assert!(!shared.stats().eyes_from_camera, "no camera frame yet");
+    let tilt_frame = shared.lock().last_frame().expect("a frame").2.to_vec();
+
+    let img = rgba(&dir.join("astronaut.png"));
+    let frame = OwnedFrame {
+        width: img.width(),
+        height: img.height(),
+        row_stride: 4 * img.width() as usize,
+        format: PixelFormat::Rgba8,
+        data: img.as_raw().clone(),
+        rotation_cw_deg: 0,
+        intrinsics: default_intrinsics(&img),
+        capture_t_ns: now_ns - 30_000_000,
+    };
+    // A camera at 30 Hz for one second, each frame 30 ms old when it is handed over (from a
+    // thread of its own, as on the phones); the eyes move from the tilt model's to the camera's
+    // at the tracker's speed limit, so it takes a few hundred milliseconds.
+    let mut t = now_ns;
+    for k in 0..30 {
+        t += 33_000_000;
+        let mut f = frame.clone();
+        f.capture_t_ns = t - 30_000_000;
+        let producer = {
+            let shared = Arc::clone(&shared);
+            std::thread::spawn(move || shared.camera_frame(f).expect("a valid frame"))
+        };
+        assert!(producer.join().expect("the camera thread"), "face tracking is on");
+        let worker = shared.lock().face_worker().expect("face tracking is on");
+        let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+        while worker.newest().is_none_or(|o| o.capture_t_ns != t - 30_000_000) {
+            assert!(std::time::Instant::now() < deadline, "frame {k} was never processed");
+            std::thread::sleep(std::time::Duration::from_millis(2));
+        }
+        shared.lock().draw(Some(t)).expect("drawing");
+        assert!(
+            shared.stats().eyes_from_camera,
+            "frame {k}: the eyes must come from the camera"
+        );
+    }
+    let camera_frame = shared.lock().last_frame().expect("a frame").2.to_vec();
+    let changed = tilt_frame
+        .iter()
+        .zip(&camera_frame)
+        .filter(|(a, b)| a.abs_diff(**b) > 8)
+        .count();
+    let stats = shared.stats();
+    println!(
+        "camera through the engine: {} frame(s) submitted, {changed} bytes changed",
+        stats.camera_frames
+    );
+    assert_eq!(stats.camera_frames, 30);
+    assert!(
+        changed > 50,
+        "the camera's eyes did not change the picture ({changed} bytes)"
+    );
+}

@@ -45,7 +45,13 @@ fn main() -> Result<()> {
         ["ci"] => {
             cargo(&["fmt", "--all", "--check"])?;
             cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"])?;
-            cargo(&["check", "-p", "phantogram-android", "--features", "android-typecheck"])?;
+            cargo(&[
+                "check",
+                "--workspace",
+                "--all-targets",
+                "--features",
+                "phantogram-android/android-typecheck",
+            ])?;
             cargo(&["test", "--workspace"])
         }
         [] | ["help"] | ["--help"] => {
