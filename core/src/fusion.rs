@@ -96,6 +96,12 @@ pub struct FusionParams {
     pub max_bridge_doubt_rad: f64,
     /// Averaging window after a start or a gap, s.
     pub reinit_window_s: f64,
+    /// After a doubtful gap no longer than [`Self::max_bridge_s`], the bridged heading still
+    /// counts as this many magnetometer samples in the fresh heading average (two seconds at
+    /// 50 Hz): a second of motion cannot have turned it far, while the first magnetometer
+    /// samples after the gap carry the local field's errors. After longer gaps the heading is
+    /// averaged from scratch.
+    pub heading_prior_after_short_gap: u32,
     /// With no gyroscope event for this long, fall back to the low-pass, s.
     pub gyro_timeout_s: f64,
 }
@@ -121,6 +127,7 @@ impl Default for FusionParams {
             max_bridge_s: 2.0,
             max_bridge_doubt_rad: 5f64.to_radians(),
             reinit_window_s: 0.5,
+            heading_prior_after_short_gap: 100,
             gyro_timeout_s: 0.5,
         }
     }
@@ -441,7 +448,11 @@ impl FusedOrientation {
                     self.stats.gaps_bridged += 1;
                 } else {
                     self.acc_lp.restart(self.params.reinit_window_s);
-                    self.heading_corrections = 0;
+                    self.heading_corrections = if dt <= self.params.max_bridge_s {
+                        self.heading_corrections.min(self.params.heading_prior_after_short_gap)
+                    } else {
+                        0
+                    };
                     self.stats.restarts_after_gap += 1;
                 }
             }
