@@ -381,12 +381,9 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeTouch<'local>(
                 format!("touch phase must be 0 to 3, got {phase}"),
             )
         })?;
-        Ok(match engine.lock().touch(phase, pointer_id, x_px, y_px, time_ns) {
-            None => 0,
-            Some(Gesture::StraightOn) => 1,
-            Some(Gesture::AnchorLight) => 2,
-            Some(Gesture::ToggleStereo) => 3,
-        })
+        Ok(Gesture::code(
+            engine.lock().touch(phase, pointer_id, x_px, y_px, time_ns),
+        ))
     })
 }
 

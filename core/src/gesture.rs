@@ -47,6 +47,19 @@ pub enum Gesture {
     ToggleStereo,
 }
 
+impl Gesture {
+    /// The number the C ABI and the JNI bridge report for a touch's outcome: 0 none, 1 straight
+    /// on, 2 light re-anchored, 3 stereo toggled.
+    pub fn code(gesture: Option<Gesture>) -> i32 {
+        match gesture {
+            None => 0,
+            Some(Gesture::StraightOn) => 1,
+            Some(Gesture::AnchorLight) => 2,
+            Some(Gesture::ToggleStereo) => 3,
+        }
+    }
+}
+
 /// Longest press that still counts as a tap, ns.
 const TAP_MAX_NS: i64 = 300_000_000;
 /// Longest gap between the two taps of a double tap, ns.
@@ -264,6 +277,8 @@ mod tests {
         assert_eq!(g.touch(TouchPhase::Up, 0, 300.0, 300.0, 1060 * MS), None);
         assert_eq!(tap(&mut g, 1100, 300.0), None);
         assert_eq!(TouchPhase::from_code(4), None);
+        assert_eq!(Gesture::code(None), 0);
+        assert_eq!(Gesture::code(Some(Gesture::ToggleStereo)), 3);
         assert_eq!(TouchPhase::from_code(2), Some(TouchPhase::Up));
         // NaN positions are ignored.
         assert_eq!(g.touch(TouchPhase::Down, 0, f32::NAN, 0.0, 0), None);

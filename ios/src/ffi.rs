@@ -496,12 +496,7 @@ pub unsafe extern "C" fn pg_touch(
             .ok_or_else(|| Failure::new(PgStatus::InvalidArgument, "time stamp is not finite"))?;
         let g = engine.shared.lock().touch(phase, pointer, x_px, y_px, t_ns);
         if !gesture.is_null() {
-            let code = match g {
-                None => 0,
-                Some(Gesture::StraightOn) => 1,
-                Some(Gesture::AnchorLight) => 2,
-                Some(Gesture::ToggleStereo) => 3,
-            };
+            let code = Gesture::code(g);
             // SAFETY: non-null, and the caller promises it is writable.
             unsafe { *gesture = code };
         }
