@@ -283,6 +283,7 @@ impl Engine {
         let mut host = SurfaceHost::new();
         host.resume(self.renderer.gpu(), window, width, height)?;
         self.target = Target::Window(Box::new(host));
+        self.last_frame = None;
         self.stats.resumed += 1;
         Ok(())
     }
@@ -291,6 +292,8 @@ impl Engine {
     pub fn resume_offscreen(&mut self, width: u32, height: u32) -> Result<(), EngineError> {
         check_size(width, height)?;
         self.target = Target::Offscreen { width, height };
+        // A frame of the previous target must not be read as this one's.
+        self.last_frame = None;
         self.stats.resumed += 1;
         Ok(())
     }
