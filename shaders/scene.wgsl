@@ -39,6 +39,17 @@ struct Material {
     transforms: array<vec4<f32>, 10>,
 };
 
+// Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
+// material has, and whether it is alpha-masked. A slot it lacks holds a 1×1 default that changes
+// nothing, so it is not sampled at all; an opaque material never discards, which keeps early
+// depth testing. The defaults (everything on) give the general shader.
+override HAS_BASE_TEXTURE: bool = true;
+override HAS_METALLIC_ROUGHNESS_TEXTURE: bool = true;
+override HAS_NORMAL_TEXTURE: bool = true;
+override HAS_OCCLUSION_TEXTURE: bool = true;
+override HAS_EMISSIVE_TEXTURE: bool = true;
+override ALPHA_MASK: bool = true;
+
 @group(0) @binding(0) var<uniform> eye: Eye;
 @group(0) @binding(1) var shadow_map: texture_depth_2d;
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
@@ -176,15 +187,31 @@ fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
 
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    // Sample everything first: derivatives need uniform control flow.
-    let base_sample = textureSample(base_texture, base_sampler, slot_uv(0u, material.uv_sets.x, in.uv));
-    let mr_sample = textureSample(mr_texture, mr_sampler, slot_uv(1u, material.uv_sets.y, in.uv));
-    let normal_sample = textureSample(normal_texture, normal_sampler, slot_uv(2u, material.uv_sets.z, in.uv));
-    let occlusion_sample = textureSample(occlusion_texture, occlusion_sampler, slot_uv(3u, material.uv_sets.w, in.uv));
-    let emissive_sample = textureSample(emissive_texture, emissive_sampler, slot_uv(4u, material.flags.x, in.uv));
+    // Sample everything first: derivatives need uniform control flow (the pipeline constants are
+    // uniform). A missing slot reads as the default texture would: white, or a flat normal.
+    var base_sample = vec4<f32>(1.0);
+    if (HAS_BASE_TEXTURE) {
+        base_sample = textureSample(base_texture, base_sampler, slot_uv(0u, material.uv_sets.x, in.uv));
+    }
+    var mr_sample = vec4<f32>(1.0);
+    if (HAS_METALLIC_ROUGHNESS_TEXTURE) {
+        mr_sample = textureSample(mr_texture, mr_sampler, slot_uv(1u, material.uv_sets.y, in.uv));
+    }
+    var normal_sample = vec4<f32>(0.5, 0.5, 1.0, 1.0);
+    if (HAS_NORMAL_TEXTURE) {
+        normal_sample = textureSample(normal_texture, normal_sampler, slot_uv(2u, material.uv_sets.z, in.uv));
+    }
+    var occlusion_sample = vec4<f32>(1.0);
+    if (HAS_OCCLUSION_TEXTURE) {
+        occlusion_sample = textureSample(occlusion_texture, occlusion_sampler, slot_uv(3u, material.uv_sets.w, in.uv));
+    }
+    var emissive_sample = vec4<f32>(1.0);
+    if (HAS_EMISSIVE_TEXTURE) {
+        emissive_sample = textureSample(emissive_texture, emissive_sampler, slot_uv(4u, material.flags.x, in.uv));
+    }
 
     let base_rgba = in.color * material.base_color * base_sample;
-    if (material.params.z >= 0.0 && base_rgba.a < material.params.z) {
+    if (ALPHA_MASK && material.params.z >= 0.0 && base_rgba.a < material.params.z) {
         discard;
     }
 
@@ -196,7 +223,7 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
         n = -n;
         t = -t;
     }
-    if (material.flags.y > 0.5 && dot(t, t) > 1e-8) {
+    if (HAS_NORMAL_TEXTURE && material.flags.y > 0.5 && dot(t, t) > 1e-8) {
         let tn = normalize(t - n * dot(n, t));
         let bn = cross(n, tn) * select(1.0, -1.0, handedness < 0.0);
         var m = normal_sample.xyz * 2.0 - vec3<f32>(1.0);

@@ -465,3 +465,52 @@ fn mirror_metal_reflects_the_environment_and_rough_metal_blurs_it() {
     assert!(mirror > 150.0, "the mirror should show the disc: {mirror}");
     assert!(mirror > 3.0 * rough, "{mirror} vs {rough}");
 }
+
+/// Each material's pipeline samples only the texture slots it has (render.rs,
+/// `MaterialVariant`). Skipping a slot must look exactly like sampling its neutral default: the
+/// amphora with only a (tilted) normal map, drawn by its specialised pipeline, equals the same
+/// amphora with every other slot filled by a neutral 1×1 image, drawn by the general one. Were a
+/// present texture skipped, or a missing one replaced by the wrong value, the frames would differ.
+#[test]
+fn pipelines_that_skip_missing_textures_draw_the_same_picture() {
+    use phantogram::model::{Image, TextureRef};
+    let Some(gpu) = gpu() else { return };
+    let image = |name: &str, rgba: [u8; 4]| Image {
+        name: name.into(),
+        width: 2,
+        height: 2,
+        rgba8: rgba.repeat(4),
+    };
+    let slot = |image: usize| TextureRef {
+        image,
+        tex_coord: 0,
+        transform: Default::default(),
+        sampler: Default::default(),
+    };
+    let mut normal_only = default_model();
+    // Normals tilted 30° towards +u: visibly different shading if the map were skipped.
+    normal_only.images.push(image("tilted normal", [192, 128, 238, 255]));
+    normal_only.materials[0].normal_texture = Some((slot(0), 1.0));
+    let mut every_slot = normal_only.clone();
+    every_slot.images.push(image("white", [255; 4]));
+    let m = &mut every_slot.materials[0];
+    m.base_color_texture = Some(slot(1));
+    m.metallic_roughness_texture = Some(slot(1));
+    m.occlusion_texture = Some((slot(1), 1.0));
+    m.emissive_texture = Some(slot(1));
+    let view = oblique_view();
+    let input = FrameInput::from_view(&view, Vec3::ZERO);
+    let mut renderer = Renderer::new(gpu, &normal_only).unwrap();
+    let specialised = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
+    renderer.set_model(&every_slot).unwrap();
+    let general = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
+    renderer.set_model(&default_model()).unwrap();
+    let untextured = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
+    let max_diff = |a: &[u8], b: &[u8]| a.iter().zip(b).map(|(x, y)| x.abs_diff(*y)).max().unwrap_or(0);
+    assert!(
+        max_diff(&specialised, &untextured) > 8,
+        "the normal map should change the picture"
+    );
+    let d = max_diff(&specialised, &general);
+    assert!(d <= 1, "specialised and general pipelines differ by {d} levels");
+}
