@@ -9,9 +9,10 @@
 //!   toolchain on the phone builds).
 //! * Node transforms are baked into the vertices (negative determinants flip the winding).
 //! * Materials: base colour, metallic–roughness, normal (with scale), occlusion (with strength)
-//!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform`, alpha
-//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded (PNG, JPEG) to RGBA8. (Texture
-//!   transforms on normal and occlusion textures are not read yet: gltf-rs does not expose them.)
+//!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform` on every
+//!   slot (gltf-rs types it only on `textureInfo`, so for normal and occlusion textures it is read
+//!   from the raw extension object; a malformed one becomes a warning), alpha
+//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded (PNG, JPEG) to RGBA8.
 //! * Tangents come from the file or, where a normal map needs them, from MikkTSpace
 //!   (`bevy_mikktspace`, the reference algorithm that normal maps are baked against).
 //! * Smithsonian Voyager scans: when a `scene.svx.json` beside the file lists it as a derivative,
@@ -661,20 +662,11 @@ mod loader {
         }
     }
 
-    fn texture_ref(
-        t: &gltf::Texture,
-        tex_coord: u32,
-        transform: Option<gltf::texture::TextureTransform>,
-    ) -> TextureRef {
+    /// A texture reference; `transform` is `KHR_texture_transform` with its optional texCoord
+    /// override.
+    fn texture_ref(t: &gltf::Texture, tex_coord: u32, transform: Option<(UvTransform, Option<u32>)>) -> TextureRef {
         let (transform, tex_coord) = match transform {
-            Some(tt) => (
-                UvTransform {
-                    offset: tt.offset(),
-                    rotation_rad: tt.rotation(),
-                    scale: tt.scale(),
-                },
-                tt.tex_coord().unwrap_or(tex_coord),
-            ),
+            Some((uv, set)) => (uv, set.unwrap_or(tex_coord)),
             None => (UvTransform::default(), tex_coord),
         };
         TextureRef {
@@ -685,13 +677,60 @@ mod loader {
         }
     }
 
-    fn material_of(m: &gltf::Material) -> Material {
+    fn typed_transform(tt: gltf::texture::TextureTransform) -> (UvTransform, Option<u32>) {
+        let uv = UvTransform {
+            offset: tt.offset(),
+            rotation_rad: tt.rotation(),
+            scale: tt.scale(),
+        };
+        (uv, tt.tex_coord())
+    }
+
+    /// `KHR_texture_transform` on a normal or occlusion texture. gltf-rs types the extension
+    /// only on `textureInfo`, so here it is read from the raw extension object; a malformed one
+    /// is reported in `warnings` and the texture used untransformed.
+    fn raw_transform(
+        value: Option<&serde_json::Value>,
+        what: &str,
+        warnings: &mut Vec<String>,
+    ) -> Option<(UvTransform, Option<u32>)> {
+        let value = value?;
+        match serde_json::from_value::<gltf::json::extensions::texture::TextureTransform>(value.clone()) {
+            Ok(tt) => Some((
+                UvTransform {
+                    offset: tt.offset.0,
+                    rotation_rad: tt.rotation.0,
+                    scale: tt.scale.0,
+                },
+                tt.tex_coord,
+            )),
+            Err(e) => {
+                warnings.push(format!("{what}: KHR_texture_transform ignored ({e})"));
+                None
+            }
+        }
+    }
+
+    fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
         let pbr = m.pbr_metallic_roughness();
-        let info = |i: gltf::texture::Info| texture_ref(&i.texture(), i.tex_coord(), i.texture_transform());
+        let info = |i: gltf::texture::Info| {
+            texture_ref(&i.texture(), i.tex_coord(), i.texture_transform().map(typed_transform))
+        };
+        let name = m.name().unwrap_or("unnamed");
+        let normal_texture = m.normal_texture().map(|n| {
+            let what = format!("material {name}, normal texture");
+            let transform = raw_transform(n.extension_value("KHR_texture_transform"), &what, warnings);
+            (texture_ref(&n.texture(), n.tex_coord(), transform), n.scale())
+        });
+        let occlusion_texture = m.occlusion_texture().map(|o| {
+            let what = format!("material {name}, occlusion texture");
+            let transform = raw_transform(o.extension_value("KHR_texture_transform"), &what, warnings);
+            (texture_ref(&o.texture(), o.tex_coord(), transform), o.strength())
+        });
         let strength = m.emissive_strength().unwrap_or(1.0);
         let e = m.emissive_factor();
         Material {
-            name: m.name().unwrap_or("unnamed").to_owned(),
+            name: name.to_owned(),
             // glTF colour factors are linear already.
             base_color: pbr.base_color_factor(),
             metallic: pbr.metallic_factor(),
@@ -705,14 +744,8 @@ mod loader {
             double_sided: m.double_sided(),
             base_color_texture: pbr.base_color_texture().map(info),
             metallic_roughness_texture: pbr.metallic_roughness_texture().map(info),
-            // TODO(issue #3): gltf-rs exposes KHR_texture_transform only on `Info`, so normal and
-            // occlusion textures are read untransformed for now.
-            normal_texture: m
-                .normal_texture()
-                .map(|n| (texture_ref(&n.texture(), n.tex_coord(), None), n.scale())),
-            occlusion_texture: m
-                .occlusion_texture()
-                .map(|o| (texture_ref(&o.texture(), o.tex_coord(), None), o.strength())),
+            normal_texture,
+            occlusion_texture,
             emissive_texture: m.emissive_texture().map(info),
         }
     }
@@ -1018,7 +1051,8 @@ mod loader {
             });
         }
 
-        let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m)).collect();
+        let mut warnings = Vec::new();
+        let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m, &mut warnings)).collect();
         let default_material = materials.len();
         materials.push(Material::default());
 
@@ -1028,6 +1062,7 @@ mod loader {
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default(),
             images,
+            warnings,
             ..Model::default()
         };
         let scene = doc.default_scene().or_else(|| doc.scenes().next());

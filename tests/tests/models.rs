@@ -220,6 +220,53 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
     );
 }
 
+/// `KHR_texture_transform` applies to every texture slot, normal and occlusion included (gltf-rs
+/// types it only on the other slots' `textureInfo`); a malformed one is reported, not fatal.
+#[test]
+fn texture_transforms_reach_normal_and_occlusion_textures() {
+    let dir = scratch("gltf-transform");
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(1, 1, image::Rgba([128, 128, 255, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let image = format!("data:image/png;base64,{}", base64_encode(&png));
+    let materials = |occlusion_transform: &str| {
+        format!(
+            r#","extensionsUsed":["KHR_texture_transform"],
+            "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
+            "materials":[{{"name":"relief",
+              "normalTexture":{{"index":0,"scale":0.5,"extensions":{{"KHR_texture_transform":
+                {{"offset":[0.25,0.5],"rotation":0.3,"scale":[2,3],"texCoord":1}}}}}},
+              "occlusionTexture":{{"index":0,"strength":0.7,"extensions":{{"KHR_texture_transform":{occlusion_transform}}}}}}}]"#
+        )
+    };
+    let model = load_gltf(&tiny_gltf(&dir, "relief.gltf", &materials(r#"{"scale":[4,4]}"#))).unwrap();
+    let m = &model.materials[0];
+    let (normal, scale) = m.normal_texture.unwrap();
+    assert_eq!(scale, 0.5);
+    assert_eq!(normal.tex_coord, 1);
+    assert_eq!(normal.transform.offset, [0.25, 0.5]);
+    assert_eq!(normal.transform.rotation_rad, 0.3);
+    assert_eq!(normal.transform.scale, [2.0, 3.0]);
+    let (occlusion, strength) = m.occlusion_texture.unwrap();
+    assert_eq!(strength, 0.7);
+    assert_eq!(occlusion.tex_coord, 0);
+    assert_eq!(occlusion.transform.scale, [4.0, 4.0]);
+    assert_eq!(occlusion.transform.offset, [0.0, 0.0]);
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+
+    let bad = load_gltf(&tiny_gltf(&dir, "bad.gltf", &materials(r#"{"scale":"big"}"#))).unwrap();
+    let (occlusion, _) = bad.materials[0].occlusion_texture.unwrap();
+    assert_eq!(occlusion.transform.scale, [1.0, 1.0]);
+    assert!(
+        bad.warnings
+            .iter()
+            .any(|w| w.contains("relief") && w.contains("occlusion") && w.contains("KHR_texture_transform")),
+        "{:?}",
+        bad.warnings
+    );
+}
+
 #[test]
 fn every_shared_environment_map_loads_into_finite_irradiance() {
     let Some(dir) = data_subdir("env") else {
