@@ -5,7 +5,7 @@
 //!   `PHANTOGRAM_DATA`; skipped with a notice otherwise): file read, Draco decoding, image
 //!   decoding, mip generation, upload, pipeline creation and one 1080×2400 stereo frame read back;
 //! * stereo (Dubois) / mono frame time at 1080×2400 for the default artifact and the turtle,
-//!   as the median of several frames each, measured in the same run;
+//!   as the median of 11 frames each, mono and stereo alternating;
 //! * peak resident memory of the process (VmHWM).
 //!
 //! Frame times include reading the frame back to the CPU, as `phantogram render` does.
@@ -33,21 +33,27 @@ fn peak_rss_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
-fn frame_times(renderer: &mut Renderer, input: &FrameInput, method: Method, frames: usize) -> f64 {
-    renderer.render(input, method, W, H).expect("warm-up frame");
-    let samples = (0..frames)
-        .map(|_| {
-            let start = Instant::now();
-            std::hint::black_box(renderer.render(input, method, W, H).expect("frame"));
-            start.elapsed().as_secs_f64() * 1e3
-        })
-        .collect();
-    median_ms(samples)
+/// Median mono and stereo frame times, ms. The two are measured alternately, frame by frame, so
+/// that the load of this shared machine weighs on both alike.
+fn frame_times(renderer: &mut Renderer, input: &FrameInput, frames: usize) -> (f64, f64) {
+    let mut time = |method: Method| {
+        let start = Instant::now();
+        std::hint::black_box(renderer.render(input, method, W, H).expect("frame"));
+        start.elapsed().as_secs_f64() * 1e3
+    };
+    time(Method::Mono);
+    time(Method::DuboisRedCyan);
+    let (mut mono, mut stereo) = (Vec::new(), Vec::new());
+    for _ in 0..frames {
+        mono.push(time(Method::Mono));
+        stereo.push(time(Method::DuboisRedCyan));
+    }
+    (median_ms(mono), median_ms(stereo))
 }
 
 fn main() {
     let quick = std::env::args().any(|a| a == "--test" || a == "--list");
-    let frames = if quick { 1 } else { 7 };
+    let frames = if quick { 1 } else { 11 };
     let gpu = match Gpu::headless() {
         Ok(g) => g,
         Err(e) => {
@@ -97,8 +103,7 @@ fn main() {
     };
     for (name, model) in &models {
         renderer.set_model(model).expect("model");
-        let mono = frame_times(&mut renderer, &input, Method::Mono, frames);
-        let stereo = frame_times(&mut renderer, &input, Method::DuboisRedCyan, frames);
+        let (mono, stereo) = frame_times(&mut renderer, &input, frames);
         println!(
             "{name}, {W}x{H}: mono {mono:.1} ms, stereo {stereo:.1} ms, stereo/mono {:.2}x",
             stereo / mono
