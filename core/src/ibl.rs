@@ -17,6 +17,9 @@
 //!
 //!   The renderer uploads the levels as an `Rgba16Float` mip chain and the table as an `Rg16Float`
 //!   texture and samples them with the roughness as the level of detail.
+//!
+//! **Threading**: everything here is plain data and pure functions; [`prefiltered_levels`] spreads
+//! its rows over scoped threads, one per core (same result as in series), and returns when done.
 
 use glam::Vec3;
 
@@ -304,27 +307,45 @@ pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environme
             height: h,
             texels: vec![[0.0; 3]; w * h],
         };
-        for y in 0..h {
-            for x in 0..w {
-                let n = level.direction(x, y);
-                let mut acc = [0.0f32; 3];
-                let mut weight = 0.0f32;
-                for i in 0..samples {
-                    let (u1, u2) = hammersley(i, samples);
-                    let hv = ggx_half_vector(u1, u2, alpha, n);
-                    let l = (hv * 2.0 * n.dot(hv) - n).normalize();
-                    let n_dot_l = n.dot(l);
-                    if n_dot_l > 0.0 {
-                        let c = source.sample(l);
-                        for ch in 0..3 {
-                            acc[ch] += c[ch] * n_dot_l;
-                        }
-                        weight += n_dot_l;
+        let grid = Environment {
+            width: w,
+            height: h,
+            texels: Vec::new(),
+        };
+        let convolve = |x: usize, y: usize| {
+            let n = grid.direction(x, y);
+            let mut acc = [0.0f32; 3];
+            let mut weight = 0.0f32;
+            for i in 0..samples {
+                let (u1, u2) = hammersley(i, samples);
+                let hv = ggx_half_vector(u1, u2, alpha, n);
+                let l = (hv * 2.0 * n.dot(hv) - n).normalize();
+                let n_dot_l = n.dot(l);
+                if n_dot_l > 0.0 {
+                    let c = source.sample(l);
+                    for ch in 0..3 {
+                        acc[ch] += c[ch] * n_dot_l;
                     }
+                    weight += n_dot_l;
                 }
-                level.texels[y * w + x] = acc.map(|a| a / weight.max(1e-6));
             }
-        }
+            acc.map(|a| a / weight.max(1e-6))
+        };
+        // Bands of rows on every core: this runs when a renderer starts or the environment
+        // changes, on the phone's CPU, and each texel is independent (same result as in series).
+        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(h);
+        let band_rows = h.div_ceil(threads);
+        std::thread::scope(|scope| {
+            for (band, texels) in level.texels.chunks_mut(band_rows * w).enumerate() {
+                let convolve = &convolve;
+                scope.spawn(move || {
+                    for (i, texel) in texels.iter_mut().enumerate() {
+                        let at = band * band_rows * w + i;
+                        *texel = convolve(at % w, at / w);
+                    }
+                });
+            }
+        });
         levels.push(level);
     }
     levels
