@@ -795,9 +795,14 @@ impl Renderer {
             upload_model(&self.gpu, &self.material_layout, model)
         })?;
         let device = self.gpu.device.clone();
-        checked(&device, "the model's pipelines", || {
+        let before: std::collections::HashSet<MaterialVariant> = self.scene.variants.keys().copied().collect();
+        if let Err(e) = checked(&device, "the model's pipelines", || {
             self.scene.prepare(&device, &gpu_model)
-        })?;
+        }) {
+            // Keep no pipeline that failed to build; the previous model stays drawable.
+            self.scene.variants.retain(|v, _| before.contains(v));
+            return Err(e);
+        }
         self.model = gpu_model;
         Ok(())
     }
