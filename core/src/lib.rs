@@ -67,7 +67,7 @@
 //! Modules: [`screen`], [`eyes`], [`viewpoint`], [`projection`], [`containment`], [`light`],
 //! [`lowpass`], [`attitude`], [`fusion`], [`sensors`], [`sensorlog`], [`replay`], [`session`],
 //! [`synthetic`], [`orientation_eval`], [`calibration`], [`anaglyph`], [`artifact`], [`model`],
-//! [`ibl`], [`eyetrack`], [`gesture`], and with `render`, `render`, `surface` and `engine` (the
+//! [`ibl`], [`eyetrack`], [`gesture`], [`parallel`], and with `render`, `render`, `surface` and `engine` (the
 //! embedding API the phone shells drive); with `face`, `face`; with `ui`,
 //! `calibration_ui`.
 
@@ -91,6 +91,7 @@ pub mod light;
 pub mod lowpass;
 pub mod model;
 pub mod orientation_eval;
+pub mod parallel;
 pub mod projection;
 #[cfg(feature = "render")]
 pub mod render;

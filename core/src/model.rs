@@ -1032,24 +1032,33 @@ mod loader {
         let ctx = Ctx { path, buffers };
         let views: Vec<gltf::buffer::View> = doc.views().collect();
 
-        let mut images = Vec::new();
+        // Read the encoded images in order, then decode them on every core (the largest part of
+        // loading a textured scan); the first failure in file order is the one reported.
+        let mut encoded = Vec::new();
         for img in doc.images() {
-            let (raw, name) = match img.source() {
+            let (raw, name): (Vec<u8>, String) = match img.source() {
                 gltf::image::Source::View { view, .. } => {
                     (ctx.view_bytes(&view)?.to_vec(), format!("image {}", img.index()))
                 }
                 gltf::image::Source::Uri { uri, .. } => (load_uri(path, uri)?, uri.chars().take(60).collect()),
             };
-            let decoded = image::load_from_memory(&raw)
-                .map_err(|e| ctx.data(format!("image {} ({name})", img.index()), e.to_string()))?
-                .to_rgba8();
-            images.push(Image {
-                name,
-                width: decoded.width(),
-                height: decoded.height(),
-                rgba8: decoded.into_raw(),
-            });
+            encoded.push((img.index(), raw, name));
         }
+        let images = crate::parallel::map(&encoded, |(index, raw, name)| {
+            image::load_from_memory(raw)
+                .map(|decoded| decoded.to_rgba8())
+                .map_err(|e| (format!("image {index} ({name})"), e.to_string()))
+                .map(|decoded| Image {
+                    name: name.clone(),
+                    width: decoded.width(),
+                    height: decoded.height(),
+                    rgba8: decoded.into_raw(),
+                })
+        })
+        .into_iter()
+        .collect::<Result<Vec<Image>, _>>()
+        .map_err(|(what, why)| ctx.data(what, why))?;
+        drop(encoded);
 
         let mut warnings = Vec::new();
         let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m, &mut warnings)).collect();

@@ -1238,7 +1238,18 @@ pub fn mip_chain(width: u32, height: u32, rgba8: &[u8], srgb: bool) -> Vec<(u32,
 }
 
 fn upload_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8], srgb: bool) -> wgpu::TextureView {
-    let levels = mip_chain(width, height, rgba8, srgb);
+    upload_mip_chain(gpu, label, width, height, &mip_chain(width, height, rgba8, srgb), srgb)
+}
+
+/// Uploads a texture from its mip levels ([`mip_chain`]).
+fn upload_mip_chain(
+    gpu: &Gpu,
+    label: &str,
+    width: u32,
+    height: u32,
+    levels: &[(u32, u32, Vec<u8>)],
+    srgb: bool,
+) -> wgpu::TextureView {
     let format = if srgb {
         wgpu::TextureFormat::Rgba8UnormSrgb
     } else {
@@ -1312,17 +1323,30 @@ fn create_sampler(device: &wgpu::Device, s: &Sampler) -> wgpu::Sampler {
 
 fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> GpuModel {
     let device = &gpu.device;
-    // Each image once per colour space it is used in.
-    let mut views: std::collections::HashMap<(usize, bool), wgpu::TextureView> = Default::default();
+    // Each image once per colour space it is used in; the mip chains are built on every core
+    // (a good part of a textured scan's time to first frame), then uploaded in turn.
+    let mut used: Vec<(usize, bool)> = Vec::new();
     for m in &model.materials {
         for (t, srgb) in m.textures() {
-            if let (Some(img), std::collections::hash_map::Entry::Vacant(e)) =
-                (model.images.get(t.image), views.entry((t.image, srgb)))
-            {
-                e.insert(upload_texture(gpu, &img.name, img.width, img.height, &img.rgba8, srgb));
+            if t.image < model.images.len() && !used.contains(&(t.image, srgb)) {
+                used.push((t.image, srgb));
             }
         }
     }
+    let chains = crate::parallel::map(&used, |&(image, srgb)| {
+        let img = &model.images[image];
+        mip_chain(img.width, img.height, &img.rgba8, srgb)
+    });
+    let views: std::collections::HashMap<(usize, bool), wgpu::TextureView> = used
+        .iter()
+        .zip(&chains)
+        .map(|(&(image, srgb), levels)| {
+            let img = &model.images[image];
+            let view = upload_mip_chain(gpu, &img.name, img.width, img.height, levels, srgb);
+            ((image, srgb), view)
+        })
+        .collect();
+    drop(chains);
     let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());

@@ -267,6 +267,26 @@ fn texture_transforms_reach_normal_and_occlusion_textures() {
     );
 }
 
+/// Images decode in parallel, yet a broken one is still reported by its place in the file.
+#[test]
+fn a_broken_image_is_named_in_the_error() {
+    let dir = scratch("gltf-images");
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(2, 2, image::Rgba([10, 20, 30, 255]))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    let good = format!("data:image/png;base64,{}", base64_encode(&png));
+    let bad = format!("data:image/png;base64,{}", base64_encode(b"not a png at all"));
+    let images = |second: &str| format!(r#","images":[{{"uri":"{good}"}},{{"uri":"{second}"}},{{"uri":"{good}"}}]"#);
+    let model = load_gltf(&tiny_gltf(&dir, "three.gltf", &images(&good))).unwrap();
+    assert_eq!(model.images.len(), 3);
+    assert!(model.images.iter().all(|i| i.rgba8[..4] == [10, 20, 30, 255]));
+    match load_gltf(&tiny_gltf(&dir, "broken-image.gltf", &images(&bad))) {
+        Err(ModelError::Data { what, .. }) => assert!(what.starts_with("image 1"), "{what}"),
+        other => panic!("expected a data error naming image 1, got {other:?}"),
+    }
+}
+
 #[test]
 fn every_shared_environment_map_loads_into_finite_irradiance() {
     let Some(dir) = data_subdir("env") else {
