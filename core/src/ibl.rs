@@ -19,7 +19,8 @@
 //!   texture and samples them with the roughness as the level of detail.
 //!
 //! **Threading**: everything here is plain data and pure functions; [`prefiltered_levels`] spreads
-//! its rows over scoped threads, one per core (same result as in series), and returns when done.
+//! its rows over the cores ([`crate::parallel::map`]; same result as in series) and returns when
+//! done.
 
 use glam::Vec3;
 
@@ -302,11 +303,6 @@ pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environme
         while source.width > 2 * w && source.width > 8 {
             source = source.downsampled();
         }
-        let mut level = Environment {
-            width: w,
-            height: h,
-            texels: vec![[0.0; 3]; w * h],
-        };
         let grid = Environment {
             width: w,
             height: h,
@@ -331,21 +327,14 @@ pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environme
             }
             acc.map(|a| a / weight.max(1e-6))
         };
-        // Bands of rows on every core: this runs when a renderer starts or the environment
-        // changes, on the phone's CPU, and each texel is independent (same result as in series).
-        let threads = std::thread::available_parallelism().map_or(1, |n| n.get()).min(h);
-        let band_rows = h.div_ceil(threads);
-        std::thread::scope(|scope| {
-            for (band, texels) in level.texels.chunks_mut(band_rows * w).enumerate() {
-                let convolve = &convolve;
-                scope.spawn(move || {
-                    for (i, texel) in texels.iter_mut().enumerate() {
-                        let at = band * band_rows * w + i;
-                        *texel = convolve(at % w, at / w);
-                    }
-                });
-            }
-        });
+        // Rows on every core: this runs when a renderer starts or the environment changes, on
+        // the phone's CPU, and each texel is independent (same result as in series).
+        let rows: Vec<usize> = (0..h).collect();
+        let level = Environment {
+            width: w,
+            height: h,
+            texels: crate::parallel::map(&rows, |&y| (0..w).map(|x| convolve(x, y)).collect::<Vec<_>>()).concat(),
+        };
         levels.push(level);
     }
     levels
