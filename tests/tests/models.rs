@@ -169,6 +169,15 @@ fn tiny_gltf(dir: &Path, name: &str, extra: &str) -> PathBuf {
     path
 }
 
+/// A `size`×`size` PNG of one colour as a data URI, for hand-written glTF files.
+fn png_data_uri(size: u32, rgba: [u8; 4]) -> String {
+    let mut png = Vec::new();
+    image::RgbaImage::from_pixel(size, size, image::Rgba(rgba))
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .unwrap();
+    format!("data:image/png;base64,{}", base64_encode(&png))
+}
+
 fn base64_encode(bytes: &[u8]) -> String {
     const T: &[u8; 64] = b"ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
     let mut s = String::new();
@@ -225,11 +234,7 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
 #[test]
 fn texture_transforms_reach_normal_and_occlusion_textures() {
     let dir = scratch("gltf-transform");
-    let mut png = Vec::new();
-    image::RgbaImage::from_pixel(1, 1, image::Rgba([128, 128, 255, 255]))
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .unwrap();
-    let image = format!("data:image/png;base64,{}", base64_encode(&png));
+    let image = png_data_uri(1, [128, 128, 255, 255]);
     let materials = |occlusion_transform: &str| {
         format!(
             r#","extensionsUsed":["KHR_texture_transform"],
@@ -271,11 +276,7 @@ fn texture_transforms_reach_normal_and_occlusion_textures() {
 #[test]
 fn a_broken_image_is_named_in_the_error() {
     let dir = scratch("gltf-images");
-    let mut png = Vec::new();
-    image::RgbaImage::from_pixel(2, 2, image::Rgba([10, 20, 30, 255]))
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .unwrap();
-    let good = format!("data:image/png;base64,{}", base64_encode(&png));
+    let good = png_data_uri(2, [10, 20, 30, 255]);
     let bad = format!("data:image/png;base64,{}", base64_encode(b"not a png at all"));
     let images = |second: &str| format!(r#","images":[{{"uri":"{good}"}},{{"uri":"{second}"}},{{"uri":"{good}"}}]"#);
     let model = load_gltf(&tiny_gltf(&dir, "three.gltf", &images(&good))).unwrap();
