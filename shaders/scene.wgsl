@@ -148,9 +148,9 @@ fn shadow_pcf(uv: vec2<f32>, depth: f32) -> f32 {
 }
 // END shadow_pcf
 
-// Fraction of the light reaching `world` (1 = lit), filtered by `shadow_pcf`. The lookup point moves one and a half texels along the normal, and further at
-// grazing light, which removes acne without the detached shadows (peter-panning) that a large
-// constant bias gives.
+// Fraction of the light reaching `world` (1 = lit), filtered by `shadow_pcf`. The lookup point
+// moves one and a half texels along the normal, and further at grazing light, which removes acne
+// without the detached shadows (peter-panning) that a large constant bias gives.
 fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     if (eye.shadow.y < 0.5) {
         return 1.0;

@@ -1058,7 +1058,7 @@ mod loader {
         .into_iter()
         .collect::<Result<Vec<Image>, _>>()
         .map_err(|(what, why)| ctx.data(what, why))?;
-        drop(encoded);
+        drop(encoded); // the compressed copies are not needed while the meshes are built
 
         let mut warnings = Vec::new();
         let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m, &mut warnings)).collect();

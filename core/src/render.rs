@@ -402,7 +402,7 @@ pub fn light_view_proj(bounds: &crate::containment::Aabb, toward_light: Vec3) ->
 /// slots it samples and whether it can discard (WGSL `override` constants in `scene.wgsl`).
 /// Slots a material lacks hold 1×1 defaults that change nothing, so not sampling them gives the
 /// same picture for less: on lavapipe the fragment work is most of a frame, and every texture
-/// sample and the shadow filter are a large part of it (see `benches/render.rs`).
+/// sample and the shadow filter are a large part of it (see `benchmarks/render.md`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 struct MaterialVariant {
     double_sided: bool,
@@ -1339,14 +1339,13 @@ fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> Gpu
     });
     let views: std::collections::HashMap<(usize, bool), wgpu::TextureView> = used
         .iter()
-        .zip(&chains)
+        .zip(chains)
         .map(|(&(image, srgb), levels)| {
             let img = &model.images[image];
-            let view = upload_mip_chain(gpu, &img.name, img.width, img.height, levels, srgb);
+            let view = upload_mip_chain(gpu, &img.name, img.width, img.height, &levels, srgb);
             ((image, srgb), view)
         })
         .collect();
-    drop(chains);
     let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());
