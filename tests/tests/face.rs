@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use phantogram::face::{
-    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, PixelFormat, TrackingMode, UprightImage,
+    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, OwnedFrame, PixelFormat, TrackingMode, UprightImage,
 };
 use phantogram::glam::{Vec2, Vec3};
 use phantogram_integration::data_subdir;
@@ -42,6 +42,21 @@ fn frame(img: &image::RgbaImage, intrinsics: Intrinsics) -> CameraFrame<'_> {
         rotation_cw_deg: 0,
         intrinsics,
         capture_t_ns: 0,
+    }
+}
+
+/// [`frame`] as the owned frame a worker or an engine takes, captured at `capture_t_ns`.
+fn owned_frame(img: &image::RgbaImage, intrinsics: Intrinsics, capture_t_ns: i64) -> OwnedFrame {
+    let f = frame(img, intrinsics);
+    OwnedFrame {
+        width: f.width,
+        height: f.height,
+        row_stride: f.row_stride,
+        format: f.format,
+        data: f.data.to_vec(),
+        rotation_cw_deg: f.rotation_cw_deg,
+        intrinsics: f.intrinsics,
+        capture_t_ns,
     }
 }
 
@@ -284,7 +299,7 @@ fn tracking_follows_the_face_from_its_landmarks_and_gives_metric_device_eyes() {
 
 #[test]
 fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
-    use phantogram::face::{FaceWorker, OwnedFrame};
+    use phantogram::face::FaceWorker;
     let Some((models, dir)) = setup() else { return };
     let img = rgba(&dir.join("astronaut.png"));
     let k = default_intrinsics(&img);
@@ -294,16 +309,7 @@ fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
     // A burst of 20 frames submitted at once: the worker cannot keep up, so most are replaced
     // (dropped) before it starts them, and the newest one is processed last.
     for i in 0..20i64 {
-        worker.submit(OwnedFrame {
-            width: img.width(),
-            height: img.height(),
-            row_stride: 4 * img.width() as usize,
-            format: PixelFormat::Rgba8,
-            data: img.as_raw().clone(),
-            rotation_cw_deg: 0,
-            intrinsics: k,
-            capture_t_ns: i,
-        });
+        worker.submit(owned_frame(&img, k, i));
     }
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
     while worker.newest().is_none_or(|o| o.capture_t_ns != 19) {
@@ -344,7 +350,6 @@ fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
 #[test]
 fn camera_frames_through_the_engine_move_the_eyes_to_the_camera() {
     use phantogram::engine::{Engine, EngineConfig, SharedEngine};
-    use phantogram::face::OwnedFrame;
     use phantogram::sensors::SensorEvent;
     let Some((_, dir)) = setup() else { return };
     let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
@@ -381,16 +386,7 @@ fn camera_frames_through_the_engine_move_the_eyes_to_the_camera() {
     let tilt_frame = shared.lock().last_frame().expect("a frame").2.to_vec();
 
     let img = rgba(&dir.join("astronaut.png"));
-    let frame = OwnedFrame {
-        width: img.width(),
-        height: img.height(),
-        row_stride: 4 * img.width() as usize,
-        format: PixelFormat::Rgba8,
-        data: img.as_raw().clone(),
-        rotation_cw_deg: 0,
-        intrinsics: default_intrinsics(&img),
-        capture_t_ns: now_ns - 30_000_000,
-    };
+    let frame = owned_frame(&img, default_intrinsics(&img), now_ns - 30_000_000);
     // A camera at 30 Hz for one second, each frame 30 ms old when it is handed over (from a
     // thread of its own, as on the phones); the eyes move from the tilt model's to the camera's
     // at the tracker's speed limit, so it takes a few hundred milliseconds.
