@@ -4,8 +4,9 @@
 //! * cold load-to-first-frame of the Draco-compressed Smithsonian sea turtle (needs
 //!   `PHANTOGRAM_DATA`; skipped with a notice otherwise): file read, Draco decoding, image
 //!   decoding, mip generation, upload, pipeline creation and one 1080×2400 stereo frame read back;
-//! * stereo (Dubois) / mono frame time at 1080×2400 for the default artifact and the turtle,
-//!   as the median of 11 frames each, mono and stereo alternating;
+//! * stereo (Dubois) / mono frame time at 1080×2400 for the default artifact (alone, and on the
+//!   diorama floor as the app draws it) and the turtle, as the median of 11 frames each, mono
+//!   and stereo alternating;
 //! * peak resident memory of the process (VmHWM).
 //!
 //! Frame times include reading the frame back to the CPU, as `phantogram render` does.
@@ -74,7 +75,14 @@ fn main() {
     let turtle_path = std::env::var_os("PHANTOGRAM_DATA").map(|d| {
         std::path::PathBuf::from(d).join("models/heritage/smithsonian_nmnh_sea_turtle/sea_turtle-150k-1024-low.glb")
     });
-    let mut models: Vec<(String, Model)> = vec![("amphora".into(), phantogram::artifact::default_model())];
+    // The artifact alone, and as `phantogram render` and the viewer draw it: standing on the
+    // diorama's floor, which fills the rest of each eye's view with shaded, shadowed surface.
+    let mut on_floor = phantogram::artifact::default_model();
+    on_floor.add_floor(&SessionConfig::default().screen, Model::FLOOR_REACH);
+    let mut models: Vec<(String, Model)> = vec![
+        ("amphora".into(), phantogram::artifact::default_model()),
+        ("amphora on the floor".into(), on_floor),
+    ];
     let mut renderer = None;
     let mut gpu = Some(gpu);
     match turtle_path.filter(|p| p.exists()) {

@@ -197,7 +197,7 @@ impl Engine {
         };
         let bounds = model.bounds().ok_or(RenderError::EmptyModel)?;
         if config.floor {
-            model.add_floor(&screen, 2.5);
+            model.add_floor(&screen, crate::model::Model::FLOOR_REACH);
         }
         let mut renderer = Renderer::new(gpu, &model)?;
         if let Some(path) = &config.environment_path {

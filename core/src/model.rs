@@ -356,6 +356,10 @@ impl Model {
         }
     }
 
+    /// How far the app's floor reaches, in screen sizes ([`Model::add_floor`]): far enough to fill
+    /// the view at the steepest tilt the viewpoint allows.
+    pub const FLOOR_REACH: f32 = 2.5;
+
     /// Adds the diorama's floor: a matte neutral plane parallel to the glass under the model (at
     /// its lowest point), reaching `reach` screen sizes out so it fills oblique views. It is what
     /// the model stands on and where its shadow falls, the phantogram's main depth cue.

@@ -178,7 +178,7 @@ fn default_artifact_matches_its_golden_images() {
     }
     // As the README's command shows it: on the diorama floor, with its shadow.
     let mut staged = default_model();
-    staged.add_floor(&Screen::default(), 2.5);
+    staged.add_floor(&Screen::default(), Model::FLOOR_REACH);
     renderer.set_model(&staged).unwrap();
     let pixels = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
     check_golden("amphora-floor-dubois", &pixels, 3, 0.002);

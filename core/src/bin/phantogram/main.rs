@@ -768,7 +768,7 @@ fn load_for_display(
     };
     let bounds = model.bounds().context("the model is empty")?;
     if floor {
-        model.add_floor(screen, 2.5);
+        model.add_floor(screen, phantogram::model::Model::FLOOR_REACH);
     }
     Ok((model, bounds))
 }
