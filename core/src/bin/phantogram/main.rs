@@ -55,7 +55,8 @@ enum Command {
         #[arg(long, default_value_t = LowPassAttitude::DEFAULT_TAU_S)]
         tau_s: f32,
         /// Viewing distance, centimetres.
-        #[arg(long, default_value_t = EyeModel::DEFAULT_VIEWING_DISTANCE_M * 100.0)]
+        // Rounded to 0.1 mm so that the help shows "30", not f32's "30.000002".
+        #[arg(long, default_value_t = (EyeModel::DEFAULT_VIEWING_DISTANCE_M * 1000.0).round() / 10.0)]
         distance_cm: f32,
         /// Make the pose at this many seconds into the log count as "straight on" (flat-angle calibration).
         #[arg(long, value_name = "SECONDS")]
