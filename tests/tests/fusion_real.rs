@@ -285,6 +285,39 @@ fn marker_from_imu(events: &[SensorEvent]) -> (Quat, usize) {
     (r, pairs.len())
 }
 
+/// [`marker_from_imu`] over a whole trial, with how far apart the estimates from its two halves
+/// are: texting turns the phone mostly about one axis, which leaves the rotation about it loose.
+struct Mounting {
+    marker_from_imu: Quat,
+    intervals: usize,
+    halves_apart_deg: f32,
+}
+
+impl Mounting {
+    fn of(events: &[SensorEvent]) -> Self {
+        let (marker_from_imu, intervals) = marker_from_imu(events);
+        let half = events.len() / 2;
+        let halves_apart_deg = self::marker_from_imu(&events[..half])
+            .0
+            .angle_between(self::marker_from_imu(&events[half..]).0)
+            .to_degrees();
+        Self {
+            marker_from_imu,
+            intervals,
+            halves_apart_deg,
+        }
+    }
+
+    /// Used only where the halves agree within 2°.
+    fn determined(&self) -> bool {
+        self.halves_apart_deg < 2.0
+    }
+
+    fn angle_deg(&self) -> f32 {
+        self.marker_from_imu.angle_between(Quat::IDENTITY).to_degrees()
+    }
+}
+
 /// Least-squares trend of an angle over time, unwrapping it across ±180°.
 #[derive(Default)]
 struct HeadingTrend {
@@ -403,21 +436,22 @@ fn world_light_heading_drifts_less_than_two_degrees_per_minute() {
     ] {
         let Some(events) = phone_trial(name) else { return };
         let (unaligned, _) = light_drift_deg_per_min(&events);
-        // The mounting is used only where the two halves of the trial agree on it: texting
-        // turns the phone mostly about one axis, which leaves the rotation about it loose.
-        let (mounting, used) = marker_from_imu(&events);
-        let half = events.len() / 2;
-        let spread = marker_from_imu(&events[..half])
-            .0
-            .angle_between(marker_from_imu(&events[half..]).0)
-            .to_degrees();
-        let determined = spread < 2.0;
-        let aligned = light_drift_with_mounting(&events, if determined { mounting } else { Quat::IDENTITY });
+        let mounting = Mounting::of(&events);
+        let aligned = light_drift_with_mounting(
+            &events,
+            if mounting.determined() {
+                mounting.marker_from_imu
+            } else {
+                Quat::IDENTITY
+            },
+        );
         let (slope, frames) = (aligned.ours_deg_per_min, aligned.frames);
         println!(
-            "{name}: light heading drift {slope:+.3}°/min over {frames} frames (IMU {:.2}° off the marker from {used} intervals, halves {spread:.1}° apart: {}; {unaligned:+.3}°/min taking the marker for the IMU); Android's rotation vector: {:+.3?}°/min",
-            mounting.angle_between(Quat::IDENTITY).to_degrees(),
-            if determined { "used" } else { "not used" },
+            "{name}: light heading drift {slope:+.3}°/min over {frames} frames (IMU {:.2}° off the marker from {} intervals, halves {:.1}° apart: {}; {unaligned:+.3}°/min taking the marker for the IMU); Android's rotation vector: {:+.3?}°/min",
+            mounting.angle_deg(),
+            mounting.intervals,
+            mounting.halves_apart_deg,
+            if mounting.determined() { "used" } else { "not used" },
             aligned.android_deg_per_min,
         );
         results.push((name, slope, frames));
@@ -453,6 +487,79 @@ fn magnetometer_keeps_the_light_from_drifting_with_gyro_bias() {
     println!("synthetic, 0.3°/s gyro bias: light heading drift {slope:+.3}°/min over {frames} frames");
     assert!(frames > 2000);
     assert!(slope.abs() < 2.0, "{slope}°/min");
+}
+
+/// Every estimator shows a floor of about 2° of inclination error on the phone recordings (the
+/// data's README), and the fused estimator's raw RMSE exceeds Android's rotation vector's on two
+/// of them (`benchmarks/orientation.md`). The floor is the marker body's mounting on the phone:
+/// with the ground truth turned by the mounting estimated from rates alone ([`marker_from_imu`],
+/// which no estimator's output enters), both estimators' inclination RMSE falls on every trial
+/// whose mounting is determined, and there the fused estimator is the better of the two.
+/// Prints raw and aligned figures for all six trials.
+#[test]
+fn phone_inclination_floor_is_the_marker_mounting() {
+    use phantogram::orientation_eval::{PlatformRotationVector, Trial, TruthFrame, score};
+    let mut determined = 0;
+    for name in [
+        "Guillaume_Nexus5_Dist_Texting",
+        "Guillaume_Nexus5_NoDist_AR",
+        "Guillaume_Nexus5_NoDist_Texting",
+        "Thibaud_Nexus5_Dist_AR",
+        "Thibaud_Nexus5_NoDist_AR",
+        "Thibaud_Nexus5_NoDist_Texting",
+    ] {
+        let Some(events) = phone_trial(name) else { return };
+        let mounting = Mounting::of(&events);
+        let turned: Vec<SensorEvent> = events
+            .iter()
+            .map(|e| match e.quat() {
+                Some(q) if e.kind == SensorKind::GroundTruth => {
+                    SensorEvent::orientation(SensorKind::GroundTruth, e.t_ns, q * mounting.marker_from_imu)
+                }
+                _ => *e,
+            })
+            .collect();
+        // Inclination RMSE after the first 5 s, as `phantogram eval orientation` scores it:
+        // (fused, rotation vector).
+        let rmse = |events: Vec<SensorEvent>| {
+            let trial = Trial {
+                name: name.to_owned(),
+                events,
+                truth_frame: TruthFrame::ArbitraryHeading,
+                movement: None,
+            };
+            (
+                score(&trial, "fused", &mut FusedOrientation::default())
+                    .main
+                    .inclination_deg,
+                score(&trial, "rotation vector", &mut PlatformRotationVector::default())
+                    .main
+                    .inclination_deg,
+            )
+        };
+        let (raw, aligned) = (rmse(events), rmse(turned));
+        println!(
+            "{name}: inclination RMSE fused {:.2}° / rotation vector {:.2}° against the marker; {:.2}° / {:.2}° against the IMU (mounting {:.2}°, halves {:.1}° apart: {})",
+            raw.0,
+            raw.1,
+            aligned.0,
+            aligned.1,
+            mounting.angle_deg(),
+            mounting.halves_apart_deg,
+            if mounting.determined() { "determined" } else { "loose" },
+        );
+        if mounting.determined() {
+            determined += 1;
+            assert!(aligned.0 < raw.0 && aligned.1 < raw.1, "{name}: {raw:?} → {aligned:?}");
+            assert!(
+                aligned.0 <= aligned.1,
+                "{name}: fused {} > rotation vector {}",
+                aligned.0,
+                aligned.1
+            );
+        }
+    }
+    assert!(determined >= 3, "only {determined} trials with a determined mounting");
 }
 
 /// The mounting estimate recovers a known rotation between the IMU and the "marker": the

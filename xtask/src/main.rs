@@ -217,6 +217,9 @@ fn bench_orientation() -> Result<()> {
          RMSE in degrees with BROAD's definitions: `incl`, `head`, `total` over the main rows (after the\n\
          first 5 s; BROAD: movement phases only), `c.incl`, `c.head` over the first 5 s (convergence).\n\
          Phone ground truth has the motion-capture room's heading, so only inclination is scored there.\n\
+         It is also the marker body's attitude, 1–2° off the phone's IMU: that is the floor of ~2° every\n\
+         estimator shows there. `phone_inclination_floor_is_the_marker_mounting` (tests/tests/fusion_real.rs)\n\
+         scores the phone trials against the truth turned onto the IMU as well.\n\
          `ns/evt`: wall time per sensor event (accelerometer, gyroscope or magnetometer) on the machine\n\
          that ran it (shared, noisy: compare within one run).\n\n```text\n{table}```\n"
     );
