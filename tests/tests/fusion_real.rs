@@ -288,21 +288,22 @@ fn marker_from_imu(events: &[SensorEvent]) -> (Quat, usize) {
 /// [`marker_from_imu`] over a whole trial, with how far apart the estimates from its two halves
 /// are: texting turns the phone mostly about one axis, which leaves the rotation about it loose.
 struct Mounting {
-    marker_from_imu: Quat,
+    /// `marker_from_imu`'s rotation.
+    rotation: Quat,
     intervals: usize,
     halves_apart_deg: f32,
 }
 
 impl Mounting {
     fn of(events: &[SensorEvent]) -> Self {
-        let (marker_from_imu, intervals) = marker_from_imu(events);
+        let (rotation, intervals) = marker_from_imu(events);
         let half = events.len() / 2;
-        let halves_apart_deg = self::marker_from_imu(&events[..half])
+        let halves_apart_deg = marker_from_imu(&events[..half])
             .0
-            .angle_between(self::marker_from_imu(&events[half..]).0)
+            .angle_between(marker_from_imu(&events[half..]).0)
             .to_degrees();
         Self {
-            marker_from_imu,
+            rotation,
             intervals,
             halves_apart_deg,
         }
@@ -314,8 +315,21 @@ impl Mounting {
     }
 
     fn angle_deg(&self) -> f32 {
-        self.marker_from_imu.angle_between(Quat::IDENTITY).to_degrees()
+        self.rotation.angle_between(Quat::IDENTITY).to_degrees()
     }
+}
+
+/// The events with every ground-truth attitude `q` replaced by `q · by`.
+fn truth_turned(events: &[SensorEvent], by: Quat) -> Vec<SensorEvent> {
+    events
+        .iter()
+        .map(|e| match e.quat() {
+            Some(q) if e.kind == SensorKind::GroundTruth => {
+                SensorEvent::orientation(SensorKind::GroundTruth, e.t_ns, q * by)
+            }
+            _ => *e,
+        })
+        .collect()
 }
 
 /// Least-squares trend of an angle over time, unwrapping it across ±180°.
@@ -440,7 +454,7 @@ fn world_light_heading_drifts_less_than_two_degrees_per_minute() {
         let aligned = light_drift_with_mounting(
             &events,
             if mounting.determined() {
-                mounting.marker_from_imu
+                mounting.rotation
             } else {
                 Quat::IDENTITY
             },
@@ -510,15 +524,7 @@ fn phone_inclination_floor_is_the_marker_mounting() {
     ] {
         let Some(events) = phone_trial(name) else { return };
         let mounting = Mounting::of(&events);
-        let turned: Vec<SensorEvent> = events
-            .iter()
-            .map(|e| match e.quat() {
-                Some(q) if e.kind == SensorKind::GroundTruth => {
-                    SensorEvent::orientation(SensorKind::GroundTruth, e.t_ns, q * mounting.marker_from_imu)
-                }
-                _ => *e,
-            })
-            .collect();
+        let turned = truth_turned(&events, mounting.rotation);
         // Inclination RMSE after the first 5 s, as `phantogram eval orientation` scores it:
         // (fused, rotation vector).
         let rmse = |events: Vec<SensorEvent>| {
@@ -567,15 +573,7 @@ fn phone_inclination_floor_is_the_marker_mounting() {
 #[test]
 fn marker_mounting_is_recovered_from_rates() {
     let mounting = Quat::from_axis_angle(Vec3::new(1.0, -2.0, 0.5).normalize(), 4f32.to_radians());
-    let events: Vec<SensorEvent> = tilt_sweep(&ImuSpec::default())
-        .into_iter()
-        .map(|e| match e.quat() {
-            Some(q) if e.kind == SensorKind::GroundTruth => {
-                SensorEvent::orientation(SensorKind::GroundTruth, e.t_ns, q * mounting.inverse())
-            }
-            _ => e,
-        })
-        .collect();
+    let events = truth_turned(&tilt_sweep(&ImuSpec::default()), mounting.inverse());
     let (estimate, used) = marker_from_imu(&events);
     let error = estimate.angle_between(mounting).to_degrees();
     println!("mounting recovered within {error:.3}° from {used} intervals");
