@@ -97,6 +97,32 @@ fn vs_shadow(@location(0) position: vec3<f32>) -> @builtin(position) vec4<f32> {
     return eye.light_view_proj * vec4<f32>(position, 1.0);
 }
 
+// Shadow pass of alpha-masked materials: the cut-out of `fs_main`, so that the shadow has the
+// holes the surface has (leaves, lace, fretwork).
+struct ShadowMaskedOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec4<f32>,
+    @location(1) color: vec4<f32>,
+};
+
+@vertex
+fn vs_shadow_masked(@location(0) position: vec3<f32>, @location(3) uv: vec4<f32>, @location(4) color: vec4<f32>) -> ShadowMaskedOut {
+    var out: ShadowMaskedOut;
+    out.clip = eye.light_view_proj * vec4<f32>(position, 1.0);
+    out.uv = uv;
+    out.color = color;
+    return out;
+}
+
+@fragment
+fn fs_shadow_masked(in: ShadowMaskedOut) {
+    let alpha = in.color.a * material.base_color.a
+        * textureSample(base_texture, base_sampler, slot_uv(0u, material.uv_sets.x, in.uv)).a;
+    if (material.params.z >= 0.0 && alpha < material.params.z) {
+        discard;
+    }
+}
+
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
     var out: VsOut;

@@ -3,12 +3,15 @@
 //! window surface for the desktop viewer and the phones builds on the same passes.
 //!
 //! ## Passes per frame
-//! 1. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
+//! 1. Shadow pass, once for both eyes: depth from the world-fixed light (orthographic over the
+//!    model), both faces of every surface; alpha-masked materials are cut out as in the scene pass
+//!    (their shadows have the holes they have), blended ones cast none.
+//! 2. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
 //!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
 //!    Opaque and masked primitives first, then blended ones back to front (depth test, no depth
 //!    write). Mono renders only the cyclopean eye. Light, materials and textures are shared by
 //!    both eyes; only the small per-eye uniform differs.
-//! 2. Composition pass: tone mapping (Khronos PBR Neutral, exposure) of each eye, then the
+//! 3. Composition pass: tone mapping (Khronos PBR Neutral, exposure) of each eye, then the
 //!    anaglyph matrices ([`crate::anaglyph`]) in linear light, into an `Rgba8UnormSrgb` target.
 //!
 //! ## Models
@@ -413,6 +416,13 @@ struct MaterialVariant {
     mask: bool,
 }
 
+impl MaterialVariant {
+    /// Casts its shadow through the alpha-masked shadow pipeline (blended surfaces cast none).
+    fn casts_masked_shadow(&self) -> bool {
+        self.mask && !self.blend
+    }
+}
+
 /// Names of the `override` constants in `scene.wgsl`, in [`MaterialVariant::textures`] order.
 const TEXTURE_OVERRIDES: [&str; 5] = [
     "HAS_BASE_TEXTURE",
@@ -428,6 +438,11 @@ struct ScenePipelines {
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
     variants: std::collections::HashMap<MaterialVariant, wgpu::RenderPipeline>,
+    /// The light's matrix and a material: what the shadow pass of a masked material reads.
+    shadow_masked_layout: wgpu::PipelineLayout,
+    /// Shadow pass for alpha-masked materials (cut out as in the scene pass), made with the first
+    /// model that has one.
+    shadow_masked: Option<wgpu::RenderPipeline>,
 }
 
 impl ScenePipelines {
@@ -443,6 +458,55 @@ impl ScenePipelines {
                 self.variants.insert(m.variant, pipeline);
             }
         }
+        let casts_masked = model.materials.iter().any(|m| m.variant.casts_masked_shadow());
+        if casts_masked && self.shadow_masked.is_none() {
+            self.shadow_masked = Some(self.create_shadow_masked(device));
+        }
+    }
+
+    fn create_shadow_masked(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
+        let attributes = [
+            wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x3,
+                offset: std::mem::offset_of!(Vertex, position) as u64,
+                shader_location: 0,
+            },
+            wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x4,
+                offset: std::mem::offset_of!(Vertex, uv) as u64,
+                shader_location: 3,
+            },
+            wgpu::VertexAttribute {
+                format: wgpu::VertexFormat::Float32x4,
+                offset: std::mem::offset_of!(Vertex, color) as u64,
+                shader_location: 4,
+            },
+        ];
+        device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("shadow (alpha-masked)"),
+            layout: Some(&self.shadow_masked_layout),
+            vertex: wgpu::VertexState {
+                module: &self.module,
+                entry_point: Some("vs_shadow_masked"),
+                compilation_options: Default::default(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: std::mem::size_of::<Vertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &attributes,
+                })],
+            },
+            primitive: SHADOW_PRIMITIVE,
+            depth_stencil: Some(shadow_depth_state()),
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &self.module,
+                entry_point: Some("fs_shadow_masked"),
+                compilation_options: Default::default(),
+                targets: &[],
+            }),
+            multiview_mask: None,
+            cache: None,
+        })
     }
 
     fn create(&self, device: &wgpu::Device, v: &MaterialVariant) -> wgpu::RenderPipeline {
@@ -501,6 +565,33 @@ impl ScenePipelines {
             multiview_mask: None,
             cache: None,
         })
+    }
+}
+
+/// The shadow pass's triangles: both faces cast, since open and double-sided surfaces must
+/// shadow too.
+const SHADOW_PRIMITIVE: wgpu::PrimitiveState = wgpu::PrimitiveState {
+    topology: wgpu::PrimitiveTopology::TriangleList,
+    strip_index_format: None,
+    front_face: wgpu::FrontFace::Ccw,
+    cull_mode: None,
+    unclipped_depth: false,
+    polygon_mode: wgpu::PolygonMode::Fill,
+    conservative: false,
+};
+
+fn shadow_depth_state() -> wgpu::DepthStencilState {
+    wgpu::DepthStencilState {
+        format: DEPTH_FORMAT,
+        depth_write_enabled: Some(true),
+        depth_compare: Some(wgpu::CompareFunction::LessEqual),
+        stencil: Default::default(),
+        // Slope-scaled bias against acne on surfaces at a grazing angle to the light.
+        bias: wgpu::DepthBiasState {
+            constant: 2,
+            slope_scale: 2.0,
+            clamp: 0.0,
+        },
     }
 }
 
@@ -657,10 +748,17 @@ impl Renderer {
             bind_group_layouts: &[Some(&eye_layout), Some(&material_layout)],
             immediate_size: 0,
         });
+        let shadow_masked_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("shadow (alpha-masked)"),
+            bind_group_layouts: &[Some(&shadow_layout), Some(&material_layout)],
+            immediate_size: 0,
+        });
         let mut scene = ScenePipelines {
             module: scene_module.clone(),
             layout: scene_layout,
             variants: Default::default(),
+            shadow_masked_layout,
+            shadow_masked: None,
         };
         let shadow_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("shadow"),
@@ -681,23 +779,8 @@ impl Renderer {
                     attributes: &position_only,
                 })],
             },
-            // Both faces cast: open and double-sided surfaces must shadow too.
-            primitive: wgpu::PrimitiveState {
-                cull_mode: None,
-                ..Default::default()
-            },
-            depth_stencil: Some(wgpu::DepthStencilState {
-                format: DEPTH_FORMAT,
-                depth_write_enabled: Some(true),
-                depth_compare: Some(wgpu::CompareFunction::LessEqual),
-                stencil: Default::default(),
-                // Slope-scaled bias against acne on surfaces at a grazing angle to the light.
-                bias: wgpu::DepthBiasState {
-                    constant: 2,
-                    slope_scale: 2.0,
-                    clamp: 0.0,
-                },
-            }),
+            primitive: SHADOW_PRIMITIVE,
+            depth_stencil: Some(shadow_depth_state()),
             multisample: Default::default(),
             fragment: None,
             multiview_mask: None,
@@ -796,11 +879,15 @@ impl Renderer {
         })?;
         let device = self.gpu.device.clone();
         let before: std::collections::HashSet<MaterialVariant> = self.scene.variants.keys().copied().collect();
+        let had_shadow_masked = self.scene.shadow_masked.is_some();
         if let Err(e) = checked(&device, "the model's pipelines", || {
             self.scene.prepare(&device, &gpu_model)
         }) {
             // Keep no pipeline that failed to build; the previous model stays drawable.
             self.scene.variants.retain(|v, _| before.contains(v));
+            if !had_shadow_masked {
+                self.scene.shadow_masked = None;
+            }
             return Err(e);
         }
         self.model = gpu_model;
@@ -1033,15 +1120,38 @@ impl Renderer {
             });
             pass.set_pipeline(&self.shadow_pipeline);
             pass.set_bind_group(0, &self.shadow_bind, &[]);
+            let variant = |p: &GpuPrimitive| self.model.materials[p.material].variant;
             for p in self
                 .model
                 .primitives
                 .iter()
-                .filter(|p| !self.model.materials[p.material].variant.blend)
+                .filter(|p| !variant(p).blend && !variant(p).casts_masked_shadow())
             {
                 pass.set_vertex_buffer(0, p.vertices.slice(..));
                 pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
                 pass.draw_indexed(0..p.index_count, 0, 0..1);
+            }
+            let mut masked = self
+                .model
+                .primitives
+                .iter()
+                .filter(|p| variant(p).casts_masked_shadow())
+                .peekable();
+            if masked.peek().is_some() {
+                // Made with the model (`ScenePipelines::prepare`); a miss would be our bug, and
+                // those surfaces then cast no shadow rather than panic mid-frame.
+                match &self.scene.shadow_masked {
+                    Some(pipeline) => {
+                        pass.set_pipeline(pipeline);
+                        for p in masked {
+                            pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
+                            pass.set_vertex_buffer(0, p.vertices.slice(..));
+                            pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
+                            pass.draw_indexed(0..p.index_count, 0, 0..1);
+                        }
+                    }
+                    None => debug_assert!(false, "no shadow pipeline for masked materials"),
+                }
             }
         }
         for (i, u) in uniforms.iter().enumerate() {

@@ -280,13 +280,21 @@ fn gpu_composition_matches_the_cpu_reference() {
 
 /// A floor at z = −30 mm seen straight on, with a cube above it or resting on it, lit obliquely.
 fn shadow_scene(cube_centre: Vec3, half: f32, shadows: bool) -> Option<(Vec<u8>, OffAxisProjection)> {
-    let gpu = gpu()?;
-    let screen = Screen::default();
     let mut mesh = Mesh::default();
     mesh.push_cube(cube_centre, half, [0.8, 0.8, 0.8, 1.0]);
-    // A tiny marker at the floor's depth so add_floor puts the floor at z = −30 mm.
+    push_floor_marker(&mut mesh);
+    render_over_floor(Model::from_painted_mesh("shadow test", mesh), shadows)
+}
+
+/// A tiny cube whose bottom is at z = −31 mm, so that `add_floor` puts the floor there.
+fn push_floor_marker(mesh: &mut Mesh) {
     mesh.push_cube(Vec3::new(0.03, 0.06, -0.0305), 0.0005, [0.5, 0.5, 0.5, 1.0]);
-    let mut model = Model::from_painted_mesh("shadow test", mesh);
+}
+
+/// `model` on its floor seen straight on from 30 cm, lit along (0.5, 0, 1), in mono.
+fn render_over_floor(mut model: Model, shadows: bool) -> Option<(Vec<u8>, OffAxisProjection)> {
+    let gpu = gpu()?;
+    let screen = Screen::default();
     model.add_floor(&screen, 2.0);
     let eye = Vec3::new(0.0, 0.0, 0.3);
     let mono = OffAxisProjection::new(&screen, eye, DepthRange::default()).unwrap();
@@ -326,6 +334,63 @@ fn shadows_fall_where_the_light_says() {
     );
     println!("floor luminance: in the predicted shadow {dark}, at its mirror image {lit}");
     assert!(dark < 0.6 * lit, "shadow {dark} vs lit {lit}");
+}
+
+#[test]
+fn alpha_masked_surfaces_shadow_only_where_they_are_kept() {
+    use phantogram::model::{AlphaMode, Image, Material, Primitive, TextureRef};
+    // Two cubes 15 mm above the floor, both alpha-masked at 0.5: one kept, one cut out by its
+    // base-colour texture's alpha of 0. Only the kept one may shadow the floor.
+    let mut marker = Mesh::default();
+    push_floor_marker(&mut marker);
+    let mut model = Model::from_painted_mesh("masked shadows", marker);
+    model.images.push(Image {
+        name: "transparent".into(),
+        width: 1,
+        height: 1,
+        rgba8: vec![255, 255, 255, 0],
+    });
+    let transparent = TextureRef {
+        image: 0,
+        tex_coord: 0,
+        transform: Default::default(),
+        sampler: Default::default(),
+    };
+    let (kept_y, cut_y) = (0.012, -0.012);
+    for (y, texture) in [(kept_y, None), (cut_y, Some(transparent))] {
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::new(0.0, y, -0.015), 0.004, [1.0; 4]);
+        model.materials.push(Material {
+            name: "masked".into(),
+            base_color: [0.8, 0.8, 0.8, 1.0],
+            metallic: 0.0,
+            alpha: AlphaMode::Mask(0.5),
+            base_color_texture: texture,
+            ..Material::default()
+        });
+        model.primitives.push(Primitive {
+            mesh,
+            material: model.materials.len() - 1,
+        });
+    }
+    let Some((pixels, proj)) = render_over_floor(model, true) else {
+        return;
+    };
+    // As in `shadows_fall_where_the_light_says`: each cube's shadow centre is 7.5 mm towards −x.
+    let floor = |x: f32, y: f32| luminance_at(&pixels, &proj, Vec3::new(x, y, -0.03));
+    let (kept_shadow, kept_lit) = (floor(-0.0075, kept_y), floor(0.0075, kept_y));
+    let (cut_shadow, cut_lit) = (floor(-0.0075, cut_y), floor(0.0075, cut_y));
+    println!(
+        "floor luminance in / beside the shadow: kept cube {kept_shadow} / {kept_lit}, cut-out cube {cut_shadow} / {cut_lit}"
+    );
+    assert!(
+        kept_shadow < 0.6 * kept_lit,
+        "kept: shadow {kept_shadow} vs lit {kept_lit}"
+    );
+    assert!(
+        (cut_shadow - cut_lit).abs() < 0.05 * cut_lit,
+        "cut out: {cut_shadow} where its shadow would be vs {cut_lit}"
+    );
 }
 
 #[test]
