@@ -489,11 +489,7 @@ impl ScenePipelines {
                 module: &self.module,
                 entry_point: Some("vs_shadow_masked"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Vertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &attributes,
-                })],
+                buffers: &[Some(vertex_buffer(&attributes))],
             },
             primitive: SHADOW_PRIMITIVE,
             depth_stencil: Some(shadow_depth_state()),
@@ -527,11 +523,7 @@ impl ScenePipelines {
                 module: &self.module,
                 entry_point: Some("vs_main"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Vertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &vertex_attributes,
-                })],
+                buffers: &[Some(vertex_buffer(&vertex_attributes))],
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -565,6 +557,15 @@ impl ScenePipelines {
             multiview_mask: None,
             cache: None,
         })
+    }
+}
+
+/// A model's vertex buffer ([`Vertex`]), of which a pipeline reads `attributes`.
+fn vertex_buffer(attributes: &[wgpu::VertexAttribute]) -> wgpu::VertexBufferLayout<'_> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<Vertex>() as u64,
+        step_mode: wgpu::VertexStepMode::Vertex,
+        attributes,
     }
 }
 
@@ -773,11 +774,7 @@ impl Renderer {
                 module: &scene_module,
                 entry_point: Some("vs_shadow"),
                 compilation_options: Default::default(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: std::mem::size_of::<Vertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &position_only,
-                })],
+                buffers: &[Some(vertex_buffer(&position_only))],
             },
             primitive: SHADOW_PRIMITIVE,
             depth_stencil: Some(shadow_depth_state()),
