@@ -360,6 +360,15 @@ struct GpuPrimitive {
     centre: Vec3,
 }
 
+impl GpuPrimitive {
+    /// Binds the buffers and draws, with whatever pipeline and bind groups are set.
+    fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+        pass.set_vertex_buffer(0, self.vertices.slice(..));
+        pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..self.index_count, 0, 0..1);
+    }
+}
+
 struct GpuMaterial {
     bind: wgpu::BindGroup,
     variant: MaterialVariant,
@@ -1118,15 +1127,12 @@ impl Renderer {
             pass.set_pipeline(&self.shadow_pipeline);
             pass.set_bind_group(0, &self.shadow_bind, &[]);
             let variant = |p: &GpuPrimitive| self.model.materials[p.material].variant;
-            for p in self
-                .model
-                .primitives
-                .iter()
-                .filter(|p| !variant(p).blend && !variant(p).casts_masked_shadow())
-            {
-                pass.set_vertex_buffer(0, p.vertices.slice(..));
-                pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
-                pass.draw_indexed(0..p.index_count, 0, 0..1);
+            // Solid casters: opaque materials (masked ones follow, blended ones cast none).
+            for p in self.model.primitives.iter().filter(|p| {
+                let v = variant(p);
+                !v.blend && !v.mask
+            }) {
+                p.draw(&mut pass);
             }
             let mut masked = self
                 .model
@@ -1142,9 +1148,7 @@ impl Renderer {
                         pass.set_pipeline(pipeline);
                         for p in masked {
                             pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
-                            pass.set_vertex_buffer(0, p.vertices.slice(..));
-                            pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
-                            pass.draw_indexed(0..p.index_count, 0, 0..1);
+                            p.draw(&mut pass);
                         }
                     }
                     None => debug_assert!(false, "no shadow pipeline for masked materials"),
@@ -1257,9 +1261,7 @@ impl Renderer {
         };
         pass.set_pipeline(pipeline);
         pass.set_bind_group(1, &m.bind, &[]);
-        pass.set_vertex_buffer(0, p.vertices.slice(..));
-        pass.set_index_buffer(p.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..p.index_count, 0, 0..1);
+        p.draw(pass);
     }
 }
 
