@@ -20,6 +20,12 @@
 //!   scanner's frame), see [`voyager_rotation`].
 //! * A file that *requires* an extension we do not implement fails with
 //!   [`ModelError::UnsupportedExtension`] naming it; [`SUPPORTED_EXTENSIONS`] lists those we do.
+//! * A damaged file fails with an error saying where, and does not panic, hang or abort: the
+//!   document's indices and enumerations are checked before gltf-rs (which indexes unchecked)
+//!   follows them, the node hierarchy must be trees, every accessor's extent is checked before its
+//!   output is allocated, and a panic inside the Draco decoder becomes that primitive's error.
+//!   (The decoders of images and Draco streams allocate what their headers ask, within the
+//!   `image` crate's limits and not bounded by us for Draco.)
 //!
 //! ## Frames
 //! glTF is +Y up, +Z front, metres. [`Model::fit_to_diorama`] turns a standing object's +Y into
@@ -452,6 +458,10 @@ mod loader {
 
     use super::*;
 
+    /// Most values an accessor without a `bufferView` (all zeros, or sparse) may expand to:
+    /// 2²⁶ `f32`s, 256 MiB, several times the largest scan we load.
+    const MAX_ZERO_FILLED_VALUES: usize = 1 << 26;
+
     /// Extensions this loader implements; a file requiring any other fails to load.
     pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
         "KHR_draco_mesh_compression",
@@ -504,7 +514,8 @@ mod loader {
                 .buffers
                 .get(view.buffer().index())
                 .ok_or_else(|| self.data(format!("bufferView {}", view.index()), "buffer missing"))?;
-            buf.get(view.offset()..view.offset() + view.length()).ok_or_else(|| {
+            let end = view.offset().checked_add(view.length());
+            end.and_then(|end| buf.get(view.offset()..end)).ok_or_else(|| {
                 self.data(
                     format!("bufferView {}", view.index()),
                     "extends past the end of its buffer",
@@ -545,15 +556,40 @@ mod loader {
                     DataType::U32 => u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as f32,
                 }
             };
-            let mut out = vec![0.0f32; count * n];
-            if let Some(view) = accessor.view() {
-                let bytes = self.view_bytes(&view)?;
-                let elem = size * comps;
-                let stride = view.stride().unwrap_or(elem);
-                let start = accessor.offset();
-                if count > 0 && start + stride * (count - 1) + elem > bytes.len() {
-                    return Err(self.data(what(), "extends past the end of its buffer view"));
+            let elem = size * comps;
+            let data = match accessor.view() {
+                Some(view) => {
+                    let bytes = self.view_bytes(&view)?;
+                    let stride = view.stride().unwrap_or(elem);
+                    if stride < elem {
+                        return Err(self.data(what(), "byte stride smaller than one element"));
+                    }
+                    // One past the last byte read; None when it overflows.
+                    let end = |last: usize| {
+                        last.checked_mul(stride)?
+                            .checked_add(accessor.offset())?
+                            .checked_add(elem)
+                    };
+                    let fits = count
+                        .checked_sub(1)
+                        .is_none_or(|last| end(last).is_some_and(|e| e <= bytes.len()));
+                    if !fits {
+                        return Err(self.data(what(), "extends past the end of its buffer view"));
+                    }
+                    Some((bytes, stride))
                 }
+                // No data in the file: zeros (plus any sparse values), so the count alone sizes
+                // the output; bound it to what a phone could hold.
+                None if count.saturating_mul(n) > MAX_ZERO_FILLED_VALUES => {
+                    return Err(self.data(what(), format!("{count} elements without a bufferView")));
+                }
+                None => None,
+            };
+            // Every size was checked before this allocation: a damaged count must give an
+            // error, not an allocation failure (which aborts rather than unwinds).
+            let mut out = vec![0.0f32; count * n];
+            if let Some((bytes, stride)) = data {
+                let start = accessor.offset();
                 for i in 0..count {
                     let base = start + i * stride;
                     for c in 0..n.min(comps) {
@@ -570,10 +606,14 @@ mod loader {
                     gltf::accessor::sparse::IndexType::U32 => 4,
                 };
                 let val_bytes = self.view_bytes(&sparse.values().view())?;
+                // Offsets may be anything in a damaged file: ranges that overflow are out of range.
+                let range = |offset: usize, k: usize, len: usize| {
+                    let start = k.checked_mul(len)?.checked_add(offset)?;
+                    Some(start..start.checked_add(len)?)
+                };
                 for k in 0..sparse.count() {
-                    let o = sparse.indices().offset() + k * idx_size;
-                    let ib = idx_bytes
-                        .get(o..o + idx_size)
+                    let ib = range(sparse.indices().offset(), k, idx_size)
+                        .and_then(|r| idx_bytes.get(r))
                         .ok_or_else(|| self.data(what(), "sparse indices out of range"))?;
                     let i = match idx_size {
                         1 => ib[0] as usize,
@@ -583,9 +623,8 @@ mod loader {
                     if i >= count {
                         return Err(self.data(what(), "sparse index past the accessor's count"));
                     }
-                    let vo = sparse.values().offset() + k * size * comps;
-                    let vb = val_bytes
-                        .get(vo..vo + size * comps)
+                    let vb = range(sparse.values().offset(), k, elem)
+                        .and_then(|r| val_bytes.get(r))
                         .ok_or_else(|| self.data(what(), "sparse values out of range"))?;
                     for c in 0..n.min(comps) {
                         out[i * n + c] = convert(&vb[c * size..(c + 1) * size]);
@@ -605,6 +644,55 @@ mod loader {
                 ));
             }
             Ok(self.read_f32(accessor, 1)?.into_iter().map(|v| v as u32).collect())
+        }
+    }
+
+    /// The structural checks gltf-rs makes in `Gltf::from_slice`, less those that would reject
+    /// files we load correctly. gltf-rs's accessors index its arrays unchecked (`node.children()`,
+    /// `primitive.material()`, `texture.source()`, `accessor.data_type()` …), so an index out of
+    /// range or an unknown enum value must be caught here, before any of them is called, or a
+    /// damaged file panics the loader. We parse without validation because gltf-rs rejects
+    /// every required extension it does not implement itself (Draco among them), and we name an
+    /// unsupported one ourselves. Not fatal here:
+    /// * `Unsupported`: required extensions, checked against [`SUPPORTED_EXTENSIONS`] before;
+    /// * a missing `bufferView` on an accessor: Draco-compressed primitives' accessors have none
+    ///   (and the core spec fills such an accessor with zeros, as [`Ctx::read_f32`] does);
+    /// * a missing or malformed `min`/`max` on a `POSITION` accessor: we compute bounds ourselves.
+    fn check_structure(root: &gltf::json::Root) -> Result<(), String> {
+        use gltf::json::validation::{Error, Validate};
+        // gltf-json's own check of POSITION's min/max indexes the accessors unchecked: make sure
+        // it can before running it.
+        for (m, mesh) in root.meshes.iter().enumerate() {
+            for (p, prim) in mesh.primitives.iter().enumerate() {
+                for (semantic, index) in &prim.attributes {
+                    if index.value() >= root.accessors.len() {
+                        return Err(format!(
+                            "meshes[{m}].primitives[{p}].attributes.{}: accessor {} does not exist",
+                            semantic.to_string(),
+                            index.value()
+                        ));
+                    }
+                }
+            }
+        }
+        let mut errors = Vec::new();
+        root.validate(root, gltf::json::Path::new, &mut |path, error| {
+            let path = path().to_string();
+            let position_bounds = path.contains("POSITION") && (path.ends_with(".min") || path.ends_with(".max"));
+            let tolerated = match error {
+                Error::Unsupported => true,
+                Error::Missing => position_bounds || (path.starts_with("accessors[") && path.ends_with(".bufferView")),
+                Error::Invalid => position_bounds,
+                _ => false,
+            };
+            if !tolerated {
+                errors.push(format!("{path}: {error}"));
+            }
+        });
+        match errors.len() {
+            0 => Ok(()),
+            1 => Err(errors.swap_remove(0)),
+            n => Err(format!("{} (and {} more)", errors[0], n - 1)),
         }
     }
 
@@ -806,8 +894,10 @@ mod loader {
         let mut buffer = draco_core::DecoderBuffer::new(ctx.view_bytes(view)?);
         let mut decoder = draco_core::MeshDecoder::new();
         let mut mesh = draco_core::Mesh::new();
-        decoder
-            .decode(&mut buffer, &mut mesh)
+        // draco-core is a young pure-Rust port: should it panic on a damaged stream, that is
+        // this file's error, not the app's end. The half-decoded mesh is dropped unused.
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decoder.decode(&mut buffer, &mut mesh)))
+            .map_err(|_| ctx.data(what(), "Draco decoder failed on a damaged stream"))?
             .map_err(|e| ctx.data(what(), format!("Draco decoding failed: {e}")))?;
         let n = mesh.num_points();
         let attrs = ext
@@ -1011,6 +1101,10 @@ mod loader {
                 name: name.to_owned(),
             });
         }
+        check_structure(doc.as_json()).map_err(|message| ModelError::Parse {
+            path: path.to_path_buf(),
+            message,
+        })?;
         let mut buffers = Vec::new();
         for b in doc.buffers() {
             let data = match b.source() {
@@ -1081,10 +1175,29 @@ mod loader {
         let scene = doc.default_scene().or_else(|| doc.scenes().next());
         let roots: Vec<gltf::Node> = match &scene {
             Some(s) => s.nodes().collect(),
-            None => doc.nodes().collect(),
+            // No scene: every node that is nobody's child, as a scene listing them would.
+            None => {
+                let mut is_child = vec![false; doc.nodes().len()];
+                for child in doc.nodes().flat_map(|n| n.children()) {
+                    is_child[child.index()] = true;
+                }
+                doc.nodes().filter(|n| !is_child[n.index()]).collect()
+            }
         };
+        // The hierarchy must be disjoint strict trees (glTF 2.0, "Nodes and Hierarchy"); a
+        // node met twice would loop forever or draw twice.
+        let mut visited = vec![false; doc.nodes().len()];
         let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
         while let Some((node, parent)) = stack.pop() {
+            if std::mem::replace(&mut visited[node.index()], true) {
+                return Err(ModelError::Parse {
+                    path: path.to_path_buf(),
+                    message: format!(
+                        "node {} is reached twice in the scene's hierarchy (a cycle, or a node with two parents)",
+                        node.index()
+                    ),
+                });
+            }
             let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
             if let Some(mesh) = node.mesh() {
                 for prim in mesh.primitives() {

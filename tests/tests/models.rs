@@ -150,23 +150,27 @@ fn quantized_duck_matches_the_float_duck() {
 
 /// A minimal glTF with one triangle; `extra` is spliced into the top-level object.
 fn tiny_gltf(dir: &Path, name: &str, extra: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, tiny_gltf_json(extra)).unwrap();
+    path
+}
+
+/// The text of [`tiny_gltf`].
+fn tiny_gltf_json(extra: &str) -> String {
     // Three positions: (0,0,0), (1,0,0), (0,1,0) as little-endian f32.
     let mut bin = Vec::new();
     for v in [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0] {
         bin.extend_from_slice(&v.to_le_bytes());
     }
     let uri = format!("data:application/octet-stream;base64,{}", base64_encode(&bin));
-    let json = format!(
+    format!(
         r#"{{"asset":{{"version":"2.0"}}{extra},
         "buffers":[{{"byteLength":36,"uri":"{uri}"}}],
         "bufferViews":[{{"buffer":0,"byteLength":36}}],
         "accessors":[{{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}}],
         "meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],
         "nodes":[{{"mesh":0}}],"scenes":[{{"nodes":[0]}}],"scene":0}}"#
-    );
-    let path = dir.join(name);
-    std::fs::write(&path, json).unwrap();
-    path
+    )
 }
 
 /// A `size`×`size` PNG of one colour as a data URI, for hand-written glTF files.
@@ -270,6 +274,267 @@ fn texture_transforms_reach_normal_and_occlusion_textures() {
         "{:?}",
         bad.warnings
     );
+}
+
+/// Damaged files fail with an error that says what is wrong, never a panic, a hang or an
+/// allocation no phone can make. gltf-rs indexes its arrays unchecked, so before the loader
+/// checked a document's structure itself the out-of-range indices here panicked, the cycle
+/// looped forever and the huge count aborted the process.
+#[test]
+fn damaged_structure_is_an_error_not_a_panic() {
+    let dir = scratch("gltf-damaged");
+    let base = tiny_gltf_json("");
+    // (file, text to replace, replacement, what the error must name)
+    let cases = [
+        (
+            "cycle.gltf",
+            r#""nodes":[{"mesh":0}]"#,
+            r#""nodes":[{"mesh":0,"children":[0]}]"#,
+            "node 0 is reached twice",
+        ),
+        (
+            "two-parents.gltf",
+            r#""nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]"#,
+            r#""nodes":[{"children":[2]},{"children":[2]},{"mesh":0}],"scenes":[{"nodes":[0,1]}]"#,
+            "node 2 is reached twice",
+        ),
+        (
+            "child-missing.gltf",
+            r#""nodes":[{"mesh":0}]"#,
+            r#""nodes":[{"mesh":0,"children":[7]}]"#,
+            "nodes[0].children[0]",
+        ),
+        (
+            "scene-missing.gltf",
+            r#""scene":0"#,
+            r#""scene":3"#,
+            "scene: Index out of bounds",
+        ),
+        (
+            "material-missing.gltf",
+            r#""attributes":{"POSITION":0}"#,
+            r#""attributes":{"POSITION":0},"material":5"#,
+            "meshes[0].primitives[0].material",
+        ),
+        (
+            "position-missing.gltf",
+            r#""POSITION":0"#,
+            r#""POSITION":9"#,
+            "accessor 9 does not exist",
+        ),
+        ("component-type.gltf", "5126", "5999", "accessors[0].componentType"),
+        (
+            "accessor-offset.gltf",
+            r#""bufferView":0,"componentType""#,
+            r#""bufferView":0,"byteOffset":18446744073709551615,"componentType""#,
+            "accessor 0: extends past the end",
+        ),
+        (
+            "view-offset.gltf",
+            r#""buffer":0,"byteLength":36"#,
+            r#""buffer":0,"byteOffset":18446744073709551615,"byteLength":36"#,
+            "bufferView 0: extends past the end",
+        ),
+        (
+            "stride.gltf",
+            r#""buffer":0,"byteLength":36"#,
+            r#""buffer":0,"byteLength":36,"byteStride":4"#,
+            "byte stride smaller than one element",
+        ),
+        (
+            "zeros-galore.gltf",
+            r#""bufferView":0,"componentType":5126,"count":3"#,
+            r#""componentType":5126,"count":4294967295"#,
+            "4294967295 elements without a bufferView",
+        ),
+    ];
+    for (name, from, to, expected) in cases {
+        assert!(base.contains(from), "{name}: the template lacks {from}");
+        let path = dir.join(name);
+        std::fs::write(&path, base.replace(from, to)).unwrap();
+        match load_gltf(&path) {
+            Ok(_) => panic!("{name}: loaded"),
+            Err(e) => {
+                let text = e.to_string();
+                assert!(text.contains(name) && text.contains(expected), "{name}: {text}");
+            }
+        }
+    }
+
+    // Without a scene, the roots are the nodes that are nobody's child: the child is drawn
+    // once, under its parent's transform.
+    let path = dir.join("no-scene.gltf");
+    let text = base.replace(
+        r#""nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0"#,
+        r#""nodes":[{"children":[1],"translation":[0,0,5]},{"mesh":0}]"#,
+    );
+    assert!(!text.contains("scene"));
+    std::fs::write(&path, text).unwrap();
+    let model = load_gltf(&path).unwrap();
+    assert_eq!(model.triangle_count(), 1);
+    assert!(model.primitives[0].mesh.vertices.iter().all(|v| v.position[2] == 5.0));
+}
+
+/// Every unsigned number in a glTF file's JSON replaced, one at a time, by a value a damaged or
+/// hostile file could hold — small indices, 2³² − 1, 2⁶⁴ − 1 — and, in a GLB, bytes of the
+/// binary chunk flipped: each copy loads or fails with an error, and none panics. On a small
+/// textured file made here, and with `PHANTOGRAM_DATA` on Khronos' Box as GLB and as Draco.
+#[test]
+fn mutated_files_load_or_fail_without_panicking() {
+    let dir = scratch("gltf-mutants");
+    let image = png_data_uri(2, [200, 100, 50, 255]);
+    let textured = tiny_gltf_json(&format!(
+        r#","images":[{{"uri":"{image}"}}],"samplers":[{{"magFilter":9729}}],"textures":[{{"source":0,"sampler":0}}],
+        "materials":[{{"pbrMetallicRoughness":{{"baseColorTexture":{{"index":0}}}},"normalTexture":{{"index":0}}}}]"#
+    ))
+    .replace(
+        r#""attributes":{"POSITION":0}"#,
+        r#""attributes":{"POSITION":0},"material":0"#,
+    );
+    let mut files = vec![("tiny.gltf".to_owned(), textured.into_bytes(), None)];
+    if let Some(models) = models_dir() {
+        for (name, rel) in [
+            ("Box.glb", "khronos/Box/glTF-Binary/Box.glb"),
+            ("Box.gltf", "khronos/Box/glTF-Draco/Box.gltf"),
+        ] {
+            let path = models.join(rel);
+            let bytes = std::fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+            files.push((name.to_owned(), bytes, path.parent().map(Path::to_path_buf)));
+        }
+    }
+    let mut failures = Vec::new();
+    let mut tried = 0;
+    for (name, bytes, siblings) in files {
+        // External buffers (the Draco Box's .bin) sit beside the copy as they did beside the original.
+        if let Some(from) = siblings {
+            for entry in std::fs::read_dir(&from).unwrap() {
+                let entry = entry.unwrap();
+                if entry.path().extension().is_some_and(|e| e == "bin") {
+                    std::fs::copy(entry.path(), dir.join(entry.file_name())).unwrap();
+                }
+            }
+        }
+        let copy = dir.join(&name);
+        let mut check = |mutant: &[u8], what: String| {
+            std::fs::write(&copy, mutant).unwrap();
+            tried += 1;
+            if std::panic::catch_unwind(|| load_gltf(&copy)).is_err() {
+                failures.push(format!("{name}: {what}"));
+            }
+        };
+        let (json, rest) = split_glb(&bytes).unwrap_or((&bytes[..], None));
+        for (at, mutant_json) in number_mutants(json) {
+            let mutant = match rest {
+                Some(bin) => join_glb(&mutant_json, bin),
+                None => mutant_json.clone(),
+            };
+            check(
+                &mutant,
+                format!(
+                    "number at byte {at} → {}",
+                    String::from_utf8_lossy(&mutant_json[at..at + 20.min(mutant_json.len() - at)])
+                ),
+            );
+        }
+        if let Some(bin) = rest {
+            let mut seed = 0x9E37_79B9_7F4A_7C15u64;
+            for k in 0..300 {
+                let mut flipped = bin.to_vec();
+                for _ in 0..1 + k % 8 {
+                    seed = seed
+                        .wrapping_mul(6_364_136_223_846_793_005)
+                        .wrapping_add(1_442_695_040_888_963_407);
+                    // Past the chunk's own 8-byte header.
+                    let at = 8 + (seed >> 33) as usize % (flipped.len() - 8);
+                    flipped[at] ^= (seed >> 20) as u8 | 1;
+                }
+                check(&join_glb(json, &flipped), format!("binary chunk, mutant {k}"));
+            }
+        }
+    }
+    assert!(tried > 150, "only {tried} mutants");
+    assert!(
+        failures.is_empty(),
+        "{} of {tried} mutants panicked:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
+}
+
+/// A GLB's JSON chunk content and everything after it (the binary chunk with its header), or
+/// None for a text file.
+fn split_glb(bytes: &[u8]) -> Option<(&[u8], Option<&[u8]>)> {
+    if bytes.len() < 20 || &bytes[..4] != b"glTF" {
+        return None;
+    }
+    let json_len = u32::from_le_bytes(bytes[12..16].try_into().ok()?) as usize;
+    let json = bytes.get(20..20 + json_len)?;
+    Some((json, Some(&bytes[20 + json_len..])))
+}
+
+/// A GLB with this JSON (padded with spaces to 4 bytes, as the format asks) and these chunks after it.
+fn join_glb(json: &[u8], rest: &[u8]) -> Vec<u8> {
+    let mut json = json.to_vec();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + rest.len();
+    let mut out = b"glTF".to_vec();
+    out.extend_from_slice(&2u32.to_le_bytes());
+    out.extend_from_slice(&(total as u32).to_le_bytes());
+    out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    out.extend_from_slice(b"JSON");
+    out.extend_from_slice(&json);
+    out.extend_from_slice(rest);
+    out
+}
+
+/// Copies of `json` with one unsigned integer (not part of a decimal, exponent or string of
+/// base64) replaced by each of a few extreme values, with the byte where it starts.
+fn number_mutants(json: &[u8]) -> Vec<(usize, Vec<u8>)> {
+    const VALUES: [&str; 9] = [
+        "0",
+        "1",
+        "2",
+        "3",
+        "7",
+        "999",
+        "4294967295",
+        "4294967296",
+        "18446744073709551615",
+    ];
+    let mut out = Vec::new();
+    let mut in_string = false;
+    let mut i = 0;
+    while i < json.len() {
+        let c = json[i];
+        if c == b'"' {
+            in_string = !in_string;
+        }
+        let starts = !in_string
+            && c.is_ascii_digit()
+            && !matches!(
+                json.get(i.wrapping_sub(1)),
+                Some(b'.' | b'-' | b'e' | b'E' | b'0'..=b'9')
+            );
+        if !starts {
+            i += 1;
+            continue;
+        }
+        let end = i + json[i..].iter().take_while(|b| b.is_ascii_digit()).count();
+        if json.get(end).is_some_and(|b| matches!(b, b'.' | b'e' | b'E')) {
+            i = end;
+            continue;
+        }
+        for v in VALUES {
+            let mut m = json[..i].to_vec();
+            m.extend_from_slice(v.as_bytes());
+            m.extend_from_slice(&json[end..]);
+            out.push((i, m));
+        }
+        i = end;
+    }
+    out
 }
 
 /// Images decode in parallel, yet a broken one is still reported by its place in the file.
