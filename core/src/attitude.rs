@@ -91,6 +91,9 @@ impl Default for LowPassAttitude {
 
 impl OrientationEstimator for LowPassAttitude {
     fn push(&mut self, event: &SensorEvent) {
+        if !event.time_in_range() {
+            return; // its interval to the previous sample could overflow
+        }
         match event.kind {
             SensorKind::Accelerometer => {
                 self.accel.update(event.t_ns, event.vec3());

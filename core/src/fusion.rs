@@ -136,6 +136,7 @@ impl Default for FusionParams {
 /// Counters of ignored samples.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FusionStats {
+    /// NaN or infinite values, or a time stamp beyond ±[`crate::sensors::MAX_ABS_T_NS`].
     pub ignored_non_finite: u64,
     pub ignored_stale_time: u64,
     pub ignored_accel_shock: u64,
@@ -586,7 +587,7 @@ impl FusedOrientation {
 
 impl OrientationEstimator for FusedOrientation {
     fn push(&mut self, event: &SensorEvent) {
-        if !event.is_finite() {
+        if !event.is_finite() || !event.time_in_range() {
             self.stats.ignored_non_finite += 1;
             return;
         }

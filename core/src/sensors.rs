@@ -3,8 +3,9 @@
 //! Events carry the sensor's own time stamp in nanoseconds (Android's `SensorEvent.timestamp`,
 //! iOS's `CMLogItem.timestamp` converted) and values in the device frame and units of the crate
 //! docs. The inbox validates each event as it arrives:
-//! non-finite values, and time stamps that repeat or go backwards *for the same sensor*, are
-//! rejected and counted in [`SensorStats`], so a faulty driver cannot corrupt the estimators.
+//! non-finite values, time stamps beyond ±[`MAX_ABS_T_NS`], and time stamps that repeat or go
+//! backwards *for the same sensor*, are rejected and counted in [`SensorStats`], so a faulty
+//! driver cannot corrupt the estimators.
 //! Different sensors may interleave freely; [`SensorInbox::drain_into`] returns them sorted by
 //! time.
 //!
@@ -62,6 +63,11 @@ impl SensorKind {
     }
 }
 
+/// Largest time stamp magnitude accepted anywhere, ns: 2⁶² ns, about 146 years, so that the
+/// difference of any two accepted stamps fits in an `i64` (the estimators subtract them). Phone
+/// clocks count from boot, exports from 1970 (1.8·10¹⁸ ns in 2026); a larger stamp is damage.
+pub const MAX_ABS_T_NS: i64 = 1 << 62;
+
 /// One timestamped sample. Vectors use `value[0..3]` (and `value[3] == 0`); orientations store a
 /// quaternion as `[x, y, z, w]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -115,6 +121,11 @@ impl SensorEvent {
         let n = if self.kind.is_orientation() { 4 } else { 3 };
         self.value[..n].iter().all(|v| v.is_finite())
     }
+
+    /// Whether the time stamp is within ±[`MAX_ABS_T_NS`].
+    pub fn time_in_range(&self) -> bool {
+        self.t_ns.unsigned_abs() <= MAX_ABS_T_NS as u64
+    }
 }
 
 /// Why the inbox refused an event.
@@ -126,6 +137,8 @@ pub enum Rejection {
     DuplicateTimestamp,
     #[error("time stamp goes backwards for this sensor")]
     BackwardTimestamp,
+    #[error("time stamp is beyond ±2^62 ns (146 years)")]
+    TimestampOutOfRange,
 }
 
 /// Counters kept by the inbox; cheap to copy.
@@ -135,13 +148,15 @@ pub struct SensorStats {
     pub rejected_non_finite: u64,
     pub rejected_duplicate: u64,
     pub rejected_backward: u64,
+    /// Time stamps beyond ±[`MAX_ABS_T_NS`].
+    pub rejected_out_of_range: u64,
     /// Accepted events dropped because the consumer did not drain in time.
     pub dropped_overflow: u64,
 }
 
 impl SensorStats {
     pub fn rejected(&self) -> u64 {
-        self.rejected_non_finite + self.rejected_duplicate + self.rejected_backward
+        self.rejected_non_finite + self.rejected_duplicate + self.rejected_backward + self.rejected_out_of_range
     }
 }
 
@@ -194,6 +209,10 @@ impl SensorInbox {
         if !event.is_finite() {
             s.stats.rejected_non_finite += 1;
             return Err(Rejection::NonFinite);
+        }
+        if !event.time_in_range() {
+            s.stats.rejected_out_of_range += 1;
+            return Err(Rejection::TimestampOutOfRange);
         }
         let slot = &mut s.last_t_ns[event.kind.index()];
         match *slot {

@@ -276,6 +276,9 @@ impl Session {
     /// the expected presentation time (Choreographer's frame time plus the pipeline depth; Core
     /// Animation's `targetTimestamp`) and the gyroscope carries the orientation over that interval.
     pub fn frame_at(&mut self, display_t_ns: Option<i64>) -> Result<FrameView, SessionError> {
+        // A shell's nonsense time (beyond the sensors' range) must not overflow the intervals
+        // below: draw as if none were given.
+        let display_t_ns = display_t_ns.filter(|t| t.unsigned_abs() <= crate::sensors::MAX_ABS_T_NS as u64);
         self.update();
         let predicted = display_t_ns.and_then(|t| self.estimator.predict_device_to_world(t));
         let up = match predicted {
@@ -349,6 +352,56 @@ mod tests {
         assert!(last.eyes.left_m.distance(seen[0]) < 1e-4 && last.eyes.right_m.distance(seen[1]) < 1e-4);
         // The stereo pair follows the tracked eyes, and the projection is built from them.
         assert!(last.left.eye_m.distance(seen[0]) < 1e-4, "{:?}", last.left.eye_m);
+    }
+
+    /// Time stamps from a damaged log or a faulty shell, at the ends of `i64`: each interval the
+    /// estimators take from them would overflow (a panic in debug builds, nonsense in release).
+    /// Rejected at the inbox, ignored by the tracker and the frame's prediction; what follows
+    /// is used as usual.
+    #[test]
+    fn time_stamps_at_the_ends_of_i64_are_refused_not_overflowed() {
+        let mut s = Session::new(SessionConfig::default()).unwrap();
+        for t in [i64::MIN, i64::MAX, crate::sensors::MAX_ABS_T_NS + 1] {
+            assert_eq!(
+                s.push(SensorEvent::gyroscope(t, Vec3::ZERO)),
+                Err(crate::sensors::Rejection::TimestampOutOfRange)
+            );
+            s.observe_face(FaceObservation {
+                capture_t_ns: t,
+                eyes_m: Some([Vec3::new(-0.03, 0.0, 0.4), Vec3::new(0.03, 0.0, 0.4)]),
+                confidence: 0.9,
+            });
+            s.frame_at(Some(t)).unwrap();
+        }
+        assert_eq!(
+            s.eye_source(),
+            EyeSource::Tilt,
+            "out-of-range camera results are ignored"
+        );
+        for k in 0..50 {
+            s.push(SensorEvent::accelerometer(k * 10_000_000, Vec3::Y * 9.81))
+                .unwrap();
+            s.push(SensorEvent::gyroscope(k * 10_000_000, Vec3::ZERO)).unwrap();
+        }
+        let up = s.frame_at(Some(i64::MIN)).unwrap().device_to_world.unwrap().inverse() * Vec3::Z;
+        assert!(up.distance(Vec3::Y) < 0.01, "{up}");
+        assert_eq!(s.stats().rejected_out_of_range, 3);
+
+        // The estimators on their own (as `phantogram eval` uses them) skip such events too.
+        let mut fused = crate::fusion::FusedOrientation::default();
+        let mut low_pass = crate::attitude::LowPassAttitude::default();
+        for t in [i64::MIN, 0, 10_000_000, i64::MAX] {
+            for e in [
+                SensorEvent::accelerometer(t, Vec3::Z * 9.81),
+                SensorEvent::gyroscope(t, Vec3::ZERO),
+            ] {
+                fused.push(&e);
+                low_pass.push(&e);
+            }
+        }
+        assert_eq!(fused.stats().ignored_non_finite, 4);
+        assert!(fused.up_device().is_some_and(|u| u.distance(Vec3::Z) < 1e-3));
+        assert!(low_pass.up_device().is_some_and(|u| u.distance(Vec3::Z) < 1e-3));
     }
 
     #[test]

@@ -23,9 +23,11 @@ use phantogram::sensors::SensorEvent;
 /// Standard gravity used by Core Motion's g unit, m/s².
 pub const STANDARD_GRAVITY_M_S2: f64 = 9.80665;
 
-/// Seconds (Core Motion time stamp) to the core's integer nanoseconds; `None` if not finite.
+/// Seconds (Core Motion time stamp) to the core's integer nanoseconds; `None` if not finite or
+/// beyond the core's ±[`phantogram::sensors::MAX_ABS_T_NS`].
 pub fn timestamp_ns(seconds: f64) -> Option<i64> {
-    (seconds.is_finite() && seconds.abs() < 9.0e9).then(|| (seconds * 1e9).round() as i64)
+    let ns = seconds * 1e9;
+    (ns.is_finite() && ns.abs() <= phantogram::sensors::MAX_ABS_T_NS as f64).then(|| ns.round() as i64)
 }
 
 /// `CMAccelerometerData.acceleration` (g, iOS sign) → core accelerometer event (m/s², up positive).

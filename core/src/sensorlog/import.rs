@@ -390,11 +390,14 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
 /// Integer nanoseconds, or a float (some exports write `1.76e18`).
 fn parse_ns(field: &str) -> Result<i64, String> {
     let f = field.trim().trim_matches('"');
+    let limit = crate::sensors::MAX_ABS_T_NS;
     if let Ok(t) = f.parse::<i64>() {
-        return Ok(t);
+        if t.unsigned_abs() <= limit as u64 {
+            return Ok(t);
+        }
     }
     let t = parse_f64(f)?;
-    if t.is_finite() && t.abs() < 9.2e18 {
+    if t.is_finite() && t.abs() <= limit as f64 {
         Ok(t.round() as i64)
     } else {
         Err(format!("time stamp {field:?} is not usable"))

@@ -195,7 +195,7 @@ pub fn parse_f64(field: &str) -> Result<f64, String> {
 
 /// Seconds (as exported) to integer nanoseconds; refuses non-finite or absurd times.
 pub fn seconds_to_ns(t_s: f64) -> Result<i64, String> {
-    if !t_s.is_finite() || t_s.abs() > 9.0e9 {
+    if !t_s.is_finite() || t_s.abs() * 1e9 > crate::sensors::MAX_ABS_T_NS as f64 {
         return Err(format!("time stamp {t_s} s is not usable"));
     }
     Ok((t_s * 1e9).round() as i64)
@@ -309,7 +309,9 @@ fn parse_event(tag: &str, rest: &str) -> Result<SensorEvent, String> {
         .next()
         .ok_or("missing time stamp")?
         .parse::<i64>()
-        .map_err(|_| "time stamp is not an integer number of nanoseconds".to_owned())?;
+        .ok()
+        .filter(|t| t.unsigned_abs() <= crate::sensors::MAX_ABS_T_NS as u64)
+        .ok_or("time stamp is not an integer number of nanoseconds within ±2^62")?;
     let n = if kind.is_orientation() { 4 } else { 3 };
     let mut value = [0f32; 4];
     for (i, slot) in value.iter_mut().take(n).enumerate() {
@@ -471,6 +473,11 @@ mod tests {
             ("phantogram-sensor-log 1\nacc 10 1 2\n", 2, "expected 3 values"),
             ("phantogram-sensor-log 1\n# c\n\nacc 10 1 2 x\n", 4, "expected a number"),
             ("phantogram-sensor-log 1\nacc 1.5 1 2 3\n", 2, "nanoseconds"),
+            (
+                "phantogram-sensor-log 1\nacc -9223372036854775808 1 2 3\n",
+                2,
+                "within ±2^62",
+            ),
             ("phantogram-sensor-log 1\nacc 1 1 2 3\nmeta a b\n", 3, "meta line after"),
             ("phantogram-sensor-log 1\nzzz 1 1 2 3\n", 2, "unknown record"),
             ("phantogram-sensor-log 1\nrot 1 1 2 3 4 5\n", 2, "found more"),

@@ -410,13 +410,14 @@ fn replay_command(
     out.flush().ok();
     let s = summary.stats;
     eprintln!(
-        "{} events ({} accepted, {} rejected: {} non-finite, {} duplicate, {} backward time stamps), {} frames",
+        "{} events ({} accepted, {} rejected: {} non-finite, {} duplicate, {} backward and {} out-of-range time stamps), {} frames",
         summary.events_read,
         s.accepted,
         s.rejected(),
         s.rejected_non_finite,
         s.rejected_duplicate,
         s.rejected_backward,
+        s.rejected_out_of_range,
         summary.frames
     );
     Ok(())
