@@ -241,6 +241,24 @@ impl Session {
         self.viewpoint.reset_flat_angle();
     }
 
+    /// The "up" (device frame) of the pose that counts as straight on, to save with the
+    /// calibration; `None` while lying flat is straight on.
+    pub fn flat_up_device(&self) -> Option<Vec3> {
+        self.viewpoint.flat_up_device()
+    }
+
+    /// Restores a saved flat angle ([`Self::flat_up_device`]); `None` resets it. Returns `false`
+    /// and changes nothing if `up` is degenerate.
+    pub fn set_flat_up_device(&mut self, up: Option<Vec3>) -> bool {
+        match up {
+            Some(up) => self.viewpoint.calibrate_flat_angle(up),
+            None => {
+                self.viewpoint.reset_flat_angle();
+                true
+            }
+        }
+    }
+
     /// Ties the light's default direction to the room again, at the current pose.
     pub fn recalibrate_light(&mut self) -> Result<(), SessionError> {
         self.update();

@@ -56,6 +56,12 @@ impl Viewpoint {
         self.flat_reference
     }
 
+    /// The unit "up" (device frame) of the pose calibrated as straight on, as
+    /// [`Self::calibrate_flat_angle`] took it (for saving); `None` while lying flat is straight on.
+    pub fn flat_up_device(&self) -> Option<Vec3> {
+        (self.flat_reference != Quat::IDENTITY).then(|| self.flat_reference.inverse() * Vec3::Z)
+    }
+
     /// Unit direction from the screen centre to the cyclopean eye, device frame. With no usable
     /// "up" yet, the viewer is assumed straight on.
     pub fn eye_direction(&self, up_device: Option<Vec3>) -> Vec3 {
@@ -116,8 +122,15 @@ mod tests {
         let up50 = Vec3::new(0.0, t50.sin(), t50.cos());
         assert!((deg(v.eye_direction(Some(up50)), Vec3::Z) - 10.0).abs() < 1e-3);
         assert!(!v.calibrate_flat_angle(Vec3::ZERO));
+        // What a calibration file keeps gives the same viewpoint back.
+        let saved = v.flat_up_device().unwrap();
+        assert!(saved.distance(up40) < 1e-6, "{saved}");
+        let mut restored = Viewpoint::default();
+        assert!(restored.calibrate_flat_angle(saved));
+        assert!(deg(restored.eye_direction(Some(up50)), v.eye_direction(Some(up50))) < 1e-3);
         v.reset_flat_angle();
         assert_eq!(v.flat_reference(), Quat::IDENTITY);
+        assert_eq!(v.flat_up_device(), None);
     }
 
     #[test]

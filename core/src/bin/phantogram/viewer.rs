@@ -223,31 +223,49 @@ impl App {
     fn apply(&mut self, action: phantogram::calibration_ui::CalibrationAction) {
         use phantogram::calibration_ui::CalibrationAction as A;
         match action {
-            A::FlatAngleHere => match self.session.calibrate_flat_angle() {
-                Ok(()) => eprintln!("flat angle: this pose is now straight on"),
-                Err(e) => eprintln!("flat angle: {e}"),
-            },
+            A::FlatAngleHere => self.flat_angle_here(),
             A::ResetLight => match self.session.recalibrate_light() {
                 Ok(()) => eprintln!("light re-tied to the room at this pose"),
                 Err(e) => eprintln!("light: {e}"),
             },
             A::Changed(c) => {
-                self.calibration = c;
+                // The screens do not set the flat angle; the session holds the current one.
+                self.calibration = phantogram::calibration::Calibration {
+                    flat_up_device: self.calibration.flat_up_device,
+                    ..c
+                };
                 self.apply_calibration();
-                if let Some(path) = &self.calibration_path {
-                    match c.save(path) {
-                        Ok(()) => eprintln!("calibration saved to {}", path.display()),
-                        Err(e) => eprintln!("warning: could not save the calibration to {}: {e}", path.display()),
-                    }
-                }
+                self.save_calibration();
             }
             A::Closed => self.calibration_ui = None,
         }
     }
 
-    /// Puts the calibrated IPD, distance and pixel density into the session.
+    /// Makes the current pose straight on, and keeps it in the calibration file.
+    fn flat_angle_here(&mut self) {
+        match self.session.calibrate_flat_angle() {
+            Ok(()) => eprintln!("flat angle: this pose is now straight on"),
+            Err(e) => return eprintln!("flat angle: {e}"),
+        }
+        self.calibration.flat_up_device = self.session.flat_up_device();
+        self.save_calibration();
+    }
+
+    fn save_calibration(&self) {
+        if let Some(path) = &self.calibration_path {
+            match self.calibration.save(path) {
+                Ok(()) => eprintln!("calibration saved to {}", path.display()),
+                Err(e) => eprintln!("warning: could not save the calibration to {}: {e}", path.display()),
+            }
+        }
+    }
+
+    /// Puts the calibrated IPD, distance, pixel density and flat angle into the session.
     fn apply_calibration(&mut self) {
         let c = self.calibration;
+        if !self.session.set_flat_up_device(c.flat_up_device) {
+            eprintln!("warning: the calibrated flat angle (up = 0) is not usable; lying flat is straight on");
+        }
         let mut eyes = self.session.config().eyes;
         eyes.ipd_m = c.ipd_m.unwrap_or(eyes.ipd_m);
         eyes.viewing_distance_m = c.viewing_distance_m.unwrap_or(eyes.viewing_distance_m);
@@ -372,12 +390,11 @@ impl ApplicationHandler for App {
                             };
                             eprintln!("anaglyph: {}", self.method);
                         }
-                        "f" => match self.session.calibrate_flat_angle() {
-                            Ok(()) => eprintln!("flat angle: this pose is now straight on"),
-                            Err(e) => eprintln!("flat angle: {e}"),
-                        },
+                        "f" => self.flat_angle_here(),
                         "r" => {
                             self.session.reset_flat_angle();
+                            self.calibration.flat_up_device = None;
+                            self.save_calibration();
                             eprintln!("flat angle reset: lying flat is straight on");
                         }
                         "l" => match self.session.recalibrate_light() {
