@@ -472,12 +472,10 @@ mod loader {
 
     #[derive(Debug, Error)]
     pub enum ModelError {
-        #[error("{}: {source}", path.display())]
-        Io {
-            path: PathBuf,
-            #[source]
-            source: std::io::Error,
-        },
+        /// The I/O error is part of the message, deliberately not a `source()`: chain printers
+        /// (`anyhow`'s `{:#}`) would show it twice, and the shells show the message alone.
+        #[error("{}: {error}", path.display())]
+        Io { path: PathBuf, error: std::io::Error },
         #[error("{}: not a valid glTF file: {message}", path.display())]
         Parse { path: PathBuf, message: String },
         #[error(
@@ -710,7 +708,7 @@ mod loader {
             });
         }
         let file = path.parent().unwrap_or(Path::new(".")).join(percent_decode(uri));
-        std::fs::read(&file).map_err(|source| ModelError::Io { path: file, source })
+        std::fs::read(&file).map_err(|error| ModelError::Io { path: file, error })
     }
 
     fn percent_decode(uri: &str) -> String {
@@ -1086,9 +1084,9 @@ mod loader {
 
     /// Loads a `.gltf` or `.glb` file, in the file's own frame.
     pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
-        let bytes = std::fs::read(path).map_err(|source| ModelError::Io {
+        let bytes = std::fs::read(path).map_err(|error| ModelError::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         })?;
         let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| ModelError::Parse {
             path: path.to_path_buf(),

@@ -81,8 +81,31 @@ fn bad_input_is_a_clear_error() {
         .output()
         .unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("beyond the end"));
+    // A missing file is named, with the system's reason said once.
     let out = bin().args(["replay", "/nonexistent/log"]).output().unwrap();
-    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/log"));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("/nonexistent/log"), "{stderr}");
+    assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
+    let out = bin()
+        .args(["render", "/nonexistent/model.glb", "--log"])
+        .arg(default_log())
+        .arg("--out")
+        .arg(dir.join("frames"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("/nonexistent/model.glb"), "{stderr}");
+    assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
+    // --out must be a folder (or not exist yet).
+    let out = bin()
+        .args(["render", "--log"])
+        .arg(default_log())
+        .arg("--out")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("exists and is not a folder"), "{stderr}");
 }
 
 #[test]

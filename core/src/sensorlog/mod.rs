@@ -48,12 +48,10 @@ pub const VERSION: u32 = 1;
 
 #[derive(Debug, Error)]
 pub enum LogError {
-    #[error("{}: {source}", path.display())]
-    Io {
-        path: PathBuf,
-        #[source]
-        source: io::Error,
-    },
+    /// The I/O error is part of the message and deliberately not a `source()`: chain printers
+    /// (`anyhow`'s `{:#}`) would show it twice, and the shells show the message alone.
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: io::Error },
     #[error("{}:{line}: {message}", path.display())]
     Parse { path: PathBuf, line: u64, message: String },
     #[error("{}: {message}", path.display())]
@@ -61,10 +59,10 @@ pub enum LogError {
 }
 
 impl LogError {
-    pub fn io(path: &Path, source: io::Error) -> Self {
+    pub fn io(path: &Path, error: io::Error) -> Self {
         Self::Io {
             path: path.to_path_buf(),
-            source,
+            error,
         }
     }
 

@@ -684,6 +684,9 @@ fn render_command(args: RenderArgs) -> Result<()> {
         ..DioramaFit::default()
     };
     let (model, bounds) = load_for_display(model_path, &screen, &fit, floor)?;
+    if out_dir.exists() && !out_dir.is_dir() {
+        bail!("--out {}: exists and is not a folder", out_dir.display());
+    }
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
