@@ -228,6 +228,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
     ydpi: jfloat,
     rotation_value: jint,
     anaglyph: JString<'local>,
+    calibration_path: JString<'local>,
 ) -> jlong {
     run(&mut env, |env| {
         let config = EngineConfig {
@@ -243,6 +244,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
             face_models_dir: optional_string(env, &face_models_dir)?.map(Into::into),
             camera_position_m: None,
             floor: true,
+            calibration_path: optional_string(env, &calibration_path)?.map(Into::into),
         };
         let engine = Engine::new(config)?;
         Ok(Box::into_raw(Box::new(SharedEngine::new(engine))) as usize as jlong)

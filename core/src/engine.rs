@@ -18,6 +18,15 @@
 //! frustum, renders both eyes and composes them with the anaglyph method (or mono), and presents
 //! (or keeps the pixels, offscreen). Drawing while suspended is a skipped frame, not an error.
 //!
+//! ## Calibration
+//! The viewer's calibration (eye distance, viewing distance, pixel density, flat angle; see
+//! [`crate::calibration`]) is read from [`EngineConfig::calibration_path`] at start and applied;
+//! a missing or damaged file gives the defaults and [`Engine::calibration_warning`]. A
+//! three-finger tap ([`Gesture::Calibrate`]) or [`Engine::open_calibration`] opens the
+//! calibration screens ([`crate::calibration_ui`], feature `ui`): drawn over the frame, driven by
+//! the same touches, which reach no gesture while they are open. What they change, and a double
+//! tap's flat angle, is applied at once and saved to that path.
+//!
 //! ## Threading
 //! **Important:** sensor events and camera frames arrive on platform threads (Android's sensor
 //! looper and CameraX executor, Core Motion's and AVFoundation's queues) while the render thread
@@ -39,6 +48,7 @@ use glam::Vec3;
 use thiserror::Error;
 
 use crate::anaglyph::Method;
+use crate::calibration::Calibration;
 use crate::containment::{Aabb, ContainmentSmoother};
 use crate::gesture::{Gesture, Gestures, TouchPhase};
 use crate::render::{FrameInput, Gpu, RenderError, Renderer};
@@ -69,6 +79,9 @@ pub struct EngineConfig {
     pub camera_position_m: Option<Vec3>,
     /// Draw the diorama's floor under the artifact.
     pub floor: bool,
+    /// Where the viewer's calibration is kept (a file in the app's private storage); `None`: the
+    /// defaults, and nothing saved.
+    pub calibration_path: Option<PathBuf>,
 }
 
 impl Default for EngineConfig {
@@ -82,6 +95,7 @@ impl Default for EngineConfig {
             face_models_dir: None,
             camera_position_m: None,
             floor: true,
+            calibration_path: None,
         }
     }
 }
@@ -151,6 +165,26 @@ pub struct Engine {
     gestures: Gestures,
     last_frame: Option<(u32, u32, Vec<u8>)>,
     stats: EngineStats,
+    calibration: Calibration,
+    calibration_path: Option<PathBuf>,
+    calibration_warning: Option<String>,
+    /// The calibration screens, while open.
+    #[cfg(feature = "ui")]
+    screens: Option<Box<CalibrationScreens>>,
+}
+
+/// The calibration screens' state on the render thread: egui's context, the touches waiting for
+/// the next frame, and the overlay painter (made with the first frame drawn).
+#[cfg(feature = "ui")]
+struct CalibrationScreens {
+    ui: crate::calibration_ui::CalibrationUi,
+    ctx: egui::Context,
+    events: Vec<egui::Event>,
+    overlay: Option<crate::calibration_ui::Overlay>,
+    /// Texture uploads of frames that were not painted (skipped), for the next one that is.
+    unpainted_textures: egui::TexturesDelta,
+    /// The finger that drives the screens: the first one down; others are ignored.
+    pointer: Option<i32>,
 }
 
 impl std::fmt::Debug for Engine {
@@ -220,7 +254,11 @@ impl Engine {
         if config.face_models_dir.is_some() {
             return Err(EngineError::NoFaceSupport);
         }
-        Ok(Self {
+        let (calibration, calibration_warning) = match &config.calibration_path {
+            Some(path) if path.exists() => Calibration::load(path),
+            _ => (Calibration::default(), None),
+        };
+        let mut engine = Self {
             session,
             renderer,
             bounds,
@@ -239,7 +277,116 @@ impl Engine {
             gestures: Gestures::new(config.panel.xdpi),
             last_frame: None,
             stats: EngineStats::default(),
-        })
+            calibration,
+            calibration_path: config.calibration_path,
+            calibration_warning,
+            #[cfg(feature = "ui")]
+            screens: None,
+        };
+        engine.apply_calibration(config.panel, config.rotation);
+        Ok(engine)
+    }
+
+    /// Puts the calibration into the session: eye model, pixel density (over the platform's
+    /// `panel`), flat angle. A value the session refuses is reported, the rest still applied.
+    fn apply_calibration(&mut self, panel: PanelSpec, rotation: DisplayRotation) {
+        let c = self.calibration;
+        let mut problems = Vec::new();
+        let mut eyes = self.session.config().eyes;
+        eyes.ipd_m = c.ipd_m.unwrap_or(eyes.ipd_m);
+        eyes.viewing_distance_m = c.viewing_distance_m.unwrap_or(eyes.viewing_distance_m);
+        if let Err(e) = self.session.set_eye_model(eyes) {
+            problems.push(e.to_string());
+        }
+        let panel = match c.density_dpi {
+            Some(d) => PanelSpec {
+                xdpi: d.x,
+                ydpi: d.y,
+                ..panel
+            },
+            None => panel,
+        };
+        match Screen::new(panel, rotation) {
+            Ok(screen) => {
+                self.session.set_screen(screen);
+                self.gestures = Gestures::new(panel.xdpi);
+            }
+            Err(e) => problems.push(format!("calibrated density: {e}")),
+        }
+        if !self.session.set_flat_up_device(c.flat_up_device) {
+            problems.push("the flat angle's up vector is zero".into());
+        }
+        if !problems.is_empty() {
+            self.calibration_warning = Some(format!("calibration not fully applied: {}", problems.join("; ")));
+        }
+    }
+
+    /// Saves the calibration where [`EngineConfig::calibration_path`] says (if anywhere); a
+    /// failure becomes [`Self::calibration_warning`].
+    fn save_calibration(&mut self) {
+        if let Some(path) = &self.calibration_path {
+            if let Err(e) = self.calibration.save(path) {
+                self.calibration_warning = Some(format!("{}: {e}; the calibration was not saved", path.display()));
+            }
+        }
+    }
+
+    /// The calibration in use (from the file, the screens and the gestures).
+    pub fn calibration(&self) -> Calibration {
+        self.calibration
+    }
+
+    /// Why the calibration file could not be read, applied or written, if it could not: for the
+    /// shell's log. The engine runs on with the defaults (or what it could apply).
+    pub fn calibration_warning(&self) -> Option<&str> {
+        self.calibration_warning.as_deref()
+    }
+
+    /// Opens the calibration screens (also the three-finger tap). Returns `false` when this build
+    /// has none (feature `ui` off).
+    pub fn open_calibration(&mut self) -> bool {
+        #[cfg(feature = "ui")]
+        {
+            if self.screens.is_none() {
+                self.screens = Some(Box::new(CalibrationScreens {
+                    ui: crate::calibration_ui::CalibrationUi::with_calibration(self.calibration),
+                    ctx: egui::Context::default(),
+                    events: Vec::new(),
+                    overlay: None,
+                    unpainted_textures: egui::TexturesDelta::default(),
+                    pointer: None,
+                }));
+            }
+            true
+        }
+        #[cfg(not(feature = "ui"))]
+        false
+    }
+
+    /// Whether the calibration screens are showing (touches then drive them, not gestures).
+    pub fn calibration_open(&self) -> bool {
+        #[cfg(feature = "ui")]
+        return self.screens.is_some();
+        #[cfg(not(feature = "ui"))]
+        false
+    }
+
+    /// The centre of a control of the calibration screens in the last frame drawn, in physical
+    /// pixels (names as [`crate::calibration_ui::CalibrationUi::widget_rect`]): for tests and
+    /// automation.
+    #[cfg(feature = "ui")]
+    pub fn calibration_control_px(&self, name: &str) -> Option<[f32; 2]> {
+        let screens = self.screens.as_ref()?;
+        let centre = screens.ui.widget_rect(name)?.center();
+        let ppp = self.pixels_per_point();
+        Some([centre.x * ppp, centre.y * ppp])
+    }
+
+    /// Physical pixels per egui point on this display: Android's density (dpi / 160), which iOS's
+    /// scale (≈ ppi / 163) nearly equals; so controls have the platform's size.
+    #[cfg(feature = "ui")]
+    fn pixels_per_point(&self) -> f32 {
+        (self.session.config().screen.panel().xdpi / 160.0).clamp(1.0, 4.0)
     }
 
     /// The session's sensor inbox: push events from any thread.
@@ -330,12 +477,22 @@ impl Engine {
     pub fn set_display(&mut self, panel: PanelSpec, rotation: DisplayRotation) -> Result<(), EngineError> {
         self.session.set_screen(Screen::new(panel, rotation)?);
         self.gestures = Gestures::new(panel.xdpi);
+        // The platform's panel again: the calibrated density must go back over it.
+        self.apply_calibration(panel, rotation);
         Ok(())
     }
 
     /// One touch event (physical pixels, nanoseconds on a monotonic clock); acts on the gesture
     /// it completes and returns it.
     pub fn touch(&mut self, phase: TouchPhase, pointer_id: i32, x_px: f32, y_px: f32, t_ns: i64) -> Option<Gesture> {
+        #[cfg(feature = "ui")]
+        if self.screens.is_some() {
+            let ppp = self.pixels_per_point();
+            if let Some(screens) = self.screens.as_mut() {
+                screens.touch(phase, pointer_id, x_px / ppp, y_px / ppp);
+            }
+            return None;
+        }
         let g = self.gestures.touch(phase, pointer_id, x_px, y_px, t_ns)?;
         self.apply_gesture(g);
         Some(g)
@@ -347,7 +504,13 @@ impl Engine {
         // user would expect from tapping a phone that has not measured anything.
         match g {
             Gesture::StraightOn => {
-                let _ = self.session.calibrate_flat_angle();
+                if self.session.calibrate_flat_angle().is_ok() {
+                    self.calibration.flat_up_device = self.session.flat_up_device();
+                    self.save_calibration();
+                }
+            }
+            Gesture::Calibrate => {
+                self.open_calibration();
             }
             Gesture::AnchorLight => {
                 let _ = self.session.recalibrate_light();
@@ -362,9 +525,12 @@ impl Engine {
         }
     }
 
-    /// Makes the current holding pose count as straight on.
+    /// Makes the current holding pose count as straight on (and saves it with the calibration).
     pub fn calibrate_flat_angle(&mut self) -> Result<(), EngineError> {
-        Ok(self.session.calibrate_flat_angle()?)
+        self.session.calibrate_flat_angle()?;
+        self.calibration.flat_up_device = self.session.flat_up_device();
+        self.save_calibration();
+        Ok(())
     }
 
     /// Draws one frame that will be on screen at `display_t_ns` (sensor clock; `None`: for the
@@ -391,6 +557,10 @@ impl Engine {
             .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s);
         let input = FrameInput::from_view(&view, Vec3::Z * -push);
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
+        #[cfg(feature = "ui")]
+        if self.screens.is_some() {
+            return self.draw_with_screens(&input);
+        }
         let outcome = match &mut self.target {
             Target::Detached => DrawOutcome::Skipped("suspended"),
             Target::Window(host) => host.draw(&mut self.renderer, &input, self.method)?,
@@ -405,11 +575,122 @@ impl Engine {
                 }
             }
         };
+        self.count(outcome);
+        Ok(outcome)
+    }
+
+    fn count(&mut self, outcome: DrawOutcome) {
         match outcome {
             DrawOutcome::Presented => self.stats.frames_drawn += 1,
             DrawOutcome::Skipped(_) => self.stats.frames_skipped += 1,
         }
+    }
+
+    /// [`Self::draw`] with the calibration screens over the frame: one egui frame with the touches
+    /// since the last, painted over the picture, then what the viewer chose is applied.
+    #[cfg(feature = "ui")]
+    fn draw_with_screens(&mut self, input: &FrameInput) -> Result<DrawOutcome, EngineError> {
+        let size = match &self.target {
+            Target::Detached => None,
+            Target::Window(host) => match host.state() {
+                crate::surface::SurfaceState::Active { width, height } => Some((width, height)),
+                _ => None,
+            },
+            Target::Offscreen { width, height } => Some((*width, *height)),
+        };
+        let Some((w, h)) = size.filter(|&(w, h)| w > 0 && h > 0) else {
+            self.stats.frames_skipped += 1;
+            return Ok(DrawOutcome::Skipped("zero-sized"));
+        };
+        let ppp = self.pixels_per_point();
+        let screen = self.session.config().screen;
+        let Some(screens) = self.screens.as_mut() else {
+            return Ok(DrawOutcome::Skipped("no calibration screens"));
+        };
+        screens.ctx.set_pixels_per_point(ppp);
+        let raw = egui::RawInput {
+            screen_rect: Some(egui::Rect::from_min_size(
+                egui::Pos2::ZERO,
+                egui::vec2(w as f32 / ppp, h as f32 / ppp),
+            )),
+            events: std::mem::take(&mut screens.events),
+            ..Default::default()
+        };
+        let mut actions = Vec::new();
+        let ui = &mut screens.ui;
+        let mut output = screens.ctx.run_ui(raw, |root| actions = ui.show(root, &screen, ppp));
+        // egui sends each texture (the font atlas) once: what a skipped frame did not upload
+        // goes first.
+        let newer = std::mem::take(&mut output.textures_delta);
+        output.textures_delta = std::mem::take(&mut screens.unpainted_textures);
+        output.textures_delta.append(newer);
+        let ctx = screens.ctx.clone();
+        let overlay = &mut screens.overlay;
+        let (mut painted, mut lost_textures) = (false, false);
+        let mut paint = |gpu: &Gpu, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: [u32; 2]| {
+            let o = match overlay {
+                Some(o) if o.format() == format => o,
+                _ => {
+                    // A new painter (the surface's format changed) lacks the textures sent before.
+                    lost_textures = overlay.is_some();
+                    overlay.insert(crate::calibration_ui::Overlay::new(gpu, format))
+                }
+            };
+            o.paint(gpu, &ctx, std::mem::take(&mut output), view, size);
+            painted = true;
+        };
+        let outcome = match &mut self.target {
+            Target::Window(host) => host.draw_with(&mut self.renderer, input, self.method, paint)?,
+            Target::Offscreen { .. } => {
+                let pixels =
+                    self.renderer
+                        .render_with_overlay(input, self.method, w, h, |gpu, view, format, size| {
+                            paint(gpu, view, format, size)
+                        })?;
+                self.last_frame = Some((w, h, pixels));
+                DrawOutcome::Presented
+            }
+            Target::Detached => DrawOutcome::Skipped("suspended"),
+        };
+        if let Some(screens) = self.screens.as_mut() {
+            if !painted {
+                screens.unpainted_textures = std::mem::take(&mut output.textures_delta);
+            }
+            if lost_textures {
+                // A fresh context sends everything again with the next frame.
+                screens.ctx = egui::Context::default();
+            }
+        }
+        self.count(outcome);
+        for action in actions {
+            self.apply_calibration_action(action);
+        }
         Ok(outcome)
+    }
+
+    #[cfg(feature = "ui")]
+    fn apply_calibration_action(&mut self, action: crate::calibration_ui::CalibrationAction) {
+        use crate::calibration_ui::CalibrationAction as A;
+        match action {
+            A::FlatAngleHere => {
+                // Without gravity yet there is no pose to take; the screens stay as they are.
+                let _ = self.calibrate_flat_angle();
+            }
+            A::ResetLight => {
+                let _ = self.session.recalibrate_light();
+            }
+            A::Changed(c) => {
+                // The screens do not set the flat angle; the session holds the current one.
+                self.calibration = Calibration {
+                    flat_up_device: self.calibration.flat_up_device,
+                    ..c
+                };
+                let screen = self.session.config().screen;
+                self.apply_calibration(screen.panel(), screen.rotation());
+                self.save_calibration();
+            }
+            A::Closed => self.screens = None,
+        }
     }
 
     #[cfg(feature = "face")]
@@ -445,6 +726,50 @@ impl Engine {
             s.camera_frames_dropped = f.dropped_frames();
         }
         s
+    }
+}
+
+#[cfg(feature = "ui")]
+impl CalibrationScreens {
+    /// One touch, in points, as egui's pointer: the first finger down drives it.
+    fn touch(&mut self, phase: TouchPhase, pointer_id: i32, x_pt: f32, y_pt: f32) {
+        if !(x_pt.is_finite() && y_pt.is_finite()) {
+            return;
+        }
+        let pos = egui::pos2(x_pt, y_pt);
+        let button = |pressed| egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: egui::Modifiers::default(),
+        };
+        match phase {
+            TouchPhase::Down if self.pointer.is_none() => {
+                self.pointer = Some(pointer_id);
+                self.events.extend([egui::Event::PointerMoved(pos), button(true)]);
+            }
+            TouchPhase::Move if self.pointer == Some(pointer_id) => self.events.push(egui::Event::PointerMoved(pos)),
+            TouchPhase::Up if self.pointer == Some(pointer_id) => {
+                self.pointer = None;
+                self.events.extend([button(false), egui::Event::PointerGone]);
+            }
+            // Taken by the system: let go far away, which egui takes for a drag, not a click.
+            TouchPhase::Cancel if self.pointer == Some(pointer_id) => {
+                self.pointer = None;
+                let away = egui::pos2(-1.0e4, -1.0e4);
+                self.events.extend([
+                    egui::Event::PointerMoved(away),
+                    egui::Event::PointerButton {
+                        pos: away,
+                        button: egui::PointerButton::Primary,
+                        pressed: false,
+                        modifiers: egui::Modifiers::default(),
+                    },
+                    egui::Event::PointerGone,
+                ]);
+            }
+            _ => {}
+        }
     }
 }
 

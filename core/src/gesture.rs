@@ -6,7 +6,9 @@
 //! * **long press** (one finger held still) → [`Gesture::AnchorLight`]: tie the light to the room
 //!   again at the current pose;
 //! * **two-finger tap** → [`Gesture::ToggleStereo`]: anaglyph ↔ mono (for a viewer without
-//!   glasses).
+//!   glasses);
+//! * **three-finger tap** → [`Gesture::Calibrate`]: open the calibration screens (eye distance,
+//!   viewing distance, screen size, flat angle, light), where touches then drive the screens.
 //!
 //! Touches arrive as the platforms deliver them (Android `MotionEvent`, iOS `UITouch`): one event
 //! per pointer and phase, in physical pixels, on a monotonic clock in nanoseconds. Movement beyond
@@ -45,17 +47,19 @@ pub enum Gesture {
     StraightOn,
     AnchorLight,
     ToggleStereo,
+    Calibrate,
 }
 
 impl Gesture {
     /// The number the C ABI and the JNI bridge report for a touch's outcome: 0 none, 1 straight
-    /// on, 2 light re-anchored, 3 stereo toggled.
+    /// on, 2 light re-anchored, 3 stereo toggled, 4 calibration screens opened.
     pub fn code(gesture: Option<Gesture>) -> i32 {
         match gesture {
             None => 0,
             Some(Gesture::StraightOn) => 1,
             Some(Gesture::AnchorLight) => 2,
             Some(Gesture::ToggleStereo) => 3,
+            Some(Gesture::Calibrate) => 4,
         }
     }
 }
@@ -202,6 +206,10 @@ impl Gestures {
                         self.last_tap_ns = None;
                         Some(Gesture::ToggleStereo)
                     }
+                    3 => {
+                        self.last_tap_ns = None;
+                        Some(Gesture::Calibrate)
+                    }
                     _ => {
                         self.last_tap_ns = None;
                         None
@@ -282,5 +290,27 @@ mod tests {
         assert_eq!(TouchPhase::from_code(2), Some(TouchPhase::Up));
         // NaN positions are ignored.
         assert_eq!(g.touch(TouchPhase::Down, 0, f32::NAN, 0.0, 0), None);
+    }
+
+    #[test]
+    fn three_finger_tap_opens_the_calibration_and_four_do_nothing() {
+        let mut g = Gestures::new(420.0);
+        for (i, x) in [200.0, 400.0, 600.0].into_iter().enumerate() {
+            g.touch(TouchPhase::Down, i as i32, x, 300.0, i as i64 * 10 * MS);
+        }
+        assert_eq!(g.touch(TouchPhase::Up, 0, 200.0, 300.0, 100 * MS), None);
+        assert_eq!(g.touch(TouchPhase::Up, 2, 600.0, 300.0, 110 * MS), None);
+        assert_eq!(
+            g.touch(TouchPhase::Up, 1, 400.0, 300.0, 120 * MS),
+            Some(Gesture::Calibrate)
+        );
+        assert_eq!(Gesture::code(Some(Gesture::Calibrate)), 4);
+        for i in 0..4 {
+            g.touch(TouchPhase::Down, i, 100.0 * i as f32, 300.0, 1000 * MS);
+        }
+        let ends: Vec<_> = (0..4)
+            .map(|i| g.touch(TouchPhase::Up, i, 100.0 * i as f32, 300.0, 1100 * MS))
+            .collect();
+        assert!(ends.iter().all(Option::is_none), "{ends:?}");
     }
 }

@@ -1019,6 +1019,20 @@ impl Renderer {
         self.render_views(&[projection], input, Method::Mono, width, height)
     }
 
+    /// As [`Self::render`], with `overlay` painting over the composed frame before it is read back
+    /// (the calibration screens): it gets the device, the frame's view, format and size, and
+    /// submits its own work.
+    pub fn render_with_overlay(
+        &mut self,
+        input: &FrameInput,
+        method: Method,
+        width: u32,
+        height: u32,
+        overlay: impl FnOnce(&Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]),
+    ) -> Result<Vec<u8>, RenderError> {
+        self.render_views_with(&input.eyes_for(method), input, method, width, height, Some(overlay))
+    }
+
     fn render_views(
         &mut self,
         eyes: &[&OffAxisProjection],
@@ -1026,6 +1040,19 @@ impl Renderer {
         method: Method,
         width: u32,
         height: u32,
+    ) -> Result<Vec<u8>, RenderError> {
+        type NoOverlay = fn(&Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]);
+        self.render_views_with(eyes, input, method, width, height, None::<NoOverlay>)
+    }
+
+    fn render_views_with(
+        &mut self,
+        eyes: &[&OffAxisProjection],
+        input: &FrameInput,
+        method: Method,
+        width: u32,
+        height: u32,
+        overlay: Option<impl FnOnce(&Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2])>,
     ) -> Result<Vec<u8>, RenderError> {
         self.targets(width, height)?;
         let device = self.gpu.device.clone();
@@ -1036,6 +1063,15 @@ impl Renderer {
             .output_view
             .clone();
         let mut encoder = self.encode_frame(eyes, input, method, &output_view, OUTPUT_FORMAT)?;
+        if let Some(overlay) = overlay {
+            // The frame first, then the overlay's own submission over it, then the copy.
+            let queue = &self.gpu.queue;
+            checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()]))?;
+            overlay(&self.gpu, &output_view, OUTPUT_FORMAT, [width, height]);
+            encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
+                label: Some("read-back"),
+            });
+        }
         let targets = self.targets.as_ref().expect("created above");
         let offscreen = targets.offscreen.as_ref().expect("created above");
         encoder.copy_texture_to_buffer(

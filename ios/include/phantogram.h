@@ -56,6 +56,9 @@ typedef struct PgConfig {
   const char *face_models_dir;
   // Non-zero: draw the diorama floor.
   uint8_t floor;
+  // Where the viewer's calibration is kept (a file in Application Support); null: defaults,
+  // nothing saved. The calibration screens open with a three-finger tap.
+  const char *calibration_path;
 } PgConfig;
 
 // Counters, for logs and debug overlays.
@@ -171,7 +174,8 @@ enum PgStatus pg_camera_frame(const struct PgEngine *engine,
 // One touch (`UITouch`): `phase` 0 began, 1 moved, 2 ended, 3 cancelled; `pointer` a stable id
 // per finger; position in physical pixels (points × scale); time stamp in seconds. `*gesture`
 // (if not null) receives the gesture completed: 0 none, 1 straight on (double tap), 2 light
-// re-anchored (long press), 3 stereo toggled (two-finger tap).
+// re-anchored (long press), 3 stereo toggled (two-finger tap), 4 calibration screens opened
+// (three-finger tap; touches then drive the screens until they are closed).
 //
 // # Safety
 // `engine` is a live handle; `gesture` is null or valid for a write.

@@ -85,6 +85,9 @@ pub struct PgConfig {
     pub face_models_dir: *const c_char,
     /// Non-zero: draw the diorama floor.
     pub floor: u8,
+    /// Where the viewer's calibration is kept (a file in Application Support); null: defaults,
+    /// nothing saved. The calibration screens open with a three-finger tap.
+    pub calibration_path: *const c_char,
 }
 
 /// Counters, for logs and debug overlays.
@@ -243,6 +246,7 @@ pub extern "C" fn pg_config_default() -> PgConfig {
         environment_path: std::ptr::null(),
         face_models_dir: std::ptr::null(),
         floor: 1,
+        calibration_path: std::ptr::null(),
     }
 }
 
@@ -264,13 +268,14 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
         let c = unsafe { config.as_ref() }
             .copied()
             .unwrap_or_else(|| pg_config_default());
-        // SAFETY (all four): the caller promises null or NUL-terminated strings.
-        let (anaglyph, model, environment, face) = unsafe {
+        // SAFETY (all five): the caller promises null or NUL-terminated strings.
+        let (anaglyph, model, environment, face, calibration) = unsafe {
             (
                 optional_str(c.anaglyph, "anaglyph")?,
                 optional_str(c.model_path, "model_path")?,
                 optional_str(c.environment_path, "environment_path")?,
                 optional_str(c.face_models_dir, "face_models_dir")?,
+                optional_str(c.calibration_path, "calibration_path")?,
             )
         };
         let config = EngineConfig {
@@ -282,6 +287,7 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             face_models_dir: face.map(PathBuf::from),
             camera_position_m: None,
             floor: c.floor != 0,
+            calibration_path: calibration.map(PathBuf::from),
         };
         let engine = Engine::new(config)?;
         let handle = Box::new(PgEngine {
@@ -469,7 +475,8 @@ pub unsafe extern "C" fn pg_camera_frame(
 /// One touch (`UITouch`): `phase` 0 began, 1 moved, 2 ended, 3 cancelled; `pointer` a stable id
 /// per finger; position in physical pixels (points × scale); time stamp in seconds. `*gesture`
 /// (if not null) receives the gesture completed: 0 none, 1 straight on (double tap), 2 light
-/// re-anchored (long press), 3 stereo toggled (two-finger tap).
+/// re-anchored (long press), 3 stereo toggled (two-finger tap), 4 calibration screens opened
+/// (three-finger tap; touches then drive the screens until they are closed).
 ///
 /// # Safety
 /// `engine` is a live handle; `gesture` is null or valid for a write.

@@ -152,3 +152,128 @@ fn read_back(gpu: &Gpu, texture: &wgpu::Texture, w: u32, h: u32) -> Vec<u8> {
         .flat_map(|y| data[(y * row) as usize..(y * row + w * 4) as usize].to_vec())
         .collect()
 }
+
+/// The phones' path through the engine: a three-finger tap opens the screens over the picture
+/// (offscreen here, as the JVM and C bridge tests draw), the touches then drive them, "This is
+/// straight on" takes the current pose, the calibration file keeps it, and a new engine (the next
+/// start of the app) comes up with it. A damaged file gives the defaults and a warning.
+#[test]
+fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
+    use phantogram::engine::{Engine, EngineConfig};
+    use phantogram::gesture::{Gesture, TouchPhase};
+    use phantogram::sensors::SensorEvent;
+
+    let dir = phantogram_integration::scratch("engine-calibration");
+    let path = dir.join("calibration.txt");
+    // A half-resolution panel of the same physical size: fewer pixels to shade on lavapipe.
+    let panel = PanelSpec {
+        width_px: 540,
+        height_px: 1200,
+        xdpi: 210.0,
+        ydpi: 210.0,
+    };
+    let config = || EngineConfig {
+        panel,
+        method: phantogram::anaglyph::Method::Mono,
+        calibration_path: Some(path.clone()),
+        ..EngineConfig::default()
+    };
+    let mut engine = match Engine::new(config()) {
+        Ok(e) => e,
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no engine ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    };
+    assert_eq!(engine.calibration_warning(), None, "no file yet is no problem");
+    // Held 35° from flat, top edge raised.
+    let tilt = 35f32.to_radians();
+    let up = phantogram::glam::Vec3::new(0.0, tilt.sin(), tilt.cos());
+    for k in 0..20 {
+        engine
+            .inbox()
+            .push(SensorEvent::accelerometer(k * 10_000_000, up * 9.81))
+            .unwrap();
+    }
+    engine.resume_offscreen(panel.width_px, panel.height_px).unwrap();
+    let ms = 1_000_000;
+    engine.draw(Some(200 * ms)).unwrap();
+    let plain = engine.last_frame().unwrap().2.to_vec();
+
+    let mut t = 300 * ms;
+    let mut tap_fingers = |engine: &mut Engine, points: &[[f32; 2]]| {
+        let mut gesture = None;
+        for (i, p) in points.iter().enumerate() {
+            assert_eq!(engine.touch(TouchPhase::Down, i as i32, p[0], p[1], t), None);
+        }
+        t += 80 * ms;
+        for (i, p) in points.iter().enumerate() {
+            gesture = gesture.or(engine.touch(TouchPhase::Up, i as i32, p[0], p[1], t));
+        }
+        t += 400 * ms;
+        gesture
+    };
+    let three = [[150.0, 600.0], [270.0, 600.0], [390.0, 600.0]];
+    assert_eq!(tap_fingers(&mut engine, &three), Some(Gesture::Calibrate));
+    assert!(engine.calibration_open());
+    // Two frames lay the menu out; the screens are painted over the picture.
+    engine.draw(Some(1_000 * ms)).unwrap();
+    engine.draw(Some(1_020 * ms)).unwrap();
+    let with_screens = engine.last_frame().unwrap().2.to_vec();
+    let changed = plain
+        .chunks(4)
+        .zip(with_screens.chunks(4))
+        .filter(|(a, b)| a != b)
+        .count();
+    assert!(
+        changed > plain.len() / 4 / 20,
+        "the screens changed only {changed} pixels"
+    );
+    if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
+        image::RgbaImage::from_raw(panel.width_px, panel.height_px, with_screens.clone())
+            .expect("size")
+            .save(std::path::Path::new(&dir).join("calibration-engine-menu.png"))
+            .expect("saving");
+    }
+
+    let flat = engine
+        .calibration_control_px("flat")
+        .expect("the menu's straight-on button");
+    assert_eq!(
+        tap_fingers(&mut engine, &[flat]),
+        None,
+        "touches reach the screens, not gestures"
+    );
+    engine.draw(Some(1_500 * ms)).unwrap();
+    let saved = engine
+        .session()
+        .flat_up_device()
+        .expect("the pose was taken as straight on");
+    assert!(saved.distance(up) < 1e-3, "{saved} vs {up}");
+    let text = std::fs::read_to_string(&path).expect("the calibration was saved");
+    assert!(text.contains("flat_up_device"), "{text}");
+
+    let close = engine.calibration_control_px("close").expect("the menu's close button");
+    tap_fingers(&mut engine, &[close]);
+    engine.draw(Some(2_000 * ms)).unwrap();
+    assert!(!engine.calibration_open());
+    assert_eq!(
+        tap_fingers(&mut engine, &three),
+        Some(Gesture::Calibrate),
+        "gestures again"
+    );
+
+    // The next start comes up with the saved flat angle.
+    drop(engine);
+    let again = Engine::new(config()).unwrap();
+    let restored = again.session().flat_up_device().expect("restored");
+    assert!(restored.distance(up) < 1e-3, "{restored}");
+    assert_eq!(again.calibration_warning(), None);
+
+    std::fs::write(&path, "not a calibration\n").unwrap();
+    let damaged = Engine::new(config()).unwrap();
+    assert_eq!(damaged.session().flat_up_device(), None);
+    let warning = damaged.calibration_warning().expect("a warning for the damaged file");
+    assert!(warning.contains("calibration.txt"), "{warning}");
+}

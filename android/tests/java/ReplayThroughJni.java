@@ -36,12 +36,12 @@ public final class ReplayThroughJni {
         int height = Integer.parseInt(args[4]);
 
         expect(IllegalArgumentException.class, "sepia",
-                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "sepia"));
+                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "sepia", null));
         expect(IllegalArgumentException.class, "rotation",
-                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 7, null));
+                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 7, null, null));
         expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeDrawFrame(0, -1));
 
-        long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois");
+        long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois", null);
         try {
             expect(IllegalStateException.class, "no offscreen frame", () -> NativeBridge.nativeReadFrame(h));
             expect(UnsupportedOperationException.class, "only on Android",

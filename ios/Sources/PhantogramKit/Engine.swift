@@ -37,10 +37,17 @@ public final class Engine {
         config.ydpi = pixelsPerInch
         let faces = Bundle.main.resourceURL?.appendingPathComponent("models").path
         let hasFaces = faces.map { FileManager.default.fileExists(atPath: $0) } ?? false
+        // The viewer's calibration (three-finger tap), kept in Application Support.
+        let support = try? FileManager.default.url(for: .applicationSupportDirectory, in: .userDomainMask,
+                                                   appropriateFor: nil, create: true)
+        let calibration = support?.appendingPathComponent("calibration.txt").path
         var out: OpaquePointer?
         let status: PgStatus = (hasFaces ? faces! : "").withCString { facesPtr in
-            config.face_models_dir = hasFaces ? facesPtr : nil
-            return pg_engine_create(&config, &out)
+            (calibration ?? "").withCString { calibrationPtr in
+                config.face_models_dir = hasFaces ? facesPtr : nil
+                config.calibration_path = calibration != nil ? calibrationPtr : nil
+                return pg_engine_create(&config, &out)
+            }
         }
         try check(status)
         guard let engine = out else { throw PhantogramError(status: status, message: "no handle") }

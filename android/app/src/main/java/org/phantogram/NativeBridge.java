@@ -36,6 +36,8 @@ public final class NativeBridge {
     public static final int GESTURE_STRAIGHT_ON = 1;
     public static final int GESTURE_LIGHT_ANCHORED = 2;
     public static final int GESTURE_STEREO_TOGGLED = 3;
+    /** Three-finger tap: the calibration screens opened; touches drive them until closed. */
+    public static final int GESTURE_CALIBRATION_OPENED = 4;
 
     /** Touch phases for nativeTouch. */
     public static final int TOUCH_DOWN = 0;
@@ -43,9 +45,11 @@ public final class NativeBridge {
     public static final int TOUCH_UP = 2;
     public static final int TOUCH_CANCEL = 3;
 
-    /** Opens the GPU device and loads the scene; call off the UI thread. Null strings: defaults. */
+    /** Opens the GPU device and loads the scene; call off the UI thread. Null strings: defaults
+     *  (a null calibrationPath: the viewer's calibration is neither read nor saved). */
     public static native long nativeCreate(String modelPath, String faceModelsDir, int panelWidthPx,
-            int panelHeightPx, float xdpi, float ydpi, int rotation, String anaglyph);
+            int panelHeightPx, float xdpi, float ydpi, int rotation, String anaglyph,
+            String calibrationPath);
 
     public static native void nativeDestroy(long handle);
 

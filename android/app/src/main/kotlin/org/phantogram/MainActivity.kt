@@ -47,7 +47,7 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         val view = SurfaceView(this)
         view.holder.addCallback(this)
         setContentView(view)
-        render.create(extractFaceModels(), panel(), "dubois")
+        render.create(extractFaceModels(), panel(), "dubois", File(filesDir, "calibration.txt").path)
         sensors = SensorForwarder(getSystemService(SensorManager::class.java)) { render.engine }
         if (checkSelfPermission(Manifest.permission.CAMERA) == PackageManager.PERMISSION_GRANTED) {
             startCamera()

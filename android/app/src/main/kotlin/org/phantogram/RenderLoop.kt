@@ -27,10 +27,10 @@ class RenderLoop(private val onError: (Throwable) -> Unit) : Choreographer.Frame
     private var running = false // render thread only
     private var refreshPeriodNs = 16_666_667L
 
-    fun create(facesDir: String?, panel: Panel, anaglyph: String) = post {
+    fun create(facesDir: String?, panel: Panel, anaglyph: String, calibrationPath: String) = post {
         refreshPeriodNs = periodNs(panel)
         engine = NativeBridge.nativeCreate(null, facesDir, panel.widthPx, panel.heightPx,
-            panel.xdpi, panel.ydpi, panel.rotation, anaglyph)
+            panel.xdpi, panel.ydpi, panel.rotation, anaglyph, calibrationPath)
     }
 
     fun surfaceCreated(surface: Surface, width: Int, height: Int) = post {
