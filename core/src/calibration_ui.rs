@@ -404,6 +404,67 @@ impl Overlay {
     }
 }
 
+/// An [`Overlay`] for a host whose frames may be skipped and whose target may change format (a
+/// window surface): made for the target's format when first painted and again when the format
+/// changes, and egui's texture uploads of a frame that was not painted (egui sends each texture,
+/// the font atlas included, once) kept for the next that is. Per frame: [`Self::begin`] with
+/// the egui output, [`Self::paint`] from the draw (if it draws), [`Self::end`].
+#[derive(Default)]
+pub struct OverlayHost {
+    overlay: Option<Overlay>,
+    unpainted: egui::TexturesDelta,
+    painted: bool,
+    lost_textures: bool,
+}
+
+impl OverlayHost {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// Puts the texture uploads of frames not painted before `output`'s own.
+    pub fn begin(&mut self, output: &mut egui::FullOutput) {
+        let newer = std::mem::take(&mut output.textures_delta);
+        output.textures_delta = std::mem::take(&mut self.unpainted);
+        output.textures_delta.append(newer);
+        self.painted = false;
+    }
+
+    /// Paints `output` over `target` (`format`, `size_px`); see [`Overlay::paint`].
+    pub fn paint(
+        &mut self,
+        gpu: &crate::render::Gpu,
+        ctx: &egui::Context,
+        output: &mut egui::FullOutput,
+        target: &wgpu::TextureView,
+        format: wgpu::TextureFormat,
+        size_px: [u32; 2],
+    ) {
+        let overlay = match &mut self.overlay {
+            Some(o) if o.format() == format => o,
+            slot => {
+                // A new painter lacks the textures its predecessor was sent.
+                self.lost_textures |= slot.is_some();
+                slot.insert(Overlay::new(gpu, format))
+            }
+        };
+        overlay.paint(gpu, ctx, std::mem::take(output), target, size_px);
+        self.painted = true;
+    }
+
+    /// Ends the frame: keeps what it did not upload. Returns `true` when the host must replace
+    /// its egui context (a new painter was made, and only a fresh context sends every texture
+    /// again).
+    pub fn end(&mut self, output: &mut egui::FullOutput) -> bool {
+        if !self.painted {
+            let mut kept = std::mem::take(&mut self.unpainted);
+            kept.append(std::mem::take(&mut output.textures_delta));
+            self.unpainted = kept;
+        }
+        std::mem::take(&mut self.lost_textures)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -462,6 +523,41 @@ mod tests {
         // Nothing is painted here (no GPU in unit tests).
         output.textures_delta.clear();
         actions
+    }
+
+    /// egui uploads the font atlas once, with the first frame: if that frame is skipped (a
+    /// surface timing out, the app pausing), the next frame painted must still upload it, or
+    /// every later frame draws its text with a missing texture.
+    #[test]
+    fn a_skipped_frame_keeps_its_texture_uploads_for_the_next() {
+        let ctx = egui::Context::default();
+        let s = screen(DisplayRotation::Deg0);
+        let mut ui = CalibrationUi::default();
+        let mut host = OverlayHost::new();
+        let full_atlas = |o: &egui::FullOutput| {
+            o.textures_delta
+                .set
+                .iter()
+                .any(|(id, deltas)| *id == egui::TextureId::default() && deltas.iter().any(|d| d.pos.is_none()))
+        };
+        let mut run = || {
+            let input = egui::RawInput {
+                screen_rect: Some(Rect::from_min_size(Pos2::ZERO, EVec2::new(540.0, 1200.0))),
+                ..Default::default()
+            };
+            ctx.run_ui(input, |root| {
+                ui.show(root, &s, 2.0);
+            })
+        };
+        let mut first = run();
+        assert!(full_atlas(&first), "the first frame uploads the whole font atlas");
+        host.begin(&mut first);
+        assert!(!host.end(&mut first), "no painter was replaced");
+        let mut second = run();
+        assert!(!full_atlas(&second), "egui does not send it again");
+        host.begin(&mut second);
+        assert!(full_atlas(&second), "the skipped frame's upload comes first");
+        second.textures_delta.clear();
     }
 
     /// Taps the centre of a control: press in one frame, release in the next.

@@ -180,9 +180,7 @@ struct CalibrationScreens {
     ui: crate::calibration_ui::CalibrationUi,
     ctx: egui::Context,
     events: Vec<egui::Event>,
-    overlay: Option<crate::calibration_ui::Overlay>,
-    /// Texture uploads of frames that were not painted (skipped), for the next one that is.
-    unpainted_textures: egui::TexturesDelta,
+    overlay: crate::calibration_ui::OverlayHost,
     /// The finger that drives the screens: the first one down; others are ignored.
     pointer: Option<i32>,
 }
@@ -352,8 +350,7 @@ impl Engine {
                     ui: crate::calibration_ui::CalibrationUi::with_calibration(self.calibration),
                     ctx: egui::Context::default(),
                     events: Vec::new(),
-                    overlay: None,
-                    unpainted_textures: egui::TexturesDelta::default(),
+                    overlay: crate::calibration_ui::OverlayHost::new(),
                     pointer: None,
                 }));
             }
@@ -619,25 +616,11 @@ impl Engine {
         let mut actions = Vec::new();
         let ui = &mut screens.ui;
         let mut output = screens.ctx.run_ui(raw, |root| actions = ui.show(root, &screen, ppp));
-        // egui sends each texture (the font atlas) once: what a skipped frame did not upload
-        // goes first.
-        let newer = std::mem::take(&mut output.textures_delta);
-        output.textures_delta = std::mem::take(&mut screens.unpainted_textures);
-        output.textures_delta.append(newer);
+        screens.overlay.begin(&mut output);
         let ctx = screens.ctx.clone();
         let overlay = &mut screens.overlay;
-        let (mut painted, mut lost_textures) = (false, false);
         let mut paint = |gpu: &Gpu, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: [u32; 2]| {
-            let o = match overlay {
-                Some(o) if o.format() == format => o,
-                _ => {
-                    // A new painter (the surface's format changed) lacks the textures sent before.
-                    lost_textures = overlay.is_some();
-                    overlay.insert(crate::calibration_ui::Overlay::new(gpu, format))
-                }
-            };
-            o.paint(gpu, &ctx, std::mem::take(&mut output), view, size);
-            painted = true;
+            overlay.paint(gpu, &ctx, &mut output, view, format, size);
         };
         let outcome = match &mut self.target {
             Target::Window(host) => host.draw_with(&mut self.renderer, input, self.method, paint)?,
@@ -653,11 +636,7 @@ impl Engine {
             Target::Detached => DrawOutcome::Skipped("suspended"),
         };
         if let Some(screens) = self.screens.as_mut() {
-            if !painted {
-                screens.unpainted_textures = std::mem::take(&mut output.textures_delta);
-            }
-            if lost_textures {
-                // A fresh context sends everything again with the next frame.
+            if screens.overlay.end(&mut output) {
                 screens.ctx = egui::Context::default();
             }
         }

@@ -92,7 +92,7 @@ struct App {
     calibration_path: Option<std::path::PathBuf>,
     egui_ctx: egui::Context,
     egui_input: Option<egui_winit::State>,
-    overlay: Option<phantogram::calibration_ui::Overlay>,
+    overlay: phantogram::calibration_ui::OverlayHost,
 }
 
 /// The phone's density scale (pixels per point) the calibration screens are laid out for.
@@ -167,17 +167,15 @@ impl App {
             Some(mut output) => {
                 let ctx = self.egui_ctx.clone();
                 let overlay = &mut self.overlay;
+                overlay.begin(&mut output);
                 let outcome = self
                     .host
                     .draw_with(renderer, &input, self.method, |gpu, view, format, size| {
-                        let o = match overlay {
-                            Some(o) if o.format() == format => o,
-                            _ => overlay.insert(phantogram::calibration_ui::Overlay::new(gpu, format)),
-                        };
-                        o.paint(gpu, &ctx, std::mem::take(&mut output), view, size);
+                        overlay.paint(gpu, &ctx, &mut output, view, format, size)
                     })?;
-                // A skipped frame did not paint: egui's texture changes must still be dropped.
-                output.textures_delta.clear();
+                if self.overlay.end(&mut output) {
+                    self.fresh_egui();
+                }
                 outcome
             }
             None => self.host.draw(renderer, &input, self.method)?,
@@ -286,6 +284,13 @@ impl App {
         }
     }
 
+    /// A new egui context (and its input state), which sends every texture again: after the
+    /// overlay had to be remade for a new surface format.
+    fn fresh_egui(&mut self) {
+        self.egui_ctx = egui::Context::default();
+        self.egui_input = self.window.as_ref().map(|w| egui_state(&self.egui_ctx, w));
+    }
+
     fn fail(&mut self, event_loop: &ActiveEventLoop, e: anyhow::Error) {
         self.error.get_or_insert(e);
         event_loop.exit();
@@ -310,14 +315,7 @@ impl ApplicationHandler for App {
                 self.renderer = Some(Renderer::new(gpu, &self.args.model)?);
             }
             if self.egui_input.is_none() {
-                self.egui_input = Some(egui_winit::State::new(
-                    self.egui_ctx.clone(),
-                    egui::ViewportId::ROOT,
-                    &window,
-                    Some(window.scale_factor() as f32),
-                    None,
-                    None,
-                ));
+                self.egui_input = Some(egui_state(&self.egui_ctx, &window));
             }
             let (w, h) = self.size();
             let renderer = self.renderer.as_ref().expect("created above");
@@ -476,7 +474,7 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         calibration_path,
         egui_ctx: egui::Context::default(),
         egui_input: None,
-        overlay: None,
+        overlay: phantogram::calibration_ui::OverlayHost::new(),
     };
     app.apply_calibration();
     event_loop.run_app(&mut app).context("the window's event loop failed")?;
@@ -489,4 +487,16 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         Some(e) => Err(e),
         None => Ok(()),
     }
+}
+
+/// egui's input state for `window`, feeding `ctx`.
+fn egui_state(ctx: &egui::Context, window: &Window) -> egui_winit::State {
+    egui_winit::State::new(
+        ctx.clone(),
+        egui::ViewportId::ROOT,
+        window,
+        Some(window.scale_factor() as f32),
+        None,
+        None,
+    )
 }
