@@ -314,6 +314,11 @@ impl Engine {
         if !self.session.set_flat_up_device(c.flat_up_device) {
             problems.push("the flat angle's up vector is zero".into());
         }
+        // The camera's metric scale: the viewer's own IPD, once calibrated.
+        #[cfg(feature = "face")]
+        if let Some(face) = &self.face {
+            face.set_ipd_m(c.ipd_m);
+        }
         if !problems.is_empty() {
             self.calibration_warning = Some(format!("calibration not fully applied: {}", problems.join("; ")));
         }

@@ -852,6 +852,8 @@ struct WorkerShared {
     newest: Option<FaceObservation>,
     last_error: Option<String>,
     dropped_frames: u64,
+    /// A new calibrated IPD for the tracker, taken with the next frame.
+    ipd_update: Option<Option<f32>>,
     stop: bool,
 }
 
@@ -886,6 +888,9 @@ impl FaceWorker {
                         if s.stop {
                             return;
                         }
+                        if let Some(ipd_m) = s.ipd_update.take() {
+                            tracker.ipd_m = ipd_m;
+                        }
                         s.pending.take()
                     };
                     let Some(frame) = frame else { continue };
@@ -909,6 +914,11 @@ impl FaceWorker {
             s.dropped_frames += 1;
         }
         wake.notify_one();
+    }
+
+    /// The viewer's calibrated IPD ([`FaceTracker::ipd_m`]) for the frames after this call.
+    pub fn set_ipd_m(&self, ipd_m: Option<f32>) {
+        self.shared.0.lock().unwrap_or_else(|p| p.into_inner()).ipd_update = Some(ipd_m);
     }
 
     /// The newest observation, if any frame has been processed.

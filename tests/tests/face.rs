@@ -344,6 +344,43 @@ fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
     drop(worker); // joins the thread
 }
 
+/// The viewer's calibrated IPD, from the calibration file the phone keeps, sets the camera's
+/// metric scale: the tracked eyes are exactly that far apart (from the iris alone they are only
+/// within 63 ± 15 mm).
+#[test]
+fn the_calibrated_ipd_reaches_the_face_tracker_through_the_engine() {
+    use phantogram::engine::{Engine, EngineConfig};
+    let Some((_, dir)) = setup() else { return };
+    let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
+    let scratch = phantogram_integration::scratch("face-ipd");
+    let calibration = scratch.join("calibration.txt");
+    std::fs::write(&calibration, "phantogram-calibration 1\nipd_m 0.0705\n").unwrap();
+    let engine = match Engine::new(EngineConfig {
+        face_models_dir: Some(models_dir),
+        calibration_path: Some(calibration),
+        ..EngineConfig::default()
+    }) {
+        Ok(e) => e,
+        Err(phantogram::engine::EngineError::Render(e)) => {
+            eprintln!("no GPU ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("engine: {e}"),
+    };
+    assert_eq!(engine.calibration_warning(), None);
+    let worker = engine.face_worker().expect("face tracking is on");
+    let img = rgba(&dir.join("astronaut.png"));
+    worker.submit(owned_frame(&img, default_intrinsics(&img), 7));
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while worker.newest().is_none() {
+        assert!(std::time::Instant::now() < deadline, "the frame was never processed");
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let eyes = worker.newest().unwrap().eyes_m.expect("the astronaut's eyes");
+    let ipd = eyes[0].distance(eyes[1]);
+    assert!((ipd - 0.0705).abs() < 1e-4, "eyes {ipd} m apart");
+}
+
 /// Through the embedding API the shells use: camera frames handed to a `SharedEngine` from
 /// another thread reach the session, and the frames drawn afterwards take their eyes from the
 /// camera (and differ from the tilt-only frame).
