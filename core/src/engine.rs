@@ -168,6 +168,8 @@ pub struct Engine {
     calibration: Calibration,
     calibration_path: Option<PathBuf>,
     calibration_warning: Option<String>,
+    /// The panel as the platform reports it; a calibrated density goes over it.
+    platform_panel: PanelSpec,
     /// The calibration screens, while open.
     #[cfg(feature = "ui")]
     screens: Option<Box<CalibrationScreens>>,
@@ -278,49 +280,25 @@ impl Engine {
             calibration,
             calibration_path: config.calibration_path,
             calibration_warning,
+            platform_panel: config.panel,
             #[cfg(feature = "ui")]
             screens: None,
         };
-        engine.apply_calibration(config.panel, config.rotation);
+        engine.apply_calibration();
         Ok(engine)
     }
 
-    /// Puts the calibration into the session: eye model, pixel density (over the platform's
-    /// `panel`), flat angle. A value the session refuses is reported, the rest still applied.
-    fn apply_calibration(&mut self, panel: PanelSpec, rotation: DisplayRotation) {
-        let c = self.calibration;
-        let mut problems = Vec::new();
-        let mut eyes = self.session.config().eyes;
-        eyes.ipd_m = c.ipd_m.unwrap_or(eyes.ipd_m);
-        eyes.viewing_distance_m = c.viewing_distance_m.unwrap_or(eyes.viewing_distance_m);
-        if let Err(e) = self.session.set_eye_model(eyes) {
-            problems.push(e.to_string());
+    /// Puts the calibration into the session ([`Session::apply_calibration`]) over the platform's
+    /// panel, and into the gestures (their slop) and the face tracker (its metric scale).
+    fn apply_calibration(&mut self) {
+        if let Err(refused) = self.session.apply_calibration(&self.calibration, self.platform_panel) {
+            self.calibration_warning = Some(format!("calibration not fully applied: {refused}"));
         }
-        let panel = match c.density_dpi {
-            Some(d) => PanelSpec {
-                xdpi: d.x,
-                ydpi: d.y,
-                ..panel
-            },
-            None => panel,
-        };
-        match Screen::new(panel, rotation) {
-            Ok(screen) => {
-                self.session.set_screen(screen);
-                self.gestures = Gestures::new(panel.xdpi);
-            }
-            Err(e) => problems.push(format!("calibrated density: {e}")),
-        }
-        if !self.session.set_flat_up_device(c.flat_up_device) {
-            problems.push("the flat angle's up vector is zero".into());
-        }
+        self.gestures = Gestures::new(self.session.config().screen.panel().xdpi);
         // The camera's metric scale: the viewer's own IPD, once calibrated.
         #[cfg(feature = "face")]
         if let Some(face) = &self.face {
-            face.set_ipd_m(c.ipd_m);
-        }
-        if !problems.is_empty() {
-            self.calibration_warning = Some(format!("calibration not fully applied: {}", problems.join("; ")));
+            face.set_ipd_m(self.calibration.ipd_m);
         }
     }
 
@@ -478,9 +456,9 @@ impl Engine {
     /// The display's panel or rotation changed (Android configuration change, iOS trait change).
     pub fn set_display(&mut self, panel: PanelSpec, rotation: DisplayRotation) -> Result<(), EngineError> {
         self.session.set_screen(Screen::new(panel, rotation)?);
-        self.gestures = Gestures::new(panel.xdpi);
         // The platform's panel again: the calibrated density must go back over it.
-        self.apply_calibration(panel, rotation);
+        self.platform_panel = panel;
+        self.apply_calibration();
         Ok(())
     }
 
@@ -669,8 +647,7 @@ impl Engine {
                     flat_up_device: self.calibration.flat_up_device,
                     ..c
                 };
-                let screen = self.session.config().screen;
-                self.apply_calibration(screen.panel(), screen.rotation());
+                self.apply_calibration();
                 self.save_calibration();
             }
             A::Closed => self.screens = None,

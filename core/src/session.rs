@@ -23,12 +23,13 @@ use glam::{Quat, Vec3};
 use thiserror::Error;
 
 use crate::attitude::{LowPassAttitude, OrientationEstimator, device_to_world_from_up};
+use crate::calibration::Calibration;
 use crate::eyes::{EyeModel, EyeModelError, StereoEyes};
 use crate::eyetrack::{EyeSource, EyeTrackParams, EyeTracker, FaceObservation};
 use crate::fusion::{FusedOrientation, FusionParams};
 use crate::light::WorldLight;
 use crate::projection::{DepthRange, OffAxisProjection, ProjectionError};
-use crate::screen::Screen;
+use crate::screen::{PanelSpec, Screen};
 use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorStats};
 use crate::viewpoint::Viewpoint;
 
@@ -279,6 +280,40 @@ impl Session {
         Ok(())
     }
 
+    /// Puts a viewer's calibration into the session: IPD and viewing distance (the eye model),
+    /// the calibrated pixel density over the platform's `panel` (at the current rotation), and
+    /// the flat angle (none: lying flat is straight on). Each of the three is taken or refused
+    /// whole (an IPD no eye model takes keeps the old IPD and distance); what is refused is said
+    /// in the error, the rest applied.
+    pub fn apply_calibration(&mut self, c: &Calibration, panel: PanelSpec) -> Result<(), String> {
+        let mut refused = Vec::new();
+        let mut eyes = self.config.eyes;
+        eyes.ipd_m = c.ipd_m.unwrap_or(eyes.ipd_m);
+        eyes.viewing_distance_m = c.viewing_distance_m.unwrap_or(eyes.viewing_distance_m);
+        if let Err(e) = self.set_eye_model(eyes) {
+            refused.push(e.to_string());
+        }
+        let panel = match c.density_dpi {
+            Some(d) => PanelSpec {
+                xdpi: d.x,
+                ydpi: d.y,
+                ..panel
+            },
+            None => panel,
+        };
+        match Screen::new(panel, self.config.screen.rotation()) {
+            Ok(screen) => self.set_screen(screen),
+            Err(e) => refused.push(format!("calibrated density: {e}")),
+        }
+        if !self.set_flat_up_device(c.flat_up_device) {
+            refused.push("the flat angle's up vector is zero".into());
+        }
+        match refused.is_empty() {
+            true => Ok(()),
+            false => Err(refused.join("; ")),
+        }
+    }
+
     /// Drains pending sensor events and computes this frame's eyes, projections and light, for the
     /// newest sensor state.
     pub fn frame(&mut self) -> Result<FrameView, SessionError> {
@@ -420,6 +455,49 @@ mod tests {
         assert_eq!(fused.stats().ignored_non_finite, 4);
         assert!(fused.up_device().is_some_and(|u| u.distance(Vec3::Z) < 1e-3));
         assert!(low_pass.up_device().is_some_and(|u| u.distance(Vec3::Z) < 1e-3));
+    }
+
+    #[test]
+    fn a_calibration_sets_eyes_density_and_flat_angle_and_names_what_it_refuses() {
+        let mut s = Session::new(SessionConfig::default()).unwrap();
+        let panel = s.config().screen.panel();
+        let up = Vec3::new(0.0, 0.5, 0.8).normalize();
+        let c = Calibration {
+            ipd_m: Some(0.066),
+            viewing_distance_m: Some(0.4),
+            density_dpi: Some(glam::Vec2::new(460.0, 455.0)),
+            flat_up_device: Some(up),
+            ..Calibration::default()
+        };
+        s.apply_calibration(&c, panel).unwrap();
+        assert_eq!(
+            (s.config().eyes.ipd_m, s.config().eyes.viewing_distance_m),
+            (0.066, 0.4)
+        );
+        assert_eq!(
+            (s.config().screen.panel().xdpi, s.config().screen.panel().ydpi),
+            (460.0, 455.0)
+        );
+        assert_eq!(s.config().screen.panel().width_px, panel.width_px);
+        assert!(s.flat_up_device().unwrap().distance(up) < 1e-6);
+        // An IPD no eye model takes and a zero "up": both named, the density still applied.
+        let bad = Calibration {
+            ipd_m: Some(0.5),
+            density_dpi: Some(glam::Vec2::new(300.0, 300.0)),
+            flat_up_device: Some(Vec3::ZERO),
+            ..Calibration::default()
+        };
+        let refused = s.apply_calibration(&bad, panel).unwrap_err();
+        assert!(
+            refused.contains("interpupillary") && refused.contains("flat angle"),
+            "{refused}"
+        );
+        assert_eq!(s.config().screen.panel().xdpi, 300.0);
+        assert_eq!(
+            s.config().eyes.ipd_m,
+            0.066,
+            "the refused IPD left the eye model as it was"
+        );
     }
 
     #[test]

@@ -260,27 +260,10 @@ impl App {
 
     /// Puts the calibrated IPD, distance, pixel density and flat angle into the session.
     fn apply_calibration(&mut self) {
-        let c = self.calibration;
-        if !self.session.set_flat_up_device(c.flat_up_device) {
-            eprintln!("warning: the calibrated flat angle (up = 0) is not usable; lying flat is straight on");
-        }
-        let mut eyes = self.session.config().eyes;
-        eyes.ipd_m = c.ipd_m.unwrap_or(eyes.ipd_m);
-        eyes.viewing_distance_m = c.viewing_distance_m.unwrap_or(eyes.viewing_distance_m);
-        if let Err(e) = self.session.set_eye_model(eyes) {
-            eprintln!("warning: calibration not applied: {e}");
-        }
-        if let Some(d) = c.density_dpi {
-            let screen = self.session.config().screen;
-            let panel = phantogram::screen::PanelSpec {
-                xdpi: d.x,
-                ydpi: d.y,
-                ..screen.panel()
-            };
-            match phantogram::screen::Screen::new(panel, screen.rotation()) {
-                Ok(s) => self.session.set_screen(s),
-                Err(e) => eprintln!("warning: calibrated density not applied: {e}"),
-            }
+        // The virtual phone's panel as a phone would report it; a calibrated density goes over it.
+        let panel = phantogram::screen::Screen::default().panel();
+        if let Err(refused) = self.session.apply_calibration(&self.calibration, panel) {
+            eprintln!("warning: calibration not fully applied: {refused}");
         }
     }
 
