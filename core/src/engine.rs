@@ -484,10 +484,7 @@ impl Engine {
         // user would expect from tapping a phone that has not measured anything.
         match g {
             Gesture::StraightOn => {
-                if self.session.calibrate_flat_angle().is_ok() {
-                    self.calibration.flat_up_device = self.session.flat_up_device();
-                    self.save_calibration();
-                }
+                let _ = self.calibrate_flat_angle();
             }
             Gesture::Calibrate => {
                 self.open_calibration();

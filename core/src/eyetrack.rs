@@ -208,7 +208,7 @@ impl EyeTracker {
     /// Takes a camera result. Results older than the newest one taken are ignored.
     pub fn observe(&mut self, obs: FaceObservation) {
         // A capture time beyond the sensors' range would overflow the intervals taken below.
-        let in_range = obs.capture_t_ns.unsigned_abs() <= crate::sensors::MAX_ABS_T_NS as u64;
+        let in_range = crate::sensors::time_in_range(obs.capture_t_ns);
         if !in_range || self.newest.is_some_and(|(t, _, _)| obs.capture_t_ns < t) {
             return;
         }

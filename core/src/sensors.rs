@@ -68,6 +68,12 @@ impl SensorKind {
 /// clocks count from boot, exports from 1970 (1.8·10¹⁸ ns in 2026); a larger stamp is damage.
 pub const MAX_ABS_T_NS: i64 = 1 << 62;
 
+/// Whether `t_ns` is within ±[`MAX_ABS_T_NS`]: true of every time stamp the core accepts
+/// (sensor events, camera captures, display times).
+pub fn time_in_range(t_ns: i64) -> bool {
+    t_ns.unsigned_abs() <= MAX_ABS_T_NS as u64
+}
+
 /// One timestamped sample. Vectors use `value[0..3]` (and `value[3] == 0`); orientations store a
 /// quaternion as `[x, y, z, w]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -124,7 +130,7 @@ impl SensorEvent {
 
     /// Whether the time stamp is within ±[`MAX_ABS_T_NS`].
     pub fn time_in_range(&self) -> bool {
-        self.t_ns.unsigned_abs() <= MAX_ABS_T_NS as u64
+        time_in_range(self.t_ns)
     }
 }
 

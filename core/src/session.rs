@@ -331,7 +331,7 @@ impl Session {
     pub fn frame_at(&mut self, display_t_ns: Option<i64>) -> Result<FrameView, SessionError> {
         // A shell's nonsense time (beyond the sensors' range) must not overflow the intervals
         // below: draw as if none were given.
-        let display_t_ns = display_t_ns.filter(|t| t.unsigned_abs() <= crate::sensors::MAX_ABS_T_NS as u64);
+        let display_t_ns = display_t_ns.filter(|&t| crate::sensors::time_in_range(t));
         self.update();
         let predicted = display_t_ns.and_then(|t| self.estimator.predict_device_to_world(t));
         let up = match predicted {

@@ -390,14 +390,13 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
 /// Integer nanoseconds, or a float (some exports write `1.76e18`).
 fn parse_ns(field: &str) -> Result<i64, String> {
     let f = field.trim().trim_matches('"');
-    let limit = crate::sensors::MAX_ABS_T_NS;
     if let Ok(t) = f.parse::<i64>() {
-        if t.unsigned_abs() <= limit as u64 {
+        if crate::sensors::time_in_range(t) {
             return Ok(t);
         }
     }
     let t = parse_f64(f)?;
-    if t.is_finite() && t.abs() <= limit as f64 {
+    if t.is_finite() && t.abs() <= crate::sensors::MAX_ABS_T_NS as f64 {
         Ok(t.round() as i64)
     } else {
         Err(format!("time stamp {field:?} is not usable"))

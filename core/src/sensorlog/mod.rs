@@ -308,7 +308,7 @@ fn parse_event(tag: &str, rest: &str) -> Result<SensorEvent, String> {
         .ok_or("missing time stamp")?
         .parse::<i64>()
         .ok()
-        .filter(|t| t.unsigned_abs() <= crate::sensors::MAX_ABS_T_NS as u64)
+        .filter(|&t| crate::sensors::time_in_range(t))
         .ok_or("time stamp is not an integer number of nanoseconds within ±2^62")?;
     let n = if kind.is_orientation() { 4 } else { 3 };
     let mut value = [0f32; 4];
