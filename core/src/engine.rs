@@ -575,9 +575,13 @@ impl Engine {
             },
             Target::Offscreen { width, height } => Some((*width, *height)),
         };
-        let Some((w, h)) = size.filter(|&(w, h)| w > 0 && h > 0) else {
-            self.stats.frames_skipped += 1;
-            return Ok(DrawOutcome::Skipped("zero-sized"));
+        let (w, h) = match size {
+            Some((w, h)) if w > 0 && h > 0 => (w, h),
+            other => {
+                let outcome = DrawOutcome::Skipped(if other.is_some() { "zero-sized" } else { "suspended" });
+                self.count(outcome);
+                return Ok(outcome);
+            }
         };
         let ppp = self.pixels_per_point();
         let screen = self.session.config().screen;
@@ -694,22 +698,22 @@ impl CalibrationScreens {
         if !(x_pt.is_finite() && y_pt.is_finite()) {
             return;
         }
-        let pos = egui::pos2(x_pt, y_pt);
-        let button = |pressed| egui::Event::PointerButton {
+        let button = |pos, pressed| egui::Event::PointerButton {
             pos,
             button: egui::PointerButton::Primary,
             pressed,
             modifiers: egui::Modifiers::default(),
         };
+        let pos = egui::pos2(x_pt, y_pt);
         match phase {
             TouchPhase::Down if self.pointer.is_none() => {
                 self.pointer = Some(pointer_id);
-                self.events.extend([egui::Event::PointerMoved(pos), button(true)]);
+                self.events.extend([egui::Event::PointerMoved(pos), button(pos, true)]);
             }
             TouchPhase::Move if self.pointer == Some(pointer_id) => self.events.push(egui::Event::PointerMoved(pos)),
             TouchPhase::Up if self.pointer == Some(pointer_id) => {
                 self.pointer = None;
-                self.events.extend([button(false), egui::Event::PointerGone]);
+                self.events.extend([button(pos, false), egui::Event::PointerGone]);
             }
             // Taken by the system: let go far away, which egui takes for a drag, not a click.
             TouchPhase::Cancel if self.pointer == Some(pointer_id) => {
@@ -717,12 +721,7 @@ impl CalibrationScreens {
                 let away = egui::pos2(-1.0e4, -1.0e4);
                 self.events.extend([
                     egui::Event::PointerMoved(away),
-                    egui::Event::PointerButton {
-                        pos: away,
-                        button: egui::PointerButton::Primary,
-                        pressed: false,
-                        modifiers: egui::Modifiers::default(),
-                    },
+                    button(away, false),
                     egui::Event::PointerGone,
                 ]);
             }

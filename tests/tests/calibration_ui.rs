@@ -240,6 +240,17 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
     let flat = engine
         .calibration_control_px("flat")
         .expect("the menu's straight-on button");
+    // A touch the system takes back (Cancel) is no click.
+    engine.touch(TouchPhase::Down, 0, flat[0], flat[1], 1_100 * ms);
+    engine.draw(Some(1_120 * ms)).unwrap();
+    engine.touch(TouchPhase::Cancel, 0, flat[0], flat[1], 1_140 * ms);
+    engine.draw(Some(1_160 * ms)).unwrap();
+    engine.draw(Some(1_180 * ms)).unwrap();
+    assert_eq!(
+        engine.session().flat_up_device(),
+        None,
+        "a cancelled touch pressed the button"
+    );
     assert_eq!(
         tap_fingers(&mut engine, &[flat]),
         None,
