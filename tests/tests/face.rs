@@ -344,28 +344,35 @@ fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
     drop(worker); // joins the thread
 }
 
+/// An engine with face tracking, or `None` (said) where this machine has no GPU adapter.
+fn engine_with_faces(config: phantogram::engine::EngineConfig) -> Option<phantogram::engine::Engine> {
+    match phantogram::engine::Engine::new(config) {
+        Ok(e) => Some(e),
+        Err(phantogram::engine::EngineError::Render(e)) => {
+            eprintln!("no GPU ({e}): skipping");
+            None
+        }
+        Err(e) => panic!("engine: {e}"),
+    }
+}
+
 /// The viewer's calibrated IPD, from the calibration file the phone keeps, sets the camera's
 /// metric scale: the tracked eyes are exactly that far apart (from the iris alone they are only
 /// within 63 ± 15 mm).
 #[test]
 fn the_calibrated_ipd_reaches_the_face_tracker_through_the_engine() {
-    use phantogram::engine::{Engine, EngineConfig};
+    use phantogram::engine::EngineConfig;
     let Some((_, dir)) = setup() else { return };
     let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
     let scratch = phantogram_integration::scratch("face-ipd");
     let calibration = scratch.join("calibration.txt");
     std::fs::write(&calibration, "phantogram-calibration 1\nipd_m 0.0705\n").unwrap();
-    let engine = match Engine::new(EngineConfig {
+    let Some(engine) = engine_with_faces(EngineConfig {
         face_models_dir: Some(models_dir),
         calibration_path: Some(calibration),
         ..EngineConfig::default()
-    }) {
-        Ok(e) => e,
-        Err(phantogram::engine::EngineError::Render(e)) => {
-            eprintln!("no GPU ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("engine: {e}"),
+    }) else {
+        return;
     };
     assert_eq!(engine.calibration_warning(), None);
     let worker = engine.face_worker().expect("face tracking is on");
@@ -386,20 +393,15 @@ fn the_calibrated_ipd_reaches_the_face_tracker_through_the_engine() {
 /// camera (and differ from the tilt-only frame).
 #[test]
 fn camera_frames_through_the_engine_move_the_eyes_to_the_camera() {
-    use phantogram::engine::{Engine, EngineConfig, SharedEngine};
+    use phantogram::engine::{EngineConfig, SharedEngine};
     use phantogram::sensors::SensorEvent;
     let Some((_, dir)) = setup() else { return };
     let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
-    let engine = match Engine::new(EngineConfig {
+    let Some(engine) = engine_with_faces(EngineConfig {
         face_models_dir: Some(models_dir),
         ..EngineConfig::default()
-    }) {
-        Ok(e) => e,
-        Err(phantogram::engine::EngineError::Render(e)) => {
-            eprintln!("no GPU ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("engine: {e}"),
+    }) else {
+        return;
     };
     let shared = Arc::new(SharedEngine::new(engine));
     // The phone held at 30° from vertical, still, for one second.
