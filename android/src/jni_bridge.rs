@@ -567,9 +567,26 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeStats<'local>(
     })
 }
 
+/// Why the calibration file could not be read, applied or saved, for the app's log; `null` when
+/// all is well. The engine runs on regardless.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCalibrationWarning<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jni::sys::jstring {
+    run(&mut env, |env| {
+        let warning = engine(handle)?.lock().calibration_warning().map(str::to_owned);
+        Ok(match warning {
+            Some(w) => env.new_string(w)?.into_raw(),
+            None => std::ptr::null_mut(),
+        })
+    })
+}
+
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 14] = [
+pub const NATIVE_METHODS: [&str; 15] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
@@ -584,4 +601,5 @@ pub const NATIVE_METHODS: [&str; 14] = [
     "nativeDrawFrame",
     "nativeReadFrame",
     "nativeStats",
+    "nativeCalibrationWarning",
 ];

@@ -87,6 +87,18 @@ extern "C" {
 // `buffer` is null or valid for writes of `capacity` bytes.
 size_t pg_last_error(char *buffer, size_t capacity);
 
+// Why the calibration file (`PgConfig::calibration_path`) could not be read, applied or saved,
+// for the app's log: copied as [`pg_last_error`] copies its message, with the length the whole
+// message needs (NUL included; 1 when all is well) in `*needed`. The engine runs on regardless.
+//
+// # Safety
+// `engine` is a live handle; `buffer` is null or valid for writes of `capacity` bytes; `needed`
+// is valid for a write.
+enum PgStatus pg_calibration_warning(const struct PgEngine *engine,
+                                     char *buffer,
+                                     size_t capacity,
+                                     size_t *needed);
+
 // A configuration with the defaults: a 1080×2400 panel at 420 dpi, portrait, Dubois red–cyan,
 // the default artifact and studio, no face tracking, with the floor.
 struct PgConfig pg_config_default(void);

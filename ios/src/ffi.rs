@@ -218,7 +218,16 @@ fn method(name: &str) -> Result<Method, Failure> {
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pg_last_error(buffer: *mut c_char, capacity: usize) -> usize {
     let message = LAST_ERROR.with(|e| e.borrow().clone());
-    let needed = message.len() + 1;
+    // SAFETY: forwarded caller promise.
+    unsafe { copy_c_string(&message, buffer, capacity) }
+}
+
+/// Copies `message` (NUL-terminated, truncated to fit) into `buffer` of `capacity` bytes if it
+/// is not null; returns the length the whole message needs, NUL included.
+///
+/// # Safety
+/// `buffer` is null or valid for writes of `capacity` bytes.
+unsafe fn copy_c_string(message: &str, buffer: *mut c_char, capacity: usize) -> usize {
     if !buffer.is_null() && capacity > 0 {
         let n = message.len().min(capacity - 1);
         // SAFETY: the caller promises `capacity` writable bytes; we write n + 1 ≤ capacity.
@@ -227,7 +236,39 @@ pub unsafe extern "C" fn pg_last_error(buffer: *mut c_char, capacity: usize) -> 
             *buffer.add(n) = 0;
         }
     }
-    needed
+    message.len() + 1
+}
+
+/// Why the calibration file (`PgConfig::calibration_path`) could not be read, applied or saved,
+/// for the app's log: copied as [`pg_last_error`] copies its message, with the length the whole
+/// message needs (NUL included; 1 when all is well) in `*needed`. The engine runs on regardless.
+///
+/// # Safety
+/// `engine` is a live handle; `buffer` is null or valid for writes of `capacity` bytes; `needed`
+/// is valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_calibration_warning(
+    engine: *const PgEngine,
+    buffer: *mut c_char,
+    capacity: usize,
+    needed: *mut usize,
+) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let engine = unsafe { engine_ref(engine) }?;
+        if needed.is_null() {
+            return Err(Failure::new(PgStatus::NullPointer, "`needed` is null"));
+        }
+        let warning = engine
+            .shared
+            .lock()
+            .calibration_warning()
+            .unwrap_or_default()
+            .to_owned();
+        // SAFETY: forwarded caller promise for `buffer`; `needed` checked non-null and writable.
+        unsafe { *needed = copy_c_string(&warning, buffer, capacity) };
+        Ok(())
+    })
 }
 
 /// A configuration with the defaults: a 1080×2400 panel at 420 dpi, portrait, Dubois red–cyan,

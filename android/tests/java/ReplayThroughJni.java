@@ -120,11 +120,27 @@ public final class ReplayThroughJni {
             if (NativeBridge.nativeDrawFrame(h, last)) {
                 throw new AssertionError("drawing after surfaceDestroyed must be a skipped frame");
             }
+            if (NativeBridge.nativeCalibrationWarning(h) != null) {
+                throw new AssertionError("no calibration file, yet a calibration warning");
+            }
             long[] stats = NativeBridge.nativeStats(h);
             System.out.println("frames " + frames + " drawn " + stats[0] + " skipped " + stats[1]
                     + " accepted " + stats[4] + " rejected " + stats[5] + " (driver saw " + rejected + ")");
         } finally {
             NativeBridge.nativeDestroy(h);
+        }
+        // A damaged calibration file: the engine starts with the defaults and says why.
+        java.nio.file.Path damaged = java.nio.file.Paths.get(out + ".calibration.txt");
+        java.nio.file.Files.write(damaged, "not a calibration\n".getBytes(java.nio.charset.StandardCharsets.UTF_8));
+        long c = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, null, damaged.toString());
+        try {
+            String warning = NativeBridge.nativeCalibrationWarning(c);
+            if (warning == null || !warning.contains(damaged.getFileName().toString())) {
+                throw new AssertionError("calibration warning for a damaged file: " + warning);
+            }
+            System.out.println("ok: damaged calibration file: " + warning);
+        } finally {
+            NativeBridge.nativeDestroy(c);
         }
         System.out.println("done");
     }

@@ -52,6 +52,13 @@ public final class Engine {
         try check(status)
         guard let engine = out else { throw PhantogramError(status: status, message: "no handle") }
         handle = engine
+        // A calibration file that could not be read or applied: the defaults are in use; say why.
+        var needed = 0
+        if pg_calibration_warning(engine, nil, 0, &needed) == PG_STATUS_OK, needed > 1 {
+            var text = [CChar](repeating: 0, count: needed)
+            _ = pg_calibration_warning(engine, &text, needed, &needed)
+            print("Phantogram: \(String(cString: text))")
+        }
     }
 
     deinit {

@@ -148,6 +148,14 @@ int main(int argc, char **argv) {
           PG_STATUS_INVALID_ARGUMENT, "camera frame turned 45 degrees", "rotation");
     check(pg_resize(engine, width / 2, height / 2), PG_STATUS_OK, "resize", NULL);
     check(pg_suspend(engine), PG_STATUS_OK, "suspend", NULL);
+    size_t needed = 0;
+    check(pg_calibration_warning(engine, NULL, 0, &needed), PG_STATUS_OK, "calibration warning", NULL);
+    if (needed != 1) {
+        fprintf(stderr, "no calibration file, yet a calibration warning of %zu bytes\n", needed);
+        return 1;
+    }
+    check(pg_calibration_warning(engine, NULL, 0, NULL), PG_STATUS_NULL_POINTER, "calibration warning to null",
+          "needed");
     PgStats stats;
     check(pg_stats(engine, &stats), PG_STATUS_OK, "stats", NULL);
     printf("frames %d drawn %llu skipped %llu accepted %llu rejected %llu (driver saw %d)\n", frames,
@@ -156,6 +164,32 @@ int main(int argc, char **argv) {
            rejected);
     pg_engine_destroy(engine);
     pg_engine_destroy(NULL);
+
+    /* A damaged calibration file: the engine starts with the defaults and says why. */
+    char calibration_path[4096];
+    snprintf(calibration_path, sizeof calibration_path, "%s.calibration.txt", out_path);
+    FILE *damaged = fopen(calibration_path, "w");
+    if (!damaged) {
+        fprintf(stderr, "cannot write %s\n", calibration_path);
+        return 1;
+    }
+    fputs("not a calibration\n", damaged);
+    fclose(damaged);
+    config = pg_config_default();
+    config.calibration_path = calibration_path;
+    check(pg_engine_create(&config, &engine), PG_STATUS_OK, "create with a damaged calibration file", NULL);
+    char warning[8] = {0};
+    check(pg_calibration_warning(engine, warning, sizeof warning, &needed), PG_STATUS_OK, "calibration warning",
+          NULL);
+    char *whole = malloc(needed);
+    check(pg_calibration_warning(engine, whole, needed, &needed), PG_STATUS_OK, "calibration warning", NULL);
+    if (needed <= sizeof warning || strlen(warning) != sizeof warning - 1 || !strstr(whole, ".calibration.txt")) {
+        fprintf(stderr, "calibration warning: %zu bytes, \"%s\" / \"%s\"\n", needed, warning, whole);
+        return 1;
+    }
+    printf("ok: damaged calibration file -> \"%s\"\n", whole);
+    free(whole);
+    pg_engine_destroy(engine);
     printf("done\n");
     return 0;
 }

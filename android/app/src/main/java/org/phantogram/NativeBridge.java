@@ -86,4 +86,8 @@ public final class NativeBridge {
     /** [framesDrawn, framesSkipped, resumed, suspended, sensorsAccepted, sensorsRejected,
      *  cameraFrames, gestures, eyesFromCamera]. */
     public static native long[] nativeStats(long handle);
+
+    /** Why the calibration file could not be read, applied or saved, for the log; null when all is
+     *  well. The engine runs on regardless. */
+    public static native String nativeCalibrationWarning(long handle);
 }

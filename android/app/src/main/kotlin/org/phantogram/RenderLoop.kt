@@ -2,6 +2,7 @@ package org.phantogram
 
 import android.os.Handler
 import android.os.HandlerThread
+import android.util.Log
 import android.view.Choreographer
 import android.view.Surface
 import java.util.concurrent.CountDownLatch
@@ -31,6 +32,7 @@ class RenderLoop(private val onError: (Throwable) -> Unit) : Choreographer.Frame
         refreshPeriodNs = periodNs(panel)
         engine = NativeBridge.nativeCreate(null, facesDir, panel.widthPx, panel.heightPx,
             panel.xdpi, panel.ydpi, panel.rotation, anaglyph, calibrationPath)
+        NativeBridge.nativeCalibrationWarning(engine)?.let { Log.w("Phantogram", it) }
     }
 
     fun surfaceCreated(surface: Surface, width: Int, height: Int) = post {
