@@ -175,6 +175,9 @@ pub struct Engine {
     screens: Option<Box<CalibrationScreens>>,
 }
 
+/// Paints over a composed frame: the GPU, the frame's view, its format and size.
+type OverlayPaint<'a> = dyn FnMut(&Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]) + 'a;
+
 /// The calibration screens' state on the render thread: egui's context, the touches waiting for
 /// the next frame, and the overlay painter (made with the first frame drawn).
 #[cfg(feature = "ui")]
@@ -538,29 +541,45 @@ impl Engine {
         if self.screens.is_some() {
             return self.draw_with_screens(&input);
         }
+        self.present(&input, None)
+    }
+
+    /// Draws `input` to the target, `overlay` painted over the composed frame before it is
+    /// presented or read back, and counts the outcome.
+    fn present(
+        &mut self,
+        input: &FrameInput,
+        overlay: Option<&mut OverlayPaint<'_>>,
+    ) -> Result<DrawOutcome, EngineError> {
         let outcome = match &mut self.target {
             Target::Detached => DrawOutcome::Skipped("suspended"),
-            Target::Window(host) => host.draw(&mut self.renderer, &input, self.method)?,
+            Target::Window(host) => match overlay {
+                Some(paint) => {
+                    host.draw_with(&mut self.renderer, input, self.method, |g, v, f, s| paint(g, v, f, s))?
+                }
+                None => host.draw(&mut self.renderer, input, self.method)?,
+            },
             Target::Offscreen { width, height } => {
                 let (w, h) = (*width, *height);
                 if w == 0 || h == 0 {
                     DrawOutcome::Skipped("zero-sized")
                 } else {
-                    let pixels = self.renderer.render(&input, self.method, w, h)?;
+                    let pixels = match overlay {
+                        Some(paint) => self
+                            .renderer
+                            .render_with_overlay(input, self.method, w, h, |g, v, f, s| paint(g, v, f, s))?,
+                        None => self.renderer.render(input, self.method, w, h)?,
+                    };
                     self.last_frame = Some((w, h, pixels));
                     DrawOutcome::Presented
                 }
             }
         };
-        self.count(outcome);
-        Ok(outcome)
-    }
-
-    fn count(&mut self, outcome: DrawOutcome) {
         match outcome {
             DrawOutcome::Presented => self.stats.frames_drawn += 1,
             DrawOutcome::Skipped(_) => self.stats.frames_skipped += 1,
         }
+        Ok(outcome)
     }
 
     /// [`Self::draw`] with the calibration screens over the frame: one egui frame with the touches
@@ -575,18 +594,16 @@ impl Engine {
             },
             Target::Offscreen { width, height } => Some((*width, *height)),
         };
+        // Nothing to lay the screens out on: the plain draw skips (and counts) the frame.
         let (w, h) = match size {
             Some((w, h)) if w > 0 && h > 0 => (w, h),
-            other => {
-                let outcome = DrawOutcome::Skipped(if other.is_some() { "zero-sized" } else { "suspended" });
-                self.count(outcome);
-                return Ok(outcome);
-            }
+            _ => return self.present(input, None),
         };
         let ppp = self.pixels_per_point();
         let screen = self.session.config().screen;
-        let Some(screens) = self.screens.as_mut() else {
-            return Ok(DrawOutcome::Skipped("no calibration screens"));
+        // Out of `self` while the frame is drawn, which the painter needs them for.
+        let Some(mut screens) = self.screens.take() else {
+            return self.present(input, None);
         };
         screens.ctx.set_pixels_per_point(ppp);
         let raw = egui::RawInput {
@@ -601,30 +618,20 @@ impl Engine {
         let ui = &mut screens.ui;
         let mut output = screens.ctx.run_ui(raw, |root| actions = ui.show(root, &screen, ppp));
         screens.overlay.begin(&mut output);
-        let ctx = screens.ctx.clone();
-        let overlay = &mut screens.overlay;
-        let mut paint = |gpu: &Gpu, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: [u32; 2]| {
-            overlay.paint(gpu, &ctx, &mut output, view, format, size);
+        let drawn = {
+            let ctx = screens.ctx.clone();
+            let overlay = &mut screens.overlay;
+            let mut paint = |gpu: &Gpu, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: [u32; 2]| {
+                overlay.paint(gpu, &ctx, &mut output, view, format, size);
+            };
+            self.present(input, Some(&mut paint))
         };
-        let outcome = match &mut self.target {
-            Target::Window(host) => host.draw_with(&mut self.renderer, input, self.method, paint)?,
-            Target::Offscreen { .. } => {
-                let pixels =
-                    self.renderer
-                        .render_with_overlay(input, self.method, w, h, |gpu, view, format, size| {
-                            paint(gpu, view, format, size)
-                        })?;
-                self.last_frame = Some((w, h, pixels));
-                DrawOutcome::Presented
-            }
-            Target::Detached => DrawOutcome::Skipped("suspended"),
-        };
-        if let Some(screens) = self.screens.as_mut() {
-            if screens.overlay.end(&mut output) {
-                screens.ctx = egui::Context::default();
-            }
+        // Also after a failed draw: what it did not upload is kept for the next frame.
+        if screens.overlay.end(&mut output) {
+            screens.ctx = egui::Context::default();
         }
-        self.count(outcome);
+        self.screens = Some(screens);
+        let outcome = drawn?;
         for action in actions {
             self.apply_calibration_action(action);
         }
