@@ -90,11 +90,19 @@ impl Environment {
             path: path.to_path_buf(),
             message,
         };
-        let img = image::ImageReader::open(path)
+        let reader = image::ImageReader::open(path)
             .map_err(|e| err(e.to_string()))?
             .with_guessed_format()
-            .map_err(|e| err(e.to_string()))?
-            .decode()
+            .map_err(|e| err(e.to_string()))?;
+        if reader.format() == Some(image::ImageFormat::OpenExr) {
+            // A damaged EXR can otherwise abort the process (see `exr_guard`).
+            let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+            crate::exr_guard::check(file).map_err(err)?;
+        }
+        // `exr` is young: its B44 decoder panics on some damaged files. That is this file's
+        // error, not the app's end.
+        let img = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
+            .map_err(|_| err("the decoder failed on this file (damaged?)".to_owned()))?
             .map_err(|e| err(e.to_string()))?
             .into_rgb32f();
         let (width, height) = (img.width() as usize, img.height() as usize);

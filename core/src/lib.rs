@@ -51,7 +51,9 @@
 //! * `models`: `gltf` (gltf-rs, the chosen stack) for the glTF document model; `draco-core`
 //!   because museums publish Draco-compressed scans and it decodes them in pure Rust (no C++
 //!   toolchain in the phone builds); `bevy_mikktspace`, the reference tangent algorithm normal
-//!   maps are baked against; `image` for PNG/JPEG textures and HDR/EXR environments; `base64` for
+//!   maps are baked against; `image` for PNG/JPEG textures and HDR/EXR environments, with `exr`
+//!   (the version `image` decodes with) used directly to bound a damaged EXR's sizes before it is
+//!   decoded (`exr_guard`); `base64` for
 //!   data URIs; `serde_json` for Voyager scenes and extension blocks.
 //! * `render` (implies `models`): `wgpu` (the chosen stack), `pollster` to wait on its few
 //!   futures, `bytemuck` for uniform and vertex layouts.
@@ -80,6 +82,8 @@ pub mod calibration_ui;
 pub mod containment;
 #[cfg(feature = "render")]
 pub mod engine;
+#[cfg(feature = "models")]
+mod exr_guard;
 pub mod eyes;
 pub mod eyetrack;
 #[cfg(feature = "face")]

@@ -1141,9 +1141,19 @@ mod loader {
             encoded.push((img.index(), raw, name));
         }
         let images = crate::parallel::map(&encoded, |(index, raw, name)| {
-            image::load_from_memory(raw)
+            let what = || format!("image {index} ({name})");
+            // glTF images are PNG or JPEG; anything else (an EXR, say) is refused before a
+            // decoder meant for other files sees it.
+            match image::guess_format(raw) {
+                Ok(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+                Ok(other) => return Err((what(), format!("{other:?} data; glTF images must be PNG or JPEG"))),
+                Err(_) => return Err((what(), "neither PNG nor JPEG data".to_owned())),
+            }
+            // A decoder panic on a damaged image is this file's error, not the app's end.
+            std::panic::catch_unwind(|| image::load_from_memory(raw))
+                .map_err(|_| (what(), "the decoder failed on damaged data".to_owned()))?
                 .map(|decoded| decoded.to_rgba8())
-                .map_err(|e| (format!("image {index} ({name})"), e.to_string()))
+                .map_err(|e| (what(), e.to_string()))
                 .map(|decoded| Image {
                     name: name.clone(),
                     width: decoded.width(),

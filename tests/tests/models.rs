@@ -551,6 +551,21 @@ fn a_broken_image_is_named_in_the_error() {
         Err(ModelError::Data { what, .. }) => assert!(what.starts_with("image 1"), "{what}"),
         other => panic!("expected a data error naming image 1, got {other:?}"),
     }
+    // A decodable image of a kind glTF does not allow (a Radiance HDR) is refused by name: the
+    // HDR and EXR decoders are there for environments, not for what a model file carries.
+    let hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n\x80\x80\x80\x81\x80\x80\x80\x81";
+    assert!(image::load_from_memory(hdr).is_ok(), "the HDR itself decodes");
+    let hdr = format!("data:image/png;base64,{}", base64_encode(hdr));
+    match load_gltf(&tiny_gltf(&dir, "hdr-image.gltf", &images(&hdr))) {
+        Err(ModelError::Data { what, message, .. }) => {
+            assert!(what.starts_with("image 1"), "{what}");
+            assert!(
+                message.contains("Hdr data; glTF images must be PNG or JPEG"),
+                "{message}"
+            );
+        }
+        other => panic!("expected a data error naming image 1, got {other:?}"),
+    }
 }
 
 #[test]
@@ -581,4 +596,153 @@ fn every_shared_environment_map_loads_into_finite_irradiance() {
         n += 1;
     }
     assert!(n >= 9, "found {n} environment maps");
+}
+
+/// Where the pixel data of a single-part EXR starts: past the header's attributes (each
+/// `name\0type\0size value`, ended by an empty name) and the offset table. `None` if the bytes
+/// do not parse that far.
+fn exr_first_chunk(bytes: &[u8]) -> Option<usize> {
+    let mut at = 8; // magic number and version
+    loop {
+        let name_end = at + bytes.get(at..)?.iter().position(|&b| b == 0)?;
+        if name_end == at {
+            at += 1;
+            break;
+        }
+        let type_end = name_end + 1 + bytes.get(name_end + 1..)?.iter().position(|&b| b == 0)?;
+        let size = i32::from_le_bytes(bytes.get(type_end + 1..type_end + 5)?.try_into().ok()?);
+        at = type_end + 5 + usize::try_from(size).ok()?;
+    }
+    let first = u64::from_le_bytes(bytes.get(at..at + 8)?.try_into().ok()?);
+    usize::try_from(first).ok()
+}
+
+/// A small RGB environment written by the `exr` crate with `compression`, in scan lines or tiles.
+fn exr_environment(path: &Path, compression: exr::compression::Compression, blocks: exr::image::Blocks) {
+    use exr::prelude::*;
+    let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+        (
+            f16::from_f32(x as f32 / 64.0),
+            f16::from_f32(y as f32 / 32.0),
+            f16::from_f32(((x * 7 + y * 3) % 11) as f32 / 4.0),
+        )
+    });
+    let encoding = Encoding {
+        compression,
+        blocks,
+        line_order: LineOrder::Increasing,
+    };
+    Image::from_encoded_channels((64, 32), encoding, channels)
+        .write()
+        .to_file(path)
+        .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+}
+
+#[test]
+fn damaged_environment_maps_are_errors_not_aborts() {
+    use exr::compression::Compression;
+    use phantogram::ibl::Environment;
+    let dir = scratch("exr-mutants");
+    let mut files = Vec::new();
+    let tiles = exr::image::Blocks::Tiles(exr::math::Vec2(16, 16));
+    for (name, compression, blocks) in [
+        ("none", Compression::Uncompressed, exr::image::Blocks::ScanLines),
+        ("rle", Compression::RLE, exr::image::Blocks::ScanLines),
+        ("zip", Compression::ZIP16, exr::image::Blocks::ScanLines),
+        ("zips", Compression::ZIP1, exr::image::Blocks::ScanLines),
+        ("piz", Compression::PIZ, exr::image::Blocks::ScanLines),
+        ("pxr24", Compression::PXR24, exr::image::Blocks::ScanLines),
+        ("b44", Compression::B44, exr::image::Blocks::ScanLines),
+        ("dwaa", Compression::DWAA(None), exr::image::Blocks::ScanLines),
+        ("dwab", Compression::DWAB(None), exr::image::Blocks::ScanLines),
+        ("dwab-tiled", Compression::DWAB(None), tiles),
+        ("piz-tiled", Compression::PIZ, tiles),
+    ] {
+        let path = dir.join(format!("{name}.exr"));
+        exr_environment(&path, compression, blocks);
+        // Each undamaged file loads, with its pixels (f16 holds these values exactly).
+        let env = Environment::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!((env.width, env.height), (64, 32), "{name}");
+        if !matches!(
+            compression,
+            Compression::B44 | Compression::DWAA(_) | Compression::DWAB(_)
+        ) {
+            // Texel (x 16, y 8): x/64, y/32, ((7x + 3y) mod 11)/4.
+            assert_eq!(env.texels[8 * 64 + 16], [0.25, 0.25, 1.0], "{name}");
+        }
+        files.push((name.to_owned(), std::fs::read(&path).unwrap()));
+    }
+    if let Some(env) = data_subdir("env") {
+        for entry in std::fs::read_dir(&env).unwrap() {
+            let path = entry.unwrap().path();
+            if path.extension().is_some_and(|e| e == "exr" || e == "hdr") {
+                let name = path.file_name().unwrap().to_string_lossy().into_owned();
+                files.push((name, std::fs::read(&path).unwrap()));
+            }
+        }
+    }
+
+    // The two faults that aborted the process before `exr_guard`: a data window 2^26 pixels wide
+    // (the image crate bounds memory by the display window only) and a DWA chunk whose AC
+    // coefficient count is absurd (exr allocates it as told).
+    let (_, dwab) = files.iter().find(|(n, _)| n == "dwab").unwrap();
+    let window = dwab.windows(10).position(|w| w == b"dataWindow").unwrap() + 21; // past "box2i\0" and the size
+    let mut wide = dwab.clone();
+    wide[window + 11] = 0x05; // the high byte of x_max: 83 886 144 pixels wide
+    let chunk = exr_first_chunk(dwab).unwrap();
+    let mut counted = dwab.clone();
+    let ac_count = chunk + 8 + 8 * 8; // past y and size, and eight counters
+    counted[ac_count..ac_count + 8].copy_from_slice(&(1u64 << 40).to_le_bytes());
+    for (bytes, expected) in [(wide, "data window"), (counted, "AC coefficient count")] {
+        let path = dir.join("targeted.exr");
+        std::fs::write(&path, bytes).unwrap();
+        match Environment::load(&path) {
+            Err(e) => assert!(e.to_string().contains(expected), "{e}"),
+            Ok(_) => panic!("a damaged file loaded ({expected})"),
+        }
+    }
+
+    // Random damage: bytes flipped in the header and the first chunk's counters (where sizes
+    // live), anywhere, and truncation. A panic is caught and reported; an abort fails the binary.
+    let mut failures = Vec::new();
+    let mut tried = 0;
+    let mut seed = 0x2545_F491_4F6C_DD1Du64;
+    let mut next = || {
+        seed = seed
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(1_442_695_040_888_963_407);
+        seed >> 24
+    };
+    for (name, bytes) in &files {
+        let ext = if name.ends_with(".hdr") { "hdr" } else { "exr" };
+        let copy = dir.join(format!("mutant.{ext}"));
+        let sizes = exr_first_chunk(bytes).map_or(400, |c| c + 8 + 11 * 8).min(bytes.len());
+        for k in 0..120u64 {
+            let mut mutant = bytes.clone();
+            let span = if k % 3 == 2 { mutant.len() } else { sizes };
+            for _ in 0..1 + k % 4 {
+                let at = next() as usize % span;
+                mutant[at] ^= next() as u8 | 1;
+            }
+            if k % 10 == 9 {
+                mutant.truncate(next() as usize % mutant.len());
+            }
+            std::fs::write(&copy, &mutant).unwrap();
+            tried += 1;
+            let started = std::time::Instant::now();
+            if std::panic::catch_unwind(|| Environment::load(&copy)).is_err() {
+                failures.push(format!("{name} mutant {k}: panicked"));
+            }
+            // Not a timing assertion: a mutant that loops for minutes would be a hang.
+            if started.elapsed().as_secs() > 30 {
+                failures.push(format!("{name} mutant {k}: took {:?}", started.elapsed()));
+            }
+        }
+    }
+    assert!(
+        failures.is_empty(),
+        "{} of {tried} mutants:\n{}",
+        failures.len(),
+        failures.join("\n")
+    );
 }
