@@ -1066,7 +1066,8 @@ mod loader {
             .filter_map(|v| v.as_f64().map(|x| x as f32))
             .collect();
         let q = Quat::from_xyzw(*r.first()?, *r.get(1)?, *r.get(2)?, *r.get(3)?);
-        (q.length() > 0.5).then(|| q.normalize())
+        // A damaged scene (1e300 does not fit an f32) leaves the model as stored.
+        (q.is_finite() && q.length() > 0.5).then(|| q.normalize())
     }
 
     /// Loads a model as its publisher meant it to be seen: [`load_gltf`], then the orientation of a

@@ -746,3 +746,42 @@ fn damaged_environment_maps_are_errors_not_aborts() {
         failures.join("\n")
     );
 }
+
+/// A Voyager scene turns the scan it lists; a scene that is damaged, or lists other files, is
+/// ignored rather than turning the model into NaNs.
+#[test]
+fn a_voyager_scene_orients_only_what_it_lists_and_only_when_sound() {
+    use phantogram::model::voyager_rotation;
+    let dir = scratch("voyager");
+    let model = tiny_gltf(&dir, "scan.glb", "");
+    let scene = |uri: &str, rotation: &str| {
+        format!(r#"{{"models":[{{"rotation":{rotation},"derivatives":[{{"assets":[{{"uri":"{uri}"}}]}}]}}]}}"#)
+    };
+    let half = std::f32::consts::FRAC_1_SQRT_2;
+    for (text, expected) in [
+        // A quarter turn about x (w last, as Voyager writes it), stored not quite unit length.
+        (
+            scene("scan.glb", &format!("[{},0,0,{}]", 2.0 * half, 2.0 * half)),
+            Some([half, 0.0, 0.0, half]),
+        ),
+        (scene("other.glb", "[0.7071,0,0,0.7071]"), None),
+        (scene("scan.glb", "[1e300,0,0,1]"), None),
+        (scene("scan.glb", "[0,0,0,0]"), None),
+        (scene("scan.glb", "[0,0,1]"), None),
+        (scene("scan.glb", r#""upright""#), None),
+        ("{\"models\":[".to_owned(), None),
+    ] {
+        std::fs::write(dir.join("scene.svx.json"), &text).unwrap();
+        let got = voyager_rotation(&model);
+        match (got, expected) {
+            (Some(q), Some([x, y, z, w])) => {
+                assert!(
+                    q.dot(phantogram::glam::Quat::from_xyzw(x, y, z, w)).abs() > 0.99999,
+                    "{text}: {q:?}"
+                )
+            }
+            (None, None) => {}
+            _ => panic!("{text}: {got:?}, expected {expected:?}"),
+        }
+    }
+}
