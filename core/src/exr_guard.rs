@@ -42,8 +42,8 @@ pub fn check(source: impl Read + Seek) -> Result<(), String> {
             .is_none_or(|texels| texels > MAX_DATA_WINDOW_TEXELS)
         {
             return Err(format!(
-                "layer {layer}'s data window is {width}×{height} pixels, more than the {} this \
-                 loader accepts (damaged file?)",
+                "layer {layer}'s data window is {width}×{height} pixels, more than the {} pixels \
+                 this loader accepts: damaged file?",
                 MAX_DATA_WINDOW_TEXELS
             ));
         }
@@ -115,8 +115,8 @@ fn check_dwa_chunk(headers: &[Header], chunk: &Chunk) -> Result<(), String> {
         let value = counter(index);
         if value > limit as u64 {
             return Err(format!(
-                "a DWA chunk of {width}×{height} pixels claims a {what} of {value}, more than its \
-                 pixels can hold ({limit}; damaged file?)"
+                "a DWA chunk of {width}×{height} pixels gives its {what} as {value}, more than \
+                 its pixels can need ({limit}): damaged file?"
             ));
         }
     }
