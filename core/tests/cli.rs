@@ -257,4 +257,67 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
     assert!(face["distance_mm"].as_f64().unwrap() > 100.0);
     assert!((0.0..=1.0).contains(&face["confidence"].as_f64().unwrap()));
     assert_eq!(lines[1]["faces"].as_array().unwrap().len(), 0, "no face among the dogs");
+
+    // A PNG whose header claims 60000 × 60000 pixels (14 GB to decode) and a Radiance HDR are
+    // refused by name; the photo between them is still read.
+    let dir = std::env::temp_dir().join(format!("phantogram-cli-faces-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let mut bomb = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR".to_vec();
+    bomb.extend_from_slice(&60_000u32.to_be_bytes());
+    bomb.extend_from_slice(&60_000u32.to_be_bytes());
+    bomb.extend_from_slice(&[8, 6, 0, 0, 0]);
+    bomb.extend_from_slice(&crc32(&bomb[12..]).to_be_bytes());
+    // Two rows of image data, then the end: the decoder reads this far before it allocates.
+    let rows = {
+        use std::io::Write;
+        let mut z = flate2::write::ZlibEncoder::new(Vec::new(), flate2::Compression::fast());
+        z.write_all(&vec![0u8; 2 * (1 + 4 * 60_000)]).unwrap();
+        z.finish().unwrap()
+    };
+    for (kind, data) in [(&b"IDAT"[..], &rows[..]), (b"IEND", b"")] {
+        let start = bomb.len() + 4;
+        bomb.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        bomb.extend_from_slice(kind);
+        bomb.extend_from_slice(data);
+        bomb.extend_from_slice(&crc32(&bomb[start..]).to_be_bytes());
+    }
+    std::fs::write(dir.join("bomb.png"), &bomb).unwrap();
+    std::fs::write(
+        dir.join("light.hdr"),
+        b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 2\n\x80\x80\x80\x81\x80\x80\x80\x81",
+    )
+    .unwrap();
+    let out = bin()
+        .args(["eval", "face", "--json", "--models"])
+        .arg(&models)
+        .arg(dir.join("bomb.png"))
+        .arg(faces.join("astronaut.png"))
+        .arg(dir.join("light.hdr"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{err}");
+    assert!(
+        err.contains("60000×60000 pixels is more than this tool decodes"),
+        "{err}"
+    );
+    assert!(err.contains("not a PNG or JPEG photo (Hdr)"), "{err}");
+    assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1, "{err}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// CRC-32 (ISO-HDLC, as PNG uses), bit by bit: enough for one chunk header.
+fn crc32(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 == 1 {
+                (crc >> 1) ^ 0xEDB8_8320
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
 }

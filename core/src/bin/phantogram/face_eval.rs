@@ -110,7 +110,22 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
 /// 0xA405 in the Exif IFD).
 fn open_with_exif_focal(path: &Path) -> Result<(image::RgbaImage, Option<f32>)> {
     use image::ImageDecoder;
-    let mut decoder = image::ImageReader::open(path)?.with_guessed_format()?.into_decoder()?;
+    let reader = image::ImageReader::open(path)?.with_guessed_format()?;
+    // Photos: PNG or JPEG. The HDR and EXR decoders are built in for environments only.
+    match reader.format() {
+        Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+        other => anyhow::bail!(
+            "not a PNG or JPEG photo ({})",
+            other.map_or("unrecognised data".to_owned(), |f| format!("{f:?}"))
+        ),
+    }
+    let mut decoder = reader.into_decoder()?;
+    // `into_decoder` skips the memory limit `decode` applies: a header claiming 60000 × 60000
+    // pixels would otherwise abort on a 14 GB allocation.
+    if image::Limits::default().reserve(decoder.total_bytes()).is_err() {
+        let (w, h) = decoder.dimensions();
+        anyhow::bail!("{w}×{h} pixels is more than this tool decodes (512 MiB)");
+    }
     let focal = decoder
         .exif_metadata()
         .ok()
