@@ -81,6 +81,31 @@ fn bad_input_is_a_clear_error() {
         .output()
         .unwrap();
     assert!(String::from_utf8_lossy(&out.stderr).contains("beyond the end"));
+    // Numbers that parse but mean nothing are refused by name, before any work.
+    for (flag, expected) in [
+        ("--every-ms=0.001", "at least 1"),
+        ("--every-ms=NaN", "at least 1"),
+        ("--flat-at-s=NaN", "seconds from the start of the log"),
+        ("--flat-at-s=-3", "seconds from the start of the log"),
+        ("--tau-s=NaN", "time constant of 0 seconds or more"),
+        ("--tau-s=-0.1", "time constant of 0 seconds or more"),
+    ] {
+        let out = bin().args(["replay", flag]).arg(default_log()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains(expected), "{flag}: {stderr}");
+    }
+    // render knows the log's length before drawing: a flat time past it renders nothing.
+    let frames = dir.join("never");
+    let out = bin()
+        .args(["render", "--flat-at-s", "99", "--log"])
+        .arg(default_log())
+        .arg("--out")
+        .arg(&frames)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stderr.contains("beyond the end"), "{stderr}");
+    assert!(!frames.exists(), "no frames folder for a render that cannot finish");
     // A missing file is named, with the system's reason said once.
     let out = bin().args(["replay", "/nonexistent/log"]).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);

@@ -41,8 +41,8 @@ enum Command {
     Replay {
         /// A phantogram log, a BROAD CSV, or a recording folder (Android raw, Sensor Logger, phyphox).
         log: PathBuf,
-        /// Interval between printed rows, milliseconds of sensor time.
-        #[arg(long, default_value_t = 100.0)]
+        /// Interval between printed rows, milliseconds of sensor time (at least 1).
+        #[arg(long, default_value_t = 100.0, value_parser = interval_ms)]
         every_ms: f64,
         /// Print comma-separated values instead of a table.
         #[arg(long)]
@@ -52,14 +52,14 @@ enum Command {
         realtime: Option<f64>,
         /// Use the paper's low-pass viewpoint with this time constant, seconds (c = 0.1 at 100 Hz ≈ 0.095 s)
         /// instead of the fused estimator.
-        #[arg(long, default_value_t = LowPassAttitude::DEFAULT_TAU_S)]
+        #[arg(long, default_value_t = LowPassAttitude::DEFAULT_TAU_S, value_parser = time_constant_s)]
         tau_s: f32,
         /// Viewing distance, centimetres.
         // Rounded to 0.1 mm so that the help shows "30", not f32's "30.000002".
         #[arg(long, default_value_t = (EyeModel::DEFAULT_VIEWING_DISTANCE_M * 1000.0).round() / 10.0)]
         distance_cm: f32,
         /// Make the pose at this many seconds into the log count as "straight on" (flat-angle calibration).
-        #[arg(long, value_name = "SECONDS")]
+        #[arg(long, value_name = "SECONDS", value_parser = seconds_into_log)]
         flat_at_s: Option<f64>,
         /// Instead of the eye/light table, print the orientation (device → world quaternion
         /// w x y z) after each input sample time, as estimated by NAME.
@@ -103,11 +103,11 @@ enum Command {
         /// Anaglyph method: dubois, dubois-green-magenta, dubois-amber-blue, half-color, optimized, gray, color, mono.
         #[arg(long, default_value = "dubois")]
         anaglyph: phantogram::anaglyph::Method,
-        /// Interval between frames, milliseconds of sensor time.
-        #[arg(long, default_value_t = 100.0)]
+        /// Interval between frames, milliseconds of sensor time (at least 1).
+        #[arg(long, default_value_t = 100.0, value_parser = interval_ms)]
         every: f64,
         /// Make the pose at this many seconds into the log count as "straight on".
-        #[arg(long, value_name = "SECONDS")]
+        #[arg(long, value_name = "SECONDS", value_parser = seconds_into_log)]
         flat_at_s: Option<f64>,
         /// Fraction of a loaded model's height that stands in front of the glass.
         #[arg(long, default_value_t = 0.4)]
@@ -334,9 +334,6 @@ fn replay_command(
     distance_cm: f32,
     flat_at_s: Option<f64>,
 ) -> Result<()> {
-    if !(every_ms.is_finite() && every_ms > 0.0) {
-        bail!("--every-ms must be a positive number of milliseconds, got {every_ms}");
-    }
     if let Some(speed) = realtime {
         if !(speed.is_finite() && speed > 0.0) {
             bail!("--realtime must be a positive speed factor, got {speed}");
@@ -350,7 +347,7 @@ fn replay_command(
     let mut session = Session::new(config).context("invalid settings")?;
     let events = open_events(log)?;
     let pace = realtime.map_or(Pace::AsFastAsPossible, |speed| Pace::RealTime { speed });
-    let interval_ns = (every_ms * 1e6).round().max(1.0) as i64;
+    let interval_ns = (every_ms * 1e6).round() as i64;
 
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
@@ -610,6 +607,33 @@ fn broken_pipe_is_fine(err: std::io::Error) -> Result<()> {
     }
 }
 
+/// `--every`, `--every-ms`: milliseconds of sensor time between frames, at least 1 (a finer
+/// step only multiplies identical frames: no sensor here runs faster than 1 kHz).
+fn interval_ms(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(ms) if ms.is_finite() && ms >= 1.0 => Ok(ms),
+        _ => Err(format!("expected a number of milliseconds, at least 1, got {text:?}")),
+    }
+}
+
+/// `--flat-at-s`: seconds from the start of the log.
+fn seconds_into_log(text: &str) -> Result<f64, String> {
+    match text.parse::<f64>() {
+        Ok(s) if s.is_finite() && s >= 0.0 => Ok(s),
+        _ => Err(format!(
+            "expected a number of seconds from the start of the log, got {text:?}"
+        )),
+    }
+}
+
+/// `--tau-s`: the low-pass time constant; 0 means no smoothing.
+fn time_constant_s(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(s) if s.is_finite() && s >= 0.0 => Ok(s),
+        _ => Err(format!("expected a time constant of 0 seconds or more, got {text:?}")),
+    }
+}
+
 fn parse_size(text: &str) -> Result<(u32, u32)> {
     let (w, h) = text
         .split_once(['x', 'X'])
@@ -656,9 +680,6 @@ fn render_command(args: RenderArgs) -> Result<()> {
     if !(0.0..=1.0).contains(&protrude) {
         bail!("--protrude must be a fraction between 0 and 1, got {protrude}");
     }
-    if !(every_ms.is_finite() && every_ms > 0.0) {
-        bail!("--every must be a positive number of milliseconds, got {every_ms}");
-    }
     let (width, height) = parse_size(size)?;
     let config = SessionConfig::default();
     let screen = config.screen;
@@ -675,7 +696,11 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let (Some(first), Some(last)) = (events.first(), events.last()) else {
         bail!("{}: the log has no events", log.display());
     };
-    let interval_ns = (every_ms * 1e6).round().max(1.0) as i64;
+    let interval_ns = (every_ms * 1e6).round() as i64;
+    if let Some(at) = flat_at_s.filter(|at| *at > (last.t_ns - first.t_ns) as f64 * 1e-9) {
+        // Known now, before any frame is drawn.
+        bail!("--flat-at-s {at} is beyond the end of the log");
+    }
     let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
 
     let fit = DioramaFit {
@@ -752,7 +777,8 @@ fn render_command(args: RenderArgs) -> Result<()> {
         bail!("--flat-at-s {at} is beyond the end of the log");
     }
     eprintln!(
-        "wrote {index} frames ({width}x{height}, {method}) to {}",
+        "wrote {index} frame{} ({width}x{height}, {method}) to {}",
+        if index == 1 { "" } else { "s" },
         out_dir.display()
     );
     Ok(())
