@@ -323,8 +323,7 @@ mod tests {
 
     #[test]
     fn calibration_file_round_trips_and_bad_files_give_defaults() {
-        let dir = std::env::temp_dir().join(format!("phantogram-calib-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
+        let dir = crate::scratch::Scratch::new("calibration");
         let path = dir.join("calibration.txt");
         let c = Calibration {
             ipd_m: Some(0.0615),

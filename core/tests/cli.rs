@@ -131,6 +131,7 @@ fn bad_input_is_a_clear_error() {
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("exists and is not a folder"), "{stderr}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -149,6 +150,7 @@ fn import_then_info_round_trip() {
     let info = bin().arg("info").arg(&out_log).output().unwrap();
     let text = String::from_utf8_lossy(&info.stdout);
     assert!(text.contains("Accelerometer") && text.contains("1201"), "{text}");
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -236,6 +238,7 @@ fn viewer_runs_its_surface_lifecycle_in_a_window() {
     assert_eq!(after("resumed "), 2, "{line}");
     assert_eq!(after("suspended "), 1, "{line}");
     assert!(after("reconfigured ") >= 4, "{line}");
+    let _ = std::fs::remove_dir_all(&runtime);
 }
 
 /// `eval face --json`: one object per image with the documented keys; a missing model folder is a

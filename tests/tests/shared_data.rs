@@ -12,7 +12,7 @@ use phantogram::replay::{Pace, replay};
 use phantogram::sensorlog::import::{ImportedLog, import};
 use phantogram::sensors::SensorKind;
 use phantogram::{Session, SessionConfig};
-use phantogram_integration::{data_subdir, scratch};
+use phantogram_integration::{Scratch, data_subdir, scratch};
 
 /// Files in the data folders that are not sensor streams, with the reason they are not read.
 const NOT_SENSOR_DATA: &[(&str, &str)] = &[
@@ -157,8 +157,8 @@ fn gunzip_if_needed(bytes: Vec<u8>) -> (Vec<u8>, bool) {
 }
 
 /// Copies `recording` into a scratch folder with line `line` of `victim` replaced by garbage;
-/// returns the path to import.
-fn corrupted_copy(recording: &Path, victim: &Path, line: usize, tag: &str) -> PathBuf {
+/// returns the path to import, and the folder (removed when dropped).
+fn corrupted_copy(recording: &Path, victim: &Path, line: usize, tag: &str) -> (PathBuf, Scratch) {
     let dir = scratch(tag);
     let files = if recording.is_dir() {
         sorted_entries(recording)
@@ -184,11 +184,12 @@ fn corrupted_copy(recording: &Path, victim: &Path, line: usize, tag: &str) -> Pa
         };
         std::fs::File::create(&target).unwrap().write_all(&bytes).unwrap();
     }
-    if recording.is_dir() {
-        dir
+    let path = if recording.is_dir() {
+        dir.to_path_buf()
     } else {
         dir.join(recording.file_name().unwrap())
-    }
+    };
+    (path, dir)
 }
 
 #[test]
@@ -205,7 +206,7 @@ fn every_corrupted_file_fails_with_file_and_line() {
             } else {
                 1
             };
-            let copy = corrupted_copy(&rec, &victim, line, &format!("corrupt-{checked}-{i}"));
+            let (copy, _dir) = corrupted_copy(&rec, &victim, line, &format!("corrupt-{checked}-{i}"));
             let err = match import(&copy) {
                 Ok(_) => panic!("{}: corrupting line {line} of {name} went unnoticed", rec.display()),
                 Err(e) => e,

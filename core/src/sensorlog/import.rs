@@ -477,11 +477,8 @@ mod tests {
     use super::*;
     use std::io::Write;
 
-    fn temp_dir(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("phantogram-import-{}-{name}", std::process::id()));
-        let _ = std::fs::remove_dir_all(&dir);
-        std::fs::create_dir_all(&dir).unwrap();
-        dir
+    fn temp_dir(name: &str) -> crate::scratch::Scratch {
+        crate::scratch::Scratch::new(&format!("import-{name}"))
     }
 
     fn write_gz(path: &Path, text: &str) {

@@ -420,11 +420,7 @@ mod tests {
     use super::*;
     use glam::{Quat, Vec3};
 
-    fn temp(name: &str) -> PathBuf {
-        let dir = std::env::temp_dir().join(format!("phantogram-log-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        dir.join(name)
-    }
+    use crate::scratch::Scratch;
 
     fn sample_events() -> Vec<SensorEvent> {
         vec![
@@ -450,8 +446,9 @@ mod tests {
     fn round_trips_exactly_plain_and_gzip() {
         let events = sample_events();
         let meta = vec![("source".to_owned(), "unit test".to_owned())];
+        let dir = Scratch::new("log-round-trip");
         for name in ["rt.pglog", "rt.pglog.gz"] {
-            let path = temp(name);
+            let path = dir.join(name);
             write_log(&path, &meta, &events).unwrap();
             let r = LogReader::open(&path).unwrap();
             assert_eq!(r.meta(), &meta[..]);
@@ -480,8 +477,9 @@ mod tests {
             ("phantogram-sensor-log 1\nzzz 1 1 2 3\n", 2, "unknown record"),
             ("phantogram-sensor-log 1\nrot 1 1 2 3 4 5\n", 2, "found more"),
         ];
+        let dir = Scratch::new("log-errors");
         for (i, (text, line, needle)) in cases.into_iter().enumerate() {
-            let path = temp(&format!("bad{i}.pglog"));
+            let path = dir.join(format!("bad{i}.pglog"));
             std::fs::write(&path, text).unwrap();
             let err = match LogReader::open(&path) {
                 Err(e) => e,
@@ -496,16 +494,18 @@ mod tests {
 
     #[test]
     fn empty_and_missing_files_are_clear_errors() {
-        let path = temp("empty.pglog");
+        let dir = Scratch::new("log-empty");
+        let path = dir.join("empty.pglog");
         std::fs::write(&path, "").unwrap();
         assert!(LogReader::open(&path).err().unwrap().to_string().contains("empty file"));
-        let missing = temp("missing.pglog");
+        let missing = dir.join("missing.pglog");
         assert!(matches!(LogReader::open(&missing), Err(LogError::Io { .. })));
     }
 
     #[test]
     fn truncated_gzip_is_an_error_not_a_panic() {
-        let path = temp("trunc.pglog.gz");
+        let dir = Scratch::new("log-truncated");
+        let path = dir.join("trunc.pglog.gz");
         let events: Vec<_> = (0..2000)
             .map(|i| SensorEvent::accelerometer(i, Vec3::splat(i as f32)))
             .collect();

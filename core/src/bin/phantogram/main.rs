@@ -183,8 +183,10 @@ enum EvalWhat {
 }
 
 fn main() {
+    // Parsed first: on bad arguments clap exits the process, which would leave the folder behind.
+    let cli = Cli::parse();
     let runtime_dir = ensure_runtime_dir();
-    let result = run(Cli::parse());
+    let result = run(cli);
     if let Some(dir) = runtime_dir {
         let _ = std::fs::remove_dir_all(dir);
     }
@@ -210,8 +212,8 @@ fn ensure_runtime_dir() -> Option<PathBuf> {
     #[cfg(not(unix))]
     let created = false;
     if created {
-        // SAFETY: called first thing in `main`, before any other thread exists, so nothing can
-        // read the environment concurrently.
+        // SAFETY: called from `main` before any other thread exists (parsing the arguments
+        // starts none), so nothing can read the environment concurrently.
         unsafe { std::env::set_var("XDG_RUNTIME_DIR", &dir) };
         return Some(dir);
     }
