@@ -1145,13 +1145,13 @@ mod loader {
             let what = || format!("image {index} ({name})");
             // glTF images are PNG or JPEG; anything else (an EXR, say) is refused before a
             // decoder meant for other files sees it.
-            match image::guess_format(raw) {
-                Ok(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}
+            let format = match image::guess_format(raw) {
+                Ok(format @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => format,
                 Ok(other) => return Err((what(), format!("{other:?} data; glTF images must be PNG or JPEG"))),
                 Err(_) => return Err((what(), "neither PNG nor JPEG data".to_owned())),
-            }
+            };
             // A decoder panic on a damaged image is this file's error, not the app's end.
-            std::panic::catch_unwind(|| image::load_from_memory(raw))
+            std::panic::catch_unwind(|| image::load_from_memory_with_format(raw, format))
                 .map_err(|_| (what(), "the decoder failed on damaged data".to_owned()))?
                 .map(|decoded| decoded.to_rgba8())
                 .map_err(|e| (what(), e.to_string()))
