@@ -323,7 +323,7 @@ mod tests {
 
     #[test]
     fn calibration_file_round_trips_and_bad_files_give_defaults() {
-        let dir = crate::scratch::Scratch::new("calibration");
+        let dir = crate::scratch::Scratch::new("unit-calibration");
         let path = dir.join("calibration.txt");
         let c = Calibration {
             ipd_m: Some(0.0615),

@@ -100,8 +100,8 @@ pub mod projection;
 #[cfg(feature = "render")]
 pub mod render;
 pub mod replay;
-#[cfg(test)]
-mod scratch;
+#[doc(hidden)]
+pub mod scratch;
 pub mod screen;
 pub mod sensorlog;
 pub mod sensors;

@@ -1,4 +1,6 @@
-//! Scratch folders for the unit tests (compiled only for them).
+//! Scratch folders for tests: the crate's unit tests, its CLI tests and the workspace's
+//! integration tests share this one piece. Public only for them (hidden from the docs, not part of
+//! the API); the library itself never writes temporary files.
 //!
 //! Each folder is unique to the process and a name, emptied when made, and removed when
 //! dropped, unless the thread is panicking: a failing test keeps its files for inspection and
@@ -6,11 +8,13 @@
 
 use std::path::{Path, PathBuf};
 
-pub(crate) struct Scratch(PathBuf);
+pub struct Scratch(PathBuf);
 
 impl Scratch {
-    pub(crate) fn new(name: &str) -> Self {
-        let dir = std::env::temp_dir().join(format!("phantogram-unit-{}-{name}", std::process::id()));
+    /// `phantogram-NAME-PID` in the temporary folder, empty. Panics if it cannot be made (tests
+    /// only).
+    pub fn new(name: &str) -> Self {
+        let dir = std::env::temp_dir().join(format!("phantogram-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("create scratch folder");
         Self(dir)
@@ -20,6 +24,12 @@ impl Scratch {
 impl std::ops::Deref for Scratch {
     type Target = Path;
     fn deref(&self) -> &Path {
+        &self.0
+    }
+}
+
+impl AsRef<Path> for Scratch {
+    fn as_ref(&self) -> &Path {
         &self.0
     }
 }

@@ -3,6 +3,8 @@
 use std::path::PathBuf;
 use std::process::Command;
 
+use phantogram::scratch::Scratch;
+
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_phantogram"))
 }
@@ -60,8 +62,7 @@ fn flat_angle_calibration_makes_the_holding_pose_straight_on() {
 
 #[test]
 fn bad_input_is_a_clear_error() {
-    let dir = std::env::temp_dir().join(format!("phantogram-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli");
     let bad = dir.join("bad.pglog");
     std::fs::write(&bad, "phantogram-sensor-log 1\nacc 1 0 0 9.8\nacc 2 0 zero 9.8\n").unwrap();
     let out = bin().arg("replay").arg(&bad).output().unwrap();
@@ -96,14 +97,7 @@ fn bad_input_is_a_clear_error() {
     }
     // render knows the log's length before drawing: a flat time past it renders nothing.
     let frames = dir.join("never");
-    let out = bin()
-        .args(["render", "--flat-at-s", "99", "--log"])
-        .arg(default_log())
-        .arg("--out")
-        .arg(&frames)
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = failed_render(&["--flat-at-s", "99"], &frames);
     assert!(stderr.contains("beyond the end"), "{stderr}");
     assert!(!frames.exists(), "no frames folder for a render that cannot finish");
     // A missing file is named, with the system's reason said once.
@@ -111,33 +105,32 @@ fn bad_input_is_a_clear_error() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(stderr.contains("/nonexistent/log"), "{stderr}");
     assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
-    let out = bin()
-        .args(["render", "/nonexistent/model.glb", "--log"])
-        .arg(default_log())
-        .arg("--out")
-        .arg(dir.join("frames"))
-        .output()
-        .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
+    let stderr = failed_render(&["/nonexistent/model.glb"], &dir.join("frames"));
     assert!(stderr.contains("/nonexistent/model.glb"), "{stderr}");
     assert_eq!(stderr.matches("os error 2").count(), 1, "{stderr}");
     // --out must be a folder (or not exist yet).
-    let out = bin()
-        .args(["render", "--log"])
+    let stderr = failed_render(&[], &bad);
+    assert!(stderr.contains("exists and is not a folder"), "{stderr}");
+}
+
+/// `render ARGS --log <default log> --out OUT`, which must fail; its standard error.
+fn failed_render(args: &[&str], out: &std::path::Path) -> String {
+    let run = bin()
+        .arg("render")
+        .args(args)
+        .arg("--log")
         .arg(default_log())
         .arg("--out")
-        .arg(&bad)
+        .arg(out)
         .output()
         .unwrap();
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(stderr.contains("exists and is not a folder"), "{stderr}");
-    let _ = std::fs::remove_dir_all(&dir);
+    assert!(!run.status.success(), "render {args:?} succeeded");
+    String::from_utf8_lossy(&run.stderr).into_owned()
 }
 
 #[test]
 fn import_then_info_round_trip() {
-    let dir = std::env::temp_dir().join(format!("phantogram-cli-import-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-import");
     let out_log = dir.join("copy.pglog.gz");
     let status = bin()
         .arg("import")
@@ -150,7 +143,6 @@ fn import_then_info_round_trip() {
     let info = bin().arg("info").arg(&out_log).output().unwrap();
     let text = String::from_utf8_lossy(&info.stdout);
     assert!(text.contains("Accelerometer") && text.contains("1201"), "{text}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -196,13 +188,12 @@ fn viewer_runs_its_surface_lifecycle_in_a_window() {
         eprintln!("xvfb-run not found: skipping the window test");
         return;
     }
-    let runtime = std::env::temp_dir().join(format!("phantogram-xdg-{}", std::process::id()));
-    std::fs::create_dir_all(&runtime).unwrap();
+    let runtime = Scratch::new("cli-xdg");
     let out = Command::new("timeout")
         .args(["300", "xvfb-run", "-a", "-s", "-screen 0 800x1280x24"])
         .arg(env!("CARGO_BIN_EXE_phantogram"))
         .args(["view", "--frames", "20", "--lifecycle-test"])
-        .env("XDG_RUNTIME_DIR", &runtime)
+        .env("XDG_RUNTIME_DIR", &*runtime)
         .output()
         .unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);
@@ -238,7 +229,6 @@ fn viewer_runs_its_surface_lifecycle_in_a_window() {
     assert_eq!(after("resumed "), 2, "{line}");
     assert_eq!(after("suspended "), 1, "{line}");
     assert!(after("reconfigured ") >= 4, "{line}");
-    let _ = std::fs::remove_dir_all(&runtime);
 }
 
 /// `eval face --json`: one object per image with the documented keys; a missing model folder is a
@@ -288,8 +278,7 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
 
     // A PNG whose header claims 60000 × 60000 pixels (14 GB to decode) and a Radiance HDR are
     // refused by name; the photo between them is still read.
-    let dir = std::env::temp_dir().join(format!("phantogram-cli-faces-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = Scratch::new("cli-faces");
     let mut bomb = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR".to_vec();
     bomb.extend_from_slice(&60_000u32.to_be_bytes());
     bomb.extend_from_slice(&60_000u32.to_be_bytes());
@@ -331,7 +320,6 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
     );
     assert!(err.contains("not a PNG or JPEG photo (Hdr)"), "{err}");
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1, "{err}");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// CRC-32 (ISO-HDLC, as PNG uses), bit by bit: enough for one chunk header.

@@ -5,7 +5,7 @@
 //! them print a notice and pass vacuously *only* when the variable is unset; when it is set but
 //! wrong, they fail.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 /// Environment variable naming the external data folder.
 pub const DATA_ENV: &str = "PHANTOGRAM_DATA";
@@ -29,40 +29,12 @@ pub fn data_subdir(name: &str) -> Option<PathBuf> {
     }
 }
 
-/// A scratch folder unique to this process and `name`, emptied first; see [`Scratch`].
+pub use phantogram::scratch::Scratch;
+
+/// A scratch folder unique to this process and `name`, emptied first, removed when the returned
+/// guard drops unless the test is failing (see [`Scratch`]).
 pub fn scratch(name: &str) -> Scratch {
-    let dir = std::env::temp_dir().join(format!("phantogram-it-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).expect("create scratch folder");
-    Scratch(dir)
-}
-
-/// A scratch folder that is removed when dropped, unless the thread is panicking: a failing
-/// test keeps its files for inspection (and says where), a passing one leaves nothing behind.
-#[derive(Debug)]
-pub struct Scratch(PathBuf);
-
-impl std::ops::Deref for Scratch {
-    type Target = Path;
-    fn deref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl AsRef<Path> for Scratch {
-    fn as_ref(&self) -> &Path {
-        &self.0
-    }
-}
-
-impl Drop for Scratch {
-    fn drop(&mut self) {
-        if std::thread::panicking() {
-            eprintln!("kept {} for inspection", self.0.display());
-        } else {
-            let _ = std::fs::remove_dir_all(&self.0);
-        }
-    }
+    Scratch::new(&format!("it-{name}"))
 }
 
 /// Decompresses a gzip stream.

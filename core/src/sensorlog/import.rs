@@ -478,7 +478,7 @@ mod tests {
     use std::io::Write;
 
     fn temp_dir(name: &str) -> crate::scratch::Scratch {
-        crate::scratch::Scratch::new(&format!("import-{name}"))
+        crate::scratch::Scratch::new(&format!("unit-import-{name}"))
     }
 
     fn write_gz(path: &Path, text: &str) {

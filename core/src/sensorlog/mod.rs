@@ -446,7 +446,7 @@ mod tests {
     fn round_trips_exactly_plain_and_gzip() {
         let events = sample_events();
         let meta = vec![("source".to_owned(), "unit test".to_owned())];
-        let dir = Scratch::new("log-round-trip");
+        let dir = Scratch::new("unit-log-round-trip");
         for name in ["rt.pglog", "rt.pglog.gz"] {
             let path = dir.join(name);
             write_log(&path, &meta, &events).unwrap();
@@ -477,7 +477,7 @@ mod tests {
             ("phantogram-sensor-log 1\nzzz 1 1 2 3\n", 2, "unknown record"),
             ("phantogram-sensor-log 1\nrot 1 1 2 3 4 5\n", 2, "found more"),
         ];
-        let dir = Scratch::new("log-errors");
+        let dir = Scratch::new("unit-log-errors");
         for (i, (text, line, needle)) in cases.into_iter().enumerate() {
             let path = dir.join(format!("bad{i}.pglog"));
             std::fs::write(&path, text).unwrap();
@@ -494,7 +494,7 @@ mod tests {
 
     #[test]
     fn empty_and_missing_files_are_clear_errors() {
-        let dir = Scratch::new("log-empty");
+        let dir = Scratch::new("unit-log-empty");
         let path = dir.join("empty.pglog");
         std::fs::write(&path, "").unwrap();
         assert!(LogReader::open(&path).err().unwrap().to_string().contains("empty file"));
@@ -504,7 +504,7 @@ mod tests {
 
     #[test]
     fn truncated_gzip_is_an_error_not_a_panic() {
-        let dir = Scratch::new("log-truncated");
+        let dir = Scratch::new("unit-log-truncated");
         let path = dir.join("trunc.pglog.gz");
         let events: Vec<_> = (0..2000)
             .map(|i| SensorEvent::accelerometer(i, Vec3::splat(i as f32)))
