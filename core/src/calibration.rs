@@ -220,10 +220,12 @@ impl Calibration {
         Ok(c)
     }
 
-    /// Loads a calibration file. Never fails: a missing or unreadable file gives the defaults and
-    /// a warning to show the user.
+    /// Loads a calibration file. Never fails: a missing file (not calibrated yet, as on the first
+    /// run) gives the defaults; an unreadable or damaged one the defaults and a warning to show
+    /// the user.
     pub fn load(path: &Path) -> (Self, Option<String>) {
         match std::fs::read_to_string(path) {
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => (Self::default(), None),
             Ok(text) => match Self::from_text(&text) {
                 Ok(c) => (c, None),
                 Err(e) => (
@@ -348,9 +350,13 @@ mod tests {
             let warning = warning.expect("a warning");
             assert!(warning.contains(needle), "{warning}");
         }
+        // Not calibrated yet is no cause for a warning; a file that cannot be read is.
         let (got, warning) = Calibration::load(&dir.join("missing.txt"));
         assert_eq!(got, Calibration::default());
-        assert!(warning.is_some());
+        assert_eq!(warning, None);
+        let (got, warning) = Calibration::load(&dir);
+        assert_eq!(got, Calibration::default());
+        assert!(warning.is_some_and(|w| w.contains("using the default calibration")));
         // Unknown keys from newer versions are skipped.
         let newer = Calibration::from_text("phantogram-calibration 1\nfuture_key 1 2 3\nipd_m 0.063\n").unwrap();
         assert_eq!(newer.ipd_m, Some(0.063));

@@ -21,7 +21,8 @@
 //! ## Calibration
 //! The viewer's calibration (eye distance, viewing distance, pixel density, flat angle; see
 //! [`crate::calibration`]) is read from [`EngineConfig::calibration_path`] at start and applied;
-//! a missing or damaged file gives the defaults and [`Engine::calibration_warning`]. A
+//! a missing file (not calibrated yet) gives the defaults, a damaged one the defaults and
+//! [`Engine::calibration_warning`]. A
 //! three-finger tap ([`Gesture::Calibrate`]) or [`Engine::open_calibration`] opens the
 //! calibration screens ([`crate::calibration_ui`], feature `ui`): drawn over the frame, driven by
 //! the same touches, which reach no gesture while they are open. What they change, and a double
@@ -258,8 +259,8 @@ impl Engine {
             return Err(EngineError::NoFaceSupport);
         }
         let (calibration, calibration_warning) = match &config.calibration_path {
-            Some(path) if path.exists() => Calibration::load(path),
-            _ => (Calibration::default(), None),
+            Some(path) => Calibration::load(path),
+            None => (Calibration::default(), None),
         };
         let mut engine = Self {
             session,

@@ -100,6 +100,19 @@ fn bad_input_is_a_clear_error() {
     let stderr = failed_render(&["--flat-at-s", "99"], &frames);
     assert!(stderr.contains("beyond the end"), "{stderr}");
     assert!(!frames.exists(), "no frames folder for a render that cannot finish");
+    // The viewer takes render's scene options and checks them before it opens a window (so
+    // these fail the same with or without a display).
+    for (args, expected) in [
+        (
+            &["--protrude", "3"][..],
+            "--protrude must be a fraction between 0 and 1",
+        ),
+        (&["--environment", "/nonexistent/sky.hdr"], "/nonexistent/sky.hdr"),
+    ] {
+        let out = bin().arg("view").args(args).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains(expected), "{args:?}: {stderr}");
+    }
     // A missing file is named, with the system's reason said once.
     let out = bin().args(["replay", "/nonexistent/log"]).output().unwrap();
     let stderr = String::from_utf8_lossy(&out.stderr);

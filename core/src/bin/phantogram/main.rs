@@ -68,8 +68,8 @@ enum Command {
     },
     /// Open a window showing the phantogram; drag to tilt the virtual phone, or replay a log.
     View {
-        /// A glTF 2.0 model (.gltf or .glb); the default artifact when omitted.
-        model: Option<PathBuf>,
+        #[command(flatten)]
+        scene: SceneArgs,
         /// Replay this sensor log in real time instead of tilting with the mouse.
         #[arg(long)]
         log: Option<PathBuf>,
@@ -89,8 +89,8 @@ enum Command {
     },
     /// Render a sensor log as phantogram frames (PNG), headless.
     Render {
-        /// A glTF 2.0 model (.gltf or .glb); the default artifact when omitted.
-        model: Option<PathBuf>,
+        #[command(flatten)]
+        scene: SceneArgs,
         /// The sensor log to replay (any format `replay` accepts).
         #[arg(long)]
         log: PathBuf,
@@ -109,20 +109,6 @@ enum Command {
         /// Make the pose at this many seconds into the log count as "straight on".
         #[arg(long, value_name = "SECONDS", value_parser = seconds_into_log)]
         flat_at_s: Option<f64>,
-        /// Fraction of a loaded model's height that stands in front of the glass.
-        #[arg(long, default_value_t = 0.4)]
-        protrude: f32,
-        /// How a loaded model is placed: standing out of the glass, facing the viewer from within
-        /// it (reliefs, tablets), or auto (facing when thin front to back).
-        #[arg(long, value_enum, default_value = "auto")]
-        placement: PlacementArg,
-        /// Leave out the diorama floor under the model (and the shadow cast on it).
-        #[arg(long)]
-        no_floor: bool,
-        /// An equirectangular HDR environment (.hdr or .exr, world frame) to light the artifact;
-        /// a generated neutral studio when omitted.
-        #[arg(long)]
-        environment: Option<PathBuf>,
     },
     /// Convert a recording into the phantogram log format (gzip when OUT ends in .gz).
     Import {
@@ -137,6 +123,65 @@ enum Command {
         #[command(subcommand)]
         what: EvalWhat,
     },
+}
+
+/// What is shown, and how: shared by `view` and `render`, so that the window previews exactly
+/// what the frames will hold.
+#[derive(clap::Args)]
+struct SceneArgs {
+    /// A glTF 2.0 model (.gltf or .glb); the default artifact when omitted.
+    model: Option<PathBuf>,
+    /// Fraction of a loaded model's height that stands in front of the glass.
+    #[arg(long, default_value_t = 0.4)]
+    protrude: f32,
+    /// How a loaded model is placed: standing out of the glass, facing the viewer from within
+    /// it (reliefs, tablets), or auto (facing when thin front to back).
+    #[arg(long, value_enum, default_value = "auto")]
+    placement: PlacementArg,
+    /// Leave out the diorama floor under the model (and the shadow cast on it).
+    #[arg(long)]
+    no_floor: bool,
+    /// An equirectangular HDR environment (.hdr or .exr, world frame) to light the artifact;
+    /// a generated neutral studio when omitted.
+    #[arg(long)]
+    environment: Option<PathBuf>,
+}
+
+/// A scene loaded from [`SceneArgs`], ready for a renderer.
+struct Scene {
+    model: phantogram::model::Model,
+    /// The artifact's bounds (without the floor), for containment.
+    bounds: phantogram::containment::Aabb,
+    environment: Option<phantogram::ibl::Environment>,
+}
+
+impl SceneArgs {
+    /// Checks the settings and loads the model and environment (before any GPU work, so that a
+    /// bad file is reported at once).
+    fn load(&self, screen: &phantogram::screen::Screen) -> Result<Scene> {
+        if !(0.0..=1.0).contains(&self.protrude) {
+            bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
+        }
+        let fit = phantogram::model::DioramaFit {
+            placement: match self.placement {
+                PlacementArg::Auto => phantogram::model::Placement::Auto,
+                PlacementArg::Standing => phantogram::model::Placement::Standing,
+                PlacementArg::Facing => phantogram::model::Placement::Facing,
+            },
+            protrude_fraction: self.protrude,
+            ..Default::default()
+        };
+        let (model, bounds) = load_for_display(self.model.as_deref(), screen, &fit, !self.no_floor)?;
+        let environment = match &self.environment {
+            Some(path) => Some(phantogram::ibl::Environment::load(path)?),
+            None => None,
+        };
+        Ok(Scene {
+            model,
+            bounds,
+            environment,
+        })
+    }
 }
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -247,22 +292,22 @@ fn run(cli: Cli) -> Result<()> {
         }
         Command::Info { log } => info_command(&log),
         Command::View {
-            model,
+            scene,
             log,
             anaglyph,
             frames,
             lifecycle_test,
             calibration,
         } => {
-            let screen = SessionConfig::default().screen;
-            let (model, bounds) = load_for_display(model.as_deref(), &screen, &Default::default(), true)?;
+            let scene = scene.load(&SessionConfig::default().screen)?;
             let log = match log {
                 Some(path) => Some(open_events(&path)?.collect::<Result<Vec<_>, _>>()?),
                 None => None,
             };
             viewer::run(viewer::ViewerArgs {
-                model,
-                bounds,
+                model: scene.model,
+                bounds: scene.bounds,
+                environment: scene.environment,
                 log,
                 method: anaglyph,
                 frames,
@@ -271,33 +316,21 @@ fn run(cli: Cli) -> Result<()> {
             })
         }
         Command::Render {
-            model,
+            scene,
             log,
             out,
             size,
             anaglyph,
             every,
             flat_at_s,
-            protrude,
-            placement,
-            no_floor,
-            environment,
         } => render_command(RenderArgs {
-            model: model.as_deref(),
+            scene: &scene,
             log: &log,
             out_dir: &out,
             size: &size,
             method: anaglyph,
             every_ms: every,
             flat_at_s,
-            protrude,
-            placement: match placement {
-                PlacementArg::Auto => phantogram::model::Placement::Auto,
-                PlacementArg::Standing => phantogram::model::Placement::Standing,
-                PlacementArg::Facing => phantogram::model::Placement::Facing,
-            },
-            floor: !no_floor,
-            environment: environment.as_deref(),
         }),
         Command::Eval {
             what: EvalWhat::Orientation { paths },
@@ -648,40 +681,28 @@ fn parse_size(text: &str) -> Result<(u32, u32)> {
 }
 
 struct RenderArgs<'a> {
-    model: Option<&'a std::path::Path>,
+    scene: &'a SceneArgs,
     log: &'a std::path::Path,
     out_dir: &'a std::path::Path,
     size: &'a str,
     method: phantogram::anaglyph::Method,
     every_ms: f64,
     flat_at_s: Option<f64>,
-    protrude: f32,
-    placement: phantogram::model::Placement,
-    floor: bool,
-    environment: Option<&'a std::path::Path>,
 }
 
 fn render_command(args: RenderArgs) -> Result<()> {
     use phantogram::containment::ContainmentSmoother;
-    use phantogram::model::DioramaFit;
     use phantogram::render::{FrameInput, Gpu, Renderer};
 
     let RenderArgs {
-        model: model_path,
+        scene,
         log,
         out_dir,
         size,
         method,
         every_ms,
         flat_at_s,
-        protrude,
-        placement,
-        floor,
-        environment,
     } = args;
-    if !(0.0..=1.0).contains(&protrude) {
-        bail!("--protrude must be a fraction between 0 and 1, got {protrude}");
-    }
     let (width, height) = parse_size(size)?;
     let config = SessionConfig::default();
     let screen = config.screen;
@@ -705,12 +726,11 @@ fn render_command(args: RenderArgs) -> Result<()> {
     }
     let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
 
-    let fit = DioramaFit {
-        placement,
-        protrude_fraction: protrude,
-        ..DioramaFit::default()
-    };
-    let (model, bounds) = load_for_display(model_path, &screen, &fit, floor)?;
+    let Scene {
+        model,
+        bounds,
+        environment,
+    } = scene.load(&screen)?;
     if out_dir.exists() && !out_dir.is_dir() {
         bail!("--out {}: exists and is not a folder", out_dir.display());
     }
@@ -718,8 +738,8 @@ fn render_command(args: RenderArgs) -> Result<()> {
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
     let mut renderer = Renderer::new(gpu, &model)?;
-    if let Some(path) = environment {
-        renderer.set_environment(&phantogram::ibl::Environment::load(path)?)?;
+    if let Some(environment) = &environment {
+        renderer.set_environment(environment)?;
     }
     let mut session = Session::new(config).context("invalid settings")?;
     let mut smoother = ContainmentSmoother::default();

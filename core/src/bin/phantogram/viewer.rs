@@ -29,6 +29,8 @@ pub struct ViewerArgs {
     pub model: Model,
     /// The artifact's bounds (without the floor), for containment.
     pub bounds: Aabb,
+    /// Light from this environment instead of the generated studio.
+    pub environment: Option<phantogram::ibl::Environment>,
     pub log: Option<Vec<SensorEvent>>,
     pub method: Method,
     /// Exit after presenting this many frames (tests, scripted screenshots).
@@ -295,7 +297,11 @@ impl ApplicationHandler for App {
             if self.renderer.is_none() {
                 let gpu = Gpu::for_display(Box::new(event_loop.owned_display_handle()), window.clone())?;
                 eprintln!("viewing on {}", gpu.describe());
-                self.renderer = Some(Renderer::new(gpu, &self.args.model)?);
+                let mut renderer = Renderer::new(gpu, &self.args.model)?;
+                if let Some(environment) = &self.args.environment {
+                    renderer.set_environment(environment)?;
+                }
+                self.renderer = Some(renderer);
             }
             if self.egui_input.is_none() {
                 self.egui_input = Some(egui_state(&self.egui_ctx, &window));
