@@ -350,3 +350,37 @@ fn crc32(bytes: &[u8]) -> u32 {
     }
     !crc
 }
+
+/// `eval orientation` on a folder: a recording that cannot be read is named and skipped, the
+/// others are still scored, and the exit status says something was left out.
+#[test]
+fn eval_orientation_scores_what_it_can_and_names_what_it_cannot() {
+    let dir = Scratch::new("cli-eval");
+    // Ten seconds at rest, level, facing north, in BROAD's CSV layout; moving (for the scorer)
+    // after 6 s.
+    let mut good =
+        String::from("t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,gt_qw,gt_qx,gt_qy,gt_qz,movement\n");
+    for i in 0..1000 {
+        let moving = u8::from(i > 600);
+        good += &format!("{:.3},0,0,9.81,0,0,0,0,20,-40,1,0,0,0,{moving}\n", f64::from(i) * 0.01);
+    }
+    std::fs::write(dir.join("a_good.csv"), &good).unwrap();
+    std::fs::write(
+        dir.join("b_bad.csv"),
+        format!("{}\n0.0,1,2\n", good.lines().next().unwrap()),
+    )
+    .unwrap();
+    let out = bin().args(["eval", "orientation"]).arg(&*dir).output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success(), "{stderr}");
+    assert!(stderr.contains("b_bad.csv:2:"), "{stderr}");
+    assert!(stderr.contains("1 of 2 recording(s) could not be scored"), "{stderr}");
+    let fused = stdout
+        .lines()
+        .find(|l| l.starts_with("a_good") && l.contains("fused"))
+        .unwrap_or_else(|| panic!("the good recording is scored:\n{stdout}"));
+    // At rest and matching the truth: every error is (nearly) zero.
+    let errors: Vec<f64> = fused.split_whitespace().filter_map(|w| w.parse().ok()).collect();
+    assert!(errors.len() >= 3 && errors[..3].iter().all(|e| *e < 0.1), "{fused}");
+}

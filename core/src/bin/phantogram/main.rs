@@ -528,9 +528,18 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
     );
     // Per estimator: sums for the means.
     let mut sums: Vec<(String, usize, f64, f64, usize, f64)> = Vec::new();
+    // A recording that cannot be read is reported and skipped: the others are still scored.
+    let mut failures = 0;
     for (i, path) in recordings.iter().enumerate() {
         eprintln!("[{}/{}] {}", i + 1, recordings.len(), path.display());
-        let trial = Trial::load(path)?;
+        let trial = match Trial::load(path) {
+            Ok(trial) => trial,
+            Err(e) => {
+                eprintln!("error: {e}");
+                failures += 1;
+                continue;
+            }
+        };
         for s in score_all(&trial) {
             println!(
                 "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7.0}",
@@ -582,6 +591,9 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
             incl / *n as f64,
             ns / *n as f64
         );
+    }
+    if failures > 0 {
+        bail!("{failures} of {} recording(s) could not be scored", recordings.len());
     }
     Ok(())
 }
