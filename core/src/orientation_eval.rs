@@ -115,36 +115,42 @@ pub struct Rmse {
 struct Accumulator {
     n: usize,
     incl: f64,
+    /// Rows whose estimate had a heading of its own; only they score heading and total.
+    n_heading: usize,
     head: f64,
     total: f64,
 }
 
 impl Accumulator {
-    fn add(&mut self, est: DQuat, truth: DQuat) {
+    /// One row; `has_heading` is false for an estimate made from "up" alone (any heading).
+    fn add(&mut self, est: DQuat, truth: DQuat, has_heading: bool) {
         let e = (est * truth.inverse()).normalize();
         let incl = 2.0 * (e.w * e.w + e.z * e.z).sqrt().clamp(0.0, 1.0).acos();
-        let head = 2.0 * (e.z / e.w).abs().atan();
-        let total = 2.0 * e.w.abs().clamp(0.0, 1.0).acos();
         self.n += 1;
         self.incl += incl * incl;
-        self.head += head * head;
-        self.total += total * total;
+        if has_heading {
+            let head = 2.0 * (e.z / e.w).abs().atan();
+            let total = 2.0 * e.w.abs().clamp(0.0, 1.0).acos();
+            self.n_heading += 1;
+            self.head += head * head;
+            self.total += total * total;
+        }
     }
 
     fn finish(&self, frame: TruthFrame) -> Rmse {
-        let r = |s: f64| {
-            if self.n == 0 {
+        let r = |s: f64, n: usize| {
+            if n == 0 {
                 f64::NAN
             } else {
-                (s / self.n as f64).sqrt().to_degrees()
+                (s / n as f64).sqrt().to_degrees()
             }
         };
-        let north = frame == TruthFrame::EastNorthUp;
+        let north = frame == TruthFrame::EastNorthUp && self.n_heading > 0;
         Rmse {
             rows: self.n,
-            inclination_deg: r(self.incl),
-            heading_deg: north.then(|| r(self.head)),
-            total_deg: north.then(|| r(self.total)),
+            inclination_deg: r(self.incl, self.n),
+            heading_deg: north.then(|| r(self.head, self.n_heading)),
+            total_deg: north.then(|| r(self.total, self.n_heading)),
         }
     }
 }
@@ -163,9 +169,9 @@ pub struct Score {
     pub rows_without_estimate: usize,
 }
 
-/// Runs `estimator` over the trial and scores it. Orientation-free estimators (no magnetometer
-/// heading) are still scored for inclination; their heading error is meaningless but reported
-/// as computed.
+/// Runs `estimator` over the trial and scores it. An estimator that knows "up" but has no
+/// heading (the low-pass without a magnetometer) is still scored for inclination, from "up"
+/// alone; its heading and total errors are then not reported.
 pub fn score(trial: &Trial, name: &str, estimator: &mut dyn OrientationEstimator) -> Score {
     let t0 = trial.events.first().map_or(0, |e| e.t_ns);
     let mut movement = trial.movement.as_deref().map(|m| m.iter().peekable());
@@ -201,9 +207,16 @@ pub fn score(trial: &Trial, name: &str, estimator: &mut dyn OrientationEstimator
             }
             None => true,
         };
-        let Some(est) = estimator.device_to_world() else {
-            missing += 1;
-            continue;
+        let (est, has_heading) = match estimator.device_to_world() {
+            Some(q) => (q, true),
+            // Any heading will do: the inclination error does not depend on it.
+            None => match estimator.up_device().and_then(crate::attitude::device_to_world_from_up) {
+                Some(q) => (q, false),
+                None => {
+                    missing += 1;
+                    continue;
+                }
+            },
         };
         let (est, truth) = (est.as_dquat(), truth.as_dquat());
         let in_convergence = (e.t_ns - t0) as f64 * 1e-9 < CONVERGENCE_S;
@@ -211,9 +224,9 @@ pub fn score(trial: &Trial, name: &str, estimator: &mut dyn OrientationEstimator
         // vertical on either side leaves the tilt angle unchanged), so room-frame truth scores it
         // the same way; heading and total are withheld there (`Accumulator::finish`).
         if in_convergence {
-            conv.add(est, truth);
+            conv.add(est, truth, has_heading);
         } else if moving {
-            main.add(est, truth);
+            main.add(est, truth, has_heading);
         }
     }
     flush(estimator, &mut pending);
@@ -308,11 +321,11 @@ mod tests {
         // A pure heading error of 10° and a pure tilt error of 4°.
         let truth = DQuat::from_rotation_x(0.3);
         let mut acc = Accumulator::default();
-        acc.add(DQuat::from_rotation_z(10f64.to_radians()) * truth, truth);
+        acc.add(DQuat::from_rotation_z(10f64.to_radians()) * truth, truth, true);
         let r = acc.finish(TruthFrame::EastNorthUp);
         assert!((r.heading_deg.unwrap() - 10.0).abs() < 1e-9 && r.inclination_deg < 1e-6);
         let mut acc = Accumulator::default();
-        acc.add(DQuat::from_rotation_y(4f64.to_radians()) * truth, truth);
+        acc.add(DQuat::from_rotation_y(4f64.to_radians()) * truth, truth, true);
         let r = acc.finish(TruthFrame::EastNorthUp);
         assert!((r.inclination_deg - 4.0).abs() < 1e-9 && r.heading_deg.unwrap() < 1e-6);
         assert!((r.total_deg.unwrap() - 4.0).abs() < 1e-9);
@@ -320,7 +333,7 @@ mod tests {
         let est = DQuat::from_rotation_y(0.05) * truth;
         let offset_truth = DQuat::from_rotation_z(1.0) * truth;
         let mut acc = Accumulator::default();
-        acc.add(est, offset_truth);
+        acc.add(est, offset_truth, true);
         let r = acc.finish(TruthFrame::ArbitraryHeading);
         assert!((r.inclination_deg - 0.05f64.to_degrees()).abs() < 1e-6);
         assert_eq!(r.heading_deg, None);
@@ -345,5 +358,29 @@ mod tests {
             paper.main.inclination_deg > 2.0 * fused.main.inclination_deg,
             "{paper:?}"
         );
+
+        // Without a magnetometer the low-pass has no orientation, only "up": it is still scored
+        // for inclination (as before, from the accelerometer alone), with no heading.
+        let no_field = Trial {
+            events: trial
+                .events
+                .iter()
+                .filter(|e| e.kind != SensorKind::Magnetometer)
+                .copied()
+                .collect(),
+            ..trial
+        };
+        let scores = score_all(&no_field);
+        let headless = &scores[0];
+        assert_eq!(headless.main.rows, paper.main.rows, "{headless:?}");
+        assert!(
+            (headless.main.inclination_deg - paper.main.inclination_deg).abs() < 1e-3,
+            "{headless:?} vs {paper:?}"
+        );
+        assert_eq!((headless.main.heading_deg, headless.main.total_deg), (None, None));
+        // The best-c search compares real numbers, and the fused estimator runs in 6-D.
+        assert!(scores[1].main.inclination_deg <= headless.main.inclination_deg);
+        let fused_6d = scores.iter().find(|s| s.estimator == "fused").unwrap();
+        assert!(fused_6d.main.inclination_deg < 0.5, "{fused_6d:?}");
     }
 }

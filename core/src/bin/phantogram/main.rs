@@ -515,7 +515,7 @@ fn expand_recordings(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 }
 
 fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
-    use phantogram::orientation_eval::{CONVERGENCE_S, Trial, score_all};
+    use phantogram::orientation_eval::{CONVERGENCE_S, Trial, TruthFrame, score_all};
     let recordings = expand_recordings(paths)?;
     // "-" where there is nothing to score (no north in the truth, or no truth in that period).
     let fmt = |v: Option<f64>| {
@@ -526,8 +526,15 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
         "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7}",
         "trial", "estimator", "incl", "head", "total", "c.incl", "c.head", "ns/evt"
     );
-    // Per estimator: sums for the means.
-    let mut sums: Vec<(String, usize, f64, f64, usize, f64)> = Vec::new();
+    // Per estimator: sums for the means, of the trials where each figure exists.
+    #[derive(Default)]
+    struct Sums {
+        trials: usize,
+        incl: (usize, f64),
+        head: (usize, f64),
+        ns: f64,
+    }
+    let mut sums: Vec<(String, Sums)> = Vec::new();
     // A recording that cannot be read is reported and skipped: the others are still scored.
     let mut failures = 0;
     for (i, path) in recordings.iter().enumerate() {
@@ -558,20 +565,28 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
             } else {
                 s.estimator.clone()
             };
-            let group = if s.main.heading_deg.is_some() { "BROAD" } else { "phone" };
+            // By the kind of truth, not by what the estimator gave (a headless one gives no heading).
+            let group = match trial.truth_frame {
+                TruthFrame::EastNorthUp => "BROAD",
+                TruthFrame::ArbitraryHeading => "phone",
+            };
             let key = format!("{group}: {key}");
-            let entry = match sums.iter_mut().find(|e| e.0 == key) {
-                Some(e) => e,
+            let entry = match sums.iter_mut().position(|e| e.0 == key) {
+                Some(i) => &mut sums[i].1,
                 None => {
-                    sums.push((key, 0, 0.0, 0.0, 0, 0.0));
-                    sums.last_mut().expect("just pushed")
+                    sums.push((key, Sums::default()));
+                    &mut sums.last_mut().expect("just pushed").1
                 }
             };
-            entry.1 += 1;
-            entry.2 += s.main.inclination_deg;
-            entry.3 += s.main.heading_deg.unwrap_or(0.0);
-            entry.5 += s.ns_per_event;
-            entry.4 += usize::from(s.main.heading_deg.is_some());
+            entry.trials += 1;
+            entry.ns += s.ns_per_event;
+            let add = |sum: &mut (usize, f64), value: Option<f64>| {
+                if let Some(v) = value.filter(|v| v.is_finite()) {
+                    *sum = (sum.0 + 1, sum.1 + v);
+                }
+            };
+            add(&mut entry.incl, Some(s.main.inclination_deg));
+            add(&mut entry.head, s.main.heading_deg);
         }
     }
     println!();
@@ -580,16 +595,14 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
         "{:<46} {:>7} {:>6} {:>6} {:>7}",
         "estimator", "trials", "incl", "head", "ns/evt"
     );
-    for (key, n, incl, head, n_head, ns) in &sums {
-        let head = if *n_head > 0 {
-            format!("{:6.2}", head / *n_head as f64)
-        } else {
-            "     -".into()
-        };
+    let mean = |(n, sum): (usize, f64)| (n > 0).then(|| sum / n as f64);
+    for (key, s) in &sums {
         println!(
-            "{key:<46} {n:>7} {:>6.2} {head:>6} {:>7.0}",
-            incl / *n as f64,
-            ns / *n as f64
+            "{key:<46} {:>7} {:>6} {:>6} {:>7.0}",
+            s.trials,
+            fmt(mean(s.incl)),
+            fmt(mean(s.head)),
+            s.ns / s.trials as f64
         );
     }
     if failures > 0 {
