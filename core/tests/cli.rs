@@ -44,6 +44,39 @@ fn replay_prints_the_eye_above_the_tilted_phone() {
     assert!(stderr.contains("0 rejected"), "{stderr}");
 }
 
+/// `--tau-s` selects the paper's low-pass at any time constant, the paper's own value included
+/// (that value once meant "the default, fused estimator").
+#[test]
+fn tau_s_selects_the_low_pass_even_at_the_papers_value() {
+    let eyes = |extra: &[&str]| {
+        let out = bin()
+            .args(["replay", "--csv", "--every-ms", "50"])
+            .args(extra)
+            .arg(default_log())
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        rows(&out.stdout)
+    };
+    let fused = eyes(&[]);
+    let lag = |rows: &[Vec<f64>]| {
+        fused
+            .iter()
+            .zip(rows)
+            .map(|(a, b)| (a[1] - b[1]).hypot(a[2] - b[2]).hypot(a[3] - b[3]))
+            .fold(0.0, f64::max)
+    };
+    // The low-pass trails the tilt by its time constant: the eye is millimetres off while the
+    // phone turns.
+    for tau in ["0.095", "0.2"] {
+        let off = lag(&eyes(&["--tau-s", tau]));
+        assert!(
+            off > 2.0,
+            "--tau-s {tau}: the eye is at most {off:.2} mm from the fused one"
+        );
+    }
+}
+
 #[test]
 fn flat_angle_calibration_makes_the_holding_pose_straight_on() {
     let out = bin()

@@ -50,10 +50,11 @@ enum Command {
         /// Pace the replay at the recording's speed (times this factor) instead of as fast as possible.
         #[arg(long, value_name = "SPEED")]
         realtime: Option<f64>,
-        /// Use the paper's low-pass viewpoint with this time constant, seconds (c = 0.1 at 100 Hz ≈ 0.095 s)
-        /// instead of the fused estimator.
-        #[arg(long, default_value_t = LowPassAttitude::DEFAULT_TAU_S, value_parser = time_constant_s)]
-        tau_s: f32,
+        /// Use the paper's low-pass viewpoint with this time constant, seconds (the paper's c = 0.1
+        /// at 100 Hz is 0.095 s) instead of the fused estimator; with `--estimator low-pass`, its
+        /// time constant (0.095 s when omitted).
+        #[arg(long, value_name = "SECONDS", value_parser = time_constant_s)]
+        tau_s: Option<f32>,
         /// Viewing distance, centimetres.
         // Rounded to 0.1 mm so that the help shows "30", not f32's "30.000002".
         #[arg(long, default_value_t = (EyeModel::DEFAULT_VIEWING_DISTANCE_M * 1000.0).round() / 10.0)]
@@ -273,7 +274,7 @@ fn run(cli: Cli) -> Result<()> {
             tau_s,
             estimator: Some(name),
             ..
-        } => orientation_command(&log, name, tau_s, csv),
+        } => orientation_command(&log, name, tau_s.unwrap_or(LowPassAttitude::DEFAULT_TAU_S), csv),
         Command::Replay {
             log,
             every_ms,
@@ -365,7 +366,7 @@ fn replay_command(
     every_ms: f64,
     csv: bool,
     realtime: Option<f64>,
-    tau_s: f32,
+    tau_s: Option<f32>,
     distance_cm: f32,
     flat_at_s: Option<f64>,
 ) -> Result<()> {
@@ -375,7 +376,7 @@ fn replay_command(
         }
     }
     let mut config = SessionConfig::default();
-    if tau_s != LowPassAttitude::DEFAULT_TAU_S {
+    if let Some(tau_s) = tau_s {
         config.estimator = EstimatorChoice::LowPass { tau_s };
     }
     config.eyes.viewing_distance_m = distance_cm / 100.0;
