@@ -221,6 +221,18 @@ fn replay_with_an_estimator_prints_one_orientation_per_sample_time() {
         .output()
         .unwrap();
     assert!(!bad.status.success());
+    // The synthetic log has no platform rotation vector: an error, not 1201 rows of NaN. And the
+    // eye-table options do not apply to this output: refused rather than ignored.
+    for (args, expected) in [
+        (&["--estimator", "rotation-vector"][..], "has no rotation vector"),
+        (&["--estimator", "fused", "--every-ms", "500"], "cannot be used with"),
+        (&["--estimator", "fused", "--flat-at-s", "1"], "cannot be used with"),
+    ] {
+        let out = bin().arg("replay").args(args).arg(default_log()).output().unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success() && stderr.contains(expected), "{args:?}: {stderr}");
+        assert!(out.stdout.is_empty(), "{args:?}: printed {} bytes", out.stdout.len());
+    }
 }
 
 /// The window path end to end under a virtual X server: the surface lifecycle self-test

@@ -64,7 +64,7 @@ enum Command {
         flat_at_s: Option<f64>,
         /// Instead of the eye/light table, print the orientation (device → world quaternion
         /// w x y z) after each input sample time, as estimated by NAME.
-        #[arg(long, value_name = "NAME")]
+        #[arg(long, value_name = "NAME", conflicts_with_all = ["every_ms", "realtime", "distance_cm", "flat_at_s"])]
         estimator: Option<EstimatorName>,
     },
     /// Open a window showing the phantogram; drag to tilt the virtual phone, or replay a log.
@@ -613,6 +613,13 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
 }
 
 fn orientation_command(log: &std::path::Path, name: EstimatorName, tau_s: f32, csv: bool) -> Result<()> {
+    let events: Vec<SensorEvent> = open_events(log)?.collect::<Result<_, _>>()?;
+    if matches!(name, EstimatorName::RotationVector) && !events.iter().any(|e| e.kind == SensorKind::RotationVector) {
+        bail!(
+            "{}: the log has no rotation vector (the platform's own orientation) to print",
+            log.display()
+        );
+    }
     let mut estimator: Box<dyn OrientationEstimator> = match name {
         EstimatorName::LowPass => Box::new(LowPassAttitude::new(tau_s, tau_s)),
         EstimatorName::Fused => Box::new(phantogram::fusion::FusedOrientation::default()),
@@ -638,8 +645,7 @@ fn orientation_command(log: &std::path::Path, name: EstimatorName, tau_s: f32, c
     // One row per distinct input time stamp, after every event of that time (BROAD rows carry
     // three sensors at once). Ground truth is not an input.
     let mut pending_t: Option<i64> = None;
-    for event in open_events(log)? {
-        let e = event?;
+    for e in events {
         if e.kind == SensorKind::GroundTruth {
             continue;
         }
