@@ -345,9 +345,15 @@ impl Iterator for LogReader {
 }
 
 /// Streaming writer of the project's format. Gzip-compresses when the path ends in `.gz`.
+///
+/// The events go to a hidden file beside the target, renamed over it by [`LogWriter::finish`]:
+/// a log that was there is replaced only by a complete one, never left half-written by a full
+/// disk or an interrupted import (a writer dropped unfinished removes its partial file).
 pub struct LogWriter {
     path: PathBuf,
-    sink: Sink,
+    partial: PathBuf,
+    /// `None` once finished.
+    sink: Option<Sink>,
 }
 
 enum Sink {
@@ -357,7 +363,14 @@ enum Sink {
 
 impl LogWriter {
     pub fn create(path: &Path, meta: &[(String, String)]) -> Result<Self, LogError> {
-        let file = BufWriter::new(File::create(path).map_err(|e| LogError::io(path, e))?);
+        if path.is_dir() {
+            return Err(LogError::format(path, "is a folder, not a file to write the log to"));
+        }
+        let name = path
+            .file_name()
+            .ok_or_else(|| LogError::format(path, "not a file name"))?;
+        let partial = path.with_file_name(format!(".{}.{}.partial", name.to_string_lossy(), std::process::id()));
+        let file = BufWriter::new(File::create(&partial).map_err(|e| LogError::io(path, e))?);
         let sink = if path.extension().is_some_and(|e| e == "gz") {
             Sink::Gzip(GzEncoder::new(file, Compression::default()))
         } else {
@@ -365,7 +378,8 @@ impl LogWriter {
         };
         let mut w = Self {
             path: path.to_path_buf(),
-            sink,
+            partial,
+            sink: Some(sink),
         };
         let mut header = format!("{MAGIC} {VERSION}\n");
         for (k, v) in meta {
@@ -380,8 +394,9 @@ impl LogWriter {
 
     fn write_text(&mut self, text: &str) -> Result<(), LogError> {
         let result = match &mut self.sink {
-            Sink::Plain(f) => f.write_all(text.as_bytes()),
-            Sink::Gzip(gz) => gz.write_all(text.as_bytes()),
+            Some(Sink::Plain(f)) => f.write_all(text.as_bytes()),
+            Some(Sink::Gzip(gz)) => gz.write_all(text.as_bytes()),
+            None => Err(io::Error::other("the log was already finished")),
         };
         result.map_err(|e| LogError::io(&self.path, e))
     }
@@ -396,13 +411,28 @@ impl LogWriter {
         self.write_text(&line)
     }
 
-    /// Flushes and closes the file; without it a gzip stream is incomplete.
-    pub fn finish(self) -> Result<(), LogError> {
-        let result = match self.sink {
-            Sink::Plain(mut f) => f.flush(),
-            Sink::Gzip(gz) => gz.finish().and_then(|mut f| f.flush()),
-        };
+    /// Flushes and closes the file and puts it in place; without it nothing is written.
+    pub fn finish(mut self) -> Result<(), LogError> {
+        let result = match self.sink.take() {
+            Some(Sink::Plain(f)) => f.into_inner().map_err(|e| e.into_error()),
+            Some(Sink::Gzip(gz)) => gz.finish().and_then(|f| f.into_inner().map_err(|e| e.into_error())),
+            None => Err(io::Error::other("the log was already finished")),
+        }
+        .and_then(|file| file.sync_all())
+        .and_then(|()| std::fs::rename(&self.partial, &self.path));
+        if result.is_err() {
+            let _ = std::fs::remove_file(&self.partial);
+        }
         result.map_err(|e| LogError::io(&self.path, e))
+    }
+}
+
+impl Drop for LogWriter {
+    fn drop(&mut self) {
+        if self.sink.take().is_some() {
+            // Unfinished: whatever was there stays, and the partial file goes.
+            let _ = std::fs::remove_file(&self.partial);
+        }
     }
 }
 
@@ -500,6 +530,33 @@ mod tests {
         assert!(LogReader::open(&path).err().unwrap().to_string().contains("empty file"));
         let missing = dir.join("missing.pglog");
         assert!(matches!(LogReader::open(&missing), Err(LogError::Io { .. })));
+    }
+
+    #[test]
+    fn a_log_is_replaced_only_by_a_finished_one() {
+        let dir = Scratch::new("unit-log-atomic");
+        let path = dir.join("kept.pglog.gz");
+        let events = sample_events();
+        write_log(&path, &[], &events).unwrap();
+        let before = std::fs::read(&path).unwrap();
+        // An import that fails half-way: the old log stays whole, and nothing else is left.
+        {
+            let mut w = LogWriter::create(&path, &[]).unwrap();
+            w.write(&events[0]).unwrap();
+        }
+        assert_eq!(std::fs::read(&path).unwrap(), before);
+        let names: Vec<_> = std::fs::read_dir(&*dir)
+            .unwrap()
+            .map(|e| e.unwrap().file_name())
+            .collect();
+        assert_eq!(names, ["kept.pglog.gz"]);
+        // A finished one replaces it.
+        write_log(&path, &[], &events[..1]).unwrap();
+        let back: Vec<_> = LogReader::open(&path).unwrap().collect::<Result<_, _>>().unwrap();
+        assert_eq!(back.len(), 1);
+        // A folder is not a log file.
+        let err = LogWriter::create(&dir, &[]).err().unwrap();
+        assert!(err.to_string().contains("is a folder"), "{err}");
     }
 
     #[test]
