@@ -429,3 +429,38 @@ fn eval_orientation_scores_what_it_can_and_names_what_it_cannot() {
     let errors: Vec<f64> = fused.split_whitespace().filter_map(|w| w.parse().ok()).collect();
     assert!(errors.len() >= 3 && errors[..3].iter().all(|e| *e < 0.1), "{fused}");
 }
+
+/// `render` into a folder that holds an earlier, longer run: the old frames do not trail the new
+/// ones, and files that are not frames stay. Skipped (with a notice) without a GPU adapter,
+/// except under CI.
+#[test]
+fn render_replaces_an_earlier_runs_frames_and_nothing_else() {
+    let dir = Scratch::new("cli-render");
+    for stale in ["frame_00013.png", "frame_00500.png"] {
+        std::fs::write(dir.join(stale), b"old").unwrap();
+    }
+    std::fs::write(dir.join("notes.txt"), b"mine").unwrap();
+    std::fs::write(dir.join("frame_1.png"), b"not one of ours").unwrap();
+    let out = bin()
+        .args(["render", "--every", "1000", "--size", "108x240", "--log"])
+        .arg(default_log())
+        .arg("--out")
+        .arg(&*dir)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if stderr.contains("no GPU adapter") && std::env::var_os("CI").is_none() {
+        eprintln!("no GPU adapter: skipping the render test");
+        return;
+    }
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("removed 2 frames of an earlier run"), "{stderr}");
+    let mut names: Vec<String> = std::fs::read_dir(&*dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    let mut expected: Vec<String> = (0..13).map(|i| format!("frame_{i:05}.png")).collect();
+    expected.extend(["frame_1.png".to_owned(), "notes.txt".to_owned()]);
+    assert_eq!(names, expected, "0 to 12 s every second, and the user's files");
+}

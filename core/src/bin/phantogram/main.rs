@@ -767,6 +767,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
         bail!("--out {}: exists and is not a folder", out_dir.display());
     }
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    remove_earlier_frames(out_dir)?;
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
     let mut renderer = Renderer::new(gpu, &model)?;
@@ -835,6 +836,30 @@ fn render_command(args: RenderArgs) -> Result<()> {
         if index == 1 { "" } else { "s" },
         out_dir.display()
     );
+    Ok(())
+}
+
+/// Removes the frames (`frame_NNNNN.png`, the names `render` writes) of an earlier run from
+/// `dir`: a shorter run would otherwise leave the old run's last frames after its own, and a
+/// video made of the folder would end with them. Other files are left alone.
+fn remove_earlier_frames(dir: &std::path::Path) -> Result<()> {
+    let is_frame = |name: &str| {
+        name.strip_prefix("frame_")
+            .and_then(|rest| rest.strip_suffix(".png"))
+            .is_some_and(|n| n.len() == 5 && n.bytes().all(|b| b.is_ascii_digit()))
+    };
+    let mut removed = 0;
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry.with_context(|| format!("reading {}", dir.display()))?.path();
+        if path.file_name().and_then(|n| n.to_str()).is_some_and(is_frame) {
+            std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
+            removed += 1;
+        }
+    }
+    if removed > 0 {
+        let s = if removed == 1 { "" } else { "s" };
+        eprintln!("removed {removed} frame{s} of an earlier run from {}", dir.display());
+    }
     Ok(())
 }
 
