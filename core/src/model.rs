@@ -17,7 +17,9 @@
 //!   (`bevy_mikktspace`, the reference algorithm that normal maps are baked against).
 //! * Smithsonian Voyager scans: when a `scene.svx.json` beside the file lists it as a derivative,
 //!   [`load_model`] applies the model's rotation from that scene (the scans are stored in the
-//!   scanner's frame), see [`voyager_rotation`].
+//!   scanner's frame), see [`voyager_rotation`]. Given the scene itself, or its folder, it loads
+//!   the best scan the scene lists that is present ([`voyager_scan`]).
+//! * Only glTF 2.0: a file whose `asset.version` is not 2.x is refused by name.
 //! * A file that *requires* an extension we do not implement fails with
 //!   [`ModelError::UnsupportedExtension`] naming it; [`SUPPORTED_EXTENSIONS`] lists those we do.
 //! * A damaged file fails with an error saying where, and does not panic, hang or abort: the
@@ -445,7 +447,7 @@ impl Model {
 }
 
 #[cfg(feature = "models")]
-pub use loader::{ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_model, voyager_rotation};
+pub use loader::{ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_model, voyager_rotation, voyager_scan};
 
 #[cfg(feature = "models")]
 mod loader {
@@ -491,6 +493,9 @@ mod loader {
         },
         #[error("{}: no triangles to draw", path.display())]
         Empty { path: PathBuf },
+        /// A folder or a Voyager scene that names no model file this loader can open.
+        #[error("{}: {message}", path.display())]
+        NotAModel { path: PathBuf, message: String },
     }
 
     struct Ctx<'a> {
@@ -1070,9 +1075,113 @@ mod loader {
         (q.is_finite() && q.length() > 0.5).then(|| q.normalize())
     }
 
+    /// Why `version` (a glTF `asset.version`) is not one this loader reads, if it is not.
+    fn not_gltf2_version(version: &str) -> Option<String> {
+        (version.split('.').next() != Some("2"))
+            .then(|| format!("asset version {version:?}; this loader reads glTF 2.0"))
+    }
+
+    /// For a file that did not parse as glTF 2.0: whether it says it is another version (a GLB
+    /// container's header, or the JSON's `asset.version`).
+    fn not_gltf2(bytes: &[u8]) -> Option<String> {
+        if let Some(header) = bytes.strip_prefix(b"glTF") {
+            let version = u32::from_le_bytes(header.get(..4)?.try_into().ok()?);
+            return (version != 2).then(|| format!("GLB version {version}; this loader reads glTF 2.0"));
+        }
+        let json: serde_json::Value = serde_json::from_slice(bytes).ok()?;
+        not_gltf2_version(json.get("asset")?.get("version")?.as_str()?)
+    }
+
+    /// The Voyager scene file's name, which a Smithsonian download folder holds beside its scans.
+    const VOYAGER_SCENE: &str = "scene.svx.json";
+
+    /// The scan a Voyager scene (`scene.svx.json`, or a folder holding one) offers for viewing:
+    /// its best-quality "Web3D" derivative present beside it (High, then Medium, Low, Thumb: the
+    /// downloads usually hold some of them).
+    pub fn voyager_scan(scene_or_folder: &Path) -> Result<PathBuf, ModelError> {
+        let scene_path = if scene_or_folder.is_dir() {
+            scene_or_folder.join(VOYAGER_SCENE)
+        } else {
+            scene_or_folder.to_path_buf()
+        };
+        let not_a_model = |message: String| ModelError::NotAModel {
+            path: scene_or_folder.to_path_buf(),
+            message,
+        };
+        let text = std::fs::read_to_string(&scene_path).map_err(|error| {
+            if scene_or_folder.is_dir() && error.kind() == std::io::ErrorKind::NotFound {
+                not_a_model(format!(
+                    "a folder without a Voyager scene ({VOYAGER_SCENE}): give the .gltf or .glb file"
+                ))
+            } else {
+                ModelError::Io {
+                    path: scene_path.clone(),
+                    error,
+                }
+            }
+        })?;
+        let scene: serde_json::Value = serde_json::from_str(&text).map_err(|e| ModelError::Parse {
+            path: scene_path.clone(),
+            message: e.to_string(),
+        })?;
+        let folder = scene_path.parent().unwrap_or(Path::new("."));
+        let mut offered = Vec::new();
+        for d in scene
+            .get("models")
+            .and_then(|m| m.as_array())
+            .into_iter()
+            .flatten()
+            .filter_map(|m| m.get("derivatives")?.as_array())
+            .flatten()
+            .filter(|d| d.get("usage").and_then(|u| u.as_str()) == Some("Web3D"))
+        {
+            let quality = d.get("quality").and_then(|q| q.as_str()).unwrap_or("");
+            let Some(rank) = ["High", "Medium", "Low", "Thumb"].iter().position(|q| *q == quality) else {
+                continue;
+            };
+            for uri in d
+                .get("assets")
+                .and_then(|a| a.as_array())
+                .into_iter()
+                .flatten()
+                .filter_map(|a| a.get("uri")?.as_str())
+                .filter(|u| u.ends_with(".glb") || u.ends_with(".gltf"))
+            {
+                // Only plain file names beside the scene: a scene must not point elsewhere.
+                if Path::new(uri).file_name() == Some(std::ffi::OsStr::new(uri)) {
+                    offered.push((rank, uri.to_owned()));
+                }
+            }
+        }
+        offered.sort();
+        if offered.is_empty() {
+            return Err(not_a_model("the Voyager scene lists no glTF scan".into()));
+        }
+        offered
+            .iter()
+            .map(|(_, uri)| folder.join(uri))
+            .find(|p| p.is_file())
+            .ok_or_else(|| {
+                let names: Vec<&str> = offered.iter().map(|(_, u)| u.as_str()).collect();
+                not_a_model(format!(
+                    "none of the scans the Voyager scene lists is here ({})",
+                    names.join(", ")
+                ))
+            })
+    }
+
     /// Loads a model as its publisher meant it to be seen: [`load_gltf`], then the orientation of a
-    /// Voyager scene beside the file, if any ([`voyager_rotation`]).
+    /// Voyager scene beside the file, if any ([`voyager_rotation`]). `path` may also be a Voyager
+    /// scene or a folder holding one: its best scan present is loaded ([`voyager_scan`]).
     pub fn load_model(path: &Path) -> Result<Model, ModelError> {
+        let is_scene = path.is_dir() || path.file_name().is_some_and(|n| n == VOYAGER_SCENE);
+        let scan;
+        let path = if is_scene {
+            scan = voyager_scan(path)?;
+            &scan
+        } else {
+            path
+        };
         let mut model = load_gltf(path)?;
         if let Some(q) = voyager_rotation(path) {
             model.transform(Mat4::from_quat(q));
@@ -1091,13 +1200,22 @@ mod loader {
         })?;
         let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| ModelError::Parse {
             path: path.to_path_buf(),
-            message: e.to_string(),
+            // A glTF 1.0 file fails here on its different layout: say so rather than how.
+            message: not_gltf2(&bytes).unwrap_or_else(|| e.to_string()),
         })?;
         let doc = &gltf.document;
         if let Some(name) = doc.extensions_required().find(|e| !SUPPORTED_EXTENSIONS.contains(e)) {
             return Err(ModelError::UnsupportedExtension {
                 path: path.to_path_buf(),
                 name: name.to_owned(),
+            });
+        }
+        // glTF 1.0 (and the JSON of other formats with an "asset" version, such as a Voyager
+        // scene) can also parse into an empty glTF 2.0 document: "no triangles to draw".
+        if let Some(message) = not_gltf2_version(&doc.as_json().asset.version) {
+            return Err(ModelError::Parse {
+                path: path.to_path_buf(),
+                message,
             });
         }
         check_structure(doc.as_json()).map_err(|message| ModelError::Parse {

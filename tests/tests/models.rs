@@ -785,3 +785,83 @@ fn a_voyager_scene_orients_only_what_it_lists_and_only_when_sound() {
         }
     }
 }
+
+/// A Voyager scene, or the folder holding one (as Smithsonian downloads come), loads the best
+/// scan it lists that is present; what it cannot offer is said plainly.
+#[test]
+fn a_voyager_scene_or_its_folder_loads_its_best_scan_present() {
+    use phantogram::model::{ModelError, voyager_scan};
+    let dir = scratch("voyager-folder");
+    let derivative = |quality: &str, uri: &str| {
+        format!(r#"{{"usage":"Web3D","quality":"{quality}","assets":[{{"uri":"{uri}","type":"Model"}}]}}"#)
+    };
+    let scene = |derivatives: &[String]| {
+        format!(
+            r#"{{"asset":{{"type":"application/si-dpo-3d.document+json","version":"1.0"}},"models":[{{"derivatives":[{}]}}]}}"#,
+            derivatives.join(",")
+        )
+    };
+    for name in ["t-thumb.glb", "t-medium.glb", "t-low.glb"] {
+        tiny_gltf(&dir, name, "");
+    }
+    std::fs::write(
+        dir.join("scene.svx.json"),
+        scene(&[
+            derivative("Thumb", "t-thumb.glb"),
+            derivative("High", "t-high.glb"), // listed, not downloaded
+            derivative("Medium", "t-medium.glb"),
+            derivative("Low", "t-low.glb"),
+        ]),
+    )
+    .unwrap();
+    assert_eq!(voyager_scan(&dir).unwrap(), dir.join("t-medium.glb"));
+    for given in [dir.to_path_buf(), dir.join("scene.svx.json")] {
+        let model = load_model(&given).unwrap_or_else(|e| panic!("{e}"));
+        assert_eq!(model.name, "t-medium", "{}", given.display());
+    }
+    // A scene may only name files beside it; one that names nothing loadable is an error.
+    std::fs::write(
+        dir.join("scene.svx.json"),
+        scene(&[derivative("High", "../t-medium.glb")]),
+    )
+    .unwrap();
+    let err = load_model(&dir).unwrap_err();
+    assert!(
+        matches!(err, ModelError::NotAModel { .. }) && err.to_string().contains("lists no glTF scan"),
+        "{err}"
+    );
+    std::fs::write(dir.join("scene.svx.json"), scene(&[derivative("High", "t-high.glb")])).unwrap();
+    let err = load_model(&dir).unwrap_err().to_string();
+    assert!(
+        err.contains("none of the scans the Voyager scene lists is here (t-high.glb)"),
+        "{err}"
+    );
+    // A folder without a scene, and glTF 1.0, are named for what they are.
+    let empty = scratch("voyager-empty");
+    let err = load_model(&empty).unwrap_err().to_string();
+    assert!(err.contains("a folder without a Voyager scene"), "{err}");
+    let old = dir.join("old.gltf");
+    std::fs::write(&old, r#"{"asset":{"version":"1.0"},"meshes":{}}"#).unwrap();
+    let err = load_model(&old).unwrap_err().to_string();
+    assert!(
+        err.contains("asset version \"1.0\"; this loader reads glTF 2.0"),
+        "{err}"
+    );
+    let old_glb = dir.join("old.glb");
+    let mut glb = b"glTF".to_vec();
+    for word in [1u32, 20, 0, 0] {
+        glb.extend_from_slice(&word.to_le_bytes());
+    }
+    std::fs::write(&old_glb, glb).unwrap();
+    let err = load_model(&old_glb).unwrap_err().to_string();
+    assert!(err.contains("GLB version 1; this loader reads glTF 2.0"), "{err}");
+
+    // The Smithsonian sea turtle's download: High is not there, Medium is.
+    if let Some(models) = models_dir() {
+        let turtle = models.join("heritage/smithsonian_nmnh_sea_turtle");
+        assert_eq!(
+            voyager_scan(&turtle).unwrap(),
+            turtle.join("sea_turtle-150k-2048-medium.glb")
+        );
+    }
+}

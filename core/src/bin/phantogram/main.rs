@@ -130,7 +130,8 @@ enum Command {
 /// what the frames will hold.
 #[derive(clap::Args)]
 struct SceneArgs {
-    /// A glTF 2.0 model (.gltf or .glb); the default artifact when omitted.
+    /// A glTF 2.0 model (.gltf or .glb), or a Smithsonian Voyager folder or its scene.svx.json
+    /// (its best scan present); the default artifact when omitted.
     model: Option<PathBuf>,
     /// Fraction of a loaded model's height that stands in front of the glass.
     #[arg(long, default_value_t = 0.4)]
@@ -893,9 +894,11 @@ fn load_fitted(
         eprintln!("warning: {}: {w}", path.display());
     }
     model.fit_to_diorama(screen, fit);
+    // The model's name is its file's: it tells which scan a Voyager scene or folder gave.
     eprintln!(
-        "{}: {} triangles, {} materials, {} images",
+        "{}: {}, {} triangles, {} materials, {} images",
         path.display(),
+        model.name,
         model.triangle_count(),
         model.materials.len(),
         model.images.len()
