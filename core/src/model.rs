@@ -1053,17 +1053,7 @@ mod loader {
         let file_name = model_path.file_name()?.to_str()?;
         let text = std::fs::read_to_string(model_path.parent()?.join("scene.svx.json")).ok()?;
         let scene: serde_json::Value = serde_json::from_str(&text).ok()?;
-        let model = scene.get("models")?.as_array()?.iter().find(|m| {
-            m.get("derivatives").and_then(|d| d.as_array()).is_some_and(|ds| {
-                ds.iter().any(|d| {
-                    d.get("assets").and_then(|a| a.as_array()).is_some_and(|assets| {
-                        assets
-                            .iter()
-                            .any(|a| a.get("uri").and_then(|u| u.as_str()) == Some(file_name))
-                    })
-                })
-            })
-        })?;
+        let (model, _, _) = voyager_assets(&scene).find(|(_, _, uri)| *uri == file_name)?;
         let r: Vec<f32> = model
             .get("rotation")?
             .as_array()?
@@ -1090,6 +1080,23 @@ mod loader {
         }
         let json: serde_json::Value = serde_json::from_slice(bytes).ok()?;
         not_gltf2_version(json.get("asset")?.get("version")?.as_str()?)
+    }
+
+    /// Every asset a Voyager scene lists, with the model and derivative that list it:
+    /// `models[].derivatives[].assets[].uri`.
+    fn voyager_assets(
+        scene: &serde_json::Value,
+    ) -> impl Iterator<Item = (&serde_json::Value, &serde_json::Value, &str)> {
+        fn array<'a>(v: &'a serde_json::Value, key: &str) -> impl Iterator<Item = &'a serde_json::Value> + use<'a> {
+            v.get(key).and_then(|x| x.as_array()).into_iter().flatten()
+        }
+        array(scene, "models").flat_map(move |model| {
+            array(model, "derivatives").flat_map(move |derivative| {
+                array(derivative, "assets")
+                    .filter_map(|asset| asset.get("uri")?.as_str())
+                    .map(move |uri| (model, derivative, uri))
+            })
+        })
     }
 
     /// The Voyager scene file's name, which a Smithsonian download folder holds beside its scans.
@@ -1125,34 +1132,19 @@ mod loader {
             message: e.to_string(),
         })?;
         let folder = scene_path.parent().unwrap_or(Path::new("."));
-        let mut offered = Vec::new();
-        for d in scene
-            .get("models")
-            .and_then(|m| m.as_array())
-            .into_iter()
-            .flatten()
-            .filter_map(|m| m.get("derivatives")?.as_array())
-            .flatten()
-            .filter(|d| d.get("usage").and_then(|u| u.as_str()) == Some("Web3D"))
-        {
-            let quality = d.get("quality").and_then(|q| q.as_str()).unwrap_or("");
-            let Some(rank) = ["High", "Medium", "Low", "Thumb"].iter().position(|q| *q == quality) else {
-                continue;
-            };
-            for uri in d
-                .get("assets")
-                .and_then(|a| a.as_array())
-                .into_iter()
-                .flatten()
-                .filter_map(|a| a.get("uri")?.as_str())
-                .filter(|u| u.ends_with(".glb") || u.ends_with(".gltf"))
-            {
-                // Only plain file names beside the scene: a scene must not point elsewhere.
-                if Path::new(uri).file_name() == Some(std::ffi::OsStr::new(uri)) {
-                    offered.push((rank, uri.to_owned()));
-                }
-            }
-        }
+        let is = |v: &serde_json::Value, key: &str, want: &str| v.get(key).and_then(|x| x.as_str()) == Some(want);
+        let mut offered: Vec<(usize, &str)> = voyager_assets(&scene)
+            .filter(|(_, d, _)| is(d, "usage", "Web3D"))
+            .filter_map(|(_, d, uri)| {
+                let rank = ["High", "Medium", "Low", "Thumb"]
+                    .iter()
+                    .position(|q| is(d, "quality", q))?;
+                // Only glTF files, by plain names beside the scene: a scene must not point elsewhere.
+                let gltf = uri.ends_with(".glb") || uri.ends_with(".gltf");
+                let beside = Path::new(uri).file_name() == Some(std::ffi::OsStr::new(uri));
+                (gltf && beside).then_some((rank, uri))
+            })
+            .collect();
         offered.sort();
         if offered.is_empty() {
             return Err(not_a_model("the Voyager scene lists no glTF scan".into()));
@@ -1162,7 +1154,7 @@ mod loader {
             .map(|(_, uri)| folder.join(uri))
             .find(|p| p.is_file())
             .ok_or_else(|| {
-                let names: Vec<&str> = offered.iter().map(|(_, u)| u.as_str()).collect();
+                let names: Vec<&str> = offered.iter().map(|(_, u)| *u).collect();
                 not_a_model(format!(
                     "none of the scans the Voyager scene lists is here ({})",
                     names.join(", ")
