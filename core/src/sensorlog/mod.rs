@@ -122,6 +122,11 @@ pub fn open_maybe_gz(path: &Path) -> Result<Box<dyn BufRead>, LogError> {
     }
 }
 
+/// The longest line [`Lines`] reads: far above any sensor export's row, far below what a file
+/// that is not text (or a gzip stream that inflates to gigabytes without a line break) would make
+/// it hold in memory.
+pub const MAX_LINE_BYTES: usize = 1 << 20;
+
 /// Reads numbered lines, naming the file in every error.
 pub struct Lines {
     path: PathBuf,
@@ -155,17 +160,26 @@ impl Lines {
     /// Moves to the next line; `false` at the end. Read it with [`Self::current`].
     pub fn advance(&mut self) -> Result<bool, LogError> {
         self.buf.clear();
-        let n = self.reader.read_line(&mut self.buf).map_err(|e| {
-            if e.kind() == io::ErrorKind::InvalidData {
-                LogError::parse(&self.path, self.line_no + 1, "not valid UTF-8 text")
-            } else {
-                LogError::io(&self.path, e)
-            }
-        })?;
+        let n = (&mut self.reader)
+            .take(MAX_LINE_BYTES as u64 + 1)
+            .read_line(&mut self.buf)
+            .map_err(|e| {
+                if e.kind() == io::ErrorKind::InvalidData {
+                    LogError::parse(&self.path, self.line_no + 1, "not valid UTF-8 text")
+                } else {
+                    LogError::io(&self.path, e)
+                }
+            })?;
         if n == 0 {
             return Ok(false);
         }
         self.line_no += 1;
+        if n > MAX_LINE_BYTES {
+            return Err(self.error(format!(
+                "a line longer than {} MiB: not a sensor log?",
+                MAX_LINE_BYTES >> 20
+            )));
+        }
         Ok(true)
     }
 
@@ -520,6 +534,29 @@ mod tests {
             assert!(shown.contains(&format!("bad{i}.pglog:{line}:")), "{shown}");
             assert!(shown.contains(needle), "{shown}");
         }
+    }
+
+    #[test]
+    fn a_line_without_end_is_an_error_not_a_gigabyte() {
+        let dir = Scratch::new("unit-log-long-line");
+        // Gzip makes it small on disk: 2 MiB of digits without a line break.
+        let path = dir.join("long.pglog.gz");
+        let mut gz = GzEncoder::new(File::create(&path).unwrap(), Compression::fast());
+        gz.write_all(b"phantogram-sensor-log 1\nacc 1 0 0 ").unwrap();
+        gz.write_all(&vec![b'9'; 2 << 20]).unwrap();
+        gz.finish().unwrap();
+        let err = LogReader::open(&path)
+            .and_then(|r| r.collect::<Result<Vec<_>, _>>())
+            .unwrap_err();
+        assert_eq!(err.line(), Some(2), "{err}");
+        assert!(err.to_string().contains("a line longer than 1 MiB"), "{err}");
+        // A line of exactly the limit is still read (the importers' CSV headers can be long).
+        let mut lines = Lines::new(
+            &path,
+            Box::new(std::io::Cursor::new(format!("{}\n", "x".repeat(MAX_LINE_BYTES - 1)))),
+        );
+        assert!(lines.advance().unwrap());
+        assert_eq!(lines.current().len(), MAX_LINE_BYTES - 1);
     }
 
     #[test]
