@@ -337,11 +337,11 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
     // A PNG whose header claims 60000 × 60000 pixels (14 GB to decode) and a Radiance HDR are
     // refused by name; the photo between them is still read.
     let dir = Scratch::new("cli-faces");
-    let mut bomb = b"\x89PNG\r\n\x1a\n\0\0\0\rIHDR".to_vec();
-    bomb.extend_from_slice(&60_000u32.to_be_bytes());
-    bomb.extend_from_slice(&60_000u32.to_be_bytes());
-    bomb.extend_from_slice(&[8, 6, 0, 0, 0]);
-    bomb.extend_from_slice(&crc32(&bomb[12..]).to_be_bytes());
+    let mut header = Vec::new();
+    for side in [60_000u32, 60_000] {
+        header.extend_from_slice(&side.to_be_bytes());
+    }
+    header.extend_from_slice(&[8, 6, 0, 0, 0]); // 8-bit RGBA
     // Two rows of image data, then the end: the decoder reads this far before it allocates.
     let rows = {
         use std::io::Write;
@@ -349,12 +349,15 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
         z.write_all(&vec![0u8; 2 * (1 + 4 * 60_000)]).unwrap();
         z.finish().unwrap()
     };
-    for (kind, data) in [(&b"IDAT"[..], &rows[..]), (b"IEND", b"")] {
-        let start = bomb.len() + 4;
+    let mut bomb = b"\x89PNG\r\n\x1a\n".to_vec();
+    for (kind, data) in [(&b"IHDR"[..], &header[..]), (b"IDAT", &rows), (b"IEND", b"")] {
         bomb.extend_from_slice(&(data.len() as u32).to_be_bytes());
+        let mut crc = flate2::Crc::new();
+        crc.update(kind);
+        crc.update(data);
         bomb.extend_from_slice(kind);
         bomb.extend_from_slice(data);
-        bomb.extend_from_slice(&crc32(&bomb[start..]).to_be_bytes());
+        bomb.extend_from_slice(&crc.sum().to_be_bytes());
     }
     std::fs::write(dir.join("bomb.png"), &bomb).unwrap();
     std::fs::write(
@@ -378,22 +381,6 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
     );
     assert!(err.contains("not a PNG or JPEG photo (Hdr)"), "{err}");
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1, "{err}");
-}
-
-/// CRC-32 (ISO-HDLC, as PNG uses), bit by bit: enough for one chunk header.
-fn crc32(bytes: &[u8]) -> u32 {
-    let mut crc = !0u32;
-    for &b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            crc = if crc & 1 == 1 {
-                (crc >> 1) ^ 0xEDB8_8320
-            } else {
-                crc >> 1
-            };
-        }
-    }
-    !crc
 }
 
 /// `eval orientation` on a folder: a recording that cannot be read is named and skipped, the
