@@ -1,5 +1,5 @@
-//! The fused estimator on real recordings (`$PHANTOGRAM_DATA/imu`): fault injection, and the
-//! world light's heading drift through the whole core. Without `PHANTOGRAM_DATA` these tests
+//! The fused estimator on real recordings (`$PHANTOGRAM_DATA/imu`): fault injection, the
+//! accuracy goals of issue #4, and the world light's heading drift through the whole core. Without `PHANTOGRAM_DATA` these tests
 //! print a notice and return; the synthetic fault test at the end always runs.
 
 use phantogram::attitude::OrientationEstimator;
@@ -429,12 +429,15 @@ fn light_drift_with_mounting(events: &[SensorEvent], marker_from_imu: Quat) -> L
 
 /// Known limit, kept as a failing check: on two of the four undisturbed phone recordings the
 /// light's heading trend exceeds 2°/min. Measured with the ground truth corrected for the IMU's
-/// mounting in the marker body where it is determined ([`marker_from_imu`]): +2.04 (Guillaume
-/// AR) and −2.48°/min (Thibaud Texting, mounting not determined); −0.03 (Guillaume Texting)
-/// and −0.75 (Thibaud AR) on the others. Android's own rotation vector, measured the same way,
-/// in the same order: +16.5, −1.59, −1.69 and −1.19°/min.
+/// mounting in the marker body where it is determined ([`marker_from_imu`]): +2.22 (Guillaume
+/// AR) and −2.38°/min (Thibaud Texting, mounting not determined); −0.16 (Guillaume Texting)
+/// and −1.27 (Thibaud AR) on the others (before the gyroscope bias was estimated in motion:
+/// +2.04, −2.48, −0.03 and −0.75). Android's own rotation vector, measured the same way, in the
+/// order Guillaume AR, Guillaume Texting, Thibaud AR, Thibaud Texting: +16.5, −1.69, −1.19 and
+/// −1.59°/min.
 /// The phone's magnetic heading there has pose- and place-dependent errors of ±5–10° against
-/// the motion capture; a longer heading time constant lets the gyroscope drift instead (+4.5°/min
+/// the motion capture. The following were measured before in-motion bias estimation: a longer
+/// heading time constant lets the gyroscope drift instead (+4.5°/min
 /// on Guillaume Texting at 40 s), and learning gyroscope bias about the vertical from the
 /// magnetometer's steady corrections (an integral term, 40–80 s) learns the field's errors as
 /// bias and makes it worse (−3.1 to −4.9°/min there). Even an oracle magnetometer calibration,
@@ -509,8 +512,9 @@ fn magnetometer_keeps_the_light_from_drifting_with_gyro_bias() {
 }
 
 /// Every estimator shows a floor of about 2° of inclination error on the phone recordings (the
-/// data's README), and the fused estimator's raw RMSE exceeds Android's rotation vector's on two
-/// of them (`benchmarks/orientation.md`). The floor is the marker body's mounting on the phone:
+/// data's README), which hides much of the difference between estimators (fused 1.63° against
+/// Android's 1.69° on Thibaud Texting, `benchmarks/orientation.md`). The floor is the marker
+/// body's mounting on the phone:
 /// with the ground truth turned by the mounting estimated from rates alone ([`marker_from_imu`],
 /// which no estimator's output enters), both estimators' inclination RMSE falls on every trial
 /// whose mounting is determined, and there the fused estimator is the better of the two.
@@ -584,4 +588,66 @@ fn marker_mounting_is_recovered_from_rates() {
     println!("mounting recovered within {error:.3}° from {used} intervals");
     assert!(used > 100, "{used} intervals");
     assert!(error < 0.2, "{error}°");
+}
+
+/// Issue #4's accuracy goal on the phones: on every provided recording the fused estimator's
+/// inclination RMSE (after the first 5 s, as `phantogram eval orientation` scores it) is no worse
+/// than that of Android's own rotation vector recorded beside it. Before the gyroscope bias was
+/// estimated in motion it was worse on two of them (2.38 vs 2.25°, 1.80 vs 1.69°).
+#[test]
+fn phone_inclination_no_worse_than_androids_rotation_vector() {
+    use phantogram::orientation_eval::{PlatformRotationVector, Trial, score};
+    let Some(dir) = data_subdir("imu") else { return };
+    let mut scored = 0;
+    for entry in std::fs::read_dir(dir.join("phone")).unwrap() {
+        let path = entry.unwrap().path();
+        if !path.is_dir() {
+            continue;
+        }
+        let trial = Trial::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let ours = score(&trial, "fused", &mut FusedOrientation::default()).main;
+        let android = score(&trial, "rotation vector", &mut PlatformRotationVector::default()).main;
+        println!(
+            "{}: inclination RMSE fused {:.2}° / rotation vector {:.2}° over {} rows",
+            trial.name, ours.inclination_deg, android.inclination_deg, ours.rows
+        );
+        assert!(ours.rows > 1000 && android.rows > 1000, "{}: too few rows", trial.name);
+        assert!(
+            ours.inclination_deg <= android.inclination_deg,
+            "{}: fused {:.3}° > rotation vector {:.3}°",
+            trial.name,
+            ours.inclination_deg,
+            android.inclination_deg
+        );
+        scored += 1;
+    }
+    assert!(scored >= 6, "only {scored} phone recordings");
+}
+
+/// Issue #4's accuracy goal on BROAD: mean inclination RMSE ≤ 0.7° and heading RMSE ≤ 2.0° over
+/// the provided trials (VQF reaches 0.70° / 1.92° over all 39).
+#[test]
+fn broad_means_meet_the_goal() {
+    use phantogram::orientation_eval::{Trial, score};
+    let Some(dir) = data_subdir("imu") else { return };
+    let (mut incl, mut head, mut n) = (0.0, 0.0, 0);
+    let mut paths: Vec<_> = std::fs::read_dir(dir.join("broad"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.to_string_lossy().ends_with(".csv.gz"))
+        .collect();
+    paths.sort();
+    for path in paths {
+        let trial = Trial::load(&path).unwrap_or_else(|e| panic!("{e}"));
+        let main = score(&trial, "fused", &mut FusedOrientation::default()).main;
+        let heading = main.heading_deg.expect("BROAD has a heading");
+        println!("{}: {:.2}° / {heading:.2}°", trial.name, main.inclination_deg);
+        incl += main.inclination_deg;
+        head += heading;
+        n += 1;
+    }
+    assert!(n >= 14, "only {n} BROAD trials");
+    let (incl, head) = (incl / n as f64, head / n as f64);
+    println!("BROAD means over {n} trials: inclination {incl:.2}°, heading {head:.2}°");
+    assert!(incl <= 0.7 && head <= 2.0, "{incl}° / {head}°");
 }
