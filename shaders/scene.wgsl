@@ -186,10 +186,13 @@ fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     let offset = n * texel * (1.5 + 2.0 * sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l);
     let p = eye.light_view_proj * vec4<f32>(world + offset, 1.0);
     let uv = vec2<f32>(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5);
-    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) || p.z > 1.0) {
+    // The map covers the casters only (render.rs, `shadow_casters`): a receiver outside it is lit,
+    // and one beyond its far plane (the floor under a long shadow) lies behind every caster there,
+    // so it is compared at the far plane.
+    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0))) {
         return 1.0;
     }
-    return shadow_pcf(uv, p.z);
+    return shadow_pcf(uv, min(p.z, 1.0));
 }
 
 fn to_world(v: vec3<f32>) -> vec3<f32> {

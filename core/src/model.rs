@@ -283,6 +283,10 @@ pub struct Primitive {
     pub mesh: Mesh,
     /// Index into [`Model::materials`].
     pub material: usize,
+    /// The diorama floor of [`Model::add_floor`], a plane facing +z under everything else. The
+    /// renderer fits its shadow map to the rest (what the floor receives shadows from), and draws
+    /// the floor into it only when the light is below the floor's plane.
+    pub is_floor: bool,
 }
 
 /// A whole model: primitives, materials and images, all positions in one frame.
@@ -357,7 +361,11 @@ impl Model {
     pub fn from_painted_mesh(name: &str, mesh: Mesh) -> Self {
         Self {
             name: name.into(),
-            primitives: vec![Primitive { mesh, material: 0 }],
+            primitives: vec![Primitive {
+                mesh,
+                material: 0,
+                is_floor: false,
+            }],
             materials: vec![Material::vertex_painted()],
             images: Vec::new(),
             warnings: Vec::new(),
@@ -402,6 +410,7 @@ impl Model {
         self.primitives.push(Primitive {
             mesh,
             material: self.materials.len() - 1,
+            is_floor: true,
         });
     }
 
@@ -1336,6 +1345,7 @@ mod loader {
                     model.primitives.push(Primitive {
                         mesh: m,
                         material: prim.material().index().unwrap_or(default_material),
+                        is_floor: false,
                     });
                 }
             }

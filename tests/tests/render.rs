@@ -12,7 +12,7 @@ use std::path::PathBuf;
 
 use phantogram::anaglyph::Method;
 use phantogram::artifact::default_model;
-use phantogram::glam::Vec3;
+use phantogram::glam::{Mat4, Vec3};
 use phantogram::model::{Mesh, Model};
 use phantogram::projection::{DepthRange, OffAxisProjection};
 use phantogram::render::{FrameInput, Gpu, Renderer};
@@ -280,19 +280,30 @@ fn gpu_composition_matches_the_cpu_reference() {
 
 /// A floor at z = −30 mm seen straight on, with a cube above it or resting on it, lit obliquely.
 fn shadow_scene(cube_centre: Vec3, half: f32, shadows: bool) -> Option<(Vec<u8>, OffAxisProjection)> {
+    shadow_scene_lit(cube_centre, half, shadows, OBLIQUE_LIGHT)
+}
+
+fn shadow_scene_lit(
+    cube_centre: Vec3,
+    half: f32,
+    shadows: bool,
+    toward_light: Vec3,
+) -> Option<(Vec<u8>, OffAxisProjection)> {
     let mut mesh = Mesh::default();
     mesh.push_cube(cube_centre, half, [0.8, 0.8, 0.8, 1.0]);
     push_floor_marker(&mut mesh);
-    render_over_floor(Model::from_painted_mesh("shadow test", mesh), shadows)
+    render_over_floor(Model::from_painted_mesh("shadow test", mesh), shadows, toward_light)
 }
+
+const OBLIQUE_LIGHT: Vec3 = Vec3::new(0.5, 0.0, 1.0);
 
 /// A tiny cube whose bottom is at z = −31 mm, so that `add_floor` puts the floor there.
 fn push_floor_marker(mesh: &mut Mesh) {
     mesh.push_cube(Vec3::new(0.03, 0.06, -0.0305), 0.0005, [0.5, 0.5, 0.5, 1.0]);
 }
 
-/// `model` on its floor seen straight on from 30 cm, lit along (0.5, 0, 1), in mono.
-fn render_over_floor(mut model: Model, shadows: bool) -> Option<(Vec<u8>, OffAxisProjection)> {
+/// `model` on its floor seen straight on from 30 cm, lit from `toward_light`, in mono.
+fn render_over_floor(mut model: Model, shadows: bool, toward_light: Vec3) -> Option<(Vec<u8>, OffAxisProjection)> {
     let gpu = gpu()?;
     let screen = Screen::default();
     model.add_floor(&screen, 2.0);
@@ -304,7 +315,7 @@ fn render_over_floor(mut model: Model, shadows: bool) -> Option<(Vec<u8>, OffAxi
         left: &mono,
         right: &mono,
         mono: &mono,
-        toward_light: Vec3::new(0.5, 0.0, 1.0),
+        toward_light,
         device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
     };
@@ -371,9 +382,10 @@ fn alpha_masked_surfaces_shadow_only_where_they_are_kept() {
         model.primitives.push(Primitive {
             mesh,
             material: model.materials.len() - 1,
+            is_floor: false,
         });
     }
-    let Some((pixels, proj)) = render_over_floor(model, true) else {
+    let Some((pixels, proj)) = render_over_floor(model, true, OBLIQUE_LIGHT) else {
         return;
     };
     // As in `shadows_fall_where_the_light_says`: each cube's shadow centre is 7.5 mm towards −x.
@@ -423,6 +435,36 @@ fn lit_floor_has_no_acne_and_resting_objects_no_gap() {
     assert!(
         near_l < 0.6 * far_l,
         "shadow detached from a resting object: {near_l} vs {far_l}"
+    );
+}
+
+/// The shadow map covers what stands on the floor, not the floor (its texels would be ~10× coarser
+/// over the floor's extent). But a light below the floor's plane (the phone tilted past it) is
+/// hidden by the floor from everything on it: a face turned towards such a light stays in shadow.
+#[test]
+fn a_light_below_the_floor_is_blocked_by_it() {
+    // A cube turned 45° about y: one face looks up and towards +x, visible from the eye above and
+    // facing a light 17° below the floor's plane from +x (n·l ≈ 0.47). The ray from that face's
+    // centre towards the light meets the floor 72 mm further on, well inside it.
+    let below = Vec3::new(1.0, 0.0, -0.3);
+    let centre = Vec3::new(-0.015, 0.0, -0.015);
+    let render = |shadows: bool| {
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::ZERO, 0.008, [0.8, 0.8, 0.8, 1.0]);
+        mesh.transform(Mat4::from_translation(centre) * Mat4::from_rotation_y(-std::f32::consts::FRAC_PI_4));
+        push_floor_marker(&mut mesh);
+        render_over_floor(Model::from_painted_mesh("light below", mesh), shadows, below)
+    };
+    let Some((with, proj)) = render(true) else { return };
+    let Some((without, _)) = render(false) else { return };
+    let face_centre = centre + Vec3::new(1.0, 0.0, 1.0).normalize() * 0.008;
+    let face: Vec<Vec3> = (-2..=2).map(|k| face_centre + Vec3::Y * (0.002 * k as f32)).collect();
+    let mean = |pixels: &[u8]| face.iter().map(|&p| luminance_at(pixels, &proj, p)).sum::<f32>() / face.len() as f32;
+    let (shadowed, lit) = (mean(&with), mean(&without));
+    println!("face towards a light below the floor: {shadowed} with shadows, {lit} without");
+    assert!(
+        shadowed < 0.6 * lit,
+        "the floor let the light through: {shadowed} vs {lit}"
     );
 }
 
