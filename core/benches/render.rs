@@ -3,7 +3,8 @@
 //!
 //! * cold load-to-first-frame of the Draco-compressed Smithsonian sea turtle (needs
 //!   `PHANTOGRAM_DATA`; skipped with a notice otherwise): file read, Draco decoding, image
-//!   decoding, mip generation, upload, pipeline creation and one 1080×2400 stereo frame read back;
+//!   decoding, mip generation, upload, pipeline creation and one 1080×2400 stereo frame read back,
+//!   with the renderer's lighting tables computed on another thread meanwhile, as the app does;
 //! * stereo (Dubois) / mono frame time at 1080×2400 for the default artifact (alone, and on the
 //!   diorama floor as the app draws it) and the turtle, as the median of 11 frames each, mono
 //!   and stereo alternating;
@@ -88,6 +89,9 @@ fn main() {
     match turtle_path.filter(|p| p.exists()) {
         Some(path) => {
             let start = Instant::now();
+            // As `phantogram render` and the engine start: the lighting tables on another thread
+            // while the model loads.
+            std::thread::spawn(|| phantogram::render::prepare_lighting_tables(true));
             let mut turtle = phantogram::model::load_model(&path).expect("the turtle loads");
             turtle.fit_to_diorama(&SessionConfig::default().screen, &DioramaFit::default());
             let loaded = start.elapsed();

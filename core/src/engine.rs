@@ -212,8 +212,14 @@ fn check_size(width: u32, height: u32) -> Result<(), EngineError> {
 impl Engine {
     /// Opens the GPU device (hardware first, software fallback), loads and fits the model, the
     /// environment and (if asked) the face models. Takes from tens of milliseconds (default
-    /// artifact) to about a second (a large scan): call it off the UI thread.
+    /// artifact) to about a second (a large scan): call it off the UI thread. It also starts a
+    /// short-lived thread that computes the renderer's lighting tables meanwhile (once per
+    /// process, [`crate::render::prepare_lighting_tables`]).
     pub fn new(config: EngineConfig) -> Result<Self, EngineError> {
+        // The renderer's lighting tables, computed meanwhile on another thread (see
+        // `render::prepare_lighting_tables`): opening the device and loading the model overlap it.
+        let studio = config.environment_path.is_none();
+        std::thread::spawn(move || crate::render::prepare_lighting_tables(studio));
         Self::with_gpu(Gpu::headless()?, config)
     }
 
@@ -237,10 +243,11 @@ impl Engine {
         if config.floor {
             model.add_floor(&screen, crate::model::Model::FLOOR_REACH);
         }
-        let mut renderer = Renderer::new(gpu, &model)?;
-        if let Some(path) = &config.environment_path {
-            renderer.set_environment(&crate::ibl::Environment::load(path)?)?;
-        }
+        let environment = match &config.environment_path {
+            Some(path) => Some(crate::ibl::Environment::load(path)?),
+            None => None,
+        };
+        let renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
         #[cfg(feature = "face")]
         let face = match &config.face_models_dir {
             Some(dir) => {

@@ -29,7 +29,8 @@
 //! and CI run: Debian's `mesa-vulkan-drivers`). No display is needed.
 //!
 //! **Threading**: a [`Renderer`] belongs to one thread; wgpu's device and queue are internally
-//! synchronised. **Panics**: none on bad input; GPU failures come back as [`RenderError`].
+//! synchronised. [`prepare_lighting_tables`] may run on any thread (once per process; a renderer
+//! created meanwhile waits for it rather than computing the tables twice). **Panics**: none on bad input; GPU failures come back as [`RenderError`].
 
 use glam::{Mat4, Vec3};
 use thiserror::Error;
@@ -650,17 +651,39 @@ pub struct Renderer {
 }
 
 impl Renderer {
+    /// A renderer for `model`, lit by the generated neutral studio.
     pub fn new(gpu: Gpu, model: &Model) -> Result<Self, RenderError> {
+        Self::with_environment(gpu, model, None)
+    }
+
+    /// A renderer for `model`, lit by `environment` (the generated studio when `None`). The same
+    /// as [`Self::new`] then [`Self::set_environment`], without prefiltering the studio first.
+    pub fn with_environment(
+        gpu: Gpu,
+        model: &Model,
+        environment: Option<&crate::ibl::Environment>,
+    ) -> Result<Self, RenderError> {
         if model.triangle_count() == 0 {
             return Err(RenderError::EmptyModel);
         }
+        let prefiltered;
+        let (levels, sh): (&[crate::ibl::Environment], _) = match environment {
+            Some(env) => {
+                prefiltered = crate::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
+                (&prefiltered, crate::ibl::IrradianceSh::from_environment(env))
+            }
+            None => (
+                default_prefiltered_environment(),
+                crate::ibl::IrradianceSh::from_environment(&crate::ibl::Environment::studio()),
+            ),
+        };
         let device = gpu.device.clone();
         checked(&device, "the renderer's pipelines or the model", || {
-            Self::build(gpu, model)
+            Self::build(gpu, model, levels, sh.shader_coefficients())
         })
     }
 
-    fn build(gpu: Gpu, model: &Model) -> Self {
+    fn build(gpu: Gpu, model: &Model, environment: &[crate::ibl::Environment], environment_sh: [[f32; 4]; 9]) -> Self {
         let device = &gpu.device;
         let scene_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("scene.wgsl"),
@@ -731,7 +754,7 @@ impl Renderer {
                 mapped_at_creation: false,
             })
         });
-        let ibl = IblTextures::new(&gpu, default_prefiltered_environment());
+        let ibl = IblTextures::new(&gpu, environment);
         let eye_bind = eye_bind_groups(device, &eye_layout, &eye_buffers, &shadow_view, &shadow_sampler, &ibl);
         // The shadow pass reads only the light's matrix (the same in both eye blocks) and must
         // not bind the shadow map it writes.
@@ -859,8 +882,7 @@ impl Renderer {
             shadow_pipeline,
             shadow_bind,
             shadow_view,
-            environment_sh: crate::ibl::IrradianceSh::from_environment(&crate::ibl::Environment::studio())
-                .shader_coefficients(),
+            environment_sh,
             targets: None,
             lighting: Lighting::default(),
             gpu,
@@ -1609,8 +1631,21 @@ const PREFILTERED_BASE_WIDTH: usize = 256;
 /// Size of the split-sum BRDF table (n·v × roughness).
 const BRDF_LUT_SIZE: usize = 64;
 
-/// The generated studio's prefiltered levels, computed once per process: every renderer starts
-/// with them.
+/// Computes, once per process, the tables a [`Renderer`] needs before its first frame: the
+/// split-sum BRDF table and, if `studio`, the generated studio's prefiltered levels (the lighting
+/// when no environment is given). About 100 ms of CPU work on this machine's two cores; an app
+/// calls it on a background thread at start-up, overlapping it with loading the model and opening
+/// the device (the sea turtle's cold load-to-first-frame: see `benchmarks/render.md`). Calling it
+/// is never required: the renderer computes what is missing, or waits for a computation under way.
+pub fn prepare_lighting_tables(studio: bool) {
+    brdf_lut_texels();
+    if studio {
+        default_prefiltered_environment();
+    }
+}
+
+/// The generated studio's prefiltered levels, computed once per process: every renderer without
+/// an environment of its own starts with them.
 fn default_prefiltered_environment() -> &'static [crate::ibl::Environment] {
     static LEVELS: std::sync::OnceLock<Vec<crate::ibl::Environment>> = std::sync::OnceLock::new();
     LEVELS.get_or_init(|| crate::ibl::prefiltered_levels(&crate::ibl::Environment::studio(), PREFILTERED_BASE_WIDTH))

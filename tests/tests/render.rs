@@ -477,7 +477,8 @@ fn environment_light_turns_with_the_device() {
     let screen = Screen::default();
     let mut mesh = Mesh::default();
     mesh.push_cube(Vec3::new(0.0, 0.0, -0.02), 0.01, [0.8, 0.8, 0.8, 1.0]);
-    let mut renderer = Renderer::new(gpu, &Model::from_painted_mesh("cube", mesh)).unwrap();
+    let model = Model::from_painted_mesh("cube", mesh);
+    let mut renderer = Renderer::new(gpu, &model).unwrap();
     let mut sky = phantogram::ibl::Environment::studio();
     for (i, t) in sky.texels.iter_mut().enumerate() {
         let above = i / sky.width < sky.height / 2;
@@ -507,6 +508,27 @@ fn environment_light_turns_with_the_device() {
     );
     println!("cube top under a sky: device face up {face_up}, face down {face_down}");
     assert!(face_up > 2.0 * face_down, "{face_up} vs {face_down}");
+
+    // Made with the sky from the start (the studio never prefiltered), the renderer draws the
+    // same frame to the byte.
+    let Some(second_gpu) = self::gpu() else { return };
+    let mut from_start = Renderer::with_environment(second_gpu, &model, Some(&sky)).unwrap();
+    from_start.lighting = renderer.lighting;
+    let frame = |renderer: &mut Renderer| {
+        let input = FrameInput {
+            left: &mono,
+            right: &mono,
+            mono: &mono,
+            toward_light: Vec3::Z,
+            device_to_world: phantogram::glam::Quat::from_rotation_x(0.4),
+            offset: Vec3::ZERO,
+        };
+        renderer.render(&input, Method::Mono, W, H).unwrap()
+    };
+    assert!(
+        frame(&mut from_start) == frame(&mut renderer),
+        "with_environment differs from set_environment"
+    );
 }
 
 /// Specular image-based light comes from the prefiltered environment in the reflection direction

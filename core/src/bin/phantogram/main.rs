@@ -164,6 +164,9 @@ impl SceneArgs {
         if !(0.0..=1.0).contains(&self.protrude) {
             bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
         }
+        // The renderer's lighting tables, computed meanwhile on another thread.
+        let studio = self.environment.is_none();
+        std::thread::spawn(move || phantogram::render::prepare_lighting_tables(studio));
         let fit = phantogram::model::DioramaFit {
             placement: match self.placement {
                 PlacementArg::Auto => phantogram::model::Placement::Auto,
@@ -771,10 +774,7 @@ fn render_command(args: RenderArgs) -> Result<()> {
     remove_earlier_frames(out_dir)?;
     let gpu = Gpu::headless()?;
     eprintln!("rendering on {}", gpu.describe());
-    let mut renderer = Renderer::new(gpu, &model)?;
-    if let Some(environment) = &environment {
-        renderer.set_environment(environment)?;
-    }
+    let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
     let mut session = Session::new(config).context("invalid settings")?;
     let mut smoother = ContainmentSmoother::default();
 

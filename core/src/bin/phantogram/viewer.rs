@@ -297,10 +297,7 @@ impl ApplicationHandler for App {
             if self.renderer.is_none() {
                 let gpu = Gpu::for_display(Box::new(event_loop.owned_display_handle()), window.clone())?;
                 eprintln!("viewing on {}", gpu.describe());
-                let mut renderer = Renderer::new(gpu, &self.args.model)?;
-                if let Some(environment) = &self.args.environment {
-                    renderer.set_environment(environment)?;
-                }
+                let renderer = Renderer::with_environment(gpu, &self.args.model, self.args.environment.as_ref())?;
                 self.renderer = Some(renderer);
             }
             if self.egui_input.is_none() {
