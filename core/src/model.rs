@@ -415,8 +415,14 @@ impl Model {
     }
 
     pub fn bounds(&self) -> Option<Aabb> {
+        self.bounds_of(|_| true)
+    }
+
+    /// The bounds of the primitives `keep` accepts (`None` if it accepts none with vertices).
+    pub fn bounds_of(&self, keep: impl Fn(&Primitive) -> bool) -> Option<Aabb> {
         self.primitives
             .iter()
+            .filter(|p| keep(p))
             .filter_map(|p| p.mesh.bounds())
             .reduce(|a, b| Aabb::new(a.min.min(b.min), a.max.max(b.max)))
     }

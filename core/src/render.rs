@@ -4,7 +4,8 @@
 //!
 //! ## Passes per frame
 //! 1. Shadow pass, once for both eyes: depth from the world-fixed light (orthographic over the
-//!    model), both faces of every surface; alpha-masked materials are cut out as in the scene pass
+//!    model without its floor, which only receives unless the light is below it), both faces of
+//!    every surface; alpha-masked materials are cut out as in the scene pass
 //!    (their shadows have the holes they have), blended ones cast none.
 //! 2. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
 //!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
@@ -1611,13 +1612,7 @@ fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> Gpu
         .collect();
     let fallback = crate::containment::Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05));
     let bounds = model.bounds().unwrap_or(fallback);
-    let standing = model
-        .primitives
-        .iter()
-        .filter(|p| !p.is_floor)
-        .filter_map(|p| p.mesh.bounds())
-        .reduce(|a, b| crate::containment::Aabb::new(a.min.min(b.min), a.max.max(b.max)))
-        .unwrap_or(bounds);
+    let standing = model.bounds_of(|p| !p.is_floor).unwrap_or(bounds);
     GpuModel {
         primitives,
         materials,
