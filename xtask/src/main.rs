@@ -216,8 +216,10 @@ fn bench_orientation() -> Result<()> {
          `phantogram eval orientation $PHANTOGRAM_DATA/imu/broad $PHANTOGRAM_DATA/imu/phone` (release build).\n\n\
          RMSE in degrees with BROAD's definitions: `incl`, `head`, `total` over the main rows (after the\n\
          first 5 s; BROAD: movement phases only), `c.incl`, `c.head` over the first 5 s (convergence).\n\
-         Phone ground truth has the motion-capture room's heading, so only inclination is scored there.\n\
-         It is also the marker body's attitude, 1–2° off the phone's IMU: that is the floor of ~2° every\n\
+         Phone ground truth has the motion-capture room's heading, not north: there `head` and `total` are\n\
+         scored after removing the constant turn between the room and the estimator's north (the circular\n\
+         mean of its heading errors over the main rows), so they measure how steady the heading is.\n\
+         Phone truth is also the marker body's attitude, 1–2° off the phone's IMU: that is the floor of ~2° every\n\
          estimator shows there. `phone_inclination_floor_is_the_marker_mounting` (tests/tests/fusion_real.rs)\n\
          scores the phone trials against the truth turned onto the IMU as well.\n\
          `ns/evt`: wall time per sensor event (accelerometer, gyroscope or magnetometer) on the machine\n\

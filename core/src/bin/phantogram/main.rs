@@ -522,7 +522,7 @@ fn expand_recordings(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
 fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
     use phantogram::orientation_eval::{CONVERGENCE_S, Trial, TruthFrame, score_all};
     let recordings = expand_recordings(paths)?;
-    // "-" where there is nothing to score (no north in the truth, or no truth in that period).
+    // "-" where there is nothing to score (no heading in the estimate, or no truth in that period).
     let fmt = |v: Option<f64>| {
         v.filter(|x| x.is_finite())
             .map_or("     -".to_owned(), |x| format!("{x:6.2}"))
