@@ -31,7 +31,8 @@
 //!
 //! **Threading**: a [`Renderer`] belongs to one thread; wgpu's device and queue are internally
 //! synchronised. [`prepare_lighting_tables`] may run on any thread (once per process; a renderer
-//! created meanwhile waits for it rather than computing the tables twice). **Panics**: none on bad input; GPU failures come back as [`RenderError`].
+//! created meanwhile waits for it rather than computing the tables twice). **Panics**: none on
+//! bad input; GPU failures come back as [`RenderError`].
 
 use glam::{Mat4, Vec3};
 use thiserror::Error;

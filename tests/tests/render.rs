@@ -280,19 +280,10 @@ fn gpu_composition_matches_the_cpu_reference() {
 
 /// A floor at z = −30 mm seen straight on, with a cube above it or resting on it, lit obliquely.
 fn shadow_scene(cube_centre: Vec3, half: f32, shadows: bool) -> Option<(Vec<u8>, OffAxisProjection)> {
-    shadow_scene_lit(cube_centre, half, shadows, OBLIQUE_LIGHT)
-}
-
-fn shadow_scene_lit(
-    cube_centre: Vec3,
-    half: f32,
-    shadows: bool,
-    toward_light: Vec3,
-) -> Option<(Vec<u8>, OffAxisProjection)> {
     let mut mesh = Mesh::default();
     mesh.push_cube(cube_centre, half, [0.8, 0.8, 0.8, 1.0]);
     push_floor_marker(&mut mesh);
-    render_over_floor(Model::from_painted_mesh("shadow test", mesh), shadows, toward_light)
+    render_over_floor(Model::from_painted_mesh("shadow test", mesh), shadows, OBLIQUE_LIGHT)
 }
 
 const OBLIQUE_LIGHT: Vec3 = Vec3::new(0.5, 0.0, 1.0);
