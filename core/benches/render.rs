@@ -91,7 +91,7 @@ fn main() {
             let start = Instant::now();
             // As `phantogram render` and the engine start: the lighting tables on another thread
             // while the model loads.
-            std::thread::spawn(|| phantogram::render::prepare_lighting_tables(true));
+            phantogram::render::prepare_lighting_tables_in_background(true);
             let mut turtle = phantogram::model::load_model(&path).expect("the turtle loads");
             turtle.fit_to_diorama(&SessionConfig::default().screen, &DioramaFit::default());
             let loaded = start.elapsed();

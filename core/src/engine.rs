@@ -216,10 +216,8 @@ impl Engine {
     /// short-lived thread that computes the renderer's lighting tables meanwhile (once per
     /// process, [`crate::render::prepare_lighting_tables`]).
     pub fn new(config: EngineConfig) -> Result<Self, EngineError> {
-        // The renderer's lighting tables, computed meanwhile on another thread (see
-        // `render::prepare_lighting_tables`): opening the device and loading the model overlap it.
-        let studio = config.environment_path.is_none();
-        std::thread::spawn(move || crate::render::prepare_lighting_tables(studio));
+        // Opening the device and loading the model overlap the renderer's lighting tables.
+        crate::render::prepare_lighting_tables_in_background(config.environment_path.is_none());
         Self::with_gpu(Gpu::headless()?, config)
     }
 

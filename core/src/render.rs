@@ -1640,6 +1640,14 @@ pub fn prepare_lighting_tables(studio: bool) {
     }
 }
 
+/// [`prepare_lighting_tables`] on a new, detached thread. If the thread cannot be created the
+/// renderer computes the tables itself when it needs them: nothing fails, it only starts later.
+pub fn prepare_lighting_tables_in_background(studio: bool) {
+    let _ = std::thread::Builder::new()
+        .name("lighting tables".into())
+        .spawn(move || prepare_lighting_tables(studio));
+}
+
 /// The generated studio's prefiltered levels, computed once per process: every renderer without
 /// an environment of its own starts with them.
 fn default_prefiltered_environment() -> &'static [crate::ibl::Environment] {

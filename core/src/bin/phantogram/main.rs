@@ -164,9 +164,8 @@ impl SceneArgs {
         if !(0.0..=1.0).contains(&self.protrude) {
             bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
         }
-        // The renderer's lighting tables, computed meanwhile on another thread.
-        let studio = self.environment.is_none();
-        std::thread::spawn(move || phantogram::render::prepare_lighting_tables(studio));
+        // Loading the model and environment overlaps the renderer's lighting tables.
+        phantogram::render::prepare_lighting_tables_in_background(self.environment.is_none());
         let fit = phantogram::model::DioramaFit {
             placement: match self.placement {
                 PlacementArg::Auto => phantogram::model::Placement::Auto,
