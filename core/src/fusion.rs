@@ -303,8 +303,9 @@ impl BiasEstimator {
         q6: DQuat,
         rest_rate: Option<DVec3>,
     ) {
-        let r = DMat3::from_quat(q6).transpose(); // rows of R as columns
-        let rb = DMat3::from_quat(q6) * *bias;
+        let device_to_earth = DMat3::from_quat(q6);
+        let r = device_to_earth.transpose(); // rows of R as columns
+        let rb = device_to_earth * *bias;
         let r_lp = DMat3::from_cols(
             self.r_lp[0].update(r.x_axis, dt_s),
             self.r_lp[1].update(r.y_axis, dt_s),
@@ -633,7 +634,8 @@ impl FusedOrientation {
         if !self.gyro_is_live(t_ns) {
             return;
         }
-        let a_inertial = self.q_gyr_at(t_ns) * a;
+        let q_gyr = self.q_gyr_at(t_ns);
+        let a_inertial = q_gyr * a;
         let filtered = self.acc_lp.update(a_inertial, dt);
         let Some(up) = (self.q_acc * filtered).try_normalize() else {
             return;
@@ -644,7 +646,7 @@ impl FusedOrientation {
         // start or a doubtful gap) its corrections measure the initial error, not a drift rate.
         if dt > 0.0 && self.acc_lp.primed {
             let rest_rate = if self.at_rest() { self.rest_gyr_lp } else { None };
-            let q6 = self.q_acc * self.q_gyr_at(t_ns);
+            let q6 = self.q_acc * q_gyr;
             self.bias_est
                 .update(&self.params, &mut self.bias, dt, up, q6, rest_rate);
         }
