@@ -480,7 +480,7 @@ fn environment_light_turns_with_the_device() {
     renderer.lighting.shadows = false;
     let eye = Vec3::new(0.0, 0.0, 0.3);
     let mono = OffAxisProjection::new(&screen, eye, DepthRange::default()).unwrap();
-    let brightness = |renderer: &mut Renderer, q: phantogram::glam::Quat| {
+    let frame = |renderer: &mut Renderer, q: phantogram::glam::Quat| {
         let input = FrameInput {
             left: &mono,
             right: &mono,
@@ -489,9 +489,9 @@ fn environment_light_turns_with_the_device() {
             device_to_world: q,
             offset: Vec3::ZERO,
         };
-        let px = renderer.render(&input, Method::Mono, W, H).unwrap();
-        luminance_at(&px, &mono, Vec3::new(0.0, 0.0, -0.01))
+        renderer.render(&input, Method::Mono, W, H).unwrap()
     };
+    let brightness = |renderer: &mut Renderer, q| luminance_at(&frame(renderer, q), &mono, Vec3::new(0.0, 0.0, -0.01));
     let face_up = brightness(&mut renderer, phantogram::glam::Quat::IDENTITY);
     let face_down = brightness(
         &mut renderer,
@@ -505,19 +505,9 @@ fn environment_light_turns_with_the_device() {
     let Some(second_gpu) = self::gpu() else { return };
     let mut from_start = Renderer::with_environment(second_gpu, &model, Some(&sky)).unwrap();
     from_start.lighting = renderer.lighting;
-    let frame = |renderer: &mut Renderer| {
-        let input = FrameInput {
-            left: &mono,
-            right: &mono,
-            mono: &mono,
-            toward_light: Vec3::Z,
-            device_to_world: phantogram::glam::Quat::from_rotation_x(0.4),
-            offset: Vec3::ZERO,
-        };
-        renderer.render(&input, Method::Mono, W, H).unwrap()
-    };
+    let tilted = phantogram::glam::Quat::from_rotation_x(0.4);
     assert!(
-        frame(&mut from_start) == frame(&mut renderer),
+        frame(&mut from_start, tilted) == frame(&mut renderer, tilted),
         "with_environment differs from set_environment"
     );
 }
