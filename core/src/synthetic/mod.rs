@@ -4,7 +4,10 @@
 //! **These are not recordings.** The phone is rotated about the centre of its screen (so the
 //! accelerometer sees gravity alone), the field is a fixed Earth-like vector, and the noise is
 //! white Gaussian from a seeded generator. Real behaviour is tested on the recordings in
-//! `../shared/data/imu`.
+//! `../shared/data/imu`. [`vigorous`] shakes any orientation track (recorded motion-capture truth
+//! included) with the hand motion the recordings lack.
+
+pub mod vigorous;
 
 use glam::{EulerRot, Quat, Vec3};
 
