@@ -306,34 +306,62 @@ pub const PAPER_C: f32 = 0.1;
 /// paper's own among them).
 pub const LOW_PASS_C_GRID: [f32; 10] = [0.002, 0.005, 0.01, 0.02, 0.03, 0.05, 0.1, 0.2, 0.3, 0.5];
 
+/// Which estimators [`score_selected`] runs.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Selection {
+    /// The paper's low-pass at c = 0.1 and at its best c.
+    pub low_pass: bool,
+    pub fused: bool,
+    /// The platform's rotation vector, where the recording has one.
+    pub platform: bool,
+}
+
+impl Selection {
+    pub const ALL: Self = Self {
+        low_pass: true,
+        fused: true,
+        platform: true,
+    };
+}
+
 /// All scores for one trial: low-pass at c = 0.1, low-pass at its best c (lowest main
 /// inclination RMSE over [`LOW_PASS_C_GRID`]), the fused estimator, and the platform rotation
 /// vector where the recording has one.
 pub fn score_all(trial: &Trial) -> Vec<Score> {
-    let rate = trial.accel_rate_hz() as f32;
-    let low_pass = |c: f32| {
-        let tau = time_constant_from_paper_coefficient(c, rate).unwrap_or(0.0);
-        let mut est = LowPassAttitude::new(tau, tau);
-        score(trial, &format!("low-pass c={c}"), &mut est)
-    };
-    // Each coefficient of the grid once; the paper's c = 0.1 is one of them.
-    let grid: Vec<Score> = LOW_PASS_C_GRID.iter().map(|&c| low_pass(c)).collect();
-    let paper = grid
-        .iter()
-        .zip(LOW_PASS_C_GRID)
-        .find(|(_, c)| *c == PAPER_C)
-        .map(|(s, _)| s.clone())
-        .expect("the grid holds the paper's coefficient");
-    let mut out = vec![paper];
-    if let Some(mut best) = grid
-        .into_iter()
-        .min_by(|a, b| a.main.inclination_deg.total_cmp(&b.main.inclination_deg))
-    {
-        best.estimator = format!("{} (best)", best.estimator);
-        out.push(best);
+    score_selected(trial, Selection::ALL)
+}
+
+/// The scores of [`score_all`] that `which` selects, in the same order.
+pub fn score_selected(trial: &Trial, which: Selection) -> Vec<Score> {
+    let mut out = Vec::new();
+    if which.low_pass {
+        let rate = trial.accel_rate_hz() as f32;
+        let low_pass = |c: f32| {
+            let tau = time_constant_from_paper_coefficient(c, rate).unwrap_or(0.0);
+            let mut est = LowPassAttitude::new(tau, tau);
+            score(trial, &format!("low-pass c={c}"), &mut est)
+        };
+        // Each coefficient of the grid once; the paper's c = 0.1 is one of them.
+        let grid: Vec<Score> = LOW_PASS_C_GRID.iter().map(|&c| low_pass(c)).collect();
+        let paper = grid
+            .iter()
+            .zip(LOW_PASS_C_GRID)
+            .find(|(_, c)| *c == PAPER_C)
+            .map(|(s, _)| s.clone())
+            .expect("the grid holds the paper's coefficient");
+        out.push(paper);
+        if let Some(mut best) = grid
+            .into_iter()
+            .min_by(|a, b| a.main.inclination_deg.total_cmp(&b.main.inclination_deg))
+        {
+            best.estimator = format!("{} (best)", best.estimator);
+            out.push(best);
+        }
     }
-    out.push(score(trial, "fused", &mut FusedOrientation::default()));
-    if trial.has(SensorKind::RotationVector) {
+    if which.fused {
+        out.push(score(trial, "fused", &mut FusedOrientation::default()));
+    }
+    if which.platform && trial.has(SensorKind::RotationVector) {
         out.push(score(
             trial,
             "platform rotation vector",
@@ -341,6 +369,110 @@ pub fn score_all(trial: &Trial) -> Vec<Score> {
         ));
     }
     out
+}
+
+/// Another program's orientation track for a trial (VQF's, say: `benchmarks/vqf/`), replayed as
+/// an estimator so that it is scored by exactly the same rows and definitions as ours. The file
+/// is CSV with the header `t_ns,w,x,y,z`: device → world quaternions in the trial's time base,
+/// each row the estimate after the input samples up to its time stamp. Rows whose quaternion is
+/// not finite or not of unit length (±1 %) are refused, as are time stamps that go backwards.
+#[derive(Clone, Debug, Default)]
+pub struct RecordedTrack {
+    rows: Vec<(i64, glam::Quat)>,
+    next: usize,
+    latest: Option<glam::Quat>,
+}
+
+/// A [`RecordedTrack`] file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum TrackError {
+    #[error("{}: {error}", path.display())]
+    Io {
+        path: std::path::PathBuf,
+        error: std::io::Error,
+    },
+    #[error("{}:{line}: {message}", path.display())]
+    Parse {
+        path: std::path::PathBuf,
+        line: usize,
+        message: &'static str,
+    },
+}
+
+impl RecordedTrack {
+    /// Reads a track file (see the type's docs).
+    pub fn load(path: &Path) -> Result<Self, TrackError> {
+        let text = std::fs::read_to_string(path).map_err(|error| TrackError::Io {
+            path: path.to_path_buf(),
+            error,
+        })?;
+        let parse_err = |line: usize, message| TrackError::Parse {
+            path: path.to_path_buf(),
+            line,
+            message,
+        };
+        let mut lines = text.lines().enumerate();
+        match lines.next() {
+            Some((_, header)) if header.trim() == "t_ns,w,x,y,z" => {}
+            _ => return Err(parse_err(1, "expected the header t_ns,w,x,y,z")),
+        }
+        let mut rows: Vec<(i64, glam::Quat)> = Vec::new();
+        for (i, line) in lines {
+            if line.trim().is_empty() {
+                continue;
+            }
+            let mut fields = line.split(',').map(str::trim);
+            let t_ns = fields
+                .next()
+                .and_then(|f| f.parse::<i64>().ok())
+                .ok_or_else(|| parse_err(i + 1, "expected an integer time stamp in ns"))?;
+            let v: Vec<f32> = fields
+                .map(|f| f.parse::<f32>())
+                .collect::<Result<_, _>>()
+                .map_err(|_| parse_err(i + 1, "expected four numbers w,x,y,z"))?;
+            let [w, x, y, z] = v[..] else {
+                return Err(parse_err(i + 1, "expected four numbers w,x,y,z"));
+            };
+            let q = glam::Quat::from_xyzw(x, y, z, w);
+            if !q.is_finite() || (q.length() - 1.0).abs() > 0.01 {
+                return Err(parse_err(i + 1, "not a unit quaternion"));
+            }
+            if rows.last().is_some_and(|(t, _)| t_ns < *t) {
+                return Err(parse_err(i + 1, "time stamp goes backwards"));
+            }
+            rows.push((t_ns, q.normalize()));
+        }
+        Ok(Self {
+            rows,
+            next: 0,
+            latest: None,
+        })
+    }
+}
+
+impl OrientationEstimator for RecordedTrack {
+    fn push(&mut self, event: &SensorEvent) {
+        while let Some((t, q)) = self.rows.get(self.next) {
+            if *t > event.t_ns {
+                break;
+            }
+            self.latest = Some(*q);
+            self.next += 1;
+        }
+    }
+
+    fn up_device(&self) -> Option<glam::Vec3> {
+        self.latest.map(|q| q.inverse() * glam::Vec3::Z)
+    }
+
+    fn device_to_world(&self) -> Option<glam::Quat> {
+        self.latest
+    }
+
+    fn reset(&mut self) {
+        self.next = 0;
+        self.latest = None;
+    }
 }
 
 #[cfg(test)]
@@ -391,6 +523,44 @@ mod tests {
         assert!((r.total_deg.unwrap() - 6.0).abs() < 1e-9, "{r:?}");
         assert_eq!(r.rows, 8);
         assert_eq!(Accumulator::default().finish(Some(0.0)).heading_deg, None);
+    }
+
+    #[test]
+    fn a_recorded_track_is_scored_like_an_estimator() {
+        let scratch = crate::scratch::Scratch::new("recorded-track");
+        let events = tilt_sweep(&ImuSpec::default());
+        let trial = Trial {
+            name: "synthetic".into(),
+            events: events.clone(),
+            truth_frame: TruthFrame::EastNorthUp,
+            movement: None,
+        };
+        // The truth itself, turned 2° about x, as another program's track.
+        let tilt = glam::Quat::from_rotation_x(2f32.to_radians());
+        let mut text = String::from("t_ns,w,x,y,z\n");
+        for e in events.iter().filter(|e| e.kind == SensorKind::GroundTruth) {
+            let q = tilt * e.quat().unwrap();
+            text += &format!("{},{},{},{},{}\n", e.t_ns, q.w, q.x, q.y, q.z);
+        }
+        let path = scratch.join("synthetic.csv");
+        std::fs::write(&path, text).unwrap();
+        let mut track = RecordedTrack::load(&path).unwrap();
+        let s = score(&trial, "track", &mut track);
+        assert!((s.main.inclination_deg - 2.0).abs() < 0.01, "{s:?}");
+        assert!(s.main.heading_deg.unwrap() < 0.01, "{s:?}");
+
+        for (bad, why) in [
+            ("t,w,x,y,z\n", "expected the header"),
+            ("t_ns,w,x,y,z\n10,1,0,0\n", "four numbers"),
+            ("t_ns,w,x,y,z\n10,2,0,0,0\n", "unit quaternion"),
+            ("t_ns,w,x,y,z\n10,1,0,0,0\n5,1,0,0,0\n", "backwards"),
+            ("t_ns,w,x,y,z\nten,1,0,0,0\n", "integer time stamp"),
+        ] {
+            std::fs::write(&path, bad).unwrap();
+            let err = RecordedTrack::load(&path).unwrap_err().to_string();
+            assert!(err.contains(why) && err.contains("synthetic.csv"), "{err}");
+        }
+        assert!(RecordedTrack::load(&scratch.join("missing.csv")).is_err());
     }
 
     #[test]

@@ -417,6 +417,76 @@ fn eval_orientation_scores_what_it_can_and_names_what_it_cannot() {
     assert!(errors.len() >= 3 && errors[..3].iter().all(|e| *e < 0.1), "{fused}");
 }
 
+/// `eval orientation --estimator … --reference NAME=DIR`: only the chosen estimators, plus another
+/// program's track scored by the same rows; a missing track is named and fails the run.
+#[test]
+fn eval_orientation_scores_a_reference_track() {
+    let dir = Scratch::new("cli-eval-reference");
+    let mut csv =
+        String::from("t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,gt_qw,gt_qx,gt_qy,gt_qz,movement\n");
+    // The track: the truth (level, north) tilted 3° about x.
+    let half = 1.5f64.to_radians();
+    let mut track = String::from("t_ns,w,x,y,z\n");
+    for i in 0..1000 {
+        csv += &format!(
+            "{:.3},0,0,9.81,0,0,0,0,20,-40,1,0,0,0,{}\n",
+            f64::from(i) * 0.01,
+            u8::from(i > 600)
+        );
+        track += &format!("{},{},{},0,0\n", i64::from(i) * 10_000_000, half.cos(), half.sin());
+    }
+    std::fs::write(dir.join("still.csv"), &csv).unwrap();
+    let tracks = dir.join("tracks");
+    std::fs::create_dir_all(&tracks).unwrap();
+    std::fs::write(tracks.join("still.csv"), &track).unwrap();
+    let out = bin()
+        .args(["eval", "orientation", "--estimator", "fused", "--reference"])
+        .arg(format!("THREE={}", tracks.display()))
+        .arg(dir.join("still.csv"))
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!stdout.contains("low-pass"), "{stdout}");
+    let row = |name: &str| -> Vec<f64> {
+        let line = stdout
+            .lines()
+            .find(|l| l.starts_with("still") && l.contains(name))
+            .unwrap_or_else(|| panic!("no {name} row:\n{stdout}"));
+        line.split_whitespace().filter_map(|w| w.parse().ok()).collect()
+    };
+    // incl, head, total, c.incl, c.head and the time per event (ours only).
+    let fused = row("fused");
+    assert!(fused.len() == 6 && fused[0] < 0.1 && fused[5] > 0.0, "{stdout}");
+    let three = row("THREE");
+    assert!(three.len() == 5, "no time for a replayed track:\n{stdout}");
+    assert!((three[0] - 3.0).abs() < 0.01 && three[1] < 0.01, "{stdout}");
+
+    // A folder without the trial's track: named, and the run fails.
+    let empty = dir.join("empty");
+    std::fs::create_dir_all(&empty).unwrap();
+    let out = bin()
+        .args(["eval", "orientation", "--estimator", "fused", "--reference"])
+        .arg(format!("NONE={}", empty.display()))
+        .arg(dir.join("still.csv"))
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(!out.status.success());
+    assert!(
+        stderr.contains("--reference NONE") && stderr.contains("still.csv"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("1 reference track(s) could not be read"), "{stderr}");
+    let out = bin()
+        .args(["eval", "orientation", "--reference", "nonsense"])
+        .arg(dir.join("still.csv"))
+        .output()
+        .unwrap();
+    assert!(!out.status.success());
+    assert!(String::from_utf8_lossy(&out.stderr).contains("expected NAME=DIR"));
+}
+
 /// `render` into a folder that holds an earlier, longer run: the old frames do not trail the new
 /// ones, and files that are not frames stay. Skipped (with a notice) without a GPU adapter,
 /// except under CI.

@@ -212,6 +212,13 @@ enum EvalWhat {
         /// BROAD CSVs, phone recording folders, or folders containing them.
         #[arg(required = true)]
         paths: Vec<PathBuf>,
+        /// Score only these of our estimators (repeatable; all when omitted).
+        #[arg(long = "estimator", value_enum)]
+        estimators: Vec<EstimatorName>,
+        /// Also score another program's orientation tracks: NAME=DIR, with DIR/<trial>.csv
+        /// holding `t_ns,w,x,y,z` rows (what `benchmarks/vqf/vqf_reference.py` writes). Repeatable.
+        #[arg(long = "reference", value_name = "NAME=DIR", value_parser = reference_arg)]
+        references: Vec<(String, PathBuf)>,
     },
     /// Faces in images: each face's two eye centres (pixels, left/right as seen in the image)
     /// and its distance from the iris size, assuming a field of view.
@@ -337,8 +344,13 @@ fn run(cli: Cli) -> Result<()> {
             flat_at_s,
         }),
         Command::Eval {
-            what: EvalWhat::Orientation { paths },
-        } => eval_orientation_command(&paths),
+            what:
+                EvalWhat::Orientation {
+                    paths,
+                    estimators,
+                    references,
+                },
+        } => eval_orientation_command(&paths, &estimators, &references),
         Command::Eval {
             what:
                 EvalWhat::Face {
@@ -518,13 +530,51 @@ fn expand_recordings(paths: &[PathBuf]) -> Result<Vec<PathBuf>> {
     Ok(out)
 }
 
-fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
-    use phantogram::orientation_eval::{CONVERGENCE_S, Trial, TruthFrame, score_all};
+/// `--reference NAME=DIR`.
+fn reference_arg(text: &str) -> Result<(String, PathBuf), String> {
+    match text.split_once('=') {
+        Some((name, dir)) if !name.trim().is_empty() && !dir.is_empty() => {
+            Ok((name.trim().to_owned(), PathBuf::from(dir)))
+        }
+        _ => Err(format!("expected NAME=DIR, got {text:?}")),
+    }
+}
+
+fn eval_orientation_command(
+    paths: &[PathBuf],
+    estimators: &[EstimatorName],
+    references: &[(String, PathBuf)],
+) -> Result<()> {
+    use phantogram::orientation_eval::{
+        CONVERGENCE_S, RecordedTrack, Score, Selection, Trial, TruthFrame, score, score_selected,
+    };
     let recordings = expand_recordings(paths)?;
+    for (name, dir) in references {
+        if !dir.is_dir() {
+            bail!("--reference {name}: {} is not a folder", dir.display());
+        }
+    }
+    let selection = if estimators.is_empty() {
+        Selection::ALL
+    } else {
+        Selection {
+            low_pass: estimators.iter().any(|e| matches!(e, EstimatorName::LowPass)),
+            fused: estimators.iter().any(|e| matches!(e, EstimatorName::Fused)),
+            platform: estimators.iter().any(|e| matches!(e, EstimatorName::RotationVector)),
+        }
+    };
     // "-" where there is nothing to score (no heading in the estimate, or no truth in that period).
     let fmt = |v: Option<f64>| {
         v.filter(|x| x.is_finite())
             .map_or("     -".to_owned(), |x| format!("{x:6.2}"))
+    };
+    // "-" for a replayed track, whose run time is not ours to measure.
+    let fmt_ns = |ns: f64| {
+        if ns.is_finite() {
+            format!("{ns:7.0}")
+        } else {
+            "      -".to_owned()
+        }
     };
     println!(
         "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7}",
@@ -541,6 +591,7 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
     let mut sums: Vec<(String, Sums)> = Vec::new();
     // A recording that cannot be read is reported and skipped: the others are still scored.
     let mut failures = 0;
+    let mut missing_tracks = 0;
     for (i, path) in recordings.iter().enumerate() {
         eprintln!("[{}/{}] {}", i + 1, recordings.len(), path.display());
         let trial = match Trial::load(path) {
@@ -551,9 +602,24 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
                 continue;
             }
         };
-        for s in score_all(&trial) {
+        let mut scores = score_selected(&trial, selection);
+        for (name, dir) in references {
+            let path = dir.join(format!("{}.csv", trial.name));
+            match RecordedTrack::load(&path) {
+                // Replaying a track costs nothing worth reporting: its own run time is unknown.
+                Ok(mut track) => scores.push(Score {
+                    ns_per_event: f64::NAN,
+                    ..score(&trial, name, &mut track)
+                }),
+                Err(e) => {
+                    eprintln!("error: --reference {name}: {e}");
+                    missing_tracks += 1;
+                }
+            }
+        }
+        for s in scores {
             println!(
-                "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7.0}",
+                "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7}",
                 trial.name,
                 s.estimator,
                 fmt(Some(s.main.inclination_deg)),
@@ -561,7 +627,7 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
                 fmt(s.main.total_deg),
                 fmt(Some(s.convergence.inclination_deg)),
                 fmt(s.convergence.heading_deg),
-                s.ns_per_event
+                fmt_ns(s.ns_per_event)
             );
             // "low-pass c=… (best)" rows are grouped as one estimator for the means.
             let key = if s.estimator.ends_with("(best)") {
@@ -569,11 +635,17 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
             } else {
                 s.estimator.clone()
             };
-            // By the kind of truth, not by what the estimator gave (a headless one gives no heading).
-            let group = match trial.truth_frame {
-                TruthFrame::EastNorthUp => "BROAD",
-                TruthFrame::ArbitraryHeading => "phone",
-            };
+            // By the folder the recording came from (imu/broad, imu/broad-extra, imu/phone keep
+            // their figures apart), else by the kind of truth, not by what the estimator gave (a
+            // headless one gives no heading).
+            let group = path
+                .parent()
+                .and_then(|p| p.file_name())
+                .map(|n| n.to_string_lossy().into_owned())
+                .unwrap_or_else(|| match trial.truth_frame {
+                    TruthFrame::EastNorthUp => "BROAD".to_owned(),
+                    TruthFrame::ArbitraryHeading => "phone".to_owned(),
+                });
             let key = format!("{group}: {key}");
             let entry = match sums.iter_mut().position(|e| e.0 == key) {
                 Some(i) => &mut sums[i].1,
@@ -602,15 +674,18 @@ fn eval_orientation_command(paths: &[PathBuf]) -> Result<()> {
     let mean = |(n, sum): (usize, f64)| (n > 0).then(|| sum / n as f64);
     for (key, s) in &sums {
         println!(
-            "{key:<46} {:>7} {:>6} {:>6} {:>7.0}",
+            "{key:<46} {:>7} {:>6} {:>6} {:>7}",
             s.trials,
             fmt(mean(s.incl)),
             fmt(mean(s.head)),
-            s.ns / s.trials as f64
+            fmt_ns(s.ns / s.trials as f64)
         );
     }
     if failures > 0 {
         bail!("{failures} of {} recording(s) could not be scored", recordings.len());
+    }
+    if missing_tracks > 0 {
+        bail!("{missing_tracks} reference track(s) could not be read");
     }
     Ok(())
 }
