@@ -617,15 +617,17 @@ impl FusedOrientation {
             return;
         }
         let w = DVec3::from_array(raw.map(f64::from));
-        if verdict == RangeVerdict::Saturated {
-            self.stats.gyro_saturated += 1;
-            self.saturation.gyro_saturated();
-        }
         if let Some((last_t, _)) = self.last_gyr {
             if t_ns <= last_t {
                 self.stats.ignored_stale_time += 1;
                 return;
             }
+        }
+        if verdict == RangeVerdict::Saturated {
+            self.stats.gyro_saturated += 1;
+            self.saturation.gyro_saturated();
+        }
+        if let Some((last_t, _)) = self.last_gyr {
             let dt = (t_ns - last_t) as f64 * 1e-9;
             let prev = self.last_gyr.map_or(w, |(_, p)| p);
             if dt <= self.params.max_gap_s {
