@@ -285,7 +285,10 @@ fn bench_orientation() -> Result<()> {
          `imu/broad-extra` and `imu/phone` (release build), with a VQF column: VQF 2.1.2 (PyPI `vqf`,\n\
          default parameters, 9-D) run by `benchmarks/vqf/vqf_reference.py` on the same samples\n\
          (phones: accelerometer and magnetometer interpolated onto the gyroscope's time stamps) and\n\
-         scored by the same code (`--reference VQF=DIR`).\n\n\
+         scored by the same code (`--reference VQF=DIR`). VQF needs one sample rate, so it steps\n\
+         through a gap in the gyroscope as one sample: in `Guillaume_Nexus5_NoDist_AR` the gyroscope\n\
+         stops for 23.7 s at 66.7 s, where VQF (and Android's rotation vector) lose the attitude;\n\
+         the phone means of those two rest on that trial.\n\n\
          RMSE in degrees with BROAD's definitions: `incl`, `head`, `total` over the main rows (after the\n\
          first 5 s; BROAD: movement phases only), `c.incl`, `c.head` over the first 5 s (convergence).\n\
          Phone ground truth has the motion-capture room's heading, not north: there `head` and `total` are\n\
