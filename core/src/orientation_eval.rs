@@ -17,7 +17,8 @@
 //! the main figures.
 //!
 //! Estimators see the events in time order; at each ground-truth time stamp the estimate is read
-//! (no prediction).
+//! (no prediction). Another program's estimates (VQF's, for the benchmark) are scored the same way
+//! by replaying its track as an estimator ([`RecordedTrack`]).
 
 use std::path::Path;
 use std::time::Instant;
@@ -391,6 +392,8 @@ pub enum TrackError {
         path: std::path::PathBuf,
         error: std::io::Error,
     },
+    #[error("{}: larger than {max_bytes} bytes: not an orientation track", path.display())]
+    TooLarge { path: std::path::PathBuf, max_bytes: u64 },
     #[error("{}:{line}: {message}", path.display())]
     Parse {
         path: std::path::PathBuf,
@@ -399,12 +402,38 @@ pub enum TrackError {
     },
 }
 
+/// Largest track file read, bytes: seven hours of rows at 200 Hz. A larger file (or a device
+/// that never ends, such as `/dev/zero`) is refused rather than read into memory.
+pub const MAX_TRACK_BYTES: u64 = 256 << 20;
+
 impl RecordedTrack {
     /// Reads a track file (see the type's docs).
     pub fn load(path: &Path) -> Result<Self, TrackError> {
-        let text = std::fs::read_to_string(path).map_err(|error| TrackError::Io {
+        Self::load_at_most(path, MAX_TRACK_BYTES)
+    }
+
+    fn load_at_most(path: &Path, max_bytes: u64) -> Result<Self, TrackError> {
+        use std::io::Read;
+        let io = |error| TrackError::Io {
             path: path.to_path_buf(),
             error,
+        };
+        let mut bytes = Vec::new();
+        std::fs::File::open(path)
+            .map_err(io)?
+            .take(max_bytes + 1)
+            .read_to_end(&mut bytes)
+            .map_err(io)?;
+        if bytes.len() as u64 > max_bytes {
+            return Err(TrackError::TooLarge {
+                path: path.to_path_buf(),
+                max_bytes,
+            });
+        }
+        let text = String::from_utf8(bytes).map_err(|_| TrackError::Parse {
+            path: path.to_path_buf(),
+            line: 1,
+            message: "not UTF-8 text",
         })?;
         let parse_err = |line: usize, message| TrackError::Parse {
             path: path.to_path_buf(),
@@ -561,6 +590,12 @@ mod tests {
             assert!(err.contains(why) && err.contains("synthetic.csv"), "{err}");
         }
         assert!(RecordedTrack::load(&scratch.join("missing.csv")).is_err());
+        std::fs::write(&path, "t_ns,w,x,y,z\n10,1,0,0,0\n").unwrap();
+        assert!(RecordedTrack::load_at_most(&path, 100).is_ok());
+        let err = RecordedTrack::load_at_most(&path, 10).unwrap_err().to_string();
+        assert!(err.contains("larger than 10 bytes"), "{err}");
+        std::fs::write(&path, b"t_ns,w,x,y,z\n\xff\n").unwrap();
+        assert!(RecordedTrack::load(&path).unwrap_err().to_string().contains("UTF-8"));
     }
 
     #[test]

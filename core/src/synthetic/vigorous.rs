@@ -71,8 +71,9 @@ pub struct VigorousSpec {
 impl VigorousSpec {
     /// A phone-like IMU (200 Hz, ±`range_g` g accelerometer, ±2000 °/s gyroscope, 50 Hz
     /// magnetometer, consumer noise and a small gyroscope bias) shaken in bouts of 4 s every
-    /// 12 s from 20 s on (the estimators have learnt the gyroscope bias by then), peaks rising from 10 to 16 g and rates from 400 to 700 °/s, up to
-    /// `duration_s`, with at least 4 s of calm after the last bout.
+    /// 12 s from 20 s on (the estimators have learnt the gyroscope bias by then), peaks rising
+    /// from 10 to 16 g and rates from 400 to 700 °/s, up to `duration_s`, with at least 4 s of
+    /// calm after the last bout.
     pub fn phone(range_g: f64, duration_s: f64, seed: u64) -> Self {
         let mut bouts = Vec::new();
         let mut start = 20.0;
