@@ -479,6 +479,27 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSetDisplay<'local>
     })
 }
 
+/// The motion sensors' ranges, `Sensor.getMaximumRange()` of the accelerometer (m/s²) and the
+/// gyroscope (rad/s); 0 (or anything implausible) where the sensor is missing.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSetSensorRanges<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    accel_max_range: jfloat,
+    gyro_max_range: jfloat,
+) {
+    run(&mut env, |_| {
+        engine(handle)?
+            .lock()
+            .set_sensor_ranges(phantogram::sensors::SensorRanges::from_platform(
+                accel_max_range,
+                gyro_max_range,
+            ));
+        Ok(())
+    })
+}
+
 /// `dubois` (default), `dubois-green-magenta`, `dubois-amber-blue`, `half-color`, `optimized`,
 /// `gray`, `color` or `mono`.
 #[unsafe(no_mangle)]
@@ -586,7 +607,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCalibrationWarning
 
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 15] = [
+pub const NATIVE_METHODS: [&str; 16] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
@@ -598,6 +619,7 @@ pub const NATIVE_METHODS: [&str; 15] = [
     "nativeSurfaceDestroyed",
     "nativeSetDisplay",
     "nativeSetAnaglyph",
+    "nativeSetSensorRanges",
     "nativeDrawFrame",
     "nativeReadFrame",
     "nativeStats",

@@ -33,6 +33,11 @@ pub trait OrientationEstimator: Send {
     }
     /// Clears all state (e.g. after the sensors restart).
     fn reset(&mut self);
+    /// The sensors' ranges as the platform declares them; estimators that do not use them
+    /// ignore them.
+    fn set_sensor_ranges(&mut self, ranges: crate::sensors::SensorRanges) {
+        let _ = ranges;
+    }
 }
 
 /// The orientation with rows east, north, up expressed in the device frame, from the "up"

@@ -408,6 +408,12 @@ impl Engine {
         }
     }
 
+    /// The motion sensors' ranges as the platform declares them (Android's
+    /// `Sensor.getMaximumRange()`), so that clipped readings are known from the first one.
+    pub fn set_sensor_ranges(&mut self, ranges: crate::sensors::SensorRanges) {
+        self.session.set_sensor_ranges(ranges);
+    }
+
     /// A drawable appeared: draw into `window` at `width × height` physical pixels.
     pub fn resume_window(
         &mut self,

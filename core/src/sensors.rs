@@ -134,6 +134,31 @@ impl SensorEvent {
     }
 }
 
+/// The measuring ranges a platform declares for its motion sensors, per axis (Android's
+/// `Sensor.getMaximumRange()`; iOS declares none). `None` where not declared or implausible.
+/// The fused estimator treats readings at a declared range as saturated from the first one,
+/// instead of learning the ceiling (`fusion/screen.rs`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SensorRanges {
+    /// Accelerometer, m/s².
+    pub accel_m_s2: Option<f32>,
+    /// Gyroscope, rad/s.
+    pub gyro_rad_s: Option<f32>,
+}
+
+impl SensorRanges {
+    /// From the platform's figures: a range outside what motion sensors have (accelerometers
+    /// about ±2–64 g, gyroscopes ±125–8000 °/s, with a margin below for rounding), zero,
+    /// negative or not finite counts as not declared.
+    pub fn from_platform(accel_m_s2: f32, gyro_rad_s: f32) -> Self {
+        let within = |v: f32, lo: f32, hi: f32| (v.is_finite() && (lo..=hi).contains(&v)).then_some(v);
+        Self {
+            accel_m_s2: within(accel_m_s2, 1.9 * 9.80665, 64.0 * 9.80665),
+            gyro_rad_s: within(gyro_rad_s, 100f32.to_radians(), 8000f32.to_radians()),
+        }
+    }
+}
+
 /// Why the inbox refused an event.
 #[derive(Clone, Copy, Debug, Error, PartialEq, Eq)]
 pub enum Rejection {

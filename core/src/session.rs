@@ -30,7 +30,7 @@ use crate::fusion::{FusedOrientation, FusionParams};
 use crate::light::WorldLight;
 use crate::projection::{DepthRange, OffAxisProjection, ProjectionError};
 use crate::screen::{PanelSpec, Screen};
-use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorStats};
+use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorRanges, SensorStats};
 use crate::viewpoint::Viewpoint;
 
 /// Which orientation estimator drives the viewpoint and the light.
@@ -266,6 +266,11 @@ impl Session {
         let q = self.device_to_world().ok_or(SessionError::NoGravityYet)?;
         self.light.anchor(q);
         Ok(())
+    }
+
+    /// The motion sensors' ranges as the platform declares them (see [`SensorRanges`]).
+    pub fn set_sensor_ranges(&mut self, ranges: SensorRanges) {
+        self.estimator.set_sensor_ranges(ranges);
     }
 
     /// After a display rotation or a surface resize.

@@ -241,6 +241,17 @@ enum PgStatus pg_set_display(const struct PgEngine *engine,
                              float ydpi,
                              int32_t rotation_quarter_turns);
 
+// The motion sensors' ranges per axis as the platform declares them: the accelerometer's in
+// m/s², the gyroscope's in rad/s; 0 (or anything implausible) where not declared. Core Motion
+// declares none, so the Swift shell does not call this; other embedders with the figures should,
+// so that clipped readings are known from the first one.
+//
+// # Safety
+// `engine` is a live handle (or null, reported).
+enum PgStatus pg_set_sensor_ranges(const struct PgEngine *engine,
+                                   float accel_m_s2,
+                                   float gyro_rad_s);
+
 // Chooses the composition: `dubois` (red–cyan, default), `dubois-green-magenta`,
 // `dubois-amber-blue`, `half-color`, `optimized`, `gray`, `color` or `mono`.
 //

@@ -648,6 +648,25 @@ pub unsafe extern "C" fn pg_set_display(
     })
 }
 
+/// The motion sensors' ranges per axis as the platform declares them: the accelerometer's in
+/// m/s², the gyroscope's in rad/s; 0 (or anything implausible) where not declared. Core Motion
+/// declares none, so the Swift shell does not call this; other embedders with the figures should,
+/// so that clipped readings are known from the first one.
+///
+/// # Safety
+/// `engine` is a live handle (or null, reported).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_set_sensor_ranges(engine: *const PgEngine, accel_m_s2: f32, gyro_rad_s: f32) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        unsafe { engine_ref(engine) }?
+            .shared
+            .lock()
+            .set_sensor_ranges(phantogram::sensors::SensorRanges::from_platform(accel_m_s2, gyro_rad_s));
+        Ok(())
+    })
+}
+
 /// Chooses the composition: `dubois` (red–cyan, default), `dubois-green-magenta`,
 /// `dubois-amber-blue`, `half-color`, `optimized`, `gray`, `color` or `mono`.
 ///

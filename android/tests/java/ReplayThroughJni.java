@@ -40,6 +40,7 @@ public final class ReplayThroughJni {
         expect(IllegalArgumentException.class, "rotation",
                 () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 7, null, null));
         expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeDrawFrame(0, -1));
+        expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeSetSensorRanges(0, 78.4532f, 34.9f));
 
         long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois", null);
         try {
@@ -51,6 +52,8 @@ public final class ReplayThroughJni {
             if (NativeBridge.nativeDrawFrame(h, -1)) {
                 throw new AssertionError("drawing without a surface must be a skipped frame");
             }
+            // A +-8 g accelerometer and a +-2000 deg/s gyroscope, as a Nexus 5 declares them.
+            NativeBridge.nativeSetSensorRanges(h, 78.4532f, 34.906586f);
             NativeBridge.nativeResumeOffscreen(h, width, height);
 
             final long stepNs = 100_000_000L;

@@ -127,8 +127,8 @@ pub struct FusionParams {
     /// After rejecting the magnetometer this long, adopt the current field anyway, s.
     pub mag_max_reject_s: f64,
     /// The accelerometer's range per axis, m/s², as the platform declares it (Android's
-    /// `Sensor.getMaximumRange()`); infinite when unknown, and the ceiling is then learnt from
-    /// the readings. Readings beyond it are glitches, readings at it saturated (`fusion/screen.rs`).
+    /// `Sensor.getMaximumRange()`, through `Engine::set_sensor_ranges`); infinite when unknown,
+    /// and the ceiling is then learnt from the readings. Readings beyond it are glitches, readings at it saturated (`fusion/screen.rs`).
     pub accel_range_m_s2: f64,
     /// The gyroscope's range per axis, rad/s, as the platform declares it; infinite when
     /// unknown, and the ceiling is then learnt from the readings (readings beyond ±4000 °/s are
@@ -901,6 +901,20 @@ impl OrientationEstimator for FusedOrientation {
     fn reset(&mut self) {
         *self = Self::new(self.params);
     }
+
+    /// A declared range replaces the learnt ceiling (and a withdrawn one brings learning back).
+    fn set_sensor_ranges(&mut self, ranges: crate::sensors::SensorRanges) {
+        let accel = ranges.accel_m_s2.map_or(f64::INFINITY, f64::from);
+        let gyro = ranges.gyro_rad_s.map_or(f64::INFINITY, f64::from);
+        if accel != self.params.accel_range_m_s2 {
+            self.params.accel_range_m_s2 = accel;
+            self.acc_range = Range::new(accel, screen::ASSUMED_MAX_ACCEL_M_S2, screen::MIN_ACCEL_RANGE_M_S2);
+        }
+        if gyro != self.params.gyro_range_rad_s {
+            self.params.gyro_range_rad_s = gyro;
+            self.gyr_range = Range::new(gyro, screen::ASSUMED_MAX_GYRO_RAD_S, screen::MIN_GYRO_RANGE_RAD_S);
+        }
+    }
 }
 
 #[cfg(test)]
@@ -1023,6 +1037,37 @@ mod tests {
         assert!(worst < 0.1, "{worst}° from the clean run");
         assert_eq!(f.stats().accel_spikes_replaced, injected);
         assert_eq!(clean_f.stats().accel_spikes_replaced, 0);
+    }
+
+    /// A range the platform declares marks clipping from the first clipped reading; implausible
+    /// figures count as undeclared.
+    #[test]
+    fn a_declared_range_marks_clipping_from_the_first_reading() {
+        use crate::sensors::SensorRanges;
+        let still = simulate(&ImuSpec::default(), 2.0, 0, |_| Quat::IDENTITY);
+        let t = still.last().unwrap().t_ns + 10_000_000;
+        let clipped = SensorEvent::accelerometer(t, Vec3::new(8.0 * 9.80665, 0.0, 9.8));
+        let saturated = |ranges: SensorRanges| {
+            let mut f = FusedOrientation::default();
+            f.set_sensor_ranges(ranges);
+            for e in &still {
+                f.push(e);
+            }
+            f.push(&clipped);
+            f.stats().accel_saturated
+        };
+        assert_eq!(saturated(SensorRanges::from_platform(8.0 * 9.80665, 34.9)), 1);
+        // Learnt, one reading proves nothing.
+        assert_eq!(saturated(SensorRanges::default()), 0);
+        assert_eq!(SensorRanges::from_platform(0.0, f32::NAN), SensorRanges::default());
+        assert_eq!(SensorRanges::from_platform(1e9, 0.1), SensorRanges::default());
+        assert_eq!(
+            SensorRanges::from_platform(19.6133, 4.3633),
+            SensorRanges {
+                accel_m_s2: Some(19.6133),
+                gyro_rad_s: Some(4.3633)
+            }
+        );
     }
 
     /// A phone in the hand is never at rest: the bias must be learnt from the accelerometer's

@@ -59,6 +59,8 @@ int main(int argc, char **argv) {
     check(pg_read_frame(engine, NULL, 0, &w, &h), PG_STATUS_NO_FRAME, "read before drawing", "no offscreen frame");
     check(pg_resume_view(engine, NULL, 10, 10), PG_STATUS_NULL_POINTER, "resume a null view", "ui_view");
     check(pg_set_anaglyph(engine, "sepia"), PG_STATUS_INVALID_ARGUMENT, "set anaglyph sepia", "sepia");
+    check(pg_set_sensor_ranges(NULL, 78.4532f, 34.906586f), PG_STATUS_NULL_POINTER, "sensor ranges on null", "null");
+    check(pg_set_sensor_ranges(engine, 78.4532f, 34.906586f), PG_STATUS_OK, "sensor ranges", NULL);
     uint8_t presented = 9;
     check(pg_draw(engine, -1.0, &presented), PG_STATUS_OK, "draw while suspended", NULL);
     if (presented != 0) {

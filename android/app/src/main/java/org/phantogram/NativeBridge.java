@@ -77,6 +77,9 @@ public final class NativeBridge {
 
     public static native void nativeSetAnaglyph(long handle, String name);
 
+    /** Sensor.getMaximumRange() of the accelerometer (m/s^2) and gyroscope (rad/s); 0 if absent. */
+    public static native void nativeSetSensorRanges(long handle, float accelMaxRange, float gyroMaxRange);
+
     /** Draws the frame shown at displayTimeNs (negative: no prediction); false if skipped. */
     public static native boolean nativeDrawFrame(long handle, long displayTimeNs);
 

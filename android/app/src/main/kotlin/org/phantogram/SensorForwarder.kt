@@ -16,6 +16,11 @@ import android.os.HandlerThread
 class SensorForwarder(private val manager: SensorManager, private val engine: () -> Long) : SensorEventListener {
     private val thread = HandlerThread("phantogram-sensors").apply { start() }
     private val handler = Handler(thread.looper)
+    /** Sensor.getMaximumRange() of the accelerometer and gyroscope (0: missing), told to each new
+     *  engine once, from the sensor thread, before its first reading. */
+    @Volatile private var accelRange = 0f
+    @Volatile private var gyroRange = 0f
+    private var rangesToldTo = 0L
     private val types = intArrayOf(
         Sensor.TYPE_ACCELEROMETER,
         Sensor.TYPE_GYROSCOPE,
@@ -26,6 +31,10 @@ class SensorForwarder(private val manager: SensorManager, private val engine: ()
     fun start() {
         for (type in types) {
             val sensor = manager.getDefaultSensor(type) ?: continue
+            when (type) {
+                Sensor.TYPE_ACCELEROMETER -> accelRange = sensor.maximumRange
+                Sensor.TYPE_GYROSCOPE -> gyroRange = sensor.maximumRange
+            }
             manager.registerListener(this, sensor, SAMPLING_PERIOD_US, handler)
         }
     }
@@ -40,6 +49,11 @@ class SensorForwarder(private val manager: SensorManager, private val engine: ()
     override fun onSensorChanged(event: SensorEvent) {
         val e = engine()
         if (e == 0L) return
+        if (e != rangesToldTo) {
+            // Clipped readings are then known from the first one (the core learns them otherwise).
+            NativeBridge.nativeSetSensorRanges(e, accelRange, gyroRange)
+            rangesToldTo = e
+        }
         val v = event.values
         val w = if (v.size >= 4) v[3] else Float.NaN
         // Rejected samples (NaN, repeated time stamps) return false and are counted by the core.
