@@ -29,12 +29,11 @@ class SensorForwarder(private val manager: SensorManager, private val engine: ()
     )
 
     fun start() {
-        for (type in types) {
-            val sensor = manager.getDefaultSensor(type) ?: continue
-            when (type) {
-                Sensor.TYPE_ACCELEROMETER -> accelRange = sensor.maximumRange
-                Sensor.TYPE_GYROSCOPE -> gyroRange = sensor.maximumRange
-            }
+        val sensors = types.map { manager.getDefaultSensor(it) }.filterNotNull()
+        // Both ranges are known before the first reading can arrive.
+        accelRange = sensors.firstOrNull { it.type == Sensor.TYPE_ACCELEROMETER }?.maximumRange ?: 0f
+        gyroRange = sensors.firstOrNull { it.type == Sensor.TYPE_GYROSCOPE }?.maximumRange ?: 0f
+        for (sensor in sensors) {
             manager.registerListener(this, sensor, SAMPLING_PERIOD_US, handler)
         }
     }
