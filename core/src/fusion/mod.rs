@@ -623,7 +623,7 @@ impl FusedOrientation {
                 return;
             }
         }
-        if verdict == RangeVerdict::Saturated {
+        if matches!(verdict, RangeVerdict::Saturated { .. }) {
             self.stats.gyro_saturated += 1;
             self.saturation.gyro_saturated();
         }
@@ -714,9 +714,8 @@ impl FusedOrientation {
         if !self.gyro_is_live(t_ns) {
             return;
         }
-        let ceiling = self.acc_range.ceiling();
-        let pinned = raw.map(|v| ceiling.is_some_and(|c| v.abs() >= c));
-        let saturated = verdict == RangeVerdict::Saturated || pinned.iter().any(|p| *p);
+        let pinned = verdict.pinned_axes();
+        let saturated = pinned.iter().any(|p| *p);
         if saturated {
             self.stats.accel_saturated += 1;
         }

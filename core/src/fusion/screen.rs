@@ -68,8 +68,21 @@ pub(super) struct Range {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum RangeVerdict {
     Measurement,
-    Saturated,
+    /// `axes`: those at the range limit (their values are bounds, not measurements).
+    Saturated {
+        axes: [bool; 3],
+    },
     OutOfRange,
+}
+
+impl RangeVerdict {
+    /// The axes at the range limit (none for a measurement).
+    pub(super) fn pinned_axes(self) -> [bool; 3] {
+        match self {
+            Self::Saturated { axes } => axes,
+            _ => [false; 3],
+        }
+    }
 }
 
 /// Where the range is not declared: the widest range of phone accelerometers, ±16 g (the
@@ -100,15 +113,6 @@ impl Range {
         }
     }
 
-    /// The level from which an axis reads saturated, once known.
-    pub(super) fn ceiling(&self) -> Option<f32> {
-        if self.declared.is_finite() {
-            Some(self.declared as f32 * 0.999)
-        } else {
-            (self.pinned_episodes >= CEILING_REPEATS).then_some(self.top_seen)
-        }
-    }
-
     /// `a` as the sensor gave it (f32: exact repeats are what clipping looks like).
     pub(super) fn judge(&mut self, a: [f32; 3]) -> RangeVerdict {
         let top = a.iter().fold(0.0f32, |m, v| m.max(v.abs()));
@@ -117,7 +121,9 @@ impl Range {
             return if top > range * 1.05 {
                 RangeVerdict::OutOfRange
             } else if top >= range * 0.999 {
-                RangeVerdict::Saturated
+                RangeVerdict::Saturated {
+                    axes: a.map(|v| v.abs() >= range * 0.999),
+                }
             } else {
                 RangeVerdict::Measurement
             };
@@ -142,7 +148,9 @@ impl Range {
         }
         self.pinned_now = pinned;
         if self.pinned_episodes >= CEILING_REPEATS && top == self.top_seen {
-            RangeVerdict::Saturated
+            RangeVerdict::Saturated {
+                axes: a.map(|v| v.abs() == self.top_seen),
+            }
         } else {
             RangeVerdict::Measurement
         }
@@ -479,7 +487,12 @@ mod tests {
         let mut r = Range::new(8.0 * 9.80665, ASSUMED_MAX_ACCEL_M_S2, MIN_ACCEL_RANGE_M_S2);
         assert_eq!(r.judge([1.0, 2.0, G]), RangeVerdict::Measurement);
         assert_eq!(r.judge([7.9 * G, 0.0, 0.0]), RangeVerdict::Measurement);
-        assert_eq!(r.judge([0.0, -8.0 * G, 1.0]), RangeVerdict::Saturated);
+        assert_eq!(
+            r.judge([0.0, -8.0 * G, 1.0]),
+            RangeVerdict::Saturated {
+                axes: [false, true, false]
+            }
+        );
         assert_eq!(r.judge([0.0, 0.0, 9.0 * G]), RangeVerdict::OutOfRange);
     }
 
@@ -503,10 +516,18 @@ mod tests {
             "{verdicts:?}"
         );
         assert!(
-            verdicts[17..20].iter().all(|v| *v == RangeVerdict::Saturated),
+            verdicts[17..20].iter().all(|v| *v
+                == RangeVerdict::Saturated {
+                    axes: [true, false, false]
+                }),
             "{verdicts:?}"
         );
-        assert_eq!(r.judge([-clip, 3.0, 2.0]), RangeVerdict::Saturated);
+        assert_eq!(
+            r.judge([-clip, 3.0, 2.0]),
+            RangeVerdict::Saturated {
+                axes: [true, false, false]
+            }
+        );
         assert_eq!(r.judge([0.5 * clip, 3.0, 2.0]), RangeVerdict::Measurement);
         // A larger reading shows the ceiling was no limit.
         assert_eq!(r.judge([clip * 1.2, 0.0, 0.0]), RangeVerdict::Measurement);
