@@ -54,19 +54,32 @@ pub struct Trial {
     pub movement: Option<Vec<(i64, bool)>>,
 }
 
+/// A recording's trial name: its file name without `.csv.gz` / `.csv` (BROAD), or its folder's
+/// name (phone recordings). Tables, reference tracks (`DIR/<name>.csv`) and the benchmark's logs
+/// are keyed by it.
+pub fn trial_name(path: &Path) -> String {
+    path.file_name()
+        .map(|n| {
+            n.to_string_lossy()
+                .trim_end_matches(".csv.gz")
+                .trim_end_matches(".csv")
+                .to_owned()
+        })
+        .unwrap_or_else(|| path.display().to_string())
+}
+
+/// BROAD's inclination error of an estimate, rad: `2·acos(√(w² + z²))` of the earth-frame error
+/// quaternion `est ⊗ truth⁻¹` (independent of either side's heading).
+pub fn inclination_error_rad(est: DQuat, truth: DQuat) -> f64 {
+    let e = (est * truth.inverse()).normalize();
+    2.0 * (e.w * e.w + e.z * e.z).sqrt().clamp(0.0, 1.0).acos()
+}
+
 impl Trial {
     pub fn load(path: &Path) -> Result<Self, LogError> {
         let format = import::detect(path)?;
         let log = import::import(path)?;
-        let name = path
-            .file_name()
-            .map(|n| {
-                n.to_string_lossy()
-                    .trim_end_matches(".csv.gz")
-                    .trim_end_matches(".csv")
-                    .to_owned()
-            })
-            .unwrap_or_else(|| path.display().to_string());
+        let name = trial_name(path);
         let (truth_frame, movement) = match format {
             SourceFormat::Broad => (TruthFrame::EastNorthUp, Some(import::read_broad_movement(path)?)),
             _ => (TruthFrame::ArbitraryHeading, None),
@@ -129,12 +142,11 @@ struct Accumulator {
 impl Accumulator {
     /// One row; `has_heading` is false for an estimate made from "up" alone (any heading).
     fn add(&mut self, est: DQuat, truth: DQuat, has_heading: bool) {
-        let e = (est * truth.inverse()).normalize();
-        let incl = 2.0 * (e.w * e.w + e.z * e.z).sqrt().clamp(0.0, 1.0).acos();
+        let incl = inclination_error_rad(est, truth);
         self.n += 1;
         self.incl += incl * incl;
         if has_heading {
-            self.heading_errors.push(e);
+            self.heading_errors.push((est * truth.inverse()).normalize());
         }
     }
 

@@ -13,6 +13,7 @@
 use phantogram::attitude::OrientationEstimator;
 use phantogram::fusion::{FusedOrientation, FusionParams};
 use phantogram::glam::{DQuat, DVec3};
+use phantogram::orientation_eval::inclination_error_rad;
 use phantogram::sensorlog::import::import;
 use phantogram::sensors::{SensorEvent, SensorKind};
 use phantogram::synthetic::vigorous::{VigorousSpec, simulate_vigorous, track_from_samples};
@@ -32,11 +33,6 @@ struct Outcome {
     recovery_s: Vec<Option<f64>>,
 }
 
-fn inclination_deg(est: DQuat, truth: DQuat) -> f64 {
-    let e = (est * truth.inverse()).normalize();
-    2.0 * (e.w * e.w + e.z * e.z).sqrt().clamp(0.0, 1.0).acos().to_degrees()
-}
-
 fn run(spec: &VigorousSpec, params: FusionParams, slow: impl Fn(f64) -> DQuat) -> Outcome {
     let events = simulate_vigorous(spec, DURATION_S, 0, slow);
     let mut f = FusedOrientation::new(params);
@@ -44,7 +40,10 @@ fn run(spec: &VigorousSpec, params: FusionParams, slow: impl Fn(f64) -> DQuat) -
     for e in &events {
         if e.kind == SensorKind::GroundTruth {
             if let (Some(est), Some(truth)) = (f.device_to_world(), e.quat()) {
-                errors.push((e.t_ns as f64 * 1e-9, inclination_deg(est.as_dquat(), truth.as_dquat())));
+                errors.push((
+                    e.t_ns as f64 * 1e-9,
+                    inclination_error_rad(est.as_dquat(), truth.as_dquat()).to_degrees(),
+                ));
             }
         } else {
             f.push(e);

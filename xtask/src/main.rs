@@ -204,14 +204,15 @@ fn orientation_recordings(imu: &Path) -> Result<Vec<(String, PathBuf)>> {
         let mut found: Vec<(String, PathBuf)> = std::fs::read_dir(&dir)
             .with_context(|| format!("reading {}", dir.display()))?
             .filter_map(|e| e.ok().map(|e| e.path()))
-            .filter_map(|p| {
-                let name = p.file_name()?.to_string_lossy().into_owned();
+            .filter(|p| {
                 if group == "phone" {
-                    p.join("accelerometer.txt.gz").is_file().then_some((name, p))
+                    p.join("accelerometer.txt.gz").is_file()
                 } else {
-                    name.strip_suffix(".csv.gz").map(|n| (n.to_owned(), p.clone()))
+                    p.to_string_lossy().ends_with(".csv.gz")
                 }
             })
+            // Named as `phantogram eval orientation` names the trial, which finds VQF's track by it.
+            .map(|p| (phantogram::orientation_eval::trial_name(&p), p))
             .collect();
         if found.is_empty() {
             bail!("no recordings in {}", dir.display());

@@ -258,18 +258,18 @@ impl Shake {
 }
 
 /// The device → world orientation at each time: the slow track times the shake.
-pub struct VigorousMotion<F: Fn(f64) -> DQuat> {
+struct VigorousMotion<F: Fn(f64) -> DQuat> {
     slow: F,
     shake: Shake,
 }
 
 impl<F: Fn(f64) -> DQuat> VigorousMotion<F> {
-    pub fn orientation(&self, t_s: f64) -> DQuat {
+    fn orientation(&self, t_s: f64) -> DQuat {
         ((self.slow)(t_s) * self.shake.rotation(t_s)).normalize()
     }
 
     /// Hand acceleration (gravity not included), world frame, m/s².
-    pub fn accel_world(&self, t_s: f64) -> DVec3 {
+    fn accel_world(&self, t_s: f64) -> DVec3 {
         self.shake.accel_world(t_s)
     }
 }
