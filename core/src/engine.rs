@@ -314,10 +314,10 @@ impl Engine {
     /// Saves the calibration where [`EngineConfig::calibration_path`] says (if anywhere); a
     /// failure becomes [`Self::calibration_warning`].
     fn save_calibration(&mut self) {
-        if let Some(path) = &self.calibration_path {
-            if let Err(e) = self.calibration.save(path) {
-                self.calibration_warning = Some(format!("{}: {e}; the calibration was not saved", path.display()));
-            }
+        if let Some(path) = &self.calibration_path
+            && let Err(e) = self.calibration.save(path)
+        {
+            self.calibration_warning = Some(format!("{}: {e}; the calibration was not saved", path.display()));
         }
     }
 

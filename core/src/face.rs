@@ -673,10 +673,10 @@ impl FaceModels {
         let detections = merge_detections(detections);
         let mut faces: Vec<FaceFound> = Vec::new();
         for d in detections {
-            if let Some(face) = self.face_from_detection(image, &d)? {
-                if face.confidence >= MIN_FACE_CONFIDENCE {
-                    faces.push(face);
-                }
+            if let Some(face) = self.face_from_detection(image, &d)?
+                && face.confidence >= MIN_FACE_CONFIDENCE
+            {
+                faces.push(face);
             }
         }
         // Two detections of one face (a tile's and the whole image's) give the same eyes.

@@ -736,12 +736,13 @@ mod loader {
         let mut out = Vec::with_capacity(bytes.len());
         let mut i = 0;
         while i < bytes.len() {
-            if bytes[i] == b'%' && i + 2 < bytes.len() {
-                if let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16) {
-                    out.push(v);
-                    i += 3;
-                    continue;
-                }
+            if bytes[i] == b'%'
+                && i + 2 < bytes.len()
+                && let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16)
+            {
+                out.push(v);
+                i += 3;
+                continue;
             }
             out.push(bytes[i]);
             i += 1;
@@ -999,7 +1000,7 @@ mod loader {
         check(&a.uv0, 2, "TEXCOORD_0")?;
         check(&a.uv1, 2, "TEXCOORD_1")?;
         let indices = a.indices.unwrap_or_else(|| (0..n as u32).collect());
-        if indices.len() % 3 != 0 {
+        if !indices.len().is_multiple_of(3) {
             return Err(ctx.data(what.to_owned(), "index count is not a multiple of 3"));
         }
         if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {

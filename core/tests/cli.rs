@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 use std::process::Command;
 
-use phantogram::scratch::Scratch;
+use phantogram_testkit::Scratch;
 
 fn bin() -> Command {
     Command::new(env!("CARGO_BIN_EXE_phantogram"))

@@ -29,7 +29,7 @@ pub fn data_subdir(name: &str) -> Option<PathBuf> {
     }
 }
 
-pub use phantogram::scratch::Scratch;
+pub use phantogram_testkit::Scratch;
 
 /// A scratch folder unique to this process and `name`, emptied first, removed when the returned
 /// guard drops unless the test is failing (see [`Scratch`]).

@@ -3,8 +3,8 @@
 
 use std::path::PathBuf;
 
-use phantogram::sensorlog::LogReader;
 use phantogram::synthetic::{ImuSpec, tilt_sweep};
+use phantogram_lab::sensorlog::LogReader;
 
 fn asset(path: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets").join(path)

@@ -5,9 +5,9 @@
 
 use phantogram::containment::{Aabb, ContainmentSmoother, required_push_back_m};
 use phantogram::glam::Vec3;
-use phantogram::replay::{Pace, replay};
 use phantogram::synthetic::{ImuSpec, tilt_sweep};
 use phantogram::{FrameView, Session, SessionConfig};
+use phantogram_lab::replay::{Pace, replay};
 
 const FRAME_NS: i64 = 16_666_667; // 60 Hz
 

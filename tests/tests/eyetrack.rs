@@ -8,9 +8,9 @@
 
 use phantogram::eyetrack::{EyeSource, EyeTrackParams, EyeTracker, FaceObservation};
 use phantogram::glam::Vec3;
-use phantogram::sensorlog::LogReader;
 use phantogram::synthetic::tilt_sweep_pose;
 use phantogram::{Session, SessionConfig};
+use phantogram_lab::sensorlog::LogReader;
 
 const NS: f64 = 1e9;
 

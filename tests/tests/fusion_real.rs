@@ -6,11 +6,11 @@ use phantogram::attitude::OrientationEstimator;
 use phantogram::fusion::FusedOrientation;
 use phantogram::glam::{Quat, Vec3};
 use phantogram::light::heading_rad;
-use phantogram::sensorlog::import::import;
 use phantogram::sensors::{SensorEvent, SensorKind};
 use phantogram::synthetic::{ImuSpec, tilt_sweep};
 use phantogram::{Session, SessionConfig};
 use phantogram_integration::data_subdir;
+use phantogram_lab::sensorlog::import::import;
 
 fn trial(group: &str, name: &str) -> Option<Vec<SensorEvent>> {
     let dir = data_subdir("imu")?;
@@ -71,19 +71,21 @@ fn inject_faults(clean: &[SensorEvent], first_s: i64) -> (Vec<SensorEvent>, Vec<
     for e in clean.iter().filter(|e| !e.kind.is_orientation()) {
         let mut e = *e;
         k += 1;
-        if (faults[0].start_ns..faults[0].end_ns).contains(&e.t_ns) && k % 3 == 0 {
-            e.value[(k % 3) as usize] = if k % 2 == 0 { f32::NAN } else { f32::INFINITY };
+        if (faults[0].start_ns..faults[0].end_ns).contains(&e.t_ns) && k.is_multiple_of(3) {
+            e.value[(k % 3) as usize] = if k.is_multiple_of(2) { f32::NAN } else { f32::INFINITY };
         }
         if (faults[1].start_ns..faults[1].end_ns).contains(&e.t_ns) {
             continue;
         }
-        if e.kind == SensorKind::Accelerometer && (faults[2].start_ns..faults[2].end_ns).contains(&e.t_ns) && k % 4 == 0
+        if e.kind == SensorKind::Accelerometer
+            && (faults[2].start_ns..faults[2].end_ns).contains(&e.t_ns)
+            && k.is_multiple_of(4)
         {
             let dir = Vec3::new((k as f32).sin(), (k as f32 * 1.7).cos(), 0.3).normalize();
             e = SensorEvent::accelerometer(e.t_ns, dir * 50.0 * 9.81);
         }
         out.push(e);
-        if (faults[3].start_ns..faults[3].end_ns).contains(&e.t_ns) && k % 5 == 0 {
+        if (faults[3].start_ns..faults[3].end_ns).contains(&e.t_ns) && k.is_multiple_of(5) {
             // A stale copy from 0.3 s earlier, with a garbage value.
             let mut stale = e;
             stale.t_ns -= 3 * S / 10;
@@ -521,7 +523,7 @@ fn magnetometer_keeps_the_light_from_drifting_with_gyro_bias() {
 /// Prints raw and aligned figures for all six trials.
 #[test]
 fn phone_inclination_floor_is_the_marker_mounting() {
-    use phantogram::orientation_eval::{PlatformRotationVector, Trial, TruthFrame, score};
+    use phantogram_lab::orientation_eval::{PlatformRotationVector, Trial, TruthFrame, score};
     let mut determined = 0;
     for name in [
         "Guillaume_Nexus5_Dist_Texting",
@@ -598,7 +600,7 @@ fn marker_mounting_is_recovered_from_rates() {
 /// on each, the magnetically disturbed recordings included (what a world-fixed light needs).
 #[test]
 fn phone_fused_no_worse_than_androids_rotation_vector() {
-    use phantogram::orientation_eval::{PlatformRotationVector, Trial, score};
+    use phantogram_lab::orientation_eval::{PlatformRotationVector, Trial, score};
     let Some(dir) = data_subdir("imu") else { return };
     let mut scored = 0;
     for entry in std::fs::read_dir(dir.join("phone")).unwrap() {
@@ -609,7 +611,7 @@ fn phone_fused_no_worse_than_androids_rotation_vector() {
         let trial = Trial::load(&path).unwrap_or_else(|e| panic!("{e}"));
         let ours = score(&trial, "fused", &mut FusedOrientation::default()).main;
         let android = score(&trial, "rotation vector", &mut PlatformRotationVector::default()).main;
-        let heading = |r: &phantogram::orientation_eval::Rmse| r.heading_deg.expect("both have a heading");
+        let heading = |r: &phantogram_lab::orientation_eval::Rmse| r.heading_deg.expect("both have a heading");
         println!(
             "{}: inclination RMSE fused {:.2}° / rotation vector {:.2}°, heading {:.2}° / {:.2}°, over {} rows",
             trial.name,
@@ -643,7 +645,7 @@ fn phone_fused_no_worse_than_androids_rotation_vector() {
 /// the provided trials (VQF reaches 0.70° / 1.92° over all 39).
 #[test]
 fn broad_means_meet_the_goal() {
-    use phantogram::orientation_eval::{Trial, score};
+    use phantogram_lab::orientation_eval::{Trial, score};
     let Some(dir) = data_subdir("imu") else { return };
     let (mut incl, mut head, mut n) = (0.0, 0.0, 0);
     let mut paths: Vec<_> = std::fs::read_dir(dir.join("broad"))
@@ -673,7 +675,7 @@ fn broad_means_meet_the_goal() {
 /// `cargo xtask bench orientation` reproduces them to the hundredth with our scoring).
 #[test]
 fn broad_extra_level_with_vqf() {
-    use phantogram::orientation_eval::{Trial, score};
+    use phantogram_lab::orientation_eval::{Trial, score};
     let Some(dir) = data_subdir("imu") else { return };
     // (trial, VQF inclination, VQF heading), degrees.
     let vqf = [
@@ -720,7 +722,7 @@ fn broad_extra_level_with_vqf() {
 /// tapping 0.60° → 1.26° at ±4 g.
 #[test]
 fn clipped_recordings_stay_near_the_unclipped() {
-    use phantogram::orientation_eval::{Trial, score};
+    use phantogram_lab::orientation_eval::{Trial, score};
     let Some(dir) = data_subdir("imu") else { return };
     for (name, clip_g, margin_deg) in [
         ("15_undisturbed_fast_translation_A", 3.0f32, 0.15),

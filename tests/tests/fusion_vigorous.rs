@@ -13,11 +13,11 @@
 use phantogram::attitude::OrientationEstimator;
 use phantogram::fusion::{FusedOrientation, FusionParams};
 use phantogram::glam::{DQuat, DVec3};
-use phantogram::orientation_eval::inclination_error_rad;
-use phantogram::sensorlog::import::import;
 use phantogram::sensors::{SensorEvent, SensorKind};
 use phantogram::synthetic::vigorous::{VigorousSpec, simulate_vigorous, track_from_samples};
 use phantogram_integration::data_subdir;
+use phantogram_lab::orientation_eval::inclination_error_rad;
+use phantogram_lab::sensorlog::import::import;
 
 const DURATION_S: f64 = 72.0;
 

@@ -475,7 +475,7 @@ fn split_glb(bytes: &[u8]) -> Option<(&[u8], Option<&[u8]>)> {
 /// A GLB with this JSON (padded with spaces to 4 bytes, as the format asks) and these chunks after it.
 fn join_glb(json: &[u8], rest: &[u8]) -> Vec<u8> {
     let mut json = json.to_vec();
-    while json.len() % 4 != 0 {
+    while !json.len().is_multiple_of(4) {
         json.push(b' ');
     }
     let total = 12 + 8 + json.len() + rest.len();

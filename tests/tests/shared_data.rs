@@ -8,11 +8,11 @@ use std::collections::BTreeSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use phantogram::replay::{Pace, replay};
-use phantogram::sensorlog::import::{ImportedLog, import};
 use phantogram::sensors::SensorKind;
 use phantogram::{Session, SessionConfig};
 use phantogram_integration::{Scratch, data_subdir, scratch};
+use phantogram_lab::replay::{Pace, replay};
+use phantogram_lab::sensorlog::import::{ImportedLog, import};
 
 /// Files in the data folders that are not sensor streams, with the reason they are not read.
 const NOT_SENSOR_DATA: &[(&str, &str)] = &[

@@ -187,7 +187,7 @@ fn assets() -> Result<()> {
     std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
     let path = dir.join("tilt-sweep.pglog");
     let events = tilt_sweep(&ImuSpec::default());
-    phantogram::sensorlog::write_log(&path, &tilt_sweep_meta(), &events)?;
+    phantogram_lab::sensorlog::write_log(&path, &tilt_sweep_meta(), &events)?;
     println!("wrote {} ({} events)", path.display(), events.len());
     Ok(())
 }
@@ -212,7 +212,7 @@ fn orientation_recordings(imu: &Path) -> Result<Vec<(String, PathBuf)>> {
                 }
             })
             // Named as `phantogram eval orientation` names the trial, which finds VQF's track by it.
-            .map(|p| (phantogram::orientation_eval::trial_name(&p), p))
+            .map(|p| (phantogram_lab::orientation_eval::trial_name(&p), p))
             .collect();
         if found.is_empty() {
             bail!("no recordings in {}", dir.display());

@@ -1,7 +1,7 @@
 //! `phantogram`: the desktop command-line tool.
 //!
 //! * `phantogram replay LOG` replays a sensor log (the project's format, or any export that
-//!   [`phantogram::sensorlog::import`] recognises) and prints, at a chosen interval of sensor time,
+//!   [`phantogram_lab::sensorlog::import`] recognises) and prints, at a chosen interval of sensor time,
 //!   the cyclopean eye position (mm, device frame) and the direction towards the world-fixed light.
 //! * `phantogram import SRC --out FILE` converts an export into the project's log format.
 //! * `phantogram info LOG` summarises a log: duration, events and rate per sensor.
@@ -18,11 +18,11 @@ use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use phantogram::attitude::{LowPassAttitude, OrientationEstimator};
 use phantogram::eyes::EyeModel;
-use phantogram::replay::{Pace, replay};
-use phantogram::sensorlog::{self, LogError, LogReader, import::SourceFormat};
 use phantogram::sensors::{SensorEvent, SensorKind};
 use phantogram::session::EstimatorChoice;
 use phantogram::{Session, SessionConfig};
+use phantogram_lab::replay::{Pace, replay};
+use phantogram_lab::sensorlog::{self, LogError, LogReader, import::SourceFormat};
 
 #[derive(Parser)]
 #[command(
@@ -385,10 +385,10 @@ fn replay_command(
     distance_cm: f32,
     flat_at_s: Option<f64>,
 ) -> Result<()> {
-    if let Some(speed) = realtime {
-        if !(speed.is_finite() && speed > 0.0) {
-            bail!("--realtime must be a positive speed factor, got {speed}");
-        }
+    if let Some(speed) = realtime
+        && !(speed.is_finite() && speed > 0.0)
+    {
+        bail!("--realtime must be a positive speed factor, got {speed}");
     }
     let mut config = SessionConfig::default();
     if let Some(tau_s) = tau_s {
@@ -450,10 +450,10 @@ fn replay_command(
     if let Some(at) = flat_pending {
         bail!("--flat-at-s {at} is beyond the end of the log");
     }
-    if let Some(err) = write_error {
-        if err.kind() != std::io::ErrorKind::BrokenPipe {
-            return Err(err.into());
-        }
+    if let Some(err) = write_error
+        && err.kind() != std::io::ErrorKind::BrokenPipe
+    {
+        return Err(err.into());
     }
     out.flush().ok();
     let s = summary.stats;
@@ -545,7 +545,7 @@ fn eval_orientation_command(
     estimators: &[EstimatorName],
     references: &[(String, PathBuf)],
 ) -> Result<()> {
-    use phantogram::orientation_eval::{
+    use phantogram_lab::orientation_eval::{
         CONVERGENCE_S, RecordedTrack, Score, Selection, Trial, TruthFrame, score, score_selected,
     };
     let recordings = expand_recordings(paths)?;
@@ -701,7 +701,7 @@ fn orientation_command(log: &std::path::Path, name: EstimatorName, tau_s: f32, c
     let mut estimator: Box<dyn OrientationEstimator> = match name {
         EstimatorName::LowPass => Box::new(LowPassAttitude::new(tau_s, tau_s)),
         EstimatorName::Fused => Box::new(phantogram::fusion::FusedOrientation::default()),
-        EstimatorName::RotationVector => Box::new(phantogram::orientation_eval::PlatformRotationVector::default()),
+        EstimatorName::RotationVector => Box::new(phantogram_lab::orientation_eval::PlatformRotationVector::default()),
     };
     let stdout = std::io::stdout();
     let mut out = BufWriter::new(stdout.lock());
@@ -727,18 +727,18 @@ fn orientation_command(log: &std::path::Path, name: EstimatorName, tau_s: f32, c
         if e.kind == SensorKind::GroundTruth {
             continue;
         }
-        if let Some(t) = pending_t.filter(|t| *t != e.t_ns) {
-            if let Err(err) = row(&mut out, t, estimator.as_ref()) {
-                return broken_pipe_is_fine(err);
-            }
+        if let Some(t) = pending_t.filter(|t| *t != e.t_ns)
+            && let Err(err) = row(&mut out, t, estimator.as_ref())
+        {
+            return broken_pipe_is_fine(err);
         }
         estimator.push(&e);
         pending_t = Some(e.t_ns);
     }
-    if let Some(t) = pending_t {
-        if let Err(err) = row(&mut out, t, estimator.as_ref()) {
-            return broken_pipe_is_fine(err);
-        }
+    if let Some(t) = pending_t
+        && let Err(err) = row(&mut out, t, estimator.as_ref())
+    {
+        return broken_pipe_is_fine(err);
     }
     out.flush().or_else(broken_pipe_is_fine)
 }

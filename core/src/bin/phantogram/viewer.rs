@@ -320,16 +320,16 @@ impl ApplicationHandler for App {
 
     fn window_event(&mut self, event_loop: &ActiveEventLoop, _id: WindowId, event: WindowEvent) {
         // While the calibration screens are open, the mouse and keys drive them.
-        if self.calibration_ui.is_some() {
-            if let (Some(state), Some(window)) = (self.egui_input.as_mut(), self.window.as_ref()) {
-                let consumed = state.on_window_event(window, &event).consumed;
-                let passes = matches!(
-                    event,
-                    WindowEvent::CloseRequested | WindowEvent::Resized(_) | WindowEvent::RedrawRequested
-                );
-                if consumed || !passes {
-                    return;
-                }
+        if self.calibration_ui.is_some()
+            && let (Some(state), Some(window)) = (self.egui_input.as_mut(), self.window.as_ref())
+        {
+            let consumed = state.on_window_event(window, &event).consumed;
+            let passes = matches!(
+                event,
+                WindowEvent::CloseRequested | WindowEvent::Resized(_) | WindowEvent::RedrawRequested
+            );
+            if consumed || !passes {
+                return;
             }
         }
         match event {

@@ -14,8 +14,8 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 
 use crate::sensorlog::LogError;
-use crate::sensors::{SensorEvent, SensorStats};
-use crate::session::{FrameView, Session, SessionError};
+use phantogram_sensing::sensors::{SensorEvent, SensorStats};
+use phantogram_sensing::session::{FrameView, Session, SessionError};
 
 /// Longest stretch without events that is filled with frames: one minute.
 pub const MAX_GAP_NS: i64 = 60_000_000_000;
@@ -112,8 +112,8 @@ where
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::session::SessionConfig;
     use glam::Vec3;
+    use phantogram_sensing::session::SessionConfig;
 
     fn events(times: &[i64]) -> Vec<Result<SensorEvent, LogError>> {
         times

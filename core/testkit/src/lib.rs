@@ -1,6 +1,6 @@
-//! Scratch folders for tests: the crate's unit tests, its CLI tests and the workspace's
-//! integration tests share this one piece. Public only for them (hidden from the docs, not part of
-//! the API); the library itself never writes temporary files.
+//! Scratch folders for tests: the crates' unit tests, the CLI tests and the workspace's
+//! integration tests share this one piece, as a dev-dependency only: no library writes temporary
+//! files.
 //!
 //! Each folder is unique to the process and a name, emptied when made, and removed when
 //! dropped, unless the thread is panicking: a failing test keeps its files for inspection and

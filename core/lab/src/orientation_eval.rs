@@ -25,12 +25,12 @@ use std::time::Instant;
 
 use glam::DQuat;
 
-use crate::attitude::{LowPassAttitude, OrientationEstimator};
-use crate::fusion::FusedOrientation;
-use crate::lowpass::time_constant_from_paper_coefficient;
 use crate::sensorlog::LogError;
 use crate::sensorlog::import::{self, SourceFormat};
-use crate::sensors::{SensorEvent, SensorKind};
+use phantogram_sensing::attitude::{LowPassAttitude, OrientationEstimator};
+use phantogram_sensing::fusion::FusedOrientation;
+use phantogram_sensing::lowpass::time_constant_from_paper_coefficient;
+use phantogram_sensing::sensors::{SensorEvent, SensorKind};
 
 /// Seconds at the start of a trial reported separately as convergence.
 pub const CONVERGENCE_S: f64 = 5.0;
@@ -251,7 +251,10 @@ pub fn score(trial: &Trial, name: &str, estimator: &mut dyn OrientationEstimator
         let (est, has_heading) = match estimator.device_to_world() {
             Some(q) => (q, true),
             // Any heading will do: the inclination error does not depend on it.
-            None => match estimator.up_device().and_then(crate::attitude::device_to_world_from_up) {
+            None => match estimator
+                .up_device()
+                .and_then(phantogram_sensing::attitude::device_to_world_from_up)
+            {
                 Some(q) => (q, false),
                 None => {
                     missing += 1;
@@ -519,7 +522,7 @@ impl OrientationEstimator for RecordedTrack {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::synthetic::{ImuSpec, tilt_sweep};
+    use phantogram_sensing::synthetic::{ImuSpec, tilt_sweep};
 
     #[test]
     fn error_definitions_match_broad() {
@@ -568,7 +571,7 @@ mod tests {
 
     #[test]
     fn a_recorded_track_is_scored_like_an_estimator() {
-        let scratch = crate::scratch::Scratch::new("recorded-track");
+        let scratch = phantogram_testkit::Scratch::new("recorded-track");
         let events = tilt_sweep(&ImuSpec::default());
         let trial = Trial {
             name: "synthetic".into(),

@@ -1,6 +1,6 @@
 //! The viewpoint from gravity, the paper's method: the viewer's cyclopean eye is assumed to lie
 //! along "up" at the viewing distance, `eye = d · normalize(aₜ)` in the device frame, where `aₜ` is
-//! the low-passed accelerometer ([`crate::attitude::LowPassAttitude`]).
+//! the low-passed accelerometer (`phantogram_sensing::attitude::LowPassAttitude`).
 //!
 //! **Sign**: the paper writes `v = −d·aₜ` because iOS reports −1 g on z for a phone lying face up;
 //! Android (and this crate's device frame) reads +9.81 m/s² on z in that pose, so the eye lies along

@@ -22,7 +22,7 @@ use std::path::Path;
 
 use glam::{Vec2, Vec3};
 
-use crate::screen::{PanelSpec, Screen};
+use phantogram_geometry::screen::{PanelSpec, Screen};
 
 /// Where the glass shows `viewer_eye` the reflection of `eye` (device frame, the glass is z = 0):
 /// the ray from the viewer's eye to the mirror image `(x, y, −z)` crosses the glass there.
@@ -244,7 +244,7 @@ impl Calibration {
     /// `$XDG_CONFIG_HOME/phantogram/calibration.txt`, else `~/.config/phantogram/calibration.txt`.
     /// The phone shells pass their app-private folder instead.
     pub fn default_path() -> Option<std::path::PathBuf> {
-        crate::user_path(
+        crate::storage::user_path(
             "PHANTOGRAM_CALIBRATION",
             "XDG_CONFIG_HOME",
             ".config",
@@ -325,7 +325,7 @@ mod tests {
 
     #[test]
     fn calibration_file_round_trips_and_bad_files_give_defaults() {
-        let dir = crate::scratch::Scratch::new("unit-calibration");
+        let dir = phantogram_testkit::Scratch::new("unit-calibration");
         let path = dir.join("calibration.txt");
         let c = Calibration {
             ipd_m: Some(0.0615),

@@ -23,7 +23,7 @@
 //!   (rad/s), `mag` magnetometer (µT), `lin` linear acceleration (m/s², gravity removed), each with
 //!   `x y z`; `rot` platform rotation vector and `gt` ground-truth orientation, device → world
 //!   quaternions as `x y z w`. Values may be `NaN` or `inf`: a log records what the sensor said,
-//!   and the consumer ([`crate::sensors::SensorInbox`]) rejects and counts them.
+//!   and the consumer ([`phantogram_sensing::sensors::SensorInbox`]) rejects and counts them.
 //! * Events are written in time order; readers do not reorder.
 //!
 //! Errors name the file and the 1-based line.
@@ -39,7 +39,7 @@ use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
 use thiserror::Error;
 
-use crate::sensors::{SensorEvent, SensorKind};
+use phantogram_sensing::sensors::{SensorEvent, SensorKind};
 
 /// First word of line 1.
 pub const MAGIC: &str = "phantogram-sensor-log";
@@ -207,7 +207,7 @@ pub fn parse_f64(field: &str) -> Result<f64, String> {
 
 /// Seconds (as exported) to integer nanoseconds; refuses non-finite or absurd times.
 pub fn seconds_to_ns(t_s: f64) -> Result<i64, String> {
-    if !t_s.is_finite() || t_s.abs() * 1e9 > crate::sensors::MAX_ABS_T_NS as f64 {
+    if !t_s.is_finite() || t_s.abs() * 1e9 > phantogram_sensing::sensors::MAX_ABS_T_NS as f64 {
         return Err(format!("time stamp {t_s} s is not usable"));
     }
     Ok((t_s * 1e9).round() as i64)
@@ -322,7 +322,7 @@ fn parse_event(tag: &str, rest: &str) -> Result<SensorEvent, String> {
         .ok_or("missing time stamp")?
         .parse::<i64>()
         .ok()
-        .filter(|&t| crate::sensors::time_in_range(t))
+        .filter(|&t| phantogram_sensing::sensors::time_in_range(t))
         .ok_or("time stamp is not an integer number of nanoseconds within ±2^62")?;
     let n = if kind.is_orientation() { 4 } else { 3 };
     let mut value = [0f32; 4];
@@ -464,7 +464,7 @@ mod tests {
     use super::*;
     use glam::{Quat, Vec3};
 
-    use crate::scratch::Scratch;
+    use phantogram_testkit::Scratch;
 
     fn sample_events() -> Vec<SensorEvent> {
         vec![

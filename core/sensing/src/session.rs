@@ -24,14 +24,14 @@ use thiserror::Error;
 
 use crate::attitude::{LowPassAttitude, OrientationEstimator, device_to_world_from_up};
 use crate::calibration::Calibration;
-use crate::eyes::{EyeModel, EyeModelError, StereoEyes};
 use crate::eyetrack::{EyeSource, EyeTrackParams, EyeTracker, FaceObservation};
 use crate::fusion::{FusedOrientation, FusionParams};
-use crate::light::WorldLight;
-use crate::projection::{DepthRange, OffAxisProjection, ProjectionError};
-use crate::screen::{PanelSpec, Screen};
 use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorRanges, SensorStats};
-use crate::viewpoint::Viewpoint;
+use phantogram_geometry::eyes::{EyeModel, EyeModelError, StereoEyes};
+use phantogram_geometry::light::WorldLight;
+use phantogram_geometry::projection::{DepthRange, OffAxisProjection, ProjectionError};
+use phantogram_geometry::screen::{PanelSpec, Screen};
+use phantogram_geometry::viewpoint::Viewpoint;
 
 /// Which orientation estimator drives the viewpoint and the light.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -204,7 +204,7 @@ impl Session {
         self.batch.len()
     }
 
-    /// Takes a face-tracking result (from [`crate::face`] or any other tracker): the eyes in the
+    /// Takes a face-tracking result (from `phantogram::face` or any other tracker): the eyes in the
     /// device frame at the frame's capture time, on the sensor clock.
     pub fn observe_face(&mut self, observation: FaceObservation) {
         self.eye_tracker.observe(observation);

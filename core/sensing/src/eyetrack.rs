@@ -18,7 +18,7 @@
 //!   2012) in the room-fixed frame (where a still head is still): strong smoothing at rest, little
 //!   lag when the head moves.
 //! * The stereo eye axis follows the tracked eyes: [`TrackedEyes::eye_axis`] goes to
-//!   [`crate::eyes::EyeModel::eye_axis_device`].
+//!   [`phantogram_geometry::eyes::EyeModel::eye_axis_device`].
 //!
 //! Frames: device frame, metres; times on the sensor clock, nanoseconds (see the crate docs).
 //! Threading: plain data, owned by the render thread; the face worker hands it

@@ -6,7 +6,7 @@
 //! field). Afterwards its device-frame direction is the world direction rotated back by the
 //! current orientation: turning the phone by 90° about the vertical turns the light by 90° the
 //! other way on screen, while pitching the phone leaves the light's heading in the room unchanged
-//! (the orientation's heading is tilt-compensated, see [`crate::attitude`]).
+//! (the orientation's heading is tilt-compensated, see `phantogram_sensing::attitude`).
 //!
 //! Directions are unit vectors pointing *towards* the light.
 

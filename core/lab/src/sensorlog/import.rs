@@ -22,7 +22,7 @@ use std::path::{Path, PathBuf};
 use glam::{Mat3, Quat, Vec3};
 
 use super::{Lines, LogError, LogReader, parse_f64, seconds_to_ns};
-use crate::sensors::{SensorEvent, SensorKind};
+use phantogram_sensing::sensors::{SensorEvent, SensorKind};
 
 /// A whole imported recording.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -391,12 +391,12 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
 fn parse_ns(field: &str) -> Result<i64, String> {
     let f = field.trim().trim_matches('"');
     if let Ok(t) = f.parse::<i64>() {
-        if crate::sensors::time_in_range(t) {
+        if phantogram_sensing::sensors::time_in_range(t) {
             return Ok(t);
         }
     }
     let t = parse_f64(f)?;
-    if t.is_finite() && t.abs() <= crate::sensors::MAX_ABS_T_NS as f64 {
+    if t.is_finite() && t.abs() <= phantogram_sensing::sensors::MAX_ABS_T_NS as f64 {
         Ok(t.round() as i64)
     } else {
         Err(format!("time stamp {field:?} is not usable"))
@@ -477,8 +477,8 @@ mod tests {
     use super::*;
     use std::io::Write;
 
-    fn temp_dir(name: &str) -> crate::scratch::Scratch {
-        crate::scratch::Scratch::new(&format!("unit-import-{name}"))
+    fn temp_dir(name: &str) -> phantogram_testkit::Scratch {
+        phantogram_testkit::Scratch::new(&format!("unit-import-{name}"))
     }
 
     fn write_gz(path: &Path, text: &str) {

@@ -1,0 +1,17 @@
+//! # Phantogram lab
+//!
+//! The desktop's side of the sensors: recorded logs and the formats they come in ([`sensorlog`],
+//! with importers for the public datasets in [`sensorlog::import`]), deterministic replay of a log
+//! through a `Session` ([`replay`]), and orientation scoring against motion-capture truth
+//! ([`orientation_eval`]). Used by the `phantogram` CLI, the benchmarks and the tests; the phone
+//! libraries do not link it.
+//!
+//! ## Panics and errors
+//!
+//! Files from outside never panic: a bad log yields [`sensorlog::LogError`] naming file and line,
+//! a bad track [`orientation_eval::TrackError`]. Single-threaded; replay may sleep between frames
+//! only when asked to (`Pace::RealTime`).
+
+pub mod orientation_eval;
+pub mod replay;
+pub mod sensorlog;
