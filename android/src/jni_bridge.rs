@@ -24,14 +24,15 @@ use std::ffi::c_void;
 use std::sync::OnceLock;
 
 use jni::errors::ThrowRuntimeExAndDefault;
-use jni::objects::{JByteBuffer, JClass, JObject, JString};
+use jni::objects::{JByteBuffer, JClass, JFloatArray, JIntArray, JObject, JString};
 use jni::refs::Global;
 use jni::strings::JNIString;
-use jni::sys::{JNI_VERSION_1_6, jboolean, jfloat, jint, jintArray, jlong, jlongArray};
+use jni::sys::{JNI_VERSION_1_6, jboolean, jfloat, jfloatArray, jint, jintArray, jlong, jlongArray};
 use jni::{Env, EnvUnowned, JavaVM, jni_str};
 use phantogram::anaglyph::Method;
-use phantogram::engine::{Engine, EngineConfig, EngineError, SharedEngine};
-use phantogram::face::{Intrinsics, OwnedFrame, PixelFormat};
+use phantogram::camera::android::{Camera2Characteristics, PixelRect};
+use phantogram::camera::{Intrinsics, OwnedFrame};
+use phantogram::engine::{Engine, EngineConfig, EngineError, ErrorKind, SharedEngine};
 use phantogram::gesture::{Gesture, TouchPhase};
 use phantogram::screen::{DisplayRotation, PanelSpec};
 use phantogram::surface::DrawOutcome;
@@ -60,16 +61,11 @@ impl From<jni::errors::Error> for Thrown {
 
 impl From<EngineError> for Thrown {
     fn from(e: EngineError) -> Self {
-        let kind = match &e {
-            EngineError::InvalidArgument(_)
-            | EngineError::Screen(_)
-            | EngineError::Session(_)
-            | EngineError::Face(phantogram::face::FaceError::BadFrame(_)) => Kind::IllegalArgument,
-            EngineError::NoFrame => Kind::IllegalState,
-            EngineError::NoFaceSupport => Kind::Unsupported,
-            EngineError::Render(_) | EngineError::Model(_) | EngineError::Environment(_) | EngineError::Face(_) => {
-                Kind::Runtime
-            }
+        let kind = match e.kind() {
+            ErrorKind::InvalidArgument => Kind::IllegalArgument,
+            ErrorKind::InvalidState => Kind::IllegalState,
+            ErrorKind::Unsupported => Kind::Unsupported,
+            ErrorKind::Load | ErrorKind::Render => Kind::Runtime,
         };
         Self::Java(kind, e.to_string())
     }
@@ -340,24 +336,117 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
         }
         // SAFETY: a direct buffer's memory is valid for `capacity` bytes while `luma` is alive,
         // which it is for this call; we copy before returning.
-        let data = unsafe { std::slice::from_raw_parts(address, capacity) }.to_vec();
-        let frame = OwnedFrame {
+        let data = unsafe { std::slice::from_raw_parts(address, capacity) };
+        let intrinsics = Intrinsics {
+            fx_px,
+            fy_px,
+            cx_px,
+            cy_px,
+        };
+        let frame = OwnedFrame::luma8(
             width,
             height,
             row_stride,
-            format: PixelFormat::Luma8,
             data,
             rotation_cw_deg,
-            intrinsics: Intrinsics {
-                fx_px,
-                fy_px,
-                cx_px,
-                cy_px,
-            },
-            capture_t_ns: timestamp_ns,
-        };
+            intrinsics,
+            timestamp_ns,
+        );
         Ok(engine.camera_frame(frame)?)
     })
+}
+
+/// The intrinsics `[fx, fy, cx, cy]` of a `width × height` output image of the camera whose
+/// Camera2 characteristics are given as the platform reports them (`phantogram::camera::android`
+/// does the maths): `activeArray` and `preCorrection` are `Rect`s as `[left, top, right,
+/// bottom]`, `pixelArray` `[width, height]`, `physicalSizeMm` `[width, height]`, `focalLengthMm`
+/// NaN when not reported, `lensCalibration` `LENS_INTRINSIC_CALIBRATION` as reported; the
+/// optional ones may be `null`. Throws `IllegalArgumentException` when they give no intrinsics.
+#[unsafe(no_mangle)]
+#[allow(clippy::too_many_arguments)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraIntrinsics<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    active_array: JIntArray<'local>,
+    pre_correction: JIntArray<'local>,
+    pixel_array: JIntArray<'local>,
+    physical_size_mm: JFloatArray<'local>,
+    focal_length_mm: jfloat,
+    lens_calibration: JFloatArray<'local>,
+    width: jint,
+    height: jint,
+) -> jfloatArray {
+    run(&mut env, |env| {
+        let rect = |a: Option<[jint; 4]>| {
+            a.map(|[left, top, right, bottom]| PixelRect {
+                left,
+                top,
+                right,
+                bottom,
+            })
+        };
+        let active_array = rect(fixed::<_, 4>(env, &active_array, "activeArray")?)
+            .ok_or_else(|| fail(Kind::IllegalArgument, "activeArray is null"))?;
+        let positive = |v: jint| u32::try_from(v).ok().filter(|&v| v > 0);
+        let characteristics = Camera2Characteristics {
+            active_array,
+            pre_correction_active_array: rect(fixed::<_, 4>(env, &pre_correction, "preCorrection")?),
+            pixel_array_px: fixed::<_, 2>(env, &pixel_array, "pixelArray")?
+                .and_then(|[w, h]| Some([positive(w)?, positive(h)?])),
+            physical_size_mm: fixed::<_, 2>(env, &physical_size_mm, "physicalSizeMm")?,
+            focal_length_mm: Some(focal_length_mm).filter(|f| !f.is_nan()),
+            lens_intrinsic_calibration: at_least::<4>(env, &lens_calibration, "lensCalibration")?,
+        };
+        let (width, height) = size(width, height)?;
+        let k = characteristics
+            .image_intrinsics(width, height)
+            .map_err(|e| fail(Kind::IllegalArgument, e.to_string()))?;
+        let values = [k.fx_px, k.fy_px, k.cx_px, k.cy_px];
+        let array = JFloatArray::new(env, values.len())?;
+        array.set_region(env, 0, &values)?;
+        Ok(array.into_raw())
+    })
+}
+
+/// A Java array of exactly `N` elements, `None` when it is `null`.
+fn fixed<T, const N: usize>(
+    env: &Env,
+    array: &jni::objects::JPrimitiveArray<T>,
+    name: &str,
+) -> Result<Option<[T; N]>, Thrown>
+where
+    T: jni::objects::TypeArray + Copy + Default,
+{
+    if array.is_null() {
+        return Ok(None);
+    }
+    let len = array.len(env)?;
+    if len != N {
+        return Err(fail(
+            Kind::IllegalArgument,
+            format!("{name} must have {N} elements, got {len}"),
+        ));
+    }
+    let mut out = [T::default(); N];
+    array.get_region(env, 0, &mut out)?;
+    Ok(Some(out))
+}
+
+/// The first `N` elements of a float array of at least `N`, `None` when it is `null`.
+fn at_least<const N: usize>(env: &Env, array: &JFloatArray, name: &str) -> Result<Option<[jfloat; N]>, Thrown> {
+    if array.is_null() {
+        return Ok(None);
+    }
+    let len = array.len(env)?;
+    if len < N {
+        return Err(fail(
+            Kind::IllegalArgument,
+            format!("{name} must have at least {N} elements, got {len}"),
+        ));
+    }
+    let mut out = [0.0; N];
+    array.get_region(env, 0, &mut out)?;
+    Ok(Some(out))
 }
 
 /// A `MotionEvent` pointer: phase 0 down, 1 move, 2 up, 3 cancel; position in physical pixels;
@@ -607,11 +696,12 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCalibrationWarning
 
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 16] = [
+pub const NATIVE_METHODS: [&str; 17] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
     "nativeCameraFrame",
+    "nativeCameraIntrinsics",
     "nativeTouch",
     "nativeSurfaceCreated",
     "nativeResumeOffscreen",

@@ -124,6 +124,39 @@ pub enum EngineError {
     NoFrame,
 }
 
+/// The one classification of [`EngineError`]s that both bridges map onto their platform's errors
+/// (JNI: the exception class thrown; C ABI: the `PgStatus`), so that the same failure means the
+/// same thing to the Kotlin and the Swift shell.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ErrorKind {
+    /// The caller passed something unusable (a size, a method name, a malformed camera frame).
+    InvalidArgument,
+    /// The call came in the wrong state (reading a frame before one was drawn offscreen).
+    InvalidState,
+    /// This build or engine cannot do it (face tracking without the `face` feature).
+    Unsupported,
+    /// A file or the face networks could not be loaded or run.
+    Load,
+    /// The GPU failed (device, surface, read-back).
+    Render,
+}
+
+impl EngineError {
+    pub fn kind(&self) -> ErrorKind {
+        match self {
+            Self::InvalidArgument(_) | Self::Screen(_) | Self::Session(_) => ErrorKind::InvalidArgument,
+            #[cfg(feature = "face")]
+            Self::Face(crate::face::FaceError::BadFrame(_)) => ErrorKind::InvalidArgument,
+            #[cfg(feature = "face")]
+            Self::Face(_) => ErrorKind::Load,
+            Self::Model(_) | Self::Environment(_) => ErrorKind::Load,
+            Self::Render(_) => ErrorKind::Render,
+            Self::NoFrame => ErrorKind::InvalidState,
+            Self::NoFaceSupport => ErrorKind::Unsupported,
+        }
+    }
+}
+
 /// Where frames go.
 enum Target {
     Detached,
@@ -144,6 +177,11 @@ pub struct EngineStats {
     /// Camera frames handed to the face tracker, and those it had to drop (busy).
     pub camera_frames: u64,
     pub camera_frames_dropped: u64,
+    /// Camera frames the face tracker failed on ([`Engine::face_tracking_error`] says why the
+    /// last one did), and whether tracking has stopped altogether (no thread, or an internal
+    /// error): the eyes then come from gravity alone.
+    pub camera_frames_failed: u64,
+    pub face_tracking_stopped: bool,
     pub gestures: u64,
     /// Whether the last frame's eyes came from the camera.
     pub eyes_from_camera: bool,
@@ -705,8 +743,20 @@ impl Engine {
         #[cfg(feature = "face")]
         if let Some(f) = &self.face {
             s.camera_frames_dropped = f.dropped_frames();
+            s.camera_frames_failed = f.failed_frames();
+            s.face_tracking_stopped = !f.is_running();
         }
         s
+    }
+
+    /// Why face tracking last failed on a camera frame (a malformed frame, an inference error),
+    /// if it has; counted in [`EngineStats::camera_frames_failed`].
+    pub fn face_tracking_error(&self) -> Option<String> {
+        #[cfg(feature = "face")]
+        if let Some(f) = &self.face {
+            return f.last_error();
+        }
+        None
     }
 }
 
@@ -818,6 +868,38 @@ mod tests {
     use super::*;
 
     fn assert_send_sync<T: Send + Sync>() {}
+
+    /// The bridges map these kinds, not the variants: what each variant means to a shell is
+    /// decided here once.
+    #[test]
+    fn errors_are_classified_once() {
+        assert_eq!(
+            EngineError::InvalidArgument("x".into()).kind(),
+            ErrorKind::InvalidArgument
+        );
+        assert_eq!(
+            EngineError::Screen(ScreenError::EmptyPanel {
+                width_px: 0,
+                height_px: 1
+            })
+            .kind(),
+            ErrorKind::InvalidArgument
+        );
+        assert_eq!(EngineError::NoFrame.kind(), ErrorKind::InvalidState);
+        assert_eq!(EngineError::NoFaceSupport.kind(), ErrorKind::Unsupported);
+        #[cfg(feature = "face")]
+        {
+            use crate::face::FaceError;
+            assert_eq!(
+                EngineError::Face(FaceError::BadFrame("x".into())).kind(),
+                ErrorKind::InvalidArgument
+            );
+            assert_eq!(
+                EngineError::Face(FaceError::Inference("x".into())).kind(),
+                ErrorKind::Load
+            );
+        }
+    }
 
     #[test]
     fn the_shared_engine_may_cross_threads() {

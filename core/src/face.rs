@@ -35,122 +35,16 @@
 //! None on frames or model output from outside: a buffer of the wrong size is an error, NaN
 //! model output counts as "no face".
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+pub use crate::camera::{CameraFrame, CameraPose, Intrinsics, OwnedFrame, PixelFormat};
 pub use crate::eyetrack::FaceObservation;
 use tract_onnx::prelude::*;
 
 /// Human iris diameter (horizontal visible iris), metres.
 pub const IRIS_DIAMETER_M: f32 = 0.0117;
-
-/// Pinhole intrinsics, pixels, of the image they are given with.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Intrinsics {
-    pub fx_px: f32,
-    pub fy_px: f32,
-    pub cx_px: f32,
-    pub cy_px: f32,
-}
-
-impl Intrinsics {
-    /// Square pixels, principal point at the centre, horizontal field of view `hfov_rad`.
-    pub fn from_horizontal_fov(width_px: u32, height_px: u32, hfov_rad: f32) -> Self {
-        let f = width_px as f32 * 0.5 / (hfov_rad * 0.5).tan();
-        Self {
-            fx_px: f,
-            fy_px: f,
-            cx_px: width_px as f32 * 0.5,
-            cy_px: height_px as f32 * 0.5,
-        }
-    }
-
-    /// The intrinsics of the image turned clockwise by `quarter_turns` × 90° (`width`/`height`
-    /// are the unturned image's).
-    fn turned_cw(self, width: u32, height: u32, quarter_turns: u32) -> Self {
-        let (w, h) = (width as f32, height as f32);
-        match quarter_turns % 4 {
-            0 => self,
-            // (x, y) → (h − y, x)
-            1 => Self {
-                fx_px: self.fy_px,
-                fy_px: self.fx_px,
-                cx_px: h - self.cy_px,
-                cy_px: self.cx_px,
-            },
-            // (x, y) → (w − x, h − y)
-            2 => Self {
-                cx_px: w - self.cx_px,
-                cy_px: h - self.cy_px,
-                ..self
-            },
-            // (x, y) → (y, w − x)
-            _ => Self {
-                fx_px: self.fy_px,
-                fy_px: self.fx_px,
-                cx_px: self.cy_px,
-                cy_px: w - self.cx_px,
-            },
-        }
-    }
-}
-
-/// How a frame's bytes are laid out.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PixelFormat {
-    /// One byte per pixel (the Y plane of a YUV frame).
-    Luma8,
-    /// Four bytes per pixel, R G B A.
-    Rgba8,
-}
-
-impl PixelFormat {
-    fn bytes_per_pixel(self) -> usize {
-        match self {
-            Self::Luma8 => 1,
-            Self::Rgba8 => 4,
-        }
-    }
-}
-
-/// One camera frame as the platform delivers it.
-#[derive(Clone, Copy, Debug)]
-pub struct CameraFrame<'a> {
-    pub width: u32,
-    pub height: u32,
-    /// Bytes from one row to the next (≥ width × bytes per pixel).
-    pub row_stride: usize,
-    pub format: PixelFormat,
-    pub data: &'a [u8],
-    /// Clockwise rotation (0, 90, 180, 270) that makes the image upright in the device's natural
-    /// orientation (Android's `ImageInfo.rotationDegrees` for a natural-orientation display).
-    pub rotation_cw_deg: u32,
-    /// Intrinsics of the buffer as delivered (before the rotation).
-    pub intrinsics: Intrinsics,
-    /// When the exposure happened, on the sensor clock, nanoseconds.
-    pub capture_t_ns: i64,
-}
-
-/// Where the camera sits in the device frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CameraPose {
-    pub position_m: Vec3,
-    /// Rotation taking camera-frame vectors (of the upright image) to the device frame.
-    pub device_from_camera: Quat,
-}
-
-impl CameraPose {
-    /// A front camera at `position_m` looking out of the screen, its upright image not mirrored:
-    /// image right is the device's −x (the camera faces the viewer), image down is −y, the
-    /// optical axis is +z. That is a half turn about z.
-    pub fn front(position_m: Vec3) -> Self {
-        Self {
-            position_m,
-            device_from_camera: Quat::from_rotation_z(std::f32::consts::PI),
-        }
-    }
-}
 
 #[derive(Debug, thiserror::Error)]
 pub enum FaceError {
@@ -818,40 +712,16 @@ impl FaceTracker {
     }
 }
 
-/// An owned camera frame, for handing to [`FaceWorker`].
-#[derive(Clone, Debug)]
-pub struct OwnedFrame {
-    pub width: u32,
-    pub height: u32,
-    pub row_stride: usize,
-    pub format: PixelFormat,
-    pub data: Vec<u8>,
-    pub rotation_cw_deg: u32,
-    pub intrinsics: Intrinsics,
-    pub capture_t_ns: i64,
-}
-
-impl OwnedFrame {
-    pub fn as_frame(&self) -> CameraFrame<'_> {
-        CameraFrame {
-            width: self.width,
-            height: self.height,
-            row_stride: self.row_stride,
-            format: self.format,
-            data: &self.data,
-            rotation_cw_deg: self.rotation_cw_deg,
-            intrinsics: self.intrinsics,
-            capture_t_ns: self.capture_t_ns,
-        }
-    }
-}
-
 #[derive(Default)]
 struct WorkerShared {
     pending: Option<OwnedFrame>,
     newest: Option<FaceObservation>,
     last_error: Option<String>,
     dropped_frames: u64,
+    /// Frames the tracker could not process (bad frame, inference error).
+    failed_frames: u64,
+    /// The tracker panicked (a bug) and the thread ended: no more frames are processed.
+    stopped_by_panic: bool,
     /// A new calibrated IPD for the tracker, taken with the next frame.
     ipd_update: Option<Option<f32>>,
     stop: bool,
@@ -894,11 +764,22 @@ impl FaceWorker {
                         s.pending.take()
                     };
                     let Some(frame) = frame else { continue };
-                    let result = tracker.process(frame.as_frame());
+                    // A panic here is a bug; it must not vanish with the thread, unseen.
+                    let result =
+                        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| tracker.process(frame.as_frame())));
                     let mut s = lock.lock().unwrap_or_else(|p| p.into_inner());
                     match result {
-                        Ok(obs) => s.newest = Some(obs),
-                        Err(e) => s.last_error = Some(e.to_string()),
+                        Ok(Ok(obs)) => s.newest = Some(obs),
+                        Ok(Err(e)) => {
+                            s.failed_frames += 1;
+                            s.last_error = Some(e.to_string());
+                        }
+                        Err(_) => {
+                            s.failed_frames += 1;
+                            s.stopped_by_panic = true;
+                            s.last_error = Some("face tracking stopped: internal error (please report)".into());
+                            return;
+                        }
                     }
                 }
             })
@@ -941,9 +822,15 @@ impl FaceWorker {
         self.shared.0.lock().unwrap_or_else(|p| p.into_inner()).dropped_frames
     }
 
-    /// Whether the thread could be started (it fails only when the OS refuses a thread).
+    /// Frames the tracker failed on ([`Self::last_error`] says why the last one did).
+    pub fn failed_frames(&self) -> u64 {
+        self.shared.0.lock().unwrap_or_else(|p| p.into_inner()).failed_frames
+    }
+
+    /// Whether frames are being processed: the thread could be started (it fails only when the
+    /// OS refuses a thread) and has not stopped on an internal error.
     pub fn is_running(&self) -> bool {
-        self.thread.is_some()
+        self.thread.is_some() && !self.shared.0.lock().unwrap_or_else(|p| p.into_inner()).stopped_by_panic
     }
 }
 

@@ -58,7 +58,7 @@
 //! * `ui` (on by default; implies `render`): `egui` and `egui-wgpu` draw the calibration screens
 //!   with the renderer's own device ([`calibration_ui`]); the CLI adds `egui-winit` for mouse input.
 //!
-//! Modules here: [`artifact`], [`model`], [`ibl`], [`gesture`], [`parallel`]; with `render`,
+//! Modules here: [`artifact`], [`camera`], [`model`], [`ibl`], [`gesture`], [`parallel`]; with `render`,
 //! `render`, `surface` and `engine` (the embedding API the phone shells drive); with `face`,
 //! `face`; with `ui`, `calibration_ui`.
 
@@ -68,6 +68,7 @@ pub use phantogram_sensing::{attitude, calibration, eyetrack, fusion, lowpass, s
 pub mod artifact;
 #[cfg(feature = "ui")]
 pub mod calibration_ui;
+pub mod camera;
 #[cfg(feature = "render")]
 pub mod engine;
 #[cfg(feature = "models")]

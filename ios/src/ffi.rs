@@ -24,8 +24,8 @@ use std::panic::AssertUnwindSafe;
 use std::path::PathBuf;
 
 use phantogram::anaglyph::Method;
-use phantogram::engine::{Engine, EngineConfig, EngineError, SharedEngine};
-use phantogram::face::{Intrinsics, OwnedFrame, PixelFormat};
+use phantogram::camera::{Intrinsics, OwnedFrame};
+use phantogram::engine::{Engine, EngineConfig, EngineError, ErrorKind, SharedEngine};
 use phantogram::gesture::{Gesture, TouchPhase};
 use phantogram::glam::Vec3;
 use phantogram::screen::{DisplayRotation, PanelSpec};
@@ -126,15 +126,12 @@ impl Failure {
 
 impl From<EngineError> for Failure {
     fn from(e: EngineError) -> Self {
-        let status = match &e {
-            EngineError::Render(_) => PgStatus::Render,
-            EngineError::Face(phantogram::face::FaceError::BadFrame(_)) => PgStatus::InvalidArgument,
-            EngineError::Model(_) | EngineError::Environment(_) | EngineError::Face(_) => PgStatus::Load,
-            EngineError::NoFrame => PgStatus::NoFrame,
-            EngineError::NoFaceSupport => PgStatus::Unsupported,
-            EngineError::Session(_) | EngineError::Screen(_) | EngineError::InvalidArgument(_) => {
-                PgStatus::InvalidArgument
-            }
+        let status = match e.kind() {
+            ErrorKind::InvalidArgument => PgStatus::InvalidArgument,
+            ErrorKind::InvalidState => PgStatus::NoFrame,
+            ErrorKind::Unsupported => PgStatus::Unsupported,
+            ErrorKind::Load => PgStatus::Load,
+            ErrorKind::Render => PgStatus::Render,
         };
         Self::new(status, e.to_string())
     }
@@ -485,24 +482,24 @@ pub unsafe extern "C" fn pg_camera_frame(
             .checked_mul(height as usize)
             .ok_or_else(|| Failure::new(PgStatus::InvalidArgument, "frame size overflows"))?;
         // SAFETY: the caller promises `row_stride × height` readable bytes at `luma`.
-        let data = unsafe { std::slice::from_raw_parts(luma, len) }.to_vec();
+        let data = unsafe { std::slice::from_raw_parts(luma, len) };
         let capture_t_ns = crate::timestamp_ns(timestamp_s)
             .ok_or_else(|| Failure::new(PgStatus::InvalidArgument, "time stamp is not finite"))?;
-        let frame = OwnedFrame {
+        let intrinsics = Intrinsics {
+            fx_px,
+            fy_px,
+            cx_px,
+            cy_px,
+        };
+        let frame = OwnedFrame::luma8(
             width,
             height,
             row_stride,
-            format: PixelFormat::Luma8,
             data,
             rotation_cw_deg,
-            intrinsics: Intrinsics {
-                fx_px,
-                fy_px,
-                cx_px,
-                cy_px,
-            },
+            intrinsics,
             capture_t_ns,
-        };
+        );
         match engine.shared.camera_frame(frame)? {
             true => Ok(()),
             false => Err(Failure::new(

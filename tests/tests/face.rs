@@ -86,12 +86,11 @@ fn labelled_boxes(dir: &Path) -> Vec<(PathBuf, Vec<[f32; 4]>)> {
                     };
                     boxes.push([n("left"), n("top"), n("width"), n("height")]);
                 }
-            } else if line.starts_with("</image>") {
-                if let Some(entry) = current.take() {
-                    if entry.0.is_file() {
-                        out.push(entry);
-                    }
-                }
+            } else if line.starts_with("</image>")
+                && let Some(entry) = current.take()
+                && entry.0.is_file()
+            {
+                out.push(entry);
             }
         }
     }
@@ -386,6 +385,50 @@ fn the_calibrated_ipd_reaches_the_face_tracker_through_the_engine() {
     let eyes = worker.newest().unwrap().eyes_m.expect("the astronaut's eyes");
     let ipd = eyes[0].distance(eyes[1]);
     assert!((ipd - 0.0705).abs() < 1e-4, "eyes {ipd} m apart");
+}
+
+/// A frame the tracker fails on is counted in the engine's stats and its reason kept, and
+/// tracking goes on: the shells' debug overlays see failures without test-only calls.
+#[test]
+fn face_tracking_failures_show_in_the_engine_stats() {
+    use phantogram::engine::EngineConfig;
+    let Some((_, dir)) = setup() else { return };
+    let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
+    let Some(engine) = engine_with_faces(EngineConfig {
+        face_models_dir: Some(models_dir),
+        ..EngineConfig::default()
+    }) else {
+        return;
+    };
+    assert_eq!(engine.stats().camera_frames_failed, 0);
+    assert_eq!(engine.face_tracking_error(), None);
+    let worker = engine.face_worker().expect("face tracking is on");
+    let img = rgba(&dir.join("astronaut.png"));
+    // Rows shorter than the image: `SharedEngine::camera_frame` refuses such a frame at once;
+    // handed to the worker directly it fails there.
+    let mut bad = owned_frame(&img, default_intrinsics(&img), 5);
+    bad.row_stride = 1;
+    worker.submit(bad);
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(30);
+    while engine.stats().camera_frames_failed == 0 {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "the bad frame was never processed"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    let error = engine.face_tracking_error().expect("the reason is kept");
+    assert!(error.contains("stride"), "{error}");
+    assert!(!engine.stats().face_tracking_stopped);
+    worker.submit(owned_frame(&img, default_intrinsics(&img), 9));
+    while worker.newest().is_none() {
+        assert!(
+            std::time::Instant::now() < deadline,
+            "tracking stopped after a bad frame"
+        );
+        std::thread::sleep(std::time::Duration::from_millis(5));
+    }
+    assert_eq!(engine.stats().camera_frames_failed, 1);
 }
 
 /// Through the embedding API the shells use: camera frames handed to a `SharedEngine` from

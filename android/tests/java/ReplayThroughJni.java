@@ -42,6 +42,33 @@ public final class ReplayThroughJni {
         expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeDrawFrame(0, -1));
         expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeSetSensorRanges(0, 78.4532f, 34.9f));
 
+        // Camera intrinsics from Camera2's characteristics, derived in Rust: a 4:3 sensor of
+        // 4032 x 3024 active pixels (1 um, 4.2 mm lens) seen through a 16:9 stream of 1280 x 720
+        // keeps the full width and 2268 rows from row 378 (core/src/camera/android.rs).
+        float[] k = NativeBridge.nativeCameraIntrinsics(new int[] {0, 0, 4032, 3024}, null,
+                new int[] {4032, 3024}, new float[] {4.032f, 3.024f}, 4.2f, null, 1280, 720);
+        float s = 1280f / 4032f;
+        float[] want = {4200f * s, 4200f * s, 2016f * s, (1512f - 378f) * s};
+        for (int i = 0; i < 4; i++) {
+            if (Math.abs(k[i] - want[i]) > 1e-2f) {
+                throw new AssertionError("intrinsics " + java.util.Arrays.toString(k) + ", want "
+                        + java.util.Arrays.toString(want));
+            }
+        }
+        float[] calibrated = NativeBridge.nativeCameraIntrinsics(new int[] {0, 0, 4032, 3024}, null, null, null,
+                Float.NaN, new float[] {4150f, 4160f, 2030f, 1500f, 0f}, 2016, 1512);
+        if (calibrated[0] != 2075f || calibrated[3] != 750f) {
+            throw new AssertionError("calibrated intrinsics " + java.util.Arrays.toString(calibrated));
+        }
+        expect(IllegalArgumentException.class, "focal length",
+                () -> NativeBridge.nativeCameraIntrinsics(new int[] {0, 0, 4032, 3024}, null, null, null,
+                        Float.NaN, null, 640, 480));
+        expect(IllegalArgumentException.class, "activeArray must have 4 elements",
+                () -> NativeBridge.nativeCameraIntrinsics(new int[] {0, 0, 4032}, null, null, null, 4.2f,
+                        null, 640, 480));
+        expect(IllegalArgumentException.class, "activeArray is null",
+                () -> NativeBridge.nativeCameraIntrinsics(null, null, null, null, 4.2f, null, 640, 480));
+
         long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois", null);
         try {
             expect(IllegalStateException.class, "no offscreen frame", () -> NativeBridge.nativeReadFrame(h));

@@ -61,6 +61,15 @@ public final class NativeBridge {
     public static native boolean nativeCameraFrame(long handle, ByteBuffer luma, int width, int height,
             int rowStride, int rotationDegrees, float fx, float fy, float cx, float cy, long timestampNs);
 
+    /**
+     * [fx, fy, cx, cy] of a width × height output image from Camera2's characteristics as
+     * reported: rects as [left, top, right, bottom], sizes as [width, height], focalLengthMm NaN
+     * when unknown, optional arrays null. Throws IllegalArgumentException when they give none.
+     */
+    public static native float[] nativeCameraIntrinsics(int[] activeArray, int[] preCorrection,
+            int[] pixelArray, float[] physicalSizeMm, float focalLengthMm, float[] lensCalibration,
+            int width, int height);
+
     public static native int nativeTouch(long handle, int phase, int pointerId, float x, float y, long timeNs);
 
     /** surface is an android.view.Surface. */

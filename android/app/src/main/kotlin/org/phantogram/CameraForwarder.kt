@@ -17,14 +17,23 @@ import java.util.concurrent.Executors
  * its rotation to upright, the intrinsics, and the capture time, handed to the core, which
  * tracks the face on its own thread and keeps only the newest frame.
  *
- * Intrinsics: LENS_INTRINSIC_CALIBRATION (fx, fy, cx, cy in active-array pixels) where the
- * device publishes it, else the focal length and the physical sensor size; both scaled to the
- * analysis image, assumed to span the active array's width with the height cropped centrally
- * (CameraX's default for a 4:3 analysis stream on a 4:3 sensor, where the crop is nil).
+ * Intrinsics: the camera's Camera2 characteristics (active and pre-correction arrays, pixel
+ * array, physical size, focal length, LENS_INTRINSIC_CALIBRATION where published) are read once
+ * and forwarded as they are; the core derives the intrinsics of each image size from them
+ * (`NativeBridge.nativeCameraIntrinsics`, core/src/camera/android.rs), so no camera maths lives
+ * here.
  */
 class CameraForwarder(private val context: Context, private val engine: () -> Long) {
     private val executor = Executors.newSingleThreadExecutor()
-    private var intrinsics: FloatArray? = null // fx, fy, cx, cy in active-array pixels, active width, height
+    private var lens: Lens? = null
+    // The intrinsics of the last image size seen: [width, height, fx, fy, cx, cy].
+    private var intrinsics: FloatArray? = null
+
+    /** Camera2's characteristics as reported; see NativeBridge.nativeCameraIntrinsics. */
+    private class Lens(
+        val activeArray: IntArray, val preCorrection: IntArray?, val pixelArray: IntArray?,
+        val physicalSizeMm: FloatArray?, val focalLengthMm: Float, val calibration: FloatArray?
+    )
 
     @androidx.annotation.OptIn(markerClass = [ExperimentalCamera2Interop::class])
     fun start(owner: LifecycleOwner) {
@@ -38,41 +47,61 @@ class CameraForwarder(private val context: Context, private val engine: () -> Lo
             analysis.setAnalyzer(executor, ImageAnalysis.Analyzer { image -> forward(image) })
             provider.unbindAll()
             val camera = provider.bindToLifecycle(owner, CameraSelector.DEFAULT_FRONT_CAMERA, analysis)
-            intrinsics = readIntrinsics(Camera2CameraInfo.from(camera.cameraInfo))
+            lens = readLens(Camera2CameraInfo.from(camera.cameraInfo))
         }, ContextCompat.getMainExecutor(context))
     }
 
     fun close() = executor.shutdown()
 
     @androidx.annotation.OptIn(markerClass = [ExperimentalCamera2Interop::class])
-    private fun readIntrinsics(info: Camera2CameraInfo): FloatArray? {
+    private fun readLens(info: Camera2CameraInfo): Lens? {
         val active = info.getCameraCharacteristic(CameraCharacteristics.SENSOR_INFO_ACTIVE_ARRAY_SIZE) ?: return null
-        val w = active.width().toFloat()
-        val h = active.height().toFloat()
-        val calibration = info.getCameraCharacteristic(CameraCharacteristics.LENS_INTRINSIC_CALIBRATION)
-        if (calibration != null && calibration.size >= 4 && calibration[0] > 0f) {
-            return floatArrayOf(calibration[0], calibration[1], calibration[2], calibration[3], w, h)
-        }
-        val focal = info.getCameraCharacteristic(CameraCharacteristics.LENS_INFO_AVAILABLE_FOCAL_LENGTHS)
+        val pre = info.getCameraCharacteristic(CameraCharacteristics.SENSOR_INFO_PRE_CORRECTION_ACTIVE_ARRAY_SIZE)
+        val pixels = info.getCameraCharacteristic(CameraCharacteristics.SENSOR_INFO_PIXEL_ARRAY_SIZE)
         val physical = info.getCameraCharacteristic(CameraCharacteristics.SENSOR_INFO_PHYSICAL_SIZE)
-        if (focal == null || focal.isEmpty() || physical == null || physical.width <= 0f) return null
-        val f = focal[0] / physical.width * w
-        return floatArrayOf(f, f, w / 2, h / 2, w, h)
+        val focal = info.getCameraCharacteristic(CameraCharacteristics.LENS_INFO_AVAILABLE_FOCAL_LENGTHS)
+        return Lens(
+            intArrayOf(active.left, active.top, active.right, active.bottom),
+            pre?.let { intArrayOf(it.left, it.top, it.right, it.bottom) },
+            pixels?.let { intArrayOf(it.width, it.height) },
+            physical?.let { floatArrayOf(it.width, it.height) },
+            if (focal != null && focal.isNotEmpty()) focal[0] else Float.NaN,
+            info.getCameraCharacteristic(CameraCharacteristics.LENS_INTRINSIC_CALIBRATION)
+        )
+    }
+
+    /** [fx, fy, cx, cy] of a width × height image, from the core; null when the camera's
+     * characteristics give none (face tracking then stays off, and says why once). */
+    private fun intrinsicsFor(width: Int, height: Int): FloatArray? {
+        val cached = intrinsics
+        if (cached != null && cached[0] == width.toFloat() && cached[1] == height.toFloat()) {
+            return cached.copyOfRange(2, 6)
+        }
+        val l = lens ?: return null
+        return try {
+            val k = NativeBridge.nativeCameraIntrinsics(
+                l.activeArray, l.preCorrection, l.pixelArray, l.physicalSizeMm, l.focalLengthMm, l.calibration,
+                width, height
+            )
+            intrinsics = floatArrayOf(width.toFloat(), height.toFloat(), k[0], k[1], k[2], k[3])
+            k
+        } catch (e: IllegalArgumentException) {
+            android.util.Log.e("Phantogram", "no camera intrinsics: face tracking is off", e)
+            lens = null
+            null
+        }
     }
 
     private fun forward(image: ImageProxy) {
         try {
             val e = engine()
-            val k = intrinsics ?: return
             if (e == 0L) return
             val plane = image.planes[0]
             if (plane.pixelStride != 1) return
-            // Scale from the active array to this image (width-matched, height centred).
-            val s = image.width / k[4]
-            val cropY = (k[5] * s - image.height) / 2
+            val k = intrinsicsFor(image.width, image.height) ?: return
             NativeBridge.nativeCameraFrame(
                 e, plane.buffer, image.width, image.height, plane.rowStride, image.imageInfo.rotationDegrees,
-                k[0] * s, k[1] * s, k[2] * s, k[3] * s - cropY,
+                k[0], k[1], k[2], k[3],
                 // CameraX time stamps are on the sensor-time-stamp clock (CLOCK_BOOTTIME on
                 // devices reporting SENSOR_INFO_TIMESTAMP_SOURCE_REALTIME, which phones do).
                 image.imageInfo.timestamp

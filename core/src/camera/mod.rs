@@ -1,0 +1,172 @@
+//! Camera frames as the platforms deliver them, and the pinhole intrinsics that go with them.
+//!
+//! Plain data (no networks, no GPU): the face tracker (`face`, feature `face`) consumes it, the
+//! bridges build it, and the intrinsics are derived here from what each platform reports
+//! ([`android`]: Camera2's characteristics; iOS delivers the matrix of each buffer, which is
+//! passed on as it is), so that no camera maths lives in a shell.
+//!
+//! **Image frame**: pixels with x right, y down, origin at the top-left corner of the buffer as
+//! delivered (before [`CameraFrame::rotation_cw_deg`] turns it upright).
+
+pub mod android;
+
+use glam::{Quat, Vec3};
+
+/// Pinhole intrinsics, pixels, of the image they are given with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Intrinsics {
+    pub fx_px: f32,
+    pub fy_px: f32,
+    pub cx_px: f32,
+    pub cy_px: f32,
+}
+
+impl Intrinsics {
+    /// Square pixels, principal point at the centre, horizontal field of view `hfov_rad`.
+    pub fn from_horizontal_fov(width_px: u32, height_px: u32, hfov_rad: f32) -> Self {
+        let f = width_px as f32 * 0.5 / (hfov_rad * 0.5).tan();
+        Self {
+            fx_px: f,
+            fy_px: f,
+            cx_px: width_px as f32 * 0.5,
+            cy_px: height_px as f32 * 0.5,
+        }
+    }
+
+    /// The intrinsics of the image turned clockwise by `quarter_turns` × 90° (`width`/`height`
+    /// are the unturned image's).
+    pub fn turned_cw(self, width: u32, height: u32, quarter_turns: u32) -> Self {
+        let (w, h) = (width as f32, height as f32);
+        match quarter_turns % 4 {
+            0 => self,
+            // (x, y) → (h − y, x)
+            1 => Self {
+                fx_px: self.fy_px,
+                fy_px: self.fx_px,
+                cx_px: h - self.cy_px,
+                cy_px: self.cx_px,
+            },
+            // (x, y) → (w − x, h − y)
+            2 => Self {
+                cx_px: w - self.cx_px,
+                cy_px: h - self.cy_px,
+                ..self
+            },
+            // (x, y) → (y, w − x)
+            _ => Self {
+                fx_px: self.fy_px,
+                fy_px: self.fx_px,
+                cx_px: self.cy_px,
+                cy_px: w - self.cx_px,
+            },
+        }
+    }
+}
+
+/// How a frame's bytes are laid out.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PixelFormat {
+    /// One byte per pixel (the Y plane of a YUV frame).
+    Luma8,
+    /// Four bytes per pixel, R G B A.
+    Rgba8,
+}
+
+impl PixelFormat {
+    pub fn bytes_per_pixel(self) -> usize {
+        match self {
+            Self::Luma8 => 1,
+            Self::Rgba8 => 4,
+        }
+    }
+}
+
+/// One camera frame as the platform delivers it.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraFrame<'a> {
+    pub width: u32,
+    pub height: u32,
+    /// Bytes from one row to the next (≥ width × bytes per pixel).
+    pub row_stride: usize,
+    pub format: PixelFormat,
+    pub data: &'a [u8],
+    /// Clockwise rotation (0, 90, 180, 270) that makes the image upright in the device's natural
+    /// orientation (Android's `ImageInfo.rotationDegrees` for a natural-orientation display).
+    pub rotation_cw_deg: u32,
+    /// Intrinsics of the buffer as delivered (before the rotation).
+    pub intrinsics: Intrinsics,
+    /// When the exposure happened, on the sensor clock, nanoseconds.
+    pub capture_t_ns: i64,
+}
+
+/// Where the camera sits in the device frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CameraPose {
+    pub position_m: Vec3,
+    /// Rotation taking camera-frame vectors (of the upright image) to the device frame.
+    pub device_from_camera: Quat,
+}
+
+impl CameraPose {
+    /// A front camera at `position_m` looking out of the screen, its upright image not mirrored:
+    /// image right is the device's −x (the camera faces the viewer), image down is −y, the
+    /// optical axis is +z. That is a half turn about z.
+    pub fn front(position_m: Vec3) -> Self {
+        Self {
+            position_m,
+            device_from_camera: Quat::from_rotation_z(std::f32::consts::PI),
+        }
+    }
+}
+
+/// An owned camera frame, for handing to the face tracker's worker thread.
+#[derive(Clone, Debug)]
+pub struct OwnedFrame {
+    pub width: u32,
+    pub height: u32,
+    pub row_stride: usize,
+    pub format: PixelFormat,
+    pub data: Vec<u8>,
+    pub rotation_cw_deg: u32,
+    pub intrinsics: Intrinsics,
+    pub capture_t_ns: i64,
+}
+
+impl OwnedFrame {
+    /// A luma plane (Android's YUV_420_888 plane 0, iOS's bi-planar plane 0) as the bridges
+    /// receive it, copied.
+    #[allow(clippy::too_many_arguments)]
+    pub fn luma8(
+        width: u32,
+        height: u32,
+        row_stride: usize,
+        data: &[u8],
+        rotation_cw_deg: u32,
+        intrinsics: Intrinsics,
+        capture_t_ns: i64,
+    ) -> Self {
+        Self {
+            width,
+            height,
+            row_stride,
+            format: PixelFormat::Luma8,
+            data: data.to_vec(),
+            rotation_cw_deg,
+            intrinsics,
+            capture_t_ns,
+        }
+    }
+
+    pub fn as_frame(&self) -> CameraFrame<'_> {
+        CameraFrame {
+            width: self.width,
+            height: self.height,
+            row_stride: self.row_stride,
+            format: self.format,
+            data: &self.data,
+            rotation_cw_deg: self.rotation_cw_deg,
+            intrinsics: self.intrinsics,
+            capture_t_ns: self.capture_t_ns,
+        }
+    }
+}
