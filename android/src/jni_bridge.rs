@@ -239,6 +239,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
             environment_path: None,
             face_models_dir: optional_string(env, &face_models_dir)?.map(Into::into),
             camera_position_m: None,
+            fit: Default::default(),
             floor: true,
             calibration_path: optional_string(env, &calibration_path)?.map(Into::into),
         };

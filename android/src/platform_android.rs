@@ -32,7 +32,7 @@ impl rwh::HasDisplayHandle for AndroidWindow {
 pub(crate) fn native_window(
     env: &mut Env,
     surface: &JObject,
-) -> Result<Arc<dyn phantogram::wgpu::WindowHandle>, Thrown> {
+) -> Result<Arc<dyn phantogram::wgpu::DisplayAndWindowHandle>, Thrown> {
     // SAFETY: `env` is this thread's attached JNI environment and `surface` a live local
     // reference to an `android.view.Surface` (checked non-null by the caller); the returned
     // window holds its own reference (`ANativeWindow_fromSurface` acquires one).

@@ -11,7 +11,7 @@ use crate::jni_bridge::{Kind, Thrown, fail};
 pub(crate) fn native_window(
     _env: &mut Env,
     _surface: &JObject,
-) -> Result<Arc<dyn phantogram::wgpu::WindowHandle>, Thrown> {
+) -> Result<Arc<dyn phantogram::wgpu::DisplayAndWindowHandle>, Thrown> {
     Err(fail(
         Kind::Unsupported,
         "Android surfaces exist only on Android; draw offscreen with nativeResumeOffscreen",

@@ -56,6 +56,7 @@ use crate::render::{FrameInput, Gpu, RenderError, Renderer};
 use crate::screen::{DisplayRotation, PanelSpec, Screen, ScreenError};
 use crate::sensors::{Rejection, SensorEvent, SensorInbox, SensorStats};
 use crate::surface::{DrawOutcome, SurfaceHost, SurfaceStats};
+use crate::wgpu;
 use crate::{Session, SessionConfig, SessionError};
 
 /// Largest offscreen or surface side accepted (wgpu's downlevel limit).
@@ -78,6 +79,9 @@ pub struct EngineConfig {
     /// The front camera's position in the device frame, metres; `None`: centred 4 mm above the
     /// panel's top edge (typical of phones).
     pub camera_position_m: Option<Vec3>,
+    /// How a loaded model is placed in the diorama (standing or facing, how much stands in front
+    /// of the glass); the default artifact is made to fit.
+    pub fit: crate::model::DioramaFit,
     /// Draw the diorama's floor under the artifact.
     pub floor: bool,
     /// Where the viewer's calibration is kept (a file in the app's private storage); `None`: the
@@ -95,6 +99,7 @@ impl Default for EngineConfig {
             environment_path: None,
             face_models_dir: None,
             camera_position_m: None,
+            fit: crate::model::DioramaFit::default(),
             floor: true,
             calibration_path: None,
         }
@@ -164,6 +169,18 @@ enum Target {
     Offscreen { width: u32, height: u32 },
 }
 
+/// What was loaded, for logs and the desktop tools.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelInfo {
+    /// The model's name (a loaded file's stem: it tells which scan a Voyager folder gave).
+    pub name: String,
+    pub triangles: usize,
+    pub materials: usize,
+    pub images: usize,
+    /// What the loader could not honour but worked around (an unsupported extension, …).
+    pub warnings: Vec<String>,
+}
+
 /// Counters, for logs, the shells' debug overlays and tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct EngineStats {
@@ -191,6 +208,7 @@ pub struct EngineStats {
 pub struct Engine {
     session: Session,
     renderer: Renderer,
+    model_info: ModelInfo,
     bounds: Aabb,
     smoother: ContainmentSmoother,
     method: Method,
@@ -253,15 +271,31 @@ impl Engine {
     /// artifact) to about a second (a large scan): call it off the UI thread. It also starts a
     /// short-lived thread that computes the renderer's lighting tables meanwhile (once per
     /// process, [`crate::render::prepare_lighting_tables`]).
+    ///
+    /// Files (model, environment, calibration) are read before the device is opened, so that a
+    /// bad one is reported as such even where no GPU can be found.
     pub fn new(config: EngineConfig) -> Result<Self, EngineError> {
         // Opening the device and loading the model overlap the renderer's lighting tables.
         crate::render::prepare_lighting_tables_in_background(config.environment_path.is_none());
-        Self::with_gpu(Gpu::headless()?, config)
+        Self::with_gpu_from(Gpu::headless, config)
     }
 
     /// As [`Self::new`] on a given device.
     pub fn with_gpu(gpu: Gpu, config: EngineConfig) -> Result<Self, EngineError> {
+        Self::with_gpu_from(|| Ok(gpu), config)
+    }
+
+    fn with_gpu_from(
+        gpu: impl FnOnce() -> Result<Gpu, RenderError>,
+        config: EngineConfig,
+    ) -> Result<Self, EngineError> {
         let screen = Screen::new(config.panel, config.rotation)?;
+        let protrude = config.fit.protrude_fraction;
+        if !(0.0..=1.0).contains(&protrude) {
+            return Err(EngineError::InvalidArgument(format!(
+                "the fraction of the model in front of the glass must be between 0 and 1, got {protrude}"
+            )));
+        }
         let session_config = SessionConfig {
             screen,
             ..SessionConfig::default()
@@ -270,10 +304,17 @@ impl Engine {
         let mut model = match &config.model_path {
             Some(path) => {
                 let mut m = crate::model::load_model(path)?;
-                m.fit_to_diorama(&screen, &crate::model::DioramaFit::default());
+                m.fit_to_diorama(&screen, &config.fit);
                 m
             }
             None => crate::artifact::default_model(),
+        };
+        let model_info = ModelInfo {
+            name: model.name.clone(),
+            triangles: model.triangle_count(),
+            materials: model.materials.len(),
+            images: model.images.len(),
+            warnings: model.warnings.clone(),
         };
         let bounds = model.bounds().ok_or(RenderError::EmptyModel)?;
         if config.floor {
@@ -283,7 +324,7 @@ impl Engine {
             Some(path) => Some(crate::ibl::Environment::load(path)?),
             None => None,
         };
-        let renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
+        let renderer = Renderer::with_environment(gpu()?, &model, environment.as_ref())?;
         #[cfg(feature = "face")]
         let face = match &config.face_models_dir {
             Some(dir) => {
@@ -308,6 +349,7 @@ impl Engine {
         let mut engine = Self {
             session,
             renderer,
+            model_info,
             bounds,
             smoother: ContainmentSmoother::default(),
             method: config.method,
@@ -410,10 +452,30 @@ impl Engine {
     }
 
     /// Physical pixels per egui point on this display: Android's density (dpi / 160), which iOS's
-    /// scale (≈ ppi / 163) nearly equals; so controls have the platform's size.
+    /// scale (≈ ppi / 163) nearly equals, so controls have the platform's size; times the
+    /// target's width over the panel's, so that a smaller target (the desktop viewer's window
+    /// standing in for the phone) shows the phone's layout, smaller. On a phone they are equal.
     #[cfg(feature = "ui")]
     fn pixels_per_point(&self) -> f32 {
-        (self.session.config().screen.panel().xdpi / 160.0).clamp(1.0, 4.0)
+        let screen = self.session.config().screen;
+        let density = (screen.panel().xdpi / 160.0).clamp(1.0, 4.0);
+        let target_width_px = match &self.target {
+            Target::Window(host) => match host.state() {
+                crate::surface::SurfaceState::Active { width, .. } => Some(width),
+                _ => None,
+            },
+            Target::Offscreen { width, .. } => Some(*width),
+            Target::Detached => None,
+        };
+        match target_width_px.filter(|&w| w > 0) {
+            Some(w) => density * (w as f32 / screen.width_px() as f32).clamp(0.1, 10.0),
+            None => density,
+        }
+    }
+
+    /// What was loaded ([`EngineConfig::model_path`], or the default artifact).
+    pub fn model_info(&self) -> &ModelInfo {
+        &self.model_info
     }
 
     /// The session's sensor inbox: push events from any thread.
@@ -455,7 +517,7 @@ impl Engine {
     /// A drawable appeared: draw into `window` at `width × height` physical pixels.
     pub fn resume_window(
         &mut self,
-        window: Arc<dyn wgpu::WindowHandle>,
+        window: Arc<dyn wgpu::DisplayAndWindowHandle>,
         width: u32,
         height: u32,
     ) -> Result<(), EngineError> {
@@ -561,6 +623,18 @@ impl Engine {
         self.calibration.flat_up_device = self.session.flat_up_device();
         self.save_calibration();
         Ok(())
+    }
+
+    /// Lying flat counts as straight on again (and the calibration file says so).
+    pub fn reset_flat_angle(&mut self) {
+        self.session.reset_flat_angle();
+        self.calibration.flat_up_device = None;
+        self.save_calibration();
+    }
+
+    /// Ties the light to the room again, at the current pose (as a long press does).
+    pub fn anchor_light(&mut self) -> Result<(), EngineError> {
+        Ok(self.session.recalibrate_light()?)
     }
 
     /// Draws one frame that will be on screen at `display_t_ns` (sensor clock; `None`: for the

@@ -324,6 +324,7 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             environment_path: environment.map(PathBuf::from),
             face_models_dir: face.map(PathBuf::from),
             camera_position_m: None,
+            fit: Default::default(),
             floor: c.floor != 0,
             calibration_path: calibration.map(PathBuf::from),
         };

@@ -36,7 +36,7 @@ impl rwh::HasDisplayHandle for UiView {
 ///
 /// # Safety
 /// `view` is a valid `UIView*` that stays alive until the engine's surface is dropped.
-pub unsafe fn view_window(view: *mut c_void) -> Option<Arc<dyn phantogram::wgpu::WindowHandle>> {
+pub unsafe fn view_window(view: *mut c_void) -> Option<Arc<dyn phantogram::wgpu::DisplayAndWindowHandle>> {
     let view = NonNull::new(view)?;
     if cfg!(target_os = "ios") {
         Some(Arc::new(UiView(view)))

@@ -288,3 +288,57 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
     let warning = damaged.calibration_warning().expect("a warning for the damaged file");
     assert!(warning.contains("calibration.txt"), "{warning}");
 }
+
+/// A target smaller than the panel (the desktop viewer's window standing in for the phone) shows
+/// the phone's layout scaled down, and touches there still hit the controls.
+#[test]
+fn the_screens_keep_the_phones_layout_on_a_smaller_target() {
+    use phantogram::engine::{Engine, EngineConfig};
+    use phantogram::gesture::TouchPhase;
+
+    let panel = PanelSpec {
+        width_px: 540,
+        height_px: 1200,
+        xdpi: 210.0,
+        ydpi: 210.0,
+    };
+    let mut engine = match Engine::new(EngineConfig {
+        panel,
+        method: phantogram::anaglyph::Method::Mono,
+        ..EngineConfig::default()
+    }) {
+        Ok(e) => e,
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no engine ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    };
+    let ms = 1_000_000;
+    assert!(engine.open_calibration());
+    engine.resume_offscreen(panel.width_px, panel.height_px).unwrap();
+    engine.draw(Some(10 * ms)).unwrap();
+    engine.draw(Some(20 * ms)).unwrap();
+    let full = engine.calibration_control_px("close").expect("the close button");
+    // A window of 3/8 of the panel's width, as the viewer's 405 px for a 1080 px phone.
+    let (w, h) = (panel.width_px * 3 / 8, panel.height_px * 3 / 8);
+    engine.resize(w, h).unwrap();
+    engine.draw(Some(30 * ms)).unwrap();
+    engine.draw(Some(40 * ms)).unwrap();
+    let small = engine.calibration_control_px("close").expect("the close button");
+    for i in 0..2 {
+        assert!(
+            (small[i] - full[i] * 3.0 / 8.0).abs() < 2.0,
+            "the layout changed with the target: {full:?} → {small:?}"
+        );
+    }
+    engine.touch(TouchPhase::Down, 0, small[0], small[1], 50 * ms);
+    engine.draw(Some(60 * ms)).unwrap();
+    engine.touch(TouchPhase::Up, 0, small[0], small[1], 70 * ms);
+    engine.draw(Some(80 * ms)).unwrap();
+    engine.draw(Some(90 * ms)).unwrap();
+    assert!(
+        !engine.calibration_open(),
+        "the tap at {small:?} missed the close button"
+    );
+}

@@ -49,35 +49,56 @@ pub struct ReplaySummary {
     pub stats: SensorStats,
 }
 
-/// Replays `events` through `session`, calling `on_frame(session, frame_time_ns, view)` at every
-/// frame; the callback may act on the session (e.g. calibrate) before the next events.
-pub fn replay<I>(
+/// What a replay drives: a bare [`Session`] ([`replay`]), or anything that owns one, such as the
+/// `phantogram` crate's `Engine` (the CLI's `render`), through [`drive`].
+pub trait Replayed {
+    /// Why a frame failed.
+    type Error;
+    /// One event; rejections are the target's to count (the session's inbox does).
+    fn push(&mut self, event: SensorEvent);
+    /// The frame at `t_ns`: every event up to it has been pushed.
+    fn frame(&mut self, t_ns: i64) -> Result<(), Self::Error>;
+}
+
+/// Why [`drive`] stopped.
+#[derive(Debug, Error)]
+pub enum DriveError<E> {
+    #[error(transparent)]
+    Log(#[from] LogError),
+    #[error("frame interval must be positive, got {0} ns")]
+    BadInterval(i64),
+    #[error(transparent)]
+    Frame(E),
+}
+
+/// Replays `events` into `target`, asking for a frame at every point of the grid (module docs).
+/// The summary's `stats` are left at zero: they are the target's.
+pub fn drive<I, T>(
     events: I,
-    session: &mut Session,
+    target: &mut T,
     interval_ns: i64,
     pace: Pace,
-    mut on_frame: impl FnMut(&mut Session, i64, &FrameView),
-) -> Result<ReplaySummary, ReplayError>
+) -> Result<ReplaySummary, DriveError<T::Error>>
 where
     I: IntoIterator<Item = Result<SensorEvent, LogError>>,
+    T: Replayed,
 {
     if interval_ns <= 0 {
-        return Err(ReplayError::BadInterval(interval_ns));
+        return Err(DriveError::BadInterval(interval_ns));
     }
     let mut summary = ReplaySummary::default();
     let mut next_frame_ns: Option<i64> = None;
     let wall_start = Instant::now();
-    let mut emit = |session: &mut Session, t_ns: i64, summary: &mut ReplaySummary| -> Result<(), ReplayError> {
-        if let (Pace::RealTime { speed }, Some(t0)) = (pace, summary.first_t_ns) {
-            if speed > 0.0 {
-                let due = Duration::from_secs_f64(((t_ns - t0) as f64 * 1e-9 / speed).max(0.0));
-                if let Some(wait) = due.checked_sub(wall_start.elapsed()) {
-                    std::thread::sleep(wait);
-                }
+    let emit = |target: &mut T, t_ns: i64, summary: &mut ReplaySummary| -> Result<(), DriveError<T::Error>> {
+        if let (Pace::RealTime { speed }, Some(t0)) = (pace, summary.first_t_ns)
+            && speed > 0.0
+        {
+            let due = Duration::from_secs_f64(((t_ns - t0) as f64 * 1e-9 / speed).max(0.0));
+            if let Some(wait) = due.checked_sub(wall_start.elapsed()) {
+                std::thread::sleep(wait);
             }
         }
-        let view = session.frame()?;
-        on_frame(session, t_ns, &view);
+        target.frame(t_ns).map_err(DriveError::Frame)?;
         summary.frames += 1;
         Ok(())
     };
@@ -93,19 +114,55 @@ where
         while *next < event.t_ns {
             let t = *next;
             *next += interval_ns;
-            emit(session, t, &mut summary)?;
+            emit(target, t, &mut summary)?;
         }
-        // Rejected events are counted by the inbox; replay goes on, as the app would.
-        let _ = session.push(event);
+        // Rejected events are counted by the target; replay goes on, as the app would.
+        target.push(event);
     }
     if let (Some(next), Some(last)) = (next_frame_ns, summary.last_t_ns) {
         let mut t = next;
         while t <= last {
-            emit(session, t, &mut summary)?;
+            emit(target, t, &mut summary)?;
             t += interval_ns;
         }
     }
-    summary.stats = session.stats();
+    Ok(summary)
+}
+
+/// Replays `events` through `session`, calling `on_frame(session, frame_time_ns, view)` at every
+/// frame; the callback may act on the session (e.g. calibrate) before the next events.
+pub fn replay<I>(
+    events: I,
+    session: &mut Session,
+    interval_ns: i64,
+    pace: Pace,
+    on_frame: impl FnMut(&mut Session, i64, &FrameView),
+) -> Result<ReplaySummary, ReplayError>
+where
+    I: IntoIterator<Item = Result<SensorEvent, LogError>>,
+{
+    struct WithSession<'a, F> {
+        session: &'a mut Session,
+        on_frame: F,
+    }
+    impl<F: FnMut(&mut Session, i64, &FrameView)> Replayed for WithSession<'_, F> {
+        type Error = SessionError;
+        fn push(&mut self, event: SensorEvent) {
+            let _ = self.session.push(event);
+        }
+        fn frame(&mut self, t_ns: i64) -> Result<(), SessionError> {
+            let view = self.session.frame()?;
+            (self.on_frame)(self.session, t_ns, &view);
+            Ok(())
+        }
+    }
+    let mut target = WithSession { session, on_frame };
+    let mut summary = drive(events, &mut target, interval_ns, pace).map_err(|e| match e {
+        DriveError::Log(e) => ReplayError::Log(e),
+        DriveError::BadInterval(i) => ReplayError::BadInterval(i),
+        DriveError::Frame(e) => ReplayError::Session(e),
+    })?;
+    summary.stats = target.session.stats();
     Ok(summary)
 }
 

@@ -4,7 +4,7 @@
 //! validated, thread-safe event inbox ([`sensors`]), the paper's low-pass attitude ([`lowpass`],
 //! [`attitude`]), the fused gyroscope/accelerometer/magnetometer orientation ([`fusion`]), the
 //! eye-tracking filter that blends face observations with the gravity viewpoint ([`eyetrack`]),
-//! the user's calibration ([`calibration`]) and the per-device [`session`] that ties them to the
+//! the user's calibration ([`calibration`]), front-camera frames and their intrinsics ([`camera`]) and the per-device [`session`] that ties them to the
 //! geometry of `phantogram_geometry`. [`synthetic`] simulates the sensors from a known motion, for
 //! tests and benchmarks.
 //!
@@ -25,6 +25,7 @@
 
 pub mod attitude;
 pub mod calibration;
+pub mod camera;
 pub mod eyetrack;
 pub mod fusion;
 pub mod lowpass;

@@ -1,5 +1,4 @@
-//! Where the desktop tools keep per-user files (the calibration here, the face models in
-//! `phantogram`). The phone shells pass their app-private folders instead and never use this.
+//! Where the desktop tools keep per-user files: the calibration, the face models. The phone shells pass their app-private folders instead and never use this.
 
 use std::path::PathBuf;
 
@@ -13,4 +12,11 @@ pub fn user_path(override_var: &str, xdg_var: &str, home_dir: &str, name: &str) 
         .map(PathBuf::from)
         .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(home_dir)))?;
     Some(base.join("phantogram").join(name))
+}
+
+/// Where `cargo xtask models` puts the face-tracking models and where `phantogram_vision` looks
+/// for them: `$PHANTOGRAM_MODELS` if set, else `$XDG_CACHE_HOME/phantogram/models`, else
+/// `~/.cache/phantogram/models`. `None` only without any of those variables.
+pub fn face_models_dir() -> Option<PathBuf> {
+    user_path("PHANTOGRAM_MODELS", "XDG_CACHE_HOME", ".cache", "models")
 }

@@ -12,7 +12,11 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
 mod face_eval;
+mod render_frames;
+mod scene;
 mod viewer;
+
+use scene::SceneArgs;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
@@ -124,75 +128,6 @@ enum Command {
         #[command(subcommand)]
         what: EvalWhat,
     },
-}
-
-/// What is shown, and how: shared by `view` and `render`, so that the window previews exactly
-/// what the frames will hold.
-#[derive(clap::Args)]
-struct SceneArgs {
-    /// A glTF 2.0 model (.gltf or .glb), or a Smithsonian Voyager folder or its scene.svx.json
-    /// (its best scan present); the default artifact when omitted.
-    model: Option<PathBuf>,
-    /// Fraction of a loaded model's height that stands in front of the glass.
-    #[arg(long, default_value_t = 0.4)]
-    protrude: f32,
-    /// How a loaded model is placed: standing out of the glass, facing the viewer from within
-    /// it (reliefs, tablets), or auto (facing when thin front to back).
-    #[arg(long, value_enum, default_value = "auto")]
-    placement: PlacementArg,
-    /// Leave out the diorama floor under the model (and the shadow cast on it).
-    #[arg(long)]
-    no_floor: bool,
-    /// An equirectangular HDR environment (.hdr or .exr, world frame) to light the artifact;
-    /// a generated neutral studio when omitted.
-    #[arg(long)]
-    environment: Option<PathBuf>,
-}
-
-/// A scene loaded from [`SceneArgs`], ready for a renderer.
-struct Scene {
-    model: phantogram::model::Model,
-    /// The artifact's bounds (without the floor), for containment.
-    bounds: phantogram::containment::Aabb,
-    environment: Option<phantogram::ibl::Environment>,
-}
-
-impl SceneArgs {
-    /// Checks the settings and loads the model and environment (before any GPU work, so that a
-    /// bad file is reported at once).
-    fn load(&self, screen: &phantogram::screen::Screen) -> Result<Scene> {
-        if !(0.0..=1.0).contains(&self.protrude) {
-            bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
-        }
-        // Loading the model and environment overlaps the renderer's lighting tables.
-        phantogram::render::prepare_lighting_tables_in_background(self.environment.is_none());
-        let fit = phantogram::model::DioramaFit {
-            placement: match self.placement {
-                PlacementArg::Auto => phantogram::model::Placement::Auto,
-                PlacementArg::Standing => phantogram::model::Placement::Standing,
-                PlacementArg::Facing => phantogram::model::Placement::Facing,
-            },
-            protrude_fraction: self.protrude,
-            ..Default::default()
-        };
-        let (model, bounds) = load_for_display(self.model.as_deref(), screen, &fit, !self.no_floor)?;
-        let environment = match &self.environment {
-            Some(path) => Some(phantogram::ibl::Environment::load(path)?),
-            None => None,
-        };
-        Ok(Scene {
-            model,
-            bounds,
-            environment,
-        })
-    }
-}
-
-#[derive(Clone, Copy, Debug, clap::ValueEnum)]
-enum PlacementArg {
-    Auto,
-    Standing,
-    Facing,
 }
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -310,17 +245,15 @@ fn run(cli: Cli) -> Result<()> {
             lifecycle_test,
             calibration,
         } => {
-            let scene = scene.load(&SessionConfig::default().screen)?;
             let log = match log {
                 Some(path) => Some(open_events(&path)?.collect::<Result<Vec<_>, _>>()?),
                 None => None,
             };
+            // The calibration is the user's, kept where the desktop tools keep it.
+            let engine = scene.engine(anaglyph, phantogram::calibration::Calibration::default_path())?;
             viewer::run(viewer::ViewerArgs {
-                model: scene.model,
-                bounds: scene.bounds,
-                environment: scene.environment,
+                engine,
                 log,
-                method: anaglyph,
                 frames,
                 lifecycle_test,
                 calibration,
@@ -334,7 +267,7 @@ fn run(cli: Cli) -> Result<()> {
             anaglyph,
             every,
             flat_at_s,
-        } => render_command(RenderArgs {
+        } => render_frames::render_command(render_frames::RenderArgs {
             scene: &scene,
             log: &log,
             out_dir: &out,
@@ -777,205 +710,4 @@ fn time_constant_s(text: &str) -> Result<f32, String> {
         Ok(s) if s.is_finite() && s >= 0.0 => Ok(s),
         _ => Err(format!("expected a time constant of 0 seconds or more, got {text:?}")),
     }
-}
-
-fn parse_size(text: &str) -> Result<(u32, u32)> {
-    let (w, h) = text
-        .split_once(['x', 'X'])
-        .with_context(|| format!("--size {text:?}: expected WxH, e.g. 540x1200"))?;
-    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|n| *n > 0);
-    match (parse(w), parse(h)) {
-        (Some(w), Some(h)) => Ok((w, h)),
-        _ => bail!("--size {text:?}: expected two positive whole numbers, WxH"),
-    }
-}
-
-struct RenderArgs<'a> {
-    scene: &'a SceneArgs,
-    log: &'a std::path::Path,
-    out_dir: &'a std::path::Path,
-    size: &'a str,
-    method: phantogram::anaglyph::Method,
-    every_ms: f64,
-    flat_at_s: Option<f64>,
-}
-
-fn render_command(args: RenderArgs) -> Result<()> {
-    use phantogram::containment::ContainmentSmoother;
-    use phantogram::render::{FrameInput, Gpu, Renderer};
-
-    let RenderArgs {
-        scene,
-        log,
-        out_dir,
-        size,
-        method,
-        every_ms,
-        flat_at_s,
-    } = args;
-    let (width, height) = parse_size(size)?;
-    let config = SessionConfig::default();
-    let screen = config.screen;
-    let aspect = width as f64 / height as f64;
-    let screen_aspect = screen.width_m() as f64 / screen.height_m() as f64;
-    if (aspect / screen_aspect - 1.0).abs() > 0.02 {
-        bail!(
-            "--size {width}x{height} does not match the screen's aspect ratio {}:{} (the image would be stretched)",
-            screen.width_px(),
-            screen.height_px()
-        );
-    }
-    let events: Vec<SensorEvent> = open_events(log)?.collect::<Result<_, _>>()?;
-    let (Some(first), Some(last)) = (events.first(), events.last()) else {
-        bail!("{}: the log has no events", log.display());
-    };
-    let interval_ns = (every_ms * 1e6).round() as i64;
-    if let Some(at) = flat_at_s.filter(|at| *at > (last.t_ns - first.t_ns) as f64 * 1e-9) {
-        // Known now, before any frame is drawn.
-        bail!("--flat-at-s {at} is beyond the end of the log");
-    }
-    let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
-
-    let Scene {
-        model,
-        bounds,
-        environment,
-    } = scene.load(&screen)?;
-    if out_dir.exists() && !out_dir.is_dir() {
-        bail!("--out {}: exists and is not a folder", out_dir.display());
-    }
-    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
-    remove_earlier_frames(out_dir)?;
-    let gpu = Gpu::headless()?;
-    eprintln!("rendering on {}", gpu.describe());
-    let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
-    let mut session = Session::new(config).context("invalid settings")?;
-    let mut smoother = ContainmentSmoother::default();
-
-    let bar = indicatif::ProgressBar::new(frames_expected);
-    bar.set_style(
-        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} elapsed, ETA {eta}")
-            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
-    );
-    let t0 = first.t_ns;
-    let mut index = 0u64;
-    let mut failure: Option<anyhow::Error> = None;
-    let mut flat_pending = flat_at_s;
-    replay(
-        events.into_iter().map(Ok),
-        &mut session,
-        interval_ns,
-        Pace::AsFastAsPossible,
-        |session, t_ns, view| {
-            if failure.is_some() {
-                return;
-            }
-            if flat_pending.is_some_and(|at| (t_ns - t0) as f64 * 1e-9 >= at) {
-                flat_pending = None;
-                if let Err(e) = session.calibrate_flat_angle() {
-                    failure = Some(anyhow::anyhow!("flat-angle calibration failed: {e}"));
-                    return;
-                }
-            }
-            let push = smoother.follow(
-                &bounds,
-                &view.stereo_eyes_m(),
-                &session.config().screen,
-                interval_ns as f32 * 1e-9,
-            );
-            let input = FrameInput::from_view(view, phantogram::glam::Vec3::Z * -push);
-            let result = renderer
-                .render(&input, method, width, height)
-                .map_err(anyhow::Error::from)
-                .and_then(|pixels| {
-                    let path = out_dir.join(format!("frame_{index:05}.png"));
-                    image::save_buffer(&path, &pixels, width, height, image::ExtendedColorType::Rgba8)
-                        .with_context(|| format!("writing {}", path.display()))
-                });
-            if let Err(e) = result {
-                failure = Some(e);
-            }
-            index += 1;
-            bar.inc(1);
-        },
-    )?;
-    bar.finish_and_clear();
-    if let Some(e) = failure {
-        return Err(e);
-    }
-    if let Some(at) = flat_pending {
-        bail!("--flat-at-s {at} is beyond the end of the log");
-    }
-    eprintln!(
-        "wrote {index} frame{} ({width}x{height}, {method}) to {}",
-        if index == 1 { "" } else { "s" },
-        out_dir.display()
-    );
-    Ok(())
-}
-
-/// Removes the frames (`frame_NNNNN.png`, the names `render` writes) of an earlier run from
-/// `dir`: a shorter run would otherwise leave the old run's last frames after its own, and a
-/// video made of the folder would end with them. Other files are left alone.
-fn remove_earlier_frames(dir: &std::path::Path) -> Result<()> {
-    let is_frame = |name: &str| {
-        name.strip_prefix("frame_")
-            .and_then(|rest| rest.strip_suffix(".png"))
-            .is_some_and(|n| n.len() == 5 && n.bytes().all(|b| b.is_ascii_digit()))
-    };
-    let mut removed = 0;
-    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
-        let path = entry.with_context(|| format!("reading {}", dir.display()))?.path();
-        if path.file_name().and_then(|n| n.to_str()).is_some_and(is_frame) {
-            std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
-            removed += 1;
-        }
-    }
-    if removed > 0 {
-        let s = if removed == 1 { "" } else { "s" };
-        eprintln!("removed {removed} frame{s} of an earlier run from {}", dir.display());
-    }
-    Ok(())
-}
-
-/// The model to show, with the artifact's bounds for containment (the floor, when asked for, is
-/// added after them: containment concerns the artifact, not what it stands on). A glTF file is
-/// fitted to the diorama and its warnings printed; without one, the default artifact.
-fn load_for_display(
-    path: Option<&std::path::Path>,
-    screen: &phantogram::screen::Screen,
-    fit: &phantogram::model::DioramaFit,
-    floor: bool,
-) -> Result<(phantogram::model::Model, phantogram::containment::Aabb)> {
-    let mut model = match path {
-        Some(path) => load_fitted(path, screen, fit)?,
-        None => phantogram::artifact::default_model(),
-    };
-    let bounds = model.bounds().context("the model is empty")?;
-    if floor {
-        model.add_floor(screen, phantogram::model::Model::FLOOR_REACH);
-    }
-    Ok((model, bounds))
-}
-
-fn load_fitted(
-    path: &std::path::Path,
-    screen: &phantogram::screen::Screen,
-    fit: &phantogram::model::DioramaFit,
-) -> Result<phantogram::model::Model> {
-    let mut model = phantogram::model::load_model(path)?;
-    for w in &model.warnings {
-        eprintln!("warning: {}: {w}", path.display());
-    }
-    model.fit_to_diorama(screen, fit);
-    // The model's name is its file's: it tells which scan a Voyager scene or folder gave.
-    eprintln!(
-        "{}: {}, {} triangles, {} materials, {} images",
-        path.display(),
-        model.name,
-        model.triangle_count(),
-        model.materials.len(),
-        model.images.len()
-    );
-    Ok(model)
 }

@@ -1,6 +1,6 @@
 //! Camera frames as the platforms deliver them, and the pinhole intrinsics that go with them.
 //!
-//! Plain data (no networks, no GPU): the face tracker (`face`, feature `face`) consumes it, the
+//! Plain data (no networks, no GPU): the face tracker (`phantogram_vision`) consumes it, the
 //! bridges build it, and the intrinsics are derived here from what each platform reports
 //! ([`android`]: Camera2's characteristics; iOS delivers the matrix of each buffer, which is
 //! passed on as it is), so that no camera maths lives in a shell.

@@ -1,7 +1,7 @@
 //! The calibration screens, drawn by the core with egui so that the phones and the desktop viewer
 //! show the same thing: the eye-reflection slider (IPD and head offset), the blind-spot distance
 //! test, the ID-1 card check of the pixel density, "this is straight on" (flat angle) and the
-//! world-light reset. The physics is in [`crate::calibration`]; this module places things on the
+//! world-light reset. The physics is in [`phantogram_sensing::calibration`]; this module places things on the
 //! screen and turns the viewer's answers into a [`Calibration`].
 //!
 //! egui (immediate mode, on wgpu through `egui-wgpu`) was chosen because it draws with the GPU
@@ -10,15 +10,15 @@
 //!
 //! **Coordinates**: the host gives egui the display in points; `pixels_per_point` is the display's
 //! pixels per point (on phones the density scale, e.g. 2.75). Targets are placed in display
-//! pixels by [`crate::screen::Screen`] and divided by `pixels_per_point` to draw.
+//! pixels by [`phantogram_geometry::screen::Screen`] and divided by `pixels_per_point` to draw.
 //!
 //! **Threading**: lives on the render thread with the egui context. **Panics**: none.
 
 use egui::{Align2, Color32, Pos2, Rect, Stroke, Vec2 as EVec2};
 use glam::{Vec2, Vec3};
 
-use crate::calibration::{self, Calibration, ID1_CARD_M};
-use crate::screen::Screen;
+use phantogram_geometry::screen::Screen;
+use phantogram_sensing::calibration::{self, Calibration, ID1_CARD_M};
 
 /// Which screen is showing.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -337,7 +337,7 @@ pub struct Overlay {
 }
 
 impl Overlay {
-    pub fn new(gpu: &crate::render::Gpu, format: wgpu::TextureFormat) -> Self {
+    pub fn new(gpu: &phantogram_render::Gpu, format: wgpu::TextureFormat) -> Self {
         Self {
             renderer: egui_wgpu::Renderer::new(&gpu.device, format, egui_wgpu::RendererOptions::default()),
             format,
@@ -353,7 +353,7 @@ impl Overlay {
     /// and submits.
     pub fn paint(
         &mut self,
-        gpu: &crate::render::Gpu,
+        gpu: &phantogram_render::Gpu,
         ctx: &egui::Context,
         mut output: egui::FullOutput,
         target: &wgpu::TextureView,
@@ -433,7 +433,7 @@ impl OverlayHost {
     /// Paints `output` over `target` (`format`, `size_px`); see [`Overlay::paint`].
     pub fn paint(
         &mut self,
-        gpu: &crate::render::Gpu,
+        gpu: &phantogram_render::Gpu,
         ctx: &egui::Context,
         output: &mut egui::FullOutput,
         target: &wgpu::TextureView,
@@ -468,7 +468,7 @@ impl OverlayHost {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::screen::{DisplayRotation, PanelSpec};
+    use phantogram_geometry::screen::{DisplayRotation, PanelSpec};
 
     fn screen(rotation: DisplayRotation) -> Screen {
         Screen::new(PanelSpec::TYPICAL_PHONE, rotation).unwrap()

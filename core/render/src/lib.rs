@@ -1,6 +1,12 @@
+//! # Phantogram render
+//!
 //! The renderer: draws the artifact for each eye with its own off-axis projection and composes
-//! the pair (anaglyph or mono) in linear light. Headless today (frames read back as images); the
-//! window surface for the desktop viewer and the phones builds on the same passes.
+//! the pair (anaglyph or mono) in linear light, into an offscreen target read back as an image or
+//! onto a window surface ([`surface`], the lifecycle the phones and the desktop viewer share).
+//! Depends on `phantogram_geometry` (projections, anaglyph matrices), `phantogram_assets` (what it
+//! uploads) and `phantogram_sensing` (the session's [`FrameInput::from_view`]); `wgpu` (the chosen
+//! stack), `pollster` to wait on its few futures, `bytemuck` for uniform and vertex layouts,
+//! `half` to pack f16 textures.
 //!
 //! ## Passes per frame
 //! 1. Shadow pass, once for both eyes: depth from the world-fixed light (orthographic over the
@@ -13,7 +19,7 @@
 //!    write). Mono renders only the cyclopean eye. Light, materials and textures are shared by
 //!    both eyes; only the small per-eye uniform differs.
 //! 3. Composition pass: tone mapping (Khronos PBR Neutral, exposure) of each eye, then the
-//!    anaglyph matrices ([`crate::anaglyph`]) in linear light, into an `Rgba8UnormSrgb` target.
+//!    anaglyph matrices ([`phantogram_geometry::anaglyph`]) in linear light, into an `Rgba8UnormSrgb` target.
 //!
 //! ## Models
 //! [`Model`]s upload as one vertex and index buffer per primitive, one bind group per material
@@ -27,7 +33,8 @@
 //! ## Devices
 //! [`Gpu::headless`] asks wgpu for any adapter of the backends in `WGPU_BACKEND` (default: all),
 //! preferring real hardware and falling back to a software one (Mesa's lavapipe, which is how tests
-//! and CI run: Debian's `mesa-vulkan-drivers`). No display is needed.
+//! and CI run: Debian's `mesa-vulkan-drivers`). No display is needed: a window handed over later
+//! brings its own display handle (as on the phones).
 //!
 //! **Threading**: a [`Renderer`] belongs to one thread; wgpu's device and queue are internally
 //! synchronised. [`prepare_lighting_tables`] may run on any thread (once per process; a renderer
@@ -38,14 +45,28 @@ use glam::{Mat4, Vec3};
 use thiserror::Error;
 use wgpu::util::DeviceExt;
 
-use crate::anaglyph::Method;
-use crate::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
-use crate::projection::OffAxisProjection;
-use crate::session::FrameView;
+use phantogram_assets::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
+use phantogram_geometry::anaglyph::Method;
+use phantogram_geometry::projection::OffAxisProjection;
+use phantogram_sensing::session::FrameView;
+
+mod gpu;
+mod lighting_tables;
+pub mod surface;
+mod upload;
+
+/// The wgpu this crate is built on, for shells that hand it window handles.
+pub use wgpu;
+
+pub use gpu::Gpu;
+use lighting_tables::*;
+pub use lighting_tables::{prepare_lighting_tables, prepare_lighting_tables_in_background};
+pub use upload::mip_chain;
+use upload::*;
 
 /// WGSL sources, validated by naga in the tests.
-pub const SCENE_WGSL: &str = include_str!("../../shaders/scene.wgsl");
-pub const COMPOSE_WGSL: &str = include_str!("../../shaders/compose.wgsl");
+pub const SCENE_WGSL: &str = include_str!("../../../shaders/scene.wgsl");
+pub const COMPOSE_WGSL: &str = include_str!("../../../shaders/compose.wgsl");
 
 const HDR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 /// Shadow map resolution: 1024² texels over what casts shadows, the model without its floor
@@ -79,89 +100,6 @@ pub enum RenderError {
     Gpu { what: &'static str, message: String },
     #[error("reading the frame back from the GPU failed: {0}")]
     Readback(String),
-}
-
-/// An instance, adapter, device and queue.
-pub struct Gpu {
-    /// Kept to create window surfaces ([`crate::surface`]).
-    pub instance: wgpu::Instance,
-    pub adapter: wgpu::Adapter,
-    pub device: wgpu::Device,
-    pub queue: wgpu::Queue,
-}
-
-impl Gpu {
-    /// A device without any window, on the first adapter that works: hardware first, then a
-    /// software fallback.
-    pub fn headless() -> Result<Self, RenderError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        Self::with_instance(instance, None)
-    }
-
-    /// A device able to present to windows of `display` (a winit event loop or window, an
-    /// Android or iOS display handle): the instance keeps the display connection, and the adapter
-    /// is chosen to present to `probe`, a window of that display.
-    pub fn for_display(
-        display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
-        probe: std::sync::Arc<dyn wgpu::WindowHandle>,
-    ) -> Result<Self, RenderError> {
-        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(display));
-        let surface = instance
-            .create_surface(window_target(probe))
-            .map_err(|e| RenderError::Device(format!("cannot create a surface for the window: {e}")))?;
-        let gpu = Self::with_instance(instance.clone(), Some(&surface))?;
-        drop(surface);
-        Ok(gpu)
-    }
-
-    /// A device on `instance` whose adapter can present to `surface` (if given).
-    pub fn with_instance(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self, RenderError> {
-        let mut adapter = None;
-        for force_fallback_adapter in [false, true] {
-            let found = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
-                power_preference: wgpu::PowerPreference::HighPerformance,
-                force_fallback_adapter,
-                compatible_surface: surface,
-                // Limit bucketing hides hardware from untrusted web content; not our case.
-                apply_limit_buckets: false,
-            }));
-            if let Ok(a) = found {
-                adapter = Some(a);
-                break;
-            }
-        }
-        let adapter = adapter.ok_or(RenderError::NoAdapter)?;
-        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
-            label: Some("phantogram"),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
-            ..Default::default()
-        }))
-        .map_err(|e| RenderError::Device(e.to_string()))?;
-        Ok(Self {
-            instance,
-            adapter,
-            device,
-            queue,
-        })
-    }
-
-    /// The adapter's name and backend, for logs.
-    pub fn describe(&self) -> String {
-        let info = self.adapter.get_info();
-        format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
-    }
-}
-
-/// A shared window handle as a surface target. The display connection lives in the instance
-/// ([`Gpu::for_display`]), so only the window handle is needed.
-pub(crate) fn window_target(window: std::sync::Arc<dyn wgpu::WindowHandle>) -> wgpu::SurfaceTarget<'static> {
-    struct SharedWindow(std::sync::Arc<dyn wgpu::WindowHandle>);
-    impl wgpu::rwh::HasWindowHandle for SharedWindow {
-        fn window_handle(&self) -> Result<wgpu::rwh::WindowHandle<'_>, wgpu::rwh::HandleError> {
-            self.0.window_handle()
-        }
-    }
-    wgpu::SurfaceTarget::Window(Box::new(SharedWindow(window)))
 }
 
 /// Per-eye uniform block; matches `Eye` in `scene.wgsl`.
@@ -249,7 +187,7 @@ impl MaterialUniform {
 pub struct Lighting {
     /// Radiance of the directional light, linear RGB.
     pub light_rgb: Vec3,
-    /// Scale of the environment's light ([`crate::ibl`]).
+    /// Scale of the environment's light ([`phantogram_assets::ibl`]).
     pub environment_intensity: f32,
     /// Linear exposure multiplier before tone mapping.
     pub exposure: f32,
@@ -386,9 +324,9 @@ struct GpuModel {
     primitives: Vec<GpuPrimitive>,
     materials: Vec<GpuMaterial>,
     /// Everything, floor included.
-    bounds: crate::containment::Aabb,
+    bounds: phantogram_geometry::containment::Aabb,
     /// Everything but the floor (all of it if there is nothing else).
-    standing: crate::containment::Aabb,
+    standing: phantogram_geometry::containment::Aabb,
 }
 
 impl GpuModel {
@@ -397,14 +335,14 @@ impl GpuModel {
     /// only what stands on it, at the resolution that detail needs (with the floor, 2.5 screens
     /// out, a texel would be ~10× coarser and the shadow blurred and detached from the feet).
     /// With the light below its plane the floor does cast (it hides the light from all it holds).
-    fn shadow_casters(&self, toward_light: Vec3) -> (bool, crate::containment::Aabb) {
+    fn shadow_casters(&self, toward_light: Vec3) -> (bool, phantogram_geometry::containment::Aabb) {
         let floor_casts = toward_light.z < 0.0;
         (floor_casts, if floor_casts { self.bounds } else { self.standing })
     }
 }
 
 /// The orthographic light view over `bounds` (mesh coordinates) and its texel size in metres.
-pub fn light_view_proj(bounds: &crate::containment::Aabb, toward_light: Vec3) -> (Mat4, f32) {
+pub fn light_view_proj(bounds: &phantogram_geometry::containment::Aabb, toward_light: Vec3) -> (Mat4, f32) {
     let l = toward_light.normalize_or(Vec3::Z);
     let centre = (bounds.min + bounds.max) * 0.5;
     let radius = (bounds.max - bounds.min).length() * 0.5 + 1e-4;
@@ -663,20 +601,23 @@ impl Renderer {
     pub fn with_environment(
         gpu: Gpu,
         model: &Model,
-        environment: Option<&crate::ibl::Environment>,
+        environment: Option<&phantogram_assets::ibl::Environment>,
     ) -> Result<Self, RenderError> {
         if model.triangle_count() == 0 {
             return Err(RenderError::EmptyModel);
         }
         let prefiltered;
-        let (levels, sh): (&[crate::ibl::Environment], _) = match environment {
+        let (levels, sh): (&[phantogram_assets::ibl::Environment], _) = match environment {
             Some(env) => {
-                prefiltered = crate::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
-                (&prefiltered, crate::ibl::IrradianceSh::from_environment(env))
+                prefiltered = phantogram_assets::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
+                (
+                    &prefiltered,
+                    phantogram_assets::ibl::IrradianceSh::from_environment(env),
+                )
             }
             None => (
                 default_prefiltered_environment(),
-                crate::ibl::IrradianceSh::from_environment(&crate::ibl::Environment::studio()),
+                phantogram_assets::ibl::IrradianceSh::from_environment(&phantogram_assets::ibl::Environment::studio()),
             ),
         };
         let device = gpu.device.clone();
@@ -685,7 +626,12 @@ impl Renderer {
         })
     }
 
-    fn build(gpu: Gpu, model: &Model, environment: &[crate::ibl::Environment], environment_sh: [[f32; 4]; 9]) -> Self {
+    fn build(
+        gpu: Gpu,
+        model: &Model,
+        environment: &[phantogram_assets::ibl::Environment],
+        environment_sh: [[f32; 4]; 9],
+    ) -> Self {
         let device = &gpu.device;
         let scene_module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("scene.wgsl"),
@@ -899,9 +845,9 @@ impl Renderer {
     ///
     /// Prefilters the environment for specular light on the CPU (a few tens of milliseconds in
     /// release builds for the default 256-wide base level).
-    pub fn set_environment(&mut self, env: &crate::ibl::Environment) -> Result<(), RenderError> {
-        self.environment_sh = crate::ibl::IrradianceSh::from_environment(env).shader_coefficients();
-        let levels = crate::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
+    pub fn set_environment(&mut self, env: &phantogram_assets::ibl::Environment) -> Result<(), RenderError> {
+        self.environment_sh = phantogram_assets::ibl::IrradianceSh::from_environment(env).shader_coefficients();
+        let levels = phantogram_assets::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
         let device = self.gpu.device.clone();
         checked(&device, "the environment map", || {
             self.ibl = IblTextures::new(&self.gpu, &levels);
@@ -1370,408 +1316,6 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
     }
 }
 
-fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn linear_to_srgb(c: f32) -> u8 {
-    let c = c.clamp(0.0, 1.0);
-    let s = if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5) as u8
-}
-
-/// The full mip chain of an RGBA8 image (2×2 box filter; odd sizes clamp at the edge). Colour
-/// data is averaged in linear light, alpha and data textures as stored.
-pub fn mip_chain(width: u32, height: u32, rgba8: &[u8], srgb: bool) -> Vec<(u32, u32, Vec<u8>)> {
-    let mut levels = vec![(width, height, rgba8.to_vec())];
-    while let Some((w, h, data)) = levels.last().filter(|(w, h, _)| *w > 1 || *h > 1) {
-        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
-        let mut next = vec![0u8; (nw * nh * 4) as usize];
-        for y in 0..nh {
-            for x in 0..nw {
-                for c in 0..4 {
-                    let mut sum = 0.0f32;
-                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                        let sx = (2 * x + dx).min(w - 1);
-                        let sy = (2 * y + dy).min(h - 1);
-                        let v = data[((sy * w + sx) * 4 + c) as usize];
-                        sum += if srgb && c < 3 {
-                            srgb_to_linear(v)
-                        } else {
-                            v as f32 / 255.0
-                        };
-                    }
-                    let avg = sum * 0.25;
-                    next[((y * nw + x) * 4 + c) as usize] = if srgb && c < 3 {
-                        linear_to_srgb(avg)
-                    } else {
-                        (avg * 255.0 + 0.5) as u8
-                    };
-                }
-            }
-        }
-        levels.push((nw, nh, next));
-    }
-    levels
-}
-
-fn upload_texture(gpu: &Gpu, label: &str, width: u32, height: u32, rgba8: &[u8], srgb: bool) -> wgpu::TextureView {
-    upload_mip_chain(gpu, label, width, height, &mip_chain(width, height, rgba8, srgb), srgb)
-}
-
-/// Uploads a texture from its mip levels ([`mip_chain`]).
-fn upload_mip_chain(
-    gpu: &Gpu,
-    label: &str,
-    width: u32,
-    height: u32,
-    levels: &[(u32, u32, Vec<u8>)],
-    srgb: bool,
-) -> wgpu::TextureView {
-    let format = if srgb {
-        wgpu::TextureFormat::Rgba8UnormSrgb
-    } else {
-        wgpu::TextureFormat::Rgba8Unorm
-    };
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(label),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: levels.len() as u32,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
-    for (level, (w, h, data)) in levels.iter().enumerate() {
-        gpu.queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &texture,
-                mip_level: level as u32,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            data,
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(w * 4),
-                rows_per_image: Some(*h),
-            },
-            wgpu::Extent3d {
-                width: *w,
-                height: *h,
-                depth_or_array_layers: 1,
-            },
-        );
-    }
-    texture.create_view(&Default::default())
-}
-
-fn create_sampler(device: &wgpu::Device, s: &Sampler) -> wgpu::Sampler {
-    let address = |w: Wrap| match w {
-        Wrap::Repeat => wgpu::AddressMode::Repeat,
-        Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
-        Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
-    };
-    let filter = |linear: bool| {
-        if linear {
-            wgpu::FilterMode::Linear
-        } else {
-            wgpu::FilterMode::Nearest
-        }
-    };
-    device.create_sampler(&wgpu::SamplerDescriptor {
-        label: Some("material"),
-        address_mode_u: address(s.wrap_u),
-        address_mode_v: address(s.wrap_v),
-        mag_filter: filter(s.mag_linear),
-        min_filter: filter(s.min_linear),
-        mipmap_filter: if s.mip_linear {
-            wgpu::MipmapFilterMode::Linear
-        } else {
-            wgpu::MipmapFilterMode::Nearest
-        },
-        ..Default::default()
-    })
-}
-
-fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> GpuModel {
-    let device = &gpu.device;
-    // Each image once per colour space it is used in; the mip chains are built on every core
-    // (a good part of a textured scan's time to first frame), then uploaded in turn.
-    let mut used: Vec<(usize, bool)> = Vec::new();
-    for m in &model.materials {
-        for (t, srgb) in m.textures() {
-            if t.image < model.images.len() && !used.contains(&(t.image, srgb)) {
-                used.push((t.image, srgb));
-            }
-        }
-    }
-    let chains = crate::parallel::map(&used, |&(image, srgb)| {
-        let img = &model.images[image];
-        mip_chain(img.width, img.height, &img.rgba8, srgb)
-    });
-    let views: std::collections::HashMap<(usize, bool), wgpu::TextureView> = used
-        .iter()
-        .zip(chains)
-        .map(|(&(image, srgb), levels)| {
-            let img = &model.images[image];
-            let view = upload_mip_chain(gpu, &img.name, img.width, img.height, &levels, srgb);
-            ((image, srgb), view)
-        })
-        .collect();
-    let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
-    let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
-    let default_sampler = create_sampler(device, &Sampler::default());
-    let materials = model
-        .materials
-        .iter()
-        .map(|m| {
-            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("material"),
-                contents: bytemuck::bytes_of(&MaterialUniform::new(m)),
-                usage: wgpu::BufferUsages::UNIFORM,
-            });
-            let slots = [
-                (m.base_color_texture, true, &white),
-                (m.metallic_roughness_texture, false, &white),
-                (m.normal_texture.map(|(t, _)| t), false, &flat_normal),
-                (m.occlusion_texture.map(|(t, _)| t), false, &white),
-                (m.emissive_texture, true, &white),
-            ];
-            let samplers: Vec<wgpu::Sampler> = slots
-                .iter()
-                .map(|(t, _, _)| t.map_or_else(|| default_sampler.clone(), |t| create_sampler(device, &t.sampler)))
-                .collect();
-            let mut entries = vec![wgpu::BindGroupEntry {
-                binding: 0,
-                resource: uniform.as_entire_binding(),
-            }];
-            let mut textures = [false; 5];
-            for (i, (t, srgb, fallback)) in slots.iter().enumerate() {
-                let found = t.and_then(|t| views.get(&(t.image, *srgb)));
-                textures[i] = found.is_some();
-                let view = found.unwrap_or(fallback);
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 1 + 2 * i as u32,
-                    resource: wgpu::BindingResource::TextureView(view),
-                });
-                entries.push(wgpu::BindGroupEntry {
-                    binding: 2 + 2 * i as u32,
-                    resource: wgpu::BindingResource::Sampler(&samplers[i]),
-                });
-            }
-            GpuMaterial {
-                bind: device.create_bind_group(&wgpu::BindGroupDescriptor {
-                    label: Some(&m.name),
-                    layout,
-                    entries: &entries,
-                }),
-                variant: MaterialVariant {
-                    double_sided: m.double_sided,
-                    blend: m.alpha == AlphaMode::Blend,
-                    textures,
-                    mask: matches!(m.alpha, AlphaMode::Mask(_)),
-                },
-                _uniform: uniform,
-            }
-        })
-        .collect();
-    let primitives = model
-        .primitives
-        .iter()
-        .filter(|p| !p.mesh.indices.is_empty())
-        .map(|p| GpuPrimitive {
-            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("vertices"),
-                contents: bytemuck::cast_slice(&p.mesh.vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            }),
-            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("indices"),
-                contents: bytemuck::cast_slice(&p.mesh.indices),
-                usage: wgpu::BufferUsages::INDEX,
-            }),
-            index_count: p.mesh.indices.len() as u32,
-            material: p.material.min(model.materials.len().saturating_sub(1)),
-            centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
-            is_floor: p.is_floor,
-        })
-        .collect();
-    let fallback = crate::containment::Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05));
-    let bounds = model.bounds().unwrap_or(fallback);
-    let standing = model.bounds_of(|p| !p.is_floor).unwrap_or(bounds);
-    GpuModel {
-        primitives,
-        materials,
-        bounds,
-        standing,
-    }
-}
-
-/// Width of the prefiltered environment's sharpest level (mirror-like reflections).
-const PREFILTERED_BASE_WIDTH: usize = 256;
-/// Size of the split-sum BRDF table (n·v × roughness).
-const BRDF_LUT_SIZE: usize = 64;
-
-/// Computes, once per process, the tables a [`Renderer`] needs before its first frame: the
-/// split-sum BRDF table and, if `studio`, the generated studio's prefiltered levels (the lighting
-/// when no environment is given). About 100 ms of CPU work on this machine's two cores; an app
-/// calls it on a background thread at start-up, overlapping it with loading the model and opening
-/// the device (the sea turtle's cold load-to-first-frame: see `benchmarks/render.md`). Calling it
-/// is never required: the renderer computes what is missing, or waits for a computation under way.
-pub fn prepare_lighting_tables(studio: bool) {
-    brdf_lut_texels();
-    if studio {
-        default_prefiltered_environment();
-    }
-}
-
-/// [`prepare_lighting_tables`] on a new, detached thread. If the thread cannot be created the
-/// renderer computes the tables itself when it needs them: nothing fails, it only starts later.
-pub fn prepare_lighting_tables_in_background(studio: bool) {
-    let _ = std::thread::Builder::new()
-        .name("lighting tables".into())
-        .spawn(move || prepare_lighting_tables(studio));
-}
-
-/// The generated studio's prefiltered levels, computed once per process: every renderer without
-/// an environment of its own starts with them.
-fn default_prefiltered_environment() -> &'static [crate::ibl::Environment] {
-    static LEVELS: std::sync::OnceLock<Vec<crate::ibl::Environment>> = std::sync::OnceLock::new();
-    LEVELS.get_or_init(|| crate::ibl::prefiltered_levels(&crate::ibl::Environment::studio(), PREFILTERED_BASE_WIDTH))
-}
-
-/// The split-sum table as `Rg16Float` texels, computed once per process (it depends on nothing).
-fn brdf_lut_texels() -> &'static [u8] {
-    static TEXELS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
-    TEXELS.get_or_init(|| {
-        crate::ibl::brdf_lut(BRDF_LUT_SIZE)
-            .into_iter()
-            .flat_map(|[a, b]| [half::f16::from_f32(a), half::f16::from_f32(b)])
-            .flat_map(|h| h.to_le_bytes())
-            .collect()
-    })
-}
-
-/// The GPU side of the specular image-based light.
-struct IblTextures {
-    environment: wgpu::TextureView,
-    brdf_lut: wgpu::TextureView,
-    sampler: wgpu::Sampler,
-}
-
-impl IblTextures {
-    /// Uploads `levels` (from [`crate::ibl::prefiltered_levels`], a mip chain) and the BRDF table.
-    fn new(gpu: &Gpu, levels: &[crate::ibl::Environment]) -> Self {
-        let (device, queue) = (&gpu.device, &gpu.queue);
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("prefiltered environment"),
-            size: wgpu::Extent3d {
-                width: levels[0].width as u32,
-                height: levels[0].height as u32,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: levels.len() as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        for (k, level) in levels.iter().enumerate() {
-            let bytes: Vec<u8> = level
-                .texels
-                .iter()
-                .flat_map(|t| [t[0], t[1], t[2], 1.0])
-                // f16 saturates at 65504: clamp so a very bright sun stays finite.
-                .map(|c| half::f16::from_f32(c.min(65_000.0)))
-                .flat_map(|h| h.to_le_bytes())
-                .collect();
-            queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: k as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &bytes,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(8 * level.width as u32),
-                    rows_per_image: Some(level.height as u32),
-                },
-                wgpu::Extent3d {
-                    width: level.width as u32,
-                    height: level.height as u32,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
-        let lut = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("split-sum BRDF table"),
-            size: wgpu::Extent3d {
-                width: BRDF_LUT_SIZE as u32,
-                height: BRDF_LUT_SIZE as u32,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rg16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
-        queue.write_texture(
-            wgpu::TexelCopyTextureInfo {
-                texture: &lut,
-                mip_level: 0,
-                origin: wgpu::Origin3d::ZERO,
-                aspect: wgpu::TextureAspect::All,
-            },
-            brdf_lut_texels(),
-            wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(4 * BRDF_LUT_SIZE as u32),
-                rows_per_image: Some(BRDF_LUT_SIZE as u32),
-            },
-            wgpu::Extent3d {
-                width: BRDF_LUT_SIZE as u32,
-                height: BRDF_LUT_SIZE as u32,
-                depth_or_array_layers: 1,
-            },
-        );
-        // Azimuth wraps; the shader keeps the table's coordinates inside its texel centres.
-        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("environment"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::ClampToEdge,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
-        Self {
-            environment: texture.create_view(&Default::default()),
-            brdf_lut: lut.create_view(&Default::default()),
-            sampler,
-        }
-    }
-}
-
 fn eye_bind_groups(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
@@ -1879,7 +1423,7 @@ mod tests {
     /// Every `shaders/*.wgsl` file parses and validates (naga), not only the ones compiled in.
     #[test]
     fn every_shader_validates() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../shaders");
+        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shaders");
         let mut n = 0;
         for entry in std::fs::read_dir(&dir).unwrap() {
             let path = entry.unwrap().path();

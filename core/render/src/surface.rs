@@ -22,8 +22,8 @@
 
 use std::sync::Arc;
 
-use crate::anaglyph::Method;
-use crate::render::{FrameInput, Gpu, RenderError, Renderer};
+use crate::{FrameInput, Gpu, RenderError, Renderer};
+use phantogram_geometry::anaglyph::Method;
 
 /// Where the host is in its lifecycle.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -56,7 +56,7 @@ pub struct SurfaceStats {
 /// A window surface with an explicit lifecycle.
 #[derive(Default)]
 pub struct SurfaceHost {
-    window: Option<Arc<dyn wgpu::WindowHandle>>,
+    window: Option<Arc<dyn wgpu::DisplayAndWindowHandle>>,
     surface: Option<wgpu::Surface<'static>>,
     config: Option<wgpu::SurfaceConfiguration>,
     stats: SurfaceStats,
@@ -86,13 +86,13 @@ impl SurfaceHost {
     pub fn resume(
         &mut self,
         gpu: &Gpu,
-        window: Arc<dyn wgpu::WindowHandle>,
+        window: Arc<dyn wgpu::DisplayAndWindowHandle>,
         width: u32,
         height: u32,
     ) -> Result<(), RenderError> {
         let surface = gpu
             .instance
-            .create_surface(crate::render::window_target(Arc::clone(&window)))
+            .create_surface(gpu.window_target(Arc::clone(&window)))
             .map_err(|e| RenderError::Device(format!("cannot create a surface for the window: {e}")))?;
         let caps = surface.get_capabilities(&gpu.adapter);
         // sRGB so the composition's linear output is encoded by the hardware, as offscreen.
@@ -175,7 +175,7 @@ impl SurfaceHost {
         renderer: &mut Renderer,
         input: &FrameInput,
         method: Method,
-        overlay: impl FnOnce(&crate::render::Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]),
+        overlay: impl FnOnce(&crate::Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]),
     ) -> Result<DrawOutcome, RenderError> {
         let mut overlay = Some(overlay);
         let Some(config) = self.config.clone() else {

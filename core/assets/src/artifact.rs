@@ -5,7 +5,7 @@
 //! viewer, the classic phantogram pose), with a terracotta body, a black-glaze frieze of running
 //! figures between meander borders, and a gilded band on the shoulder for specular highlights.
 //! Dimensions are real: 62 mm tall, 38 mm across, standing 24 mm out of the glass, so it fits a
-//! typical phone's diorama ([`crate::containment`] keeps it inside the front frustum).
+//! typical phone's diorama ([`phantogram_geometry::containment`] keeps it inside the front frustum).
 //!
 //! Colours are linear RGB. The mesh is plain data ([`Mesh`]); the renderer uploads it.
 

@@ -84,7 +84,6 @@ impl Environment {
     }
 
     /// Loads a Radiance `.hdr` or OpenEXR file.
-    #[cfg(feature = "models")]
     pub fn load(path: &std::path::Path) -> Result<Self, EnvironmentError> {
         let err = |message: String| EnvironmentError::Load {
             path: path.to_path_buf(),

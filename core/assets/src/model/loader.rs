@@ -1,0 +1,911 @@
+//! The glTF 2.0 loader: documents, accessors, Draco, materials and images,
+//! Smithsonian Voyager scenes, into a [`Model`] (see the parent module's docs for what it reads
+//! and how it fails).
+
+use std::path::{Path, PathBuf};
+
+use base64::Engine as _;
+use glam::{Mat4, Quat, Vec3};
+use gltf::accessor::{DataType, Dimensions};
+use thiserror::Error;
+
+use super::*;
+
+/// Most values an accessor without a `bufferView` (all zeros, or sparse) may expand to:
+/// 2²⁶ `f32`s, 256 MiB, several times the largest scan we load.
+const MAX_ZERO_FILLED_VALUES: usize = 1 << 26;
+
+/// Extensions this loader implements; a file requiring any other fails to load.
+pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
+    "KHR_draco_mesh_compression",
+    "KHR_mesh_quantization",
+    "KHR_texture_transform",
+    "KHR_materials_emissive_strength",
+];
+
+#[derive(Debug, Error)]
+pub enum ModelError {
+    /// The I/O error is part of the message, deliberately not a `source()`: chain printers
+    /// (`anyhow`'s `{:#}`) would show it twice, and the shells show the message alone.
+    #[error("{}: {error}", path.display())]
+    Io { path: PathBuf, error: std::io::Error },
+    #[error("{}: not a valid glTF file: {message}", path.display())]
+    Parse { path: PathBuf, message: String },
+    #[error(
+            "{}: requires the glTF extension {name}, which is not supported (supported: KHR_draco_mesh_compression, KHR_mesh_quantization, KHR_texture_transform, KHR_materials_emissive_strength)",
+            path.display()
+        )]
+    UnsupportedExtension { path: PathBuf, name: String },
+    #[error("{}: {what}: {message}", path.display())]
+    Data {
+        path: PathBuf,
+        what: String,
+        message: String,
+    },
+    #[error("{}: no triangles to draw", path.display())]
+    Empty { path: PathBuf },
+    /// A folder or a Voyager scene that names no model file this loader can open.
+    #[error("{}: {message}", path.display())]
+    NotAModel { path: PathBuf, message: String },
+}
+
+struct Ctx<'a> {
+    path: &'a Path,
+    buffers: Vec<Vec<u8>>,
+}
+
+impl Ctx<'_> {
+    fn data(&self, what: impl Into<String>, message: impl Into<String>) -> ModelError {
+        ModelError::Data {
+            path: self.path.to_path_buf(),
+            what: what.into(),
+            message: message.into(),
+        }
+    }
+
+    fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8], ModelError> {
+        let buf = self
+            .buffers
+            .get(view.buffer().index())
+            .ok_or_else(|| self.data(format!("bufferView {}", view.index()), "buffer missing"))?;
+        let end = view.offset().checked_add(view.length());
+        end.and_then(|end| buf.get(view.offset()..end)).ok_or_else(|| {
+            self.data(
+                format!("bufferView {}", view.index()),
+                "extends past the end of its buffer",
+            )
+        })
+    }
+
+    /// Reads an accessor as `f32` rows of `n` components (normalised integers mapped to
+    /// [0, 1] or [−1, 1] as the spec says; other integers converted as they are).
+    fn read_f32(&self, accessor: &gltf::Accessor, n: usize) -> Result<Vec<f32>, ModelError> {
+        let what = || format!("accessor {}", accessor.index());
+        // Components the accessor lacks (a VEC3 colour read as four) stay zero; the caller
+        // asks for what the attribute's semantic needs.
+        let comps = accessor.dimensions().multiplicity();
+        let count = accessor.count();
+        let ty = accessor.data_type();
+        let size = ty.size();
+        let normalized = accessor.normalized();
+        let convert = |bytes: &[u8]| -> f32 {
+            match ty {
+                DataType::F32 => f32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]),
+                DataType::U8 => {
+                    let v = bytes[0] as f32;
+                    if normalized { v / 255.0 } else { v }
+                }
+                DataType::I8 => {
+                    let v = bytes[0] as i8 as f32;
+                    if normalized { (v / 127.0).max(-1.0) } else { v }
+                }
+                DataType::U16 => {
+                    let v = u16::from_le_bytes([bytes[0], bytes[1]]) as f32;
+                    if normalized { v / 65535.0 } else { v }
+                }
+                DataType::I16 => {
+                    let v = i16::from_le_bytes([bytes[0], bytes[1]]) as f32;
+                    if normalized { (v / 32767.0).max(-1.0) } else { v }
+                }
+                DataType::U32 => u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]) as f32,
+            }
+        };
+        let elem = size * comps;
+        let data = match accessor.view() {
+            Some(view) => {
+                let bytes = self.view_bytes(&view)?;
+                let stride = view.stride().unwrap_or(elem);
+                if stride < elem {
+                    return Err(self.data(what(), "byte stride smaller than one element"));
+                }
+                // One past the last byte read; None when it overflows.
+                let end = |last: usize| {
+                    last.checked_mul(stride)?
+                        .checked_add(accessor.offset())?
+                        .checked_add(elem)
+                };
+                let fits = count
+                    .checked_sub(1)
+                    .is_none_or(|last| end(last).is_some_and(|e| e <= bytes.len()));
+                if !fits {
+                    return Err(self.data(what(), "extends past the end of its buffer view"));
+                }
+                Some((bytes, stride))
+            }
+            // No data in the file: zeros (plus any sparse values), so the count alone sizes
+            // the output; bound it to what a phone could hold.
+            None if count.saturating_mul(n) > MAX_ZERO_FILLED_VALUES => {
+                return Err(self.data(what(), format!("{count} elements without a bufferView")));
+            }
+            None => None,
+        };
+        // Every size was checked before this allocation: a damaged count must give an
+        // error, not an allocation failure (which aborts rather than unwinds).
+        let mut out = vec![0.0f32; count * n];
+        if let Some((bytes, stride)) = data {
+            let start = accessor.offset();
+            for i in 0..count {
+                let base = start + i * stride;
+                for c in 0..n.min(comps) {
+                    out[i * n + c] = convert(&bytes[base + c * size..base + (c + 1) * size]);
+                }
+            }
+        }
+        if let Some(sparse) = accessor.sparse() {
+            let idx_view = sparse.indices().view();
+            let idx_bytes = self.view_bytes(&idx_view)?;
+            let idx_size = match sparse.indices().index_type() {
+                gltf::accessor::sparse::IndexType::U8 => 1,
+                gltf::accessor::sparse::IndexType::U16 => 2,
+                gltf::accessor::sparse::IndexType::U32 => 4,
+            };
+            let val_bytes = self.view_bytes(&sparse.values().view())?;
+            // Offsets may be anything in a damaged file: ranges that overflow are out of range.
+            let range = |offset: usize, k: usize, len: usize| {
+                let start = k.checked_mul(len)?.checked_add(offset)?;
+                Some(start..start.checked_add(len)?)
+            };
+            for k in 0..sparse.count() {
+                let ib = range(sparse.indices().offset(), k, idx_size)
+                    .and_then(|r| idx_bytes.get(r))
+                    .ok_or_else(|| self.data(what(), "sparse indices out of range"))?;
+                let i = match idx_size {
+                    1 => ib[0] as usize,
+                    2 => u16::from_le_bytes([ib[0], ib[1]]) as usize,
+                    _ => u32::from_le_bytes([ib[0], ib[1], ib[2], ib[3]]) as usize,
+                };
+                if i >= count {
+                    return Err(self.data(what(), "sparse index past the accessor's count"));
+                }
+                let vb = range(sparse.values().offset(), k, elem)
+                    .and_then(|r| val_bytes.get(r))
+                    .ok_or_else(|| self.data(what(), "sparse values out of range"))?;
+                for c in 0..n.min(comps) {
+                    out[i * n + c] = convert(&vb[c * size..(c + 1) * size]);
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    fn read_indices(&self, accessor: &gltf::Accessor) -> Result<Vec<u32>, ModelError> {
+        if accessor.dimensions() != Dimensions::Scalar
+            || !matches!(accessor.data_type(), DataType::U8 | DataType::U16 | DataType::U32)
+        {
+            return Err(self.data(
+                format!("accessor {}", accessor.index()),
+                "indices must be unsigned scalars",
+            ));
+        }
+        Ok(self.read_f32(accessor, 1)?.into_iter().map(|v| v as u32).collect())
+    }
+}
+
+/// The structural checks gltf-rs makes in `Gltf::from_slice`, less those that would reject
+/// files we load correctly. gltf-rs's accessors index its arrays unchecked (`node.children()`,
+/// `primitive.material()`, `texture.source()`, `accessor.data_type()` …), so an index out of
+/// range or an unknown enum value must be caught here, before any of them is called, or a
+/// damaged file panics the loader. We parse without validation because gltf-rs rejects
+/// every required extension it does not implement itself (Draco among them), and we name an
+/// unsupported one ourselves. Not fatal here:
+/// * `Unsupported`: required extensions, checked against [`SUPPORTED_EXTENSIONS`] before;
+/// * a missing `bufferView` on an accessor: Draco-compressed primitives' accessors have none
+///   (and the core spec fills such an accessor with zeros, as [`Ctx::read_f32`] does);
+/// * a missing or malformed `min`/`max` on a `POSITION` accessor: we compute bounds ourselves.
+fn check_structure(root: &gltf::json::Root) -> Result<(), String> {
+    use gltf::json::validation::{Error, Validate};
+    // gltf-json's own check of POSITION's min/max indexes the accessors unchecked: make sure
+    // it can before running it.
+    for (m, mesh) in root.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            for (semantic, index) in &prim.attributes {
+                if index.value() >= root.accessors.len() {
+                    return Err(format!(
+                        "meshes[{m}].primitives[{p}].attributes.{}: accessor {} does not exist",
+                        semantic.to_string(),
+                        index.value()
+                    ));
+                }
+            }
+        }
+    }
+    let mut errors = Vec::new();
+    root.validate(root, gltf::json::Path::new, &mut |path, error| {
+        let path = path().to_string();
+        let position_bounds = path.contains("POSITION") && (path.ends_with(".min") || path.ends_with(".max"));
+        let tolerated = match error {
+            Error::Unsupported => true,
+            Error::Missing => position_bounds || (path.starts_with("accessors[") && path.ends_with(".bufferView")),
+            Error::Invalid => position_bounds,
+            _ => false,
+        };
+        if !tolerated {
+            errors.push(format!("{path}: {error}"));
+        }
+    });
+    match errors.len() {
+        0 => Ok(()),
+        1 => Err(errors.swap_remove(0)),
+        n => Err(format!("{} (and {} more)", errors[0], n - 1)),
+    }
+}
+
+fn data_uri(uri: &str) -> Option<Result<Vec<u8>, base64::DecodeError>> {
+    let rest = uri.strip_prefix("data:")?;
+    let (_, payload) = rest.split_once(";base64,")?;
+    Some(base64::engine::general_purpose::STANDARD.decode(payload))
+}
+
+fn load_uri(path: &Path, uri: &str) -> Result<Vec<u8>, ModelError> {
+    if let Some(decoded) = data_uri(uri) {
+        return decoded.map_err(|e| ModelError::Parse {
+            path: path.to_path_buf(),
+            message: format!("bad data URI: {e}"),
+        });
+    }
+    let file = path.parent().unwrap_or(Path::new(".")).join(percent_decode(uri));
+    std::fs::read(&file).map_err(|error| ModelError::Io { path: file, error })
+}
+
+fn percent_decode(uri: &str) -> String {
+    let bytes = uri.as_bytes();
+    let mut out = Vec::with_capacity(bytes.len());
+    let mut i = 0;
+    while i < bytes.len() {
+        if bytes[i] == b'%'
+            && i + 2 < bytes.len()
+            && let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16)
+        {
+            out.push(v);
+            i += 3;
+            continue;
+        }
+        out.push(bytes[i]);
+        i += 1;
+    }
+    String::from_utf8_lossy(&out).into_owned()
+}
+
+fn sampler_of(t: &gltf::Texture) -> Sampler {
+    use gltf::texture::{MagFilter, MinFilter, WrappingMode};
+    let s = t.sampler();
+    let wrap = |w: WrappingMode| match w {
+        WrappingMode::ClampToEdge => Wrap::ClampToEdge,
+        WrappingMode::MirroredRepeat => Wrap::MirroredRepeat,
+        WrappingMode::Repeat => Wrap::Repeat,
+    };
+    let (min_linear, mip_linear) = match s.min_filter() {
+        Some(MinFilter::Nearest | MinFilter::NearestMipmapNearest) => (false, false),
+        Some(MinFilter::NearestMipmapLinear) => (false, true),
+        Some(MinFilter::LinearMipmapNearest) => (true, false),
+        _ => (true, true),
+    };
+    Sampler {
+        mag_linear: !matches!(s.mag_filter(), Some(MagFilter::Nearest)),
+        min_linear,
+        mip_linear,
+        wrap_u: wrap(s.wrap_s()),
+        wrap_v: wrap(s.wrap_t()),
+    }
+}
+
+/// A texture reference; `transform` is `KHR_texture_transform` with its optional texCoord
+/// override.
+fn texture_ref(t: &gltf::Texture, tex_coord: u32, transform: Option<(UvTransform, Option<u32>)>) -> TextureRef {
+    let (transform, tex_coord) = match transform {
+        Some((uv, set)) => (uv, set.unwrap_or(tex_coord)),
+        None => (UvTransform::default(), tex_coord),
+    };
+    TextureRef {
+        image: t.source().index(),
+        tex_coord: tex_coord.min(1),
+        transform,
+        sampler: sampler_of(t),
+    }
+}
+
+fn typed_transform(tt: gltf::texture::TextureTransform) -> (UvTransform, Option<u32>) {
+    let uv = UvTransform {
+        offset: tt.offset(),
+        rotation_rad: tt.rotation(),
+        scale: tt.scale(),
+    };
+    (uv, tt.tex_coord())
+}
+
+/// `KHR_texture_transform` on a normal or occlusion texture. gltf-rs types the extension
+/// only on `textureInfo`, so here it is read from the raw extension object; a malformed one
+/// is reported in `warnings` and the texture used untransformed.
+fn raw_transform(
+    value: Option<&serde_json::Value>,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Option<(UvTransform, Option<u32>)> {
+    let value = value?;
+    match serde_json::from_value::<gltf::json::extensions::texture::TextureTransform>(value.clone()) {
+        Ok(tt) => Some((
+            UvTransform {
+                offset: tt.offset.0,
+                rotation_rad: tt.rotation.0,
+                scale: tt.scale.0,
+            },
+            tt.tex_coord,
+        )),
+        Err(e) => {
+            warnings.push(format!("{what}: KHR_texture_transform ignored ({e})"));
+            None
+        }
+    }
+}
+
+fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
+    let pbr = m.pbr_metallic_roughness();
+    let info =
+        |i: gltf::texture::Info| texture_ref(&i.texture(), i.tex_coord(), i.texture_transform().map(typed_transform));
+    let name = m.name().unwrap_or("unnamed");
+    let normal_texture = m.normal_texture().map(|n| {
+        let what = format!("material {name}, normal texture");
+        let transform = raw_transform(n.extension_value("KHR_texture_transform"), &what, warnings);
+        (texture_ref(&n.texture(), n.tex_coord(), transform), n.scale())
+    });
+    let occlusion_texture = m.occlusion_texture().map(|o| {
+        let what = format!("material {name}, occlusion texture");
+        let transform = raw_transform(o.extension_value("KHR_texture_transform"), &what, warnings);
+        (texture_ref(&o.texture(), o.tex_coord(), transform), o.strength())
+    });
+    let strength = m.emissive_strength().unwrap_or(1.0);
+    let e = m.emissive_factor();
+    Material {
+        name: name.to_owned(),
+        // glTF colour factors are linear already.
+        base_color: pbr.base_color_factor(),
+        metallic: pbr.metallic_factor(),
+        roughness: pbr.roughness_factor(),
+        emissive: [e[0] * strength, e[1] * strength, e[2] * strength],
+        alpha: match m.alpha_mode() {
+            gltf::material::AlphaMode::Opaque => AlphaMode::Opaque,
+            gltf::material::AlphaMode::Mask => AlphaMode::Mask(m.alpha_cutoff().unwrap_or(0.5)),
+            gltf::material::AlphaMode::Blend => AlphaMode::Blend,
+        },
+        double_sided: m.double_sided(),
+        base_color_texture: pbr.base_color_texture().map(info),
+        metallic_roughness_texture: pbr.metallic_roughness_texture().map(info),
+        normal_texture,
+        occlusion_texture,
+        emissive_texture: m.emissive_texture().map(info),
+    }
+}
+
+/// Attribute data of one primitive before assembly.
+#[derive(Default)]
+struct Attributes {
+    positions: Vec<f32>,
+    normals: Option<Vec<f32>>,
+    tangents: Option<Vec<f32>>,
+    uv0: Option<Vec<f32>>,
+    uv1: Option<Vec<f32>>,
+    colors: Option<(Vec<f32>, usize)>,
+    indices: Option<Vec<u32>>,
+}
+
+fn read_plain(ctx: &Ctx, prim: &gltf::Primitive) -> Result<Attributes, ModelError> {
+    use gltf::Semantic;
+    let mut a = Attributes::default();
+    for (semantic, accessor) in prim.attributes() {
+        match semantic {
+            Semantic::Positions => a.positions = ctx.read_f32(&accessor, 3)?,
+            Semantic::Normals => a.normals = Some(ctx.read_f32(&accessor, 3)?),
+            Semantic::Tangents => a.tangents = Some(ctx.read_f32(&accessor, 4)?),
+            Semantic::TexCoords(0) => a.uv0 = Some(ctx.read_f32(&accessor, 2)?),
+            Semantic::TexCoords(1) => a.uv1 = Some(ctx.read_f32(&accessor, 2)?),
+            Semantic::Colors(0) => {
+                let n = accessor.dimensions().multiplicity();
+                a.colors = Some((ctx.read_f32(&accessor, n)?, n));
+            }
+            _ => {}
+        }
+    }
+    if let Some(idx) = prim.indices() {
+        a.indices = Some(ctx.read_indices(&idx)?);
+    }
+    Ok(a)
+}
+
+fn read_draco(
+    ctx: &Ctx,
+    prim: &gltf::Primitive,
+    ext: &gltf::json::Value,
+    views: &[gltf::buffer::View],
+) -> Result<Attributes, ModelError> {
+    let what = || format!("mesh primitive {} (Draco)", prim.index());
+    let view_index = ext
+        .get("bufferView")
+        .and_then(|v| v.as_u64())
+        .ok_or_else(|| ctx.data(what(), "KHR_draco_mesh_compression without a bufferView"))?;
+    let view = views
+        .get(view_index as usize)
+        .ok_or_else(|| ctx.data(what(), format!("bufferView {view_index} does not exist")))?;
+    let mut buffer = draco_core::DecoderBuffer::new(ctx.view_bytes(view)?);
+    let mut decoder = draco_core::MeshDecoder::new();
+    let mut mesh = draco_core::Mesh::new();
+    // draco-core is a young pure-Rust port: should it panic on a damaged stream, that is
+    // this file's error, not the app's end. The half-decoded mesh is dropped unused.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decoder.decode(&mut buffer, &mut mesh)))
+        .map_err(|_| ctx.data(what(), "Draco decoder failed on a damaged stream"))?
+        .map_err(|e| ctx.data(what(), format!("Draco decoding failed: {e}")))?;
+    let n = mesh.num_points();
+    let attrs = ext
+        .get("attributes")
+        .and_then(|v| v.as_object())
+        .ok_or_else(|| ctx.data(what(), "KHR_draco_mesh_compression without attributes"))?;
+    let get = |name: &str, comps: usize| -> Result<Option<Vec<f32>>, ModelError> {
+        let Some(id) = attrs.get(name).and_then(|v| v.as_u64()) else {
+            return Ok(None);
+        };
+        let att = mesh
+            .attribute_by_unique_id(id as u32)
+            .ok_or_else(|| ctx.data(what(), format!("Draco attribute {id} ({name}) missing")))?;
+        Ok(Some(att.read_f32s(n, comps)))
+    };
+    let positions = get("POSITION", 3)?.ok_or_else(|| ctx.data(what(), "no POSITION"))?;
+    let colors = match attrs.get("COLOR_0").and_then(|v| v.as_u64()) {
+        Some(id) => {
+            let comps = mesh
+                .attribute_by_unique_id(id as u32)
+                .map_or(4, |a| a.num_components() as usize)
+                .clamp(3, 4);
+            get("COLOR_0", comps)?.map(|c| (c, comps))
+        }
+        None => None,
+    };
+    let indices = mesh.faces().iter().flat_map(|f| f.iter().map(|p| p.0)).collect();
+    Ok(Attributes {
+        positions,
+        normals: get("NORMAL", 3)?,
+        tangents: get("TANGENT", 4)?,
+        uv0: get("TEXCOORD_0", 2)?,
+        uv1: get("TEXCOORD_1", 2)?,
+        colors,
+        indices: Some(indices),
+    })
+}
+
+struct MikkGeometry<'a> {
+    mesh: &'a mut Mesh,
+}
+
+impl bevy_mikktspace::Geometry for MikkGeometry<'_> {
+    fn num_faces(&self) -> usize {
+        self.mesh.indices.len() / 3
+    }
+    fn num_vertices_of_face(&self, _face: usize) -> usize {
+        3
+    }
+    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].position
+    }
+    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
+        self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].normal
+    }
+    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
+        let uv = self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].uv;
+        [uv[0], uv[1]]
+    }
+    fn set_tangent(&mut self, tangent_space: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
+        if let Some(ts) = tangent_space {
+            let i = self.mesh.indices[face * 3 + vert] as usize;
+            self.mesh.vertices[i].tangent = ts.tangent_encoded();
+        }
+    }
+}
+
+/// Builds the vertices; computes smooth normals where the file has none.
+fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
+    let n = a.positions.len() / 3;
+    let check = |v: &Option<Vec<f32>>, comps: usize, name: &str| -> Result<(), ModelError> {
+        match v {
+            Some(v) if v.len() != n * comps => {
+                Err(ctx.data(what.to_owned(), format!("{name} count differs from POSITION")))
+            }
+            _ => Ok(()),
+        }
+    };
+    check(&a.normals, 3, "NORMAL")?;
+    check(&a.tangents, 4, "TANGENT")?;
+    check(&a.uv0, 2, "TEXCOORD_0")?;
+    check(&a.uv1, 2, "TEXCOORD_1")?;
+    let indices = a.indices.unwrap_or_else(|| (0..n as u32).collect());
+    if !indices.len().is_multiple_of(3) {
+        return Err(ctx.data(what.to_owned(), "index count is not a multiple of 3"));
+    }
+    if let Some(bad) = indices.iter().find(|&&i| i as usize >= n) {
+        return Err(ctx.data(what.to_owned(), format!("index {bad} past the {n} vertices")));
+    }
+    let mut mesh = Mesh {
+        vertices: (0..n)
+            .map(|i| {
+                let p = [a.positions[i * 3], a.positions[i * 3 + 1], a.positions[i * 3 + 2]];
+                let normal = a
+                    .normals
+                    .as_ref()
+                    .map_or([0.0; 3], |v| [v[i * 3], v[i * 3 + 1], v[i * 3 + 2]]);
+                let tangent = a.tangents.as_ref().map_or([1.0, 0.0, 0.0, 1.0], |v| {
+                    [v[i * 4], v[i * 4 + 1], v[i * 4 + 2], v[i * 4 + 3]]
+                });
+                let uv0 = a.uv0.as_ref().map_or([0.0; 2], |v| [v[i * 2], v[i * 2 + 1]]);
+                let uv1 = a.uv1.as_ref().map_or([0.0; 2], |v| [v[i * 2], v[i * 2 + 1]]);
+                let color = a.colors.as_ref().map_or([1.0; 4], |(v, c)| {
+                    let k = i * c;
+                    [v[k], v[k + 1], v[k + 2], if *c == 4 { v[k + 3] } else { 1.0 }]
+                });
+                Vertex {
+                    position: p,
+                    normal,
+                    tangent,
+                    uv: [uv0[0], uv0[1], uv1[0], uv1[1]],
+                    color,
+                    material: [1.0, 1.0],
+                }
+            })
+            .collect(),
+        indices,
+    };
+    if a.normals.is_none() {
+        smooth_normals(&mut mesh);
+    }
+    if a.tangents.is_none()
+        && a.uv0.is_some()
+        && bevy_mikktspace::generate_tangents(&mut MikkGeometry { mesh: &mut mesh }).is_err()
+    {
+        // Degenerate UVs: keep the placeholder tangents; normal maps then shade as flat.
+    }
+    Ok(mesh)
+}
+
+fn smooth_normals(mesh: &mut Mesh) {
+    let mut acc = vec![Vec3::ZERO; mesh.vertices.len()];
+    for tri in mesh.indices.chunks(3) {
+        let p = |k: usize| Vec3::from(mesh.vertices[tri[k] as usize].position);
+        let n = (p(1) - p(0)).cross(p(2) - p(0));
+        for &i in tri {
+            acc[i as usize] += n;
+        }
+    }
+    for (v, n) in mesh.vertices.iter_mut().zip(acc) {
+        v.normal = n.normalize_or(Vec3::Z).to_array();
+    }
+}
+
+/// The orientation a Smithsonian Voyager scene gives this model file: Voyager scenes
+/// (`scene.svx.json` beside the derivatives) store scans in their scanner's frame and rotate
+/// them upright in `models[].rotation`. `None` when there is no such scene, it does not list
+/// this file, or it cannot be read (the model then loads as stored).
+pub fn voyager_rotation(model_path: &Path) -> Option<Quat> {
+    let file_name = model_path.file_name()?.to_str()?;
+    let text = std::fs::read_to_string(model_path.parent()?.join("scene.svx.json")).ok()?;
+    let scene: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let (model, _, _) = voyager_assets(&scene).find(|(_, _, uri)| *uri == file_name)?;
+    let r: Vec<f32> = model
+        .get("rotation")?
+        .as_array()?
+        .iter()
+        .filter_map(|v| v.as_f64().map(|x| x as f32))
+        .collect();
+    let q = Quat::from_xyzw(*r.first()?, *r.get(1)?, *r.get(2)?, *r.get(3)?);
+    // A damaged scene (1e300 does not fit an f32) leaves the model as stored.
+    (q.is_finite() && q.length() > 0.5).then(|| q.normalize())
+}
+
+/// Why `version` (a glTF `asset.version`) is not one this loader reads, if it is not.
+fn not_gltf2_version(version: &str) -> Option<String> {
+    (version.split('.').next() != Some("2")).then(|| format!("asset version {version:?}; this loader reads glTF 2.0"))
+}
+
+/// For a file that did not parse as glTF 2.0: whether it says it is another version (a GLB
+/// container's header, or the JSON's `asset.version`).
+fn not_gltf2(bytes: &[u8]) -> Option<String> {
+    if let Some(header) = bytes.strip_prefix(b"glTF") {
+        let version = u32::from_le_bytes(header.get(..4)?.try_into().ok()?);
+        return (version != 2).then(|| format!("GLB version {version}; this loader reads glTF 2.0"));
+    }
+    let json: serde_json::Value = serde_json::from_slice(bytes).ok()?;
+    not_gltf2_version(json.get("asset")?.get("version")?.as_str()?)
+}
+
+/// Every asset a Voyager scene lists, with the model and derivative that list it:
+/// `models[].derivatives[].assets[].uri`.
+fn voyager_assets(scene: &serde_json::Value) -> impl Iterator<Item = (&serde_json::Value, &serde_json::Value, &str)> {
+    fn array<'a>(v: &'a serde_json::Value, key: &str) -> impl Iterator<Item = &'a serde_json::Value> + use<'a> {
+        v.get(key).and_then(|x| x.as_array()).into_iter().flatten()
+    }
+    array(scene, "models").flat_map(move |model| {
+        array(model, "derivatives").flat_map(move |derivative| {
+            array(derivative, "assets")
+                .filter_map(|asset| asset.get("uri")?.as_str())
+                .map(move |uri| (model, derivative, uri))
+        })
+    })
+}
+
+/// The Voyager scene file's name, which a Smithsonian download folder holds beside its scans.
+const VOYAGER_SCENE: &str = "scene.svx.json";
+
+/// The scan a Voyager scene (`scene.svx.json`, or a folder holding one) offers for viewing:
+/// its best-quality "Web3D" derivative present beside it (High, then Medium, Low, Thumb: the
+/// downloads usually hold some of them).
+pub fn voyager_scan(scene_or_folder: &Path) -> Result<PathBuf, ModelError> {
+    let scene_path = if scene_or_folder.is_dir() {
+        scene_or_folder.join(VOYAGER_SCENE)
+    } else {
+        scene_or_folder.to_path_buf()
+    };
+    let not_a_model = |message: String| ModelError::NotAModel {
+        path: scene_or_folder.to_path_buf(),
+        message,
+    };
+    let text = std::fs::read_to_string(&scene_path).map_err(|error| {
+        if scene_or_folder.is_dir() && error.kind() == std::io::ErrorKind::NotFound {
+            not_a_model(format!(
+                "a folder without a Voyager scene ({VOYAGER_SCENE}): give the .gltf or .glb file"
+            ))
+        } else {
+            ModelError::Io {
+                path: scene_path.clone(),
+                error,
+            }
+        }
+    })?;
+    let scene: serde_json::Value = serde_json::from_str(&text).map_err(|e| ModelError::Parse {
+        path: scene_path.clone(),
+        message: e.to_string(),
+    })?;
+    let folder = scene_path.parent().unwrap_or(Path::new("."));
+    let is = |v: &serde_json::Value, key: &str, want: &str| v.get(key).and_then(|x| x.as_str()) == Some(want);
+    let mut offered: Vec<(usize, &str)> = voyager_assets(&scene)
+        .filter(|(_, d, _)| is(d, "usage", "Web3D"))
+        .filter_map(|(_, d, uri)| {
+            let rank = ["High", "Medium", "Low", "Thumb"]
+                .iter()
+                .position(|q| is(d, "quality", q))?;
+            // Only glTF files, by plain names beside the scene: a scene must not point elsewhere.
+            let gltf = uri.ends_with(".glb") || uri.ends_with(".gltf");
+            let beside = Path::new(uri).file_name() == Some(std::ffi::OsStr::new(uri));
+            (gltf && beside).then_some((rank, uri))
+        })
+        .collect();
+    offered.sort();
+    if offered.is_empty() {
+        return Err(not_a_model("the Voyager scene lists no glTF scan".into()));
+    }
+    offered
+        .iter()
+        .map(|(_, uri)| folder.join(uri))
+        .find(|p| p.is_file())
+        .ok_or_else(|| {
+            let names: Vec<&str> = offered.iter().map(|(_, u)| *u).collect();
+            not_a_model(format!(
+                "none of the scans the Voyager scene lists is here ({})",
+                names.join(", ")
+            ))
+        })
+}
+
+/// Loads a model as its publisher meant it to be seen: [`load_gltf`], then the orientation of a
+/// Voyager scene beside the file, if any ([`voyager_rotation`]). `path` may also be a Voyager
+/// scene or a folder holding one: its best scan present is loaded ([`voyager_scan`]).
+pub fn load_model(path: &Path) -> Result<Model, ModelError> {
+    let is_scene = path.is_dir() || path.file_name().is_some_and(|n| n == VOYAGER_SCENE);
+    let scan;
+    let path = if is_scene {
+        scan = voyager_scan(path)?;
+        &scan
+    } else {
+        path
+    };
+    let mut model = load_gltf(path)?;
+    if let Some(q) = voyager_rotation(path) {
+        model.transform(Mat4::from_quat(q));
+        model
+            .warnings
+            .push("oriented by the Voyager scene beside it (scene.svx.json)".into());
+    }
+    Ok(model)
+}
+
+/// Loads a `.gltf` or `.glb` file, in the file's own frame.
+pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
+    let bytes = std::fs::read(path).map_err(|error| ModelError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| ModelError::Parse {
+        path: path.to_path_buf(),
+        // A glTF 1.0 file fails here on its different layout: say so rather than how.
+        message: not_gltf2(&bytes).unwrap_or_else(|| e.to_string()),
+    })?;
+    let doc = &gltf.document;
+    if let Some(name) = doc.extensions_required().find(|e| !SUPPORTED_EXTENSIONS.contains(e)) {
+        return Err(ModelError::UnsupportedExtension {
+            path: path.to_path_buf(),
+            name: name.to_owned(),
+        });
+    }
+    // glTF 1.0 (and the JSON of other formats with an "asset" version, such as a Voyager
+    // scene) can also parse into an empty glTF 2.0 document: "no triangles to draw".
+    if let Some(message) = not_gltf2_version(&doc.as_json().asset.version) {
+        return Err(ModelError::Parse {
+            path: path.to_path_buf(),
+            message,
+        });
+    }
+    check_structure(doc.as_json()).map_err(|message| ModelError::Parse {
+        path: path.to_path_buf(),
+        message,
+    })?;
+    let mut buffers = Vec::new();
+    for b in doc.buffers() {
+        let data = match b.source() {
+            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| ModelError::Parse {
+                path: path.to_path_buf(),
+                message: "buffer refers to a GLB binary chunk that is missing".into(),
+            })?,
+            gltf::buffer::Source::Uri(uri) => load_uri(path, uri)?,
+        };
+        if data.len() < b.length() {
+            return Err(ModelError::Parse {
+                path: path.to_path_buf(),
+                message: format!(
+                    "buffer {} is {} bytes, shorter than its declared {}",
+                    b.index(),
+                    data.len(),
+                    b.length()
+                ),
+            });
+        }
+        buffers.push(data);
+    }
+    let ctx = Ctx { path, buffers };
+    let views: Vec<gltf::buffer::View> = doc.views().collect();
+
+    // Read the encoded images in order, then decode them on every core (the largest part of
+    // loading a textured scan); the first failure in file order is the one reported.
+    let mut encoded = Vec::new();
+    for img in doc.images() {
+        let (raw, name): (Vec<u8>, String) = match img.source() {
+            gltf::image::Source::View { view, .. } => {
+                (ctx.view_bytes(&view)?.to_vec(), format!("image {}", img.index()))
+            }
+            gltf::image::Source::Uri { uri, .. } => (load_uri(path, uri)?, uri.chars().take(60).collect()),
+        };
+        encoded.push((img.index(), raw, name));
+    }
+    let images = crate::parallel::map(&encoded, |(index, raw, name)| {
+        let what = || format!("image {index} ({name})");
+        // glTF images are PNG or JPEG; anything else (an EXR, say) is refused before a
+        // decoder meant for other files sees it.
+        let format = match image::guess_format(raw) {
+            Ok(format @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => format,
+            Ok(other) => return Err((what(), format!("{other:?} data; glTF images must be PNG or JPEG"))),
+            Err(_) => return Err((what(), "neither PNG nor JPEG data".to_owned())),
+        };
+        // A decoder panic on a damaged image is this file's error, not the app's end.
+        std::panic::catch_unwind(|| image::load_from_memory_with_format(raw, format))
+            .map_err(|_| (what(), "the decoder failed on damaged data".to_owned()))?
+            .map(|decoded| decoded.to_rgba8())
+            .map_err(|e| (what(), e.to_string()))
+            .map(|decoded| Image {
+                name: name.clone(),
+                width: decoded.width(),
+                height: decoded.height(),
+                rgba8: decoded.into_raw(),
+            })
+    })
+    .into_iter()
+    .collect::<Result<Vec<Image>, _>>()
+    .map_err(|(what, why)| ctx.data(what, why))?;
+    drop(encoded); // the compressed copies are not needed while the meshes are built
+
+    let mut warnings = Vec::new();
+    let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m, &mut warnings)).collect();
+    let default_material = materials.len();
+    materials.push(Material::default());
+
+    let mut model = Model {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        images,
+        warnings,
+        ..Model::default()
+    };
+    let scene = doc.default_scene().or_else(|| doc.scenes().next());
+    let roots: Vec<gltf::Node> = match &scene {
+        Some(s) => s.nodes().collect(),
+        // No scene: every node that is nobody's child, as a scene listing them would.
+        None => {
+            let mut is_child = vec![false; doc.nodes().len()];
+            for child in doc.nodes().flat_map(|n| n.children()) {
+                is_child[child.index()] = true;
+            }
+            doc.nodes().filter(|n| !is_child[n.index()]).collect()
+        }
+    };
+    // The hierarchy must be disjoint strict trees (glTF 2.0, "Nodes and Hierarchy"); a
+    // node met twice would loop forever or draw twice.
+    let mut visited = vec![false; doc.nodes().len()];
+    let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
+    while let Some((node, parent)) = stack.pop() {
+        if std::mem::replace(&mut visited[node.index()], true) {
+            return Err(ModelError::Parse {
+                path: path.to_path_buf(),
+                message: format!(
+                    "node {} is reached twice in the scene's hierarchy (a cycle, or a node with two parents)",
+                    node.index()
+                ),
+            });
+        }
+        let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
+        if let Some(mesh) = node.mesh() {
+            for prim in mesh.primitives() {
+                let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    model
+                        .warnings
+                        .push(format!("{what}: {:?} primitives are not drawn", prim.mode()));
+                    continue;
+                }
+                let attributes = match prim.extension_value("KHR_draco_mesh_compression") {
+                    Some(ext) => read_draco(&ctx, &prim, ext, &views)?,
+                    None => read_plain(&ctx, &prim)?,
+                };
+                let mut m = assemble(&ctx, attributes, &what)?;
+                m.transform(world);
+                model.primitives.push(Primitive {
+                    mesh: m,
+                    material: prim.material().index().unwrap_or(default_material),
+                    is_floor: false,
+                });
+            }
+        }
+        for child in node.children() {
+            stack.push((child, world));
+        }
+    }
+    for p in &model.primitives {
+        let mat = &materials[p.material];
+        if let Some(t) = mat.textures().find(|(t, _)| t.image >= model.images.len()) {
+            return Err(ctx.data(
+                format!("material {}", mat.name),
+                format!("texture image {} does not exist", t.0.image),
+            ));
+        }
+    }
+    model.materials = materials;
+    if model.triangle_count() == 0 {
+        return Err(ModelError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    Ok(model)
+}

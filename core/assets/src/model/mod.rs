@@ -1,0 +1,543 @@
+//! Models: triangle meshes with metallic–roughness materials and textures, in the device frame,
+//! and the glTF 2.0 loader that produces them.
+//!
+//! ## Loading glTF
+//! * `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary container).
+//! * Geometry through our own accessor reader, which handles every component type, normalised or
+//!   not, byte strides and sparse accessors, so `KHR_mesh_quantization` needs no special case.
+//!   `KHR_draco_mesh_compression` primitives are decoded with `draco-core` (pure Rust: no C++
+//!   toolchain on the phone builds).
+//! * Node transforms are baked into the vertices (negative determinants flip the winding).
+//! * Materials: base colour, metallic–roughness, normal (with scale), occlusion (with strength)
+//!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform` on every
+//!   slot (gltf-rs types it only on `textureInfo`, so for normal and occlusion textures it is read
+//!   from the raw extension object; a malformed one becomes a warning), alpha
+//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded (PNG, JPEG) to RGBA8.
+//! * Tangents come from the file or, where a normal map needs them, from MikkTSpace
+//!   (`bevy_mikktspace`, the reference algorithm that normal maps are baked against).
+//! * Smithsonian Voyager scans: when a `scene.svx.json` beside the file lists it as a derivative,
+//!   [`load_model`] applies the model's rotation from that scene (the scans are stored in the
+//!   scanner's frame), see [`voyager_rotation`]. Given the scene itself, or its folder, it loads
+//!   the best scan the scene lists that is present ([`voyager_scan`]).
+//! * Only glTF 2.0: a file whose `asset.version` is not 2.x is refused by name.
+//! * A file that *requires* an extension we do not implement fails with
+//!   [`ModelError::UnsupportedExtension`] naming it; [`SUPPORTED_EXTENSIONS`] lists those we do.
+//! * A damaged file fails with an error saying where, and does not panic, hang or abort: the
+//!   document's indices and enumerations are checked before gltf-rs (which indexes unchecked)
+//!   follows them, the node hierarchy must be trees, every accessor's extent is checked before its
+//!   output is allocated, and a panic inside the Draco decoder becomes that primitive's error.
+//!   (The decoders of images and Draco streams allocate what their headers ask, within the
+//!   `image` crate's limits and not bounded by us for Draco.)
+//!
+//! ## Frames
+//! glTF is +Y up, +Z front, metres. [`Model::fit_to_diorama`] turns a standing object's +Y into
+//! the device's +Z (out of the glass towards the viewer) and its +Z into −Y (facing the bottom
+//! edge, where the viewer holds the phone); a flat one (relief, tablet) keeps its axes, lying in
+//! the glass with its front towards the viewer ([`Placement`]). It then scales the model to the
+//! diorama and places it straddling the glass.
+
+use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
+
+use phantogram_geometry::containment::Aabb;
+use phantogram_geometry::screen::Screen;
+
+/// One vertex: position and normal (device frame, metres), tangent (xyz, w = handedness),
+/// texture coordinates (`[u0, v0, u1, v1]`), linear vertex colour with alpha, and per-vertex
+/// `[metallic, roughness]` multipliers (1 for loaded models; the procedural artifact paints them).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Vertex {
+    pub position: [f32; 3],
+    pub normal: [f32; 3],
+    pub tangent: [f32; 4],
+    pub uv: [f32; 4],
+    pub color: [f32; 4],
+    pub material: [f32; 2],
+}
+
+/// A triangle mesh, counter-clockwise front faces.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Mesh {
+    pub vertices: Vec<Vertex>,
+    pub indices: Vec<u32>,
+}
+
+impl Mesh {
+    /// Axis-aligned bounds of the vertices; `None` for an empty mesh.
+    pub fn bounds(&self) -> Option<Aabb> {
+        let first = Vec3::from(self.vertices.first()?.position);
+        let (min, max) = self.vertices.iter().fold((first, first), |(lo, hi), v| {
+            let p = Vec3::from(v.position);
+            (lo.min(p), hi.max(p))
+        });
+        Some(Aabb::new(min, max))
+    }
+
+    /// Applies an affine transform to positions, normals and tangents.
+    pub fn transform(&mut self, m: Mat4) {
+        let linear = Mat3::from_mat4(m);
+        let normal_m = linear.inverse().transpose();
+        for v in &mut self.vertices {
+            v.position = m.transform_point3(Vec3::from(v.position)).to_array();
+            v.normal = (normal_m * Vec3::from(v.normal)).normalize_or_zero().to_array();
+            let t = Vec4::from(v.tangent);
+            let tt = (linear * t.truncate()).normalize_or_zero();
+            v.tangent = tt.extend(t.w).to_array();
+        }
+        if linear.determinant() < 0.0 {
+            for tri in self.indices.chunks_mut(3) {
+                tri.swap(1, 2);
+            }
+        }
+    }
+
+    /// Appends a small axis-aligned cube (markers, tests).
+    pub fn push_cube(&mut self, centre: Vec3, half: f32, color: [f32; 4]) {
+        let faces = [
+            (Vec3::X, Vec3::Y, Vec3::Z),
+            (-Vec3::X, Vec3::Z, Vec3::Y),
+            (Vec3::Y, Vec3::Z, Vec3::X),
+            (-Vec3::Y, Vec3::X, Vec3::Z),
+            (Vec3::Z, Vec3::X, Vec3::Y),
+            (-Vec3::Z, Vec3::Y, Vec3::X),
+        ];
+        for (n, u, v) in faces {
+            let base = self.vertices.len() as u32;
+            for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
+                let p = centre + (n + u * a + v * b) * half;
+                self.vertices.push(Vertex {
+                    position: p.to_array(),
+                    normal: n.to_array(),
+                    tangent: u.extend(1.0).to_array(),
+                    uv: [(a + 1.0) * 0.5, (1.0 - b) * 0.5, 0.0, 0.0],
+                    color,
+                    material: [0.0, 0.8],
+                });
+            }
+            // u × v = n for every face above, so this winding is counter-clockwise seen from n.
+            self.indices
+                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum AlphaMode {
+    Opaque,
+    /// Fragments with alpha below the cutoff are discarded.
+    Mask(f32),
+    Blend,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Wrap {
+    Repeat,
+    ClampToEdge,
+    MirroredRepeat,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sampler {
+    pub mag_linear: bool,
+    pub min_linear: bool,
+    pub mip_linear: bool,
+    pub wrap_u: Wrap,
+    pub wrap_v: Wrap,
+}
+
+impl Default for Sampler {
+    /// glTF leaves filtering to the implementation: trilinear, repeat.
+    fn default() -> Self {
+        Self {
+            mag_linear: true,
+            min_linear: true,
+            mip_linear: true,
+            wrap_u: Wrap::Repeat,
+            wrap_v: Wrap::Repeat,
+        }
+    }
+}
+
+/// `KHR_texture_transform`: `uv' = T · R · S · uv`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct UvTransform {
+    pub offset: [f32; 2],
+    pub rotation_rad: f32,
+    pub scale: [f32; 2],
+}
+
+impl Default for UvTransform {
+    fn default() -> Self {
+        Self {
+            offset: [0.0, 0.0],
+            rotation_rad: 0.0,
+            scale: [1.0, 1.0],
+        }
+    }
+}
+
+impl UvTransform {
+    /// The two rows of the 2×3 matrix, as the extension defines it (rotation counter-clockwise
+    /// in UV space, which has v pointing down).
+    pub fn rows(&self) -> [[f32; 3]; 2] {
+        let (s, c) = self.rotation_rad.sin_cos();
+        let [sx, sy] = self.scale;
+        let [ox, oy] = self.offset;
+        [[c * sx, s * sy, ox], [-s * sx, c * sy, oy]]
+    }
+
+    pub fn apply(&self, uv: [f32; 2]) -> [f32; 2] {
+        let r = self.rows();
+        [
+            r[0][0] * uv[0] + r[0][1] * uv[1] + r[0][2],
+            r[1][0] * uv[0] + r[1][1] * uv[1] + r[1][2],
+        ]
+    }
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct TextureRef {
+    /// Index into [`Model::images`].
+    pub image: usize,
+    /// Which UV set: 0 or 1.
+    pub tex_coord: u32,
+    pub transform: UvTransform,
+    pub sampler: Sampler,
+}
+
+/// glTF metallic–roughness material. Colours are linear.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Material {
+    pub name: String,
+    pub base_color: [f32; 4],
+    pub metallic: f32,
+    pub roughness: f32,
+    /// Emissive colour times `KHR_materials_emissive_strength`.
+    pub emissive: [f32; 3],
+    pub alpha: AlphaMode,
+    pub double_sided: bool,
+    pub base_color_texture: Option<TextureRef>,
+    /// Roughness in G, metallic in B.
+    pub metallic_roughness_texture: Option<TextureRef>,
+    pub normal_texture: Option<(TextureRef, f32)>,
+    pub occlusion_texture: Option<(TextureRef, f32)>,
+    pub emissive_texture: Option<TextureRef>,
+}
+
+impl Default for Material {
+    /// glTF's default material: white, fully metallic, fully rough.
+    fn default() -> Self {
+        Self {
+            name: "default".into(),
+            base_color: [1.0; 4],
+            metallic: 1.0,
+            roughness: 1.0,
+            emissive: [0.0; 3],
+            alpha: AlphaMode::Opaque,
+            double_sided: false,
+            base_color_texture: None,
+            metallic_roughness_texture: None,
+            normal_texture: None,
+            occlusion_texture: None,
+            emissive_texture: None,
+        }
+    }
+}
+
+impl Material {
+    /// For meshes that paint colour and metallic/roughness per vertex (the procedural artifact).
+    pub fn vertex_painted() -> Self {
+        Self {
+            name: "vertex painted".into(),
+            double_sided: true,
+            ..Self::default()
+        }
+    }
+
+    /// Every texture the material uses, with whether it holds colour (sRGB-encoded) data.
+    pub fn textures(&self) -> impl Iterator<Item = (TextureRef, bool)> + '_ {
+        [
+            self.base_color_texture.map(|t| (t, true)),
+            self.metallic_roughness_texture.map(|t| (t, false)),
+            self.normal_texture.map(|(t, _)| (t, false)),
+            self.occlusion_texture.map(|(t, _)| (t, false)),
+            self.emissive_texture.map(|t| (t, true)),
+        ]
+        .into_iter()
+        .flatten()
+    }
+}
+
+/// An RGBA8 image as stored in the file (colour textures sRGB-encoded, data textures linear).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Image {
+    pub name: String,
+    pub width: u32,
+    pub height: u32,
+    pub rgba8: Vec<u8>,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+pub struct Primitive {
+    pub mesh: Mesh,
+    /// Index into [`Model::materials`].
+    pub material: usize,
+    /// The diorama floor of [`Model::add_floor`], a plane facing +z under everything else. The
+    /// renderer fits its shadow map to the rest (what the floor receives shadows from), and draws
+    /// the floor into it only when the light is below the floor's plane.
+    pub is_floor: bool,
+}
+
+/// A whole model: primitives, materials and images, all positions in one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Model {
+    pub name: String,
+    pub primitives: Vec<Primitive>,
+    pub materials: Vec<Material>,
+    pub images: Vec<Image>,
+    /// Things in the file that were skipped (non-triangle primitives, …), for the user to see.
+    pub warnings: Vec<String>,
+}
+
+/// Which way a glTF model (+Y up, +Z front) is turned into the diorama.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Placement {
+    /// Standing, unless the model is thin front to back (a relief, a tablet, a panel): then facing.
+    #[default]
+    Auto,
+    /// +Y along the glass normal: the object stands out of the glass towards the viewer (vases,
+    /// statues).
+    Standing,
+    /// +Z along the glass normal, +Y up the screen: the object lies in the glass, its front
+    /// towards the viewer (reliefs, paintings, coins).
+    Facing,
+}
+
+impl Placement {
+    /// The rotation from glTF axes to the device frame, given the model's extent in glTF axes.
+    pub fn rotation(self, extent: Vec3) -> Quat {
+        let facing = match self {
+            Placement::Standing => false,
+            Placement::Facing => true,
+            // Thin front to back: under a third of both its width and height.
+            Placement::Auto => extent.z < extent.x.min(extent.y) / 3.0,
+        };
+        if facing {
+            Quat::IDENTITY
+        } else {
+            Quat::from_rotation_x(std::f32::consts::FRAC_PI_2)
+        }
+    }
+}
+
+/// How a model is placed in the diorama.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DioramaFit {
+    pub placement: Placement,
+    /// Largest height (along the glass normal), m.
+    pub max_height_m: f32,
+    /// Largest extent across the glass, as a fraction of the screen's shorter side.
+    pub max_width_fraction: f32,
+    /// Fraction of the model's height that stands in front of the glass.
+    pub protrude_fraction: f32,
+}
+
+impl Default for DioramaFit {
+    /// 62 mm tall at most (the default artifact's height), 70 % of the screen's width across,
+    /// 40 % in front of the glass.
+    fn default() -> Self {
+        Self {
+            placement: Placement::Auto,
+            max_height_m: 0.062,
+            max_width_fraction: 0.7,
+            protrude_fraction: 0.4,
+        }
+    }
+}
+
+impl Model {
+    /// A one-material model from a mesh painted per vertex.
+    pub fn from_painted_mesh(name: &str, mesh: Mesh) -> Self {
+        Self {
+            name: name.into(),
+            primitives: vec![Primitive {
+                mesh,
+                material: 0,
+                is_floor: false,
+            }],
+            materials: vec![Material::vertex_painted()],
+            images: Vec::new(),
+            warnings: Vec::new(),
+        }
+    }
+
+    /// How far the app's floor reaches, in screen sizes ([`Model::add_floor`]): far enough to fill
+    /// the view at the steepest tilt the viewpoint allows.
+    pub const FLOOR_REACH: f32 = 2.5;
+
+    /// Adds the diorama's floor: a matte neutral plane parallel to the glass under the model (at
+    /// its lowest point), reaching `reach` screen sizes out so it fills oblique views. It is what
+    /// the model stands on and where its shadow falls, the phantogram's main depth cue.
+    pub fn add_floor(&mut self, screen: &Screen, reach: f32) {
+        let Some(b) = self.bounds() else { return };
+        let (hw, hh) = (screen.panel_width_m() * reach, screen.panel_height_m() * reach);
+        let z = b.min.z;
+        let corner = |x: f32, y: f32, u: f32, v: f32| Vertex {
+            position: [x, y, z],
+            normal: [0.0, 0.0, 1.0],
+            tangent: [1.0, 0.0, 0.0, 1.0],
+            uv: [u, v, 0.0, 0.0],
+            color: [1.0; 4],
+            material: [1.0, 1.0],
+        };
+        let mesh = Mesh {
+            vertices: vec![
+                corner(-hw, -hh, 0.0, 1.0),
+                corner(hw, -hh, 1.0, 1.0),
+                corner(hw, hh, 1.0, 0.0),
+                corner(-hw, hh, 0.0, 0.0),
+            ],
+            indices: vec![0, 1, 2, 0, 2, 3],
+        };
+        self.materials.push(Material {
+            name: "diorama floor".into(),
+            base_color: [0.18, 0.18, 0.18, 1.0],
+            metallic: 0.0,
+            roughness: 0.9,
+            ..Material::default()
+        });
+        self.primitives.push(Primitive {
+            mesh,
+            material: self.materials.len() - 1,
+            is_floor: true,
+        });
+    }
+
+    pub fn bounds(&self) -> Option<Aabb> {
+        self.bounds_of(|_| true)
+    }
+
+    /// The bounds of the primitives `keep` accepts (`None` if it accepts none with vertices).
+    pub fn bounds_of(&self, keep: impl Fn(&Primitive) -> bool) -> Option<Aabb> {
+        self.primitives
+            .iter()
+            .filter(|p| keep(p))
+            .filter_map(|p| p.mesh.bounds())
+            .reduce(|a, b| Aabb::new(a.min.min(b.min), a.max.max(b.max)))
+    }
+
+    pub fn triangle_count(&self) -> usize {
+        self.primitives.iter().map(|p| p.mesh.indices.len() / 3).sum()
+    }
+
+    pub fn transform(&mut self, m: Mat4) {
+        for p in &mut self.primitives {
+            p.mesh.transform(m);
+        }
+    }
+
+    /// Turns a glTF (+Y up, +Z front) model into the device frame as `fit.placement` says, scales
+    /// it into the diorama and places it straddling the glass, centred on the screen. Returns the
+    /// scale applied.
+    pub fn fit_to_diorama(&mut self, screen: &Screen, fit: &DioramaFit) -> f32 {
+        let Some(b) = self.bounds() else { return 1.0 };
+        self.transform(Mat4::from_quat(fit.placement.rotation(b.max - b.min)));
+        let Some(b) = self.bounds() else { return 1.0 };
+        let size = b.max - b.min;
+        let across = screen.panel_width_m().min(screen.panel_height_m()) * fit.max_width_fraction;
+        let scale = [fit.max_height_m / size.z, across / size.x, across / size.y]
+            .into_iter()
+            .filter(|s| s.is_finite() && *s > 0.0)
+            .fold(f32::INFINITY, f32::min);
+        let scale = if scale.is_finite() { scale } else { 1.0 };
+        let centre = (b.min + b.max) * 0.5;
+        let base_z = -size.z * scale * (1.0 - fit.protrude_fraction);
+        let m = Mat4::from_translation(Vec3::new(0.0, 0.0, base_z))
+            * Mat4::from_scale(Vec3::splat(scale))
+            * Mat4::from_translation(Vec3::new(-centre.x, -centre.y, -b.min.z));
+        self.transform(m);
+        scale
+    }
+}
+
+pub use loader::{ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_model, voyager_rotation, voyager_scan};
+
+mod loader;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uv_transform_matches_the_extension_definition() {
+        // Rotation by 90° maps (1, 0) to (0, −1) in UV space (counter-clockwise with v down).
+        let t = UvTransform {
+            offset: [0.5, 0.25],
+            rotation_rad: std::f32::consts::FRAC_PI_2,
+            scale: [2.0, 3.0],
+        };
+        let uv = t.apply([1.0, 0.0]);
+        assert!(
+            (uv[0] - 0.5).abs() < 1e-6 && (uv[1] - (0.25 - 2.0)).abs() < 1e-6,
+            "{uv:?}"
+        );
+        assert_eq!(UvTransform::default().apply([0.3, 0.7]), [0.3, 0.7]);
+    }
+
+    #[test]
+    fn cube_faces_wind_outwards() {
+        let mut m = Mesh::default();
+        m.push_cube(Vec3::ZERO, 1.0, [1.0; 4]);
+        for tri in m.indices.chunks(3) {
+            let p = |i: u32| Vec3::from(m.vertices[i as usize].position);
+            let (a, b, c) = (p(tri[0]), p(tri[1]), p(tri[2]));
+            let n = (b - a).cross(c - a);
+            let centre = (a + b + c) / 3.0;
+            assert!(n.dot(centre) > 0.0, "triangle {tri:?} winds inwards");
+        }
+    }
+
+    #[test]
+    fn mirroring_transform_flips_the_winding() {
+        let mut m = Mesh::default();
+        m.push_cube(Vec3::ZERO, 1.0, [1.0; 4]);
+        m.transform(Mat4::from_scale(Vec3::new(-1.0, 1.0, 1.0)));
+        for tri in m.indices.chunks(3) {
+            let p = |i: u32| Vec3::from(m.vertices[i as usize].position);
+            let n = (p(tri[1]) - p(tri[0])).cross(p(tri[2]) - p(tri[0]));
+            assert!(n.dot((p(tri[0]) + p(tri[1]) + p(tri[2])) / 3.0) > 0.0);
+        }
+    }
+
+    #[test]
+    fn fitting_stands_the_model_up_and_straddles_the_glass() {
+        // A 2 m tall, 1 m wide box, +Y up.
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::ZERO, 0.5, [1.0; 4]);
+        mesh.transform(Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0)));
+        let mut model = Model::from_painted_mesh("box", mesh);
+        let fit = DioramaFit {
+            placement: Placement::Standing,
+            ..DioramaFit::default()
+        };
+        model.fit_to_diorama(&Screen::default(), &fit);
+        let b = model.bounds().unwrap();
+        assert!(
+            (b.max.z - b.min.z - fit.max_height_m).abs() < 1e-6,
+            "height along z: {b:?}"
+        );
+        assert!((b.max.z - fit.max_height_m * fit.protrude_fraction).abs() < 1e-6);
+        assert!((b.min.x + b.max.x).abs() < 1e-6 && (b.min.y + b.max.y).abs() < 1e-6);
+    }
+
+    #[test]
+    fn auto_placement_lays_flat_things_in_the_glass() {
+        let panel = Vec3::new(1.0, 0.8, 0.05);
+        let vase = Vec3::new(0.4, 1.0, 0.4);
+        assert_eq!(Placement::Auto.rotation(panel), Quat::IDENTITY);
+        assert_eq!(Placement::Auto.rotation(vase), Placement::Standing.rotation(vase));
+        // Standing: glTF up becomes the glass normal, glTF front the screen's bottom edge.
+        let q = Placement::Standing.rotation(vase);
+        assert!((q * Vec3::Y - Vec3::Z).length() < 1e-6 && (q * Vec3::Z + Vec3::Y).length() < 1e-6);
+    }
+}

@@ -1,0 +1,121 @@
+//! The device: instance, adapter, device and queue, headless (as on the phones) or for a display,
+//! and window surface targets.
+
+use super::RenderError;
+
+/// An instance, adapter, device and queue.
+pub struct Gpu {
+    /// Kept to create window surfaces ([`crate::surface`]).
+    pub instance: wgpu::Instance,
+    pub adapter: wgpu::Adapter,
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    /// Whether the instance holds a display connection ([`Self::for_display`]); without one
+    /// ([`Self::headless`], what the phones use) each window brings its own display handle.
+    instance_has_display: bool,
+}
+
+impl Gpu {
+    /// A device without any window, on the first adapter that works: hardware first, then a
+    /// software fallback.
+    pub fn headless() -> Result<Self, RenderError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
+        Self::with_instance(instance, None)
+    }
+
+    /// A window of any display as a surface target for this device's instance.
+    pub(crate) fn window_target(
+        &self,
+        window: std::sync::Arc<dyn wgpu::DisplayAndWindowHandle>,
+    ) -> wgpu::SurfaceTarget<'static> {
+        window_target(window, self.instance_has_display)
+    }
+
+    /// A device able to present to windows of `display` (a winit event loop or window, an
+    /// Android or iOS display handle): the instance keeps the display connection, and the adapter
+    /// is chosen to present to `probe`, a window of that display.
+    pub fn for_display(
+        display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
+        probe: std::sync::Arc<dyn wgpu::DisplayAndWindowHandle>,
+    ) -> Result<Self, RenderError> {
+        let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(display));
+        let surface = instance
+            .create_surface(window_target(probe, true))
+            .map_err(|e| RenderError::Device(format!("cannot create a surface for the window: {e}")))?;
+        let mut gpu = Self::with_instance(instance.clone(), Some(&surface))?;
+        gpu.instance_has_display = true;
+        drop(surface);
+        Ok(gpu)
+    }
+
+    /// A device on `instance` whose adapter can present to `surface` (if given).
+    pub fn with_instance(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self, RenderError> {
+        let mut adapter = None;
+        for force_fallback_adapter in [false, true] {
+            let found = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
+                power_preference: wgpu::PowerPreference::HighPerformance,
+                force_fallback_adapter,
+                compatible_surface: surface,
+                // Limit bucketing hides hardware from untrusted web content; not our case.
+                apply_limit_buckets: false,
+            }));
+            if let Ok(a) = found {
+                adapter = Some(a);
+                break;
+            }
+        }
+        let adapter = adapter.ok_or(RenderError::NoAdapter)?;
+        let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
+            label: Some("phantogram"),
+            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            ..Default::default()
+        }))
+        .map_err(|e| RenderError::Device(e.to_string()))?;
+        Ok(Self {
+            instance,
+            adapter,
+            device,
+            queue,
+            instance_has_display: false,
+        })
+    }
+
+    /// The adapter's name and backend, for logs.
+    pub fn describe(&self) -> String {
+        let info = self.adapter.get_info();
+        format!("{} ({:?}, {:?})", info.name, info.backend, info.device_type)
+    }
+}
+
+/// A shared window as a surface target. wgpu needs the display connection once: from the
+/// instance when it was made with one ([`Gpu::for_display`]; the window's must then be the same,
+/// so it is left out), else from the window itself ([`Gpu::headless`], as on the phones: an
+/// Android `ANativeWindow` or an iOS `UIView` brings its own). Leaving it out there made every
+/// surface fail with "missing display handle".
+pub(super) fn window_target(
+    window: std::sync::Arc<dyn wgpu::DisplayAndWindowHandle>,
+    instance_has_display: bool,
+) -> wgpu::SurfaceTarget<'static> {
+    struct SharedWindow(std::sync::Arc<dyn wgpu::DisplayAndWindowHandle>);
+    impl wgpu::rwh::HasWindowHandle for SharedWindow {
+        fn window_handle(&self) -> Result<wgpu::rwh::WindowHandle<'_>, wgpu::rwh::HandleError> {
+            self.0.window_handle()
+        }
+    }
+    impl wgpu::rwh::HasDisplayHandle for SharedWindow {
+        fn display_handle(&self) -> Result<wgpu::rwh::DisplayHandle<'_>, wgpu::rwh::HandleError> {
+            self.0.display_handle()
+        }
+    }
+    if instance_has_display {
+        struct WindowOnly(SharedWindow);
+        impl wgpu::rwh::HasWindowHandle for WindowOnly {
+            fn window_handle(&self) -> Result<wgpu::rwh::WindowHandle<'_>, wgpu::rwh::HandleError> {
+                self.0.window_handle()
+            }
+        }
+        wgpu::SurfaceTarget::Window(Box::new(WindowOnly(SharedWindow(window))))
+    } else {
+        wgpu::SurfaceTarget::DisplayAndWindow(Box::new(SharedWindow(window)))
+    }
+}

@@ -1,0 +1,159 @@
+//! The image-based light's tables: the split-sum BRDF table and the generated studio's
+//! prefiltered levels (computed once per process, optionally ahead of time), and their textures.
+
+use super::*;
+
+/// Width of the prefiltered environment's sharpest level (mirror-like reflections).
+pub(super) const PREFILTERED_BASE_WIDTH: usize = 256;
+/// Size of the split-sum BRDF table (n·v × roughness).
+pub(super) const BRDF_LUT_SIZE: usize = 64;
+
+/// Computes, once per process, the tables a [`Renderer`] needs before its first frame: the
+/// split-sum BRDF table and, if `studio`, the generated studio's prefiltered levels (the lighting
+/// when no environment is given). About 100 ms of CPU work on this machine's two cores; an app
+/// calls it on a background thread at start-up, overlapping it with loading the model and opening
+/// the device (the sea turtle's cold load-to-first-frame: see `benchmarks/render.md`). Calling it
+/// is never required: the renderer computes what is missing, or waits for a computation under way.
+pub fn prepare_lighting_tables(studio: bool) {
+    brdf_lut_texels();
+    if studio {
+        default_prefiltered_environment();
+    }
+}
+
+/// [`prepare_lighting_tables`] on a new, detached thread. If the thread cannot be created the
+/// renderer computes the tables itself when it needs them: nothing fails, it only starts later.
+pub fn prepare_lighting_tables_in_background(studio: bool) {
+    let _ = std::thread::Builder::new()
+        .name("lighting tables".into())
+        .spawn(move || prepare_lighting_tables(studio));
+}
+
+/// The generated studio's prefiltered levels, computed once per process: every renderer without
+/// an environment of its own starts with them.
+pub(super) fn default_prefiltered_environment() -> &'static [phantogram_assets::ibl::Environment] {
+    static LEVELS: std::sync::OnceLock<Vec<phantogram_assets::ibl::Environment>> = std::sync::OnceLock::new();
+    LEVELS.get_or_init(|| {
+        phantogram_assets::ibl::prefiltered_levels(
+            &phantogram_assets::ibl::Environment::studio(),
+            PREFILTERED_BASE_WIDTH,
+        )
+    })
+}
+
+/// The split-sum table as `Rg16Float` texels, computed once per process (it depends on nothing).
+pub(super) fn brdf_lut_texels() -> &'static [u8] {
+    static TEXELS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    TEXELS.get_or_init(|| {
+        phantogram_assets::ibl::brdf_lut(BRDF_LUT_SIZE)
+            .into_iter()
+            .flat_map(|[a, b]| [half::f16::from_f32(a), half::f16::from_f32(b)])
+            .flat_map(|h| h.to_le_bytes())
+            .collect()
+    })
+}
+
+/// The GPU side of the specular image-based light.
+pub(super) struct IblTextures {
+    pub(super) environment: wgpu::TextureView,
+    pub(super) brdf_lut: wgpu::TextureView,
+    pub(super) sampler: wgpu::Sampler,
+}
+
+impl IblTextures {
+    /// Uploads `levels` (from [`phantogram_assets::ibl::prefiltered_levels`], a mip chain) and the BRDF table.
+    pub(super) fn new(gpu: &Gpu, levels: &[phantogram_assets::ibl::Environment]) -> Self {
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("prefiltered environment"),
+            size: wgpu::Extent3d {
+                width: levels[0].width as u32,
+                height: levels[0].height as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: levels.len() as u32,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rgba16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        for (k, level) in levels.iter().enumerate() {
+            let bytes: Vec<u8> = level
+                .texels
+                .iter()
+                .flat_map(|t| [t[0], t[1], t[2], 1.0])
+                // f16 saturates at 65504: clamp so a very bright sun stays finite.
+                .map(|c| half::f16::from_f32(c.min(65_000.0)))
+                .flat_map(|h| h.to_le_bytes())
+                .collect();
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level: k as u32,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &bytes,
+                wgpu::TexelCopyBufferLayout {
+                    offset: 0,
+                    bytes_per_row: Some(8 * level.width as u32),
+                    rows_per_image: Some(level.height as u32),
+                },
+                wgpu::Extent3d {
+                    width: level.width as u32,
+                    height: level.height as u32,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        let lut = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("split-sum BRDF table"),
+            size: wgpu::Extent3d {
+                width: BRDF_LUT_SIZE as u32,
+                height: BRDF_LUT_SIZE as u32,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: wgpu::TextureFormat::Rg16Float,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+            view_formats: &[],
+        });
+        queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &lut,
+                mip_level: 0,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            brdf_lut_texels(),
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(4 * BRDF_LUT_SIZE as u32),
+                rows_per_image: Some(BRDF_LUT_SIZE as u32),
+            },
+            wgpu::Extent3d {
+                width: BRDF_LUT_SIZE as u32,
+                height: BRDF_LUT_SIZE as u32,
+                depth_or_array_layers: 1,
+            },
+        );
+        // Azimuth wraps; the shader keeps the table's coordinates inside its texel centres.
+        let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("environment"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::ClampToEdge,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        Self {
+            environment: texture.create_view(&Default::default()),
+            brdf_lut: lut.create_view(&Default::default()),
+            sampler,
+        }
+    }
+}

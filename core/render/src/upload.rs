@@ -1,0 +1,263 @@
+//! Uploads: a model's buffers, materials and textures (with their mip chains, averaged in linear
+//! light) and samplers.
+
+use super::*;
+
+pub(super) fn srgb_to_linear(c: u8) -> f32 {
+    let c = c as f32 / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+pub(super) fn linear_to_srgb(c: f32) -> u8 {
+    let c = c.clamp(0.0, 1.0);
+    let s = if c <= 0.003_130_8 {
+        c * 12.92
+    } else {
+        1.055 * c.powf(1.0 / 2.4) - 0.055
+    };
+    (s * 255.0 + 0.5) as u8
+}
+
+/// The full mip chain of an RGBA8 image (2×2 box filter; odd sizes clamp at the edge). Colour
+/// data is averaged in linear light, alpha and data textures as stored.
+pub fn mip_chain(width: u32, height: u32, rgba8: &[u8], srgb: bool) -> Vec<(u32, u32, Vec<u8>)> {
+    let mut levels = vec![(width, height, rgba8.to_vec())];
+    while let Some((w, h, data)) = levels.last().filter(|(w, h, _)| *w > 1 || *h > 1) {
+        let (nw, nh) = ((w / 2).max(1), (h / 2).max(1));
+        let mut next = vec![0u8; (nw * nh * 4) as usize];
+        for y in 0..nh {
+            for x in 0..nw {
+                for c in 0..4 {
+                    let mut sum = 0.0f32;
+                    for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                        let sx = (2 * x + dx).min(w - 1);
+                        let sy = (2 * y + dy).min(h - 1);
+                        let v = data[((sy * w + sx) * 4 + c) as usize];
+                        sum += if srgb && c < 3 {
+                            srgb_to_linear(v)
+                        } else {
+                            v as f32 / 255.0
+                        };
+                    }
+                    let avg = sum * 0.25;
+                    next[((y * nw + x) * 4 + c) as usize] = if srgb && c < 3 {
+                        linear_to_srgb(avg)
+                    } else {
+                        (avg * 255.0 + 0.5) as u8
+                    };
+                }
+            }
+        }
+        levels.push((nw, nh, next));
+    }
+    levels
+}
+
+pub(super) fn upload_texture(
+    gpu: &Gpu,
+    label: &str,
+    width: u32,
+    height: u32,
+    rgba8: &[u8],
+    srgb: bool,
+) -> wgpu::TextureView {
+    upload_mip_chain(gpu, label, width, height, &mip_chain(width, height, rgba8, srgb), srgb)
+}
+
+/// Uploads a texture from its mip levels ([`mip_chain`]).
+pub(super) fn upload_mip_chain(
+    gpu: &Gpu,
+    label: &str,
+    width: u32,
+    height: u32,
+    levels: &[(u32, u32, Vec<u8>)],
+    srgb: bool,
+) -> wgpu::TextureView {
+    let format = if srgb {
+        wgpu::TextureFormat::Rgba8UnormSrgb
+    } else {
+        wgpu::TextureFormat::Rgba8Unorm
+    };
+    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels.len() as u32,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (level, (w, h, data)) in levels.iter().enumerate() {
+        gpu.queue.write_texture(
+            wgpu::TexelCopyTextureInfo {
+                texture: &texture,
+                mip_level: level as u32,
+                origin: wgpu::Origin3d::ZERO,
+                aspect: wgpu::TextureAspect::All,
+            },
+            data,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(w * 4),
+                rows_per_image: Some(*h),
+            },
+            wgpu::Extent3d {
+                width: *w,
+                height: *h,
+                depth_or_array_layers: 1,
+            },
+        );
+    }
+    texture.create_view(&Default::default())
+}
+
+pub(super) fn create_sampler(device: &wgpu::Device, s: &Sampler) -> wgpu::Sampler {
+    let address = |w: Wrap| match w {
+        Wrap::Repeat => wgpu::AddressMode::Repeat,
+        Wrap::ClampToEdge => wgpu::AddressMode::ClampToEdge,
+        Wrap::MirroredRepeat => wgpu::AddressMode::MirrorRepeat,
+    };
+    let filter = |linear: bool| {
+        if linear {
+            wgpu::FilterMode::Linear
+        } else {
+            wgpu::FilterMode::Nearest
+        }
+    };
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("material"),
+        address_mode_u: address(s.wrap_u),
+        address_mode_v: address(s.wrap_v),
+        mag_filter: filter(s.mag_linear),
+        min_filter: filter(s.min_linear),
+        mipmap_filter: if s.mip_linear {
+            wgpu::MipmapFilterMode::Linear
+        } else {
+            wgpu::MipmapFilterMode::Nearest
+        },
+        ..Default::default()
+    })
+}
+
+pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> GpuModel {
+    let device = &gpu.device;
+    // Each image once per colour space it is used in; the mip chains are built on every core
+    // (a good part of a textured scan's time to first frame), then uploaded in turn.
+    let mut used: Vec<(usize, bool)> = Vec::new();
+    for m in &model.materials {
+        for (t, srgb) in m.textures() {
+            if t.image < model.images.len() && !used.contains(&(t.image, srgb)) {
+                used.push((t.image, srgb));
+            }
+        }
+    }
+    let chains = phantogram_assets::parallel::map(&used, |&(image, srgb)| {
+        let img = &model.images[image];
+        mip_chain(img.width, img.height, &img.rgba8, srgb)
+    });
+    let views: std::collections::HashMap<(usize, bool), wgpu::TextureView> = used
+        .iter()
+        .zip(chains)
+        .map(|(&(image, srgb), levels)| {
+            let img = &model.images[image];
+            let view = upload_mip_chain(gpu, &img.name, img.width, img.height, &levels, srgb);
+            ((image, srgb), view)
+        })
+        .collect();
+    let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
+    let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
+    let default_sampler = create_sampler(device, &Sampler::default());
+    let materials = model
+        .materials
+        .iter()
+        .map(|m| {
+            let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("material"),
+                contents: bytemuck::bytes_of(&MaterialUniform::new(m)),
+                usage: wgpu::BufferUsages::UNIFORM,
+            });
+            let slots = [
+                (m.base_color_texture, true, &white),
+                (m.metallic_roughness_texture, false, &white),
+                (m.normal_texture.map(|(t, _)| t), false, &flat_normal),
+                (m.occlusion_texture.map(|(t, _)| t), false, &white),
+                (m.emissive_texture, true, &white),
+            ];
+            let samplers: Vec<wgpu::Sampler> = slots
+                .iter()
+                .map(|(t, _, _)| t.map_or_else(|| default_sampler.clone(), |t| create_sampler(device, &t.sampler)))
+                .collect();
+            let mut entries = vec![wgpu::BindGroupEntry {
+                binding: 0,
+                resource: uniform.as_entire_binding(),
+            }];
+            let mut textures = [false; 5];
+            for (i, (t, srgb, fallback)) in slots.iter().enumerate() {
+                let found = t.and_then(|t| views.get(&(t.image, *srgb)));
+                textures[i] = found.is_some();
+                let view = found.unwrap_or(fallback);
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 1 + 2 * i as u32,
+                    resource: wgpu::BindingResource::TextureView(view),
+                });
+                entries.push(wgpu::BindGroupEntry {
+                    binding: 2 + 2 * i as u32,
+                    resource: wgpu::BindingResource::Sampler(&samplers[i]),
+                });
+            }
+            GpuMaterial {
+                bind: device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some(&m.name),
+                    layout,
+                    entries: &entries,
+                }),
+                variant: MaterialVariant {
+                    double_sided: m.double_sided,
+                    blend: m.alpha == AlphaMode::Blend,
+                    textures,
+                    mask: matches!(m.alpha, AlphaMode::Mask(_)),
+                },
+                _uniform: uniform,
+            }
+        })
+        .collect();
+    let primitives = model
+        .primitives
+        .iter()
+        .filter(|p| !p.mesh.indices.is_empty())
+        .map(|p| GpuPrimitive {
+            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("vertices"),
+                contents: bytemuck::cast_slice(&p.mesh.vertices),
+                usage: wgpu::BufferUsages::VERTEX,
+            }),
+            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("indices"),
+                contents: bytemuck::cast_slice(&p.mesh.indices),
+                usage: wgpu::BufferUsages::INDEX,
+            }),
+            index_count: p.mesh.indices.len() as u32,
+            material: p.material.min(model.materials.len().saturating_sub(1)),
+            centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
+            is_floor: p.is_floor,
+        })
+        .collect();
+    let fallback = phantogram_geometry::containment::Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05));
+    let bounds = model.bounds().unwrap_or(fallback);
+    let standing = model.bounds_of(|p| !p.is_floor).unwrap_or(bounds);
+    GpuModel {
+        primitives,
+        materials,
+        bounds,
+        standing,
+    }
+}

@@ -1,0 +1,175 @@
+//! `phantogram render`: a sensor log replayed through an [`Engine`] drawing offscreen, one PNG per
+//! frame — the phones' frame pipeline (sensor inbox → orientation → eyes → containment →
+//! stereo render → anaglyph), on the desktop.
+
+use std::path::Path;
+
+use anyhow::{Context, Result, bail};
+use phantogram::anaglyph::Method;
+use phantogram::engine::Engine;
+use phantogram::sensors::{SensorEvent, SensorInbox};
+use phantogram_lab::replay::{DriveError, Pace, Replayed, drive};
+
+use crate::scene::SceneArgs;
+
+pub struct RenderArgs<'a> {
+    pub scene: &'a SceneArgs,
+    pub log: &'a Path,
+    pub out_dir: &'a Path,
+    pub size: &'a str,
+    pub method: Method,
+    pub every_ms: f64,
+    pub flat_at_s: Option<f64>,
+}
+
+pub fn render_command(args: RenderArgs) -> Result<()> {
+    let RenderArgs {
+        scene,
+        log,
+        out_dir,
+        size,
+        method,
+        every_ms,
+        flat_at_s,
+    } = args;
+    let (width, height) = parse_size(size)?;
+    // The engine's screen is the default panel in portrait.
+    let screen = phantogram::screen::Screen::default();
+    let aspect = width as f64 / height as f64;
+    let screen_aspect = screen.width_m() as f64 / screen.height_m() as f64;
+    if (aspect / screen_aspect - 1.0).abs() > 0.02 {
+        bail!(
+            "--size {width}x{height} does not match the screen's aspect ratio {}:{} (the image would be stretched)",
+            screen.width_px(),
+            screen.height_px()
+        );
+    }
+    let events: Vec<SensorEvent> = crate::open_events(log)?.collect::<Result<_, _>>()?;
+    let (Some(first), Some(last)) = (events.first(), events.last()) else {
+        bail!("{}: the log has no events", log.display());
+    };
+    let interval_ns = (every_ms * 1e6).round() as i64;
+    if let Some(at) = flat_at_s.filter(|at| *at > (last.t_ns - first.t_ns) as f64 * 1e-9) {
+        // Known now, before any frame is drawn.
+        bail!("--flat-at-s {at} is beyond the end of the log");
+    }
+    let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
+    let t0 = first.t_ns;
+    if out_dir.exists() && !out_dir.is_dir() {
+        bail!("--out {}: exists and is not a folder", out_dir.display());
+    }
+    // The frames are the defaults' (no calibration file): reproducible on any machine.
+    let mut engine = scene.engine(method, None)?;
+    std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
+    remove_earlier_frames(out_dir)?;
+    engine.resume_offscreen(width, height)?;
+
+    let bar = indicatif::ProgressBar::new(frames_expected);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} elapsed, ETA {eta}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    let mut frames = Frames {
+        inbox: engine.inbox(),
+        engine,
+        out_dir,
+        index: 0,
+        t0,
+        flat_pending: flat_at_s,
+        bar,
+    };
+    let replayed = drive(
+        events.into_iter().map(Ok),
+        &mut frames,
+        interval_ns,
+        Pace::AsFastAsPossible,
+    );
+    frames.bar.finish_and_clear();
+    match replayed {
+        Ok(_) => {}
+        Err(DriveError::Frame(e)) => return Err(e),
+        Err(e) => return Err(anyhow::anyhow!("{e}")),
+    }
+    if let Some(at) = frames.flat_pending {
+        bail!("--flat-at-s {at} is beyond the end of the log");
+    }
+    let index = frames.index;
+    eprintln!(
+        "wrote {index} frame{} ({width}x{height}, {method}) to {}",
+        if index == 1 { "" } else { "s" },
+        out_dir.display()
+    );
+    Ok(())
+}
+
+/// The engine's side of the replay: events into its inbox, a PNG per frame.
+struct Frames<'a> {
+    engine: Engine,
+    inbox: std::sync::Arc<SensorInbox>,
+    out_dir: &'a Path,
+    index: u64,
+    t0: i64,
+    flat_pending: Option<f64>,
+    bar: indicatif::ProgressBar,
+}
+
+impl Replayed for Frames<'_> {
+    type Error = anyhow::Error;
+
+    fn push(&mut self, event: SensorEvent) {
+        // Rejected events are counted by the inbox; the replay goes on, as the app would.
+        let _ = self.inbox.push(event);
+    }
+
+    fn frame(&mut self, t_ns: i64) -> Result<()> {
+        if self.flat_pending.is_some_and(|at| (t_ns - self.t0) as f64 * 1e-9 >= at) {
+            self.flat_pending = None;
+            self.engine
+                .calibrate_flat_angle()
+                .context("flat-angle calibration failed")?;
+        }
+        self.engine.draw(Some(t_ns))?;
+        let (width, height, pixels) = self.engine.last_frame()?;
+        let path = self.out_dir.join(format!("frame_{:05}.png", self.index));
+        image::save_buffer(&path, pixels, width, height, image::ExtendedColorType::Rgba8)
+            .with_context(|| format!("writing {}", path.display()))?;
+        self.index += 1;
+        self.bar.inc(1);
+        Ok(())
+    }
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32)> {
+    let (w, h) = text
+        .split_once(['x', 'X'])
+        .with_context(|| format!("--size {text:?}: expected WxH, e.g. 540x1200"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().ok().filter(|n| *n > 0);
+    match (parse(w), parse(h)) {
+        (Some(w), Some(h)) => Ok((w, h)),
+        _ => bail!("--size {text:?}: expected two positive whole numbers, WxH"),
+    }
+}
+
+/// Removes the frames (`frame_NNNNN.png`, the names `render` writes) of an earlier run from
+/// `dir`: a shorter run would otherwise leave the old run's last frames after its own, and a
+/// video made of the folder would end with them. Other files are left alone.
+fn remove_earlier_frames(dir: &std::path::Path) -> Result<()> {
+    let is_frame = |name: &str| {
+        name.strip_prefix("frame_")
+            .and_then(|rest| rest.strip_suffix(".png"))
+            .is_some_and(|n| n.len() == 5 && n.bytes().all(|b| b.is_ascii_digit()))
+    };
+    let mut removed = 0;
+    for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
+        let path = entry.with_context(|| format!("reading {}", dir.display()))?.path();
+        if path.file_name().and_then(|n| n.to_str()).is_some_and(is_frame) {
+            std::fs::remove_file(&path).with_context(|| format!("removing {}", path.display()))?;
+            removed += 1;
+        }
+    }
+    if removed > 0 {
+        let s = if removed == 1 { "" } else { "s" };
+        eprintln!("removed {removed} frame{s} of an earlier run from {}", dir.display());
+    }
+    Ok(())
+}

@@ -1,0 +1,88 @@
+//! What `view` and `render` show, and the [`Engine`] that shows it: both commands drive the same
+//! embedding API as the phone shells (model loading, fitting, floor, environment, containment,
+//! rendering), so the desktop runs the phones' frame pipeline.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use phantogram::anaglyph::Method;
+use phantogram::engine::{Engine, EngineConfig};
+use phantogram::model::{DioramaFit, Placement};
+
+/// What is shown, and how: shared by `view` and `render`, so that the window previews exactly
+/// what the frames will hold.
+#[derive(clap::Args)]
+pub struct SceneArgs {
+    /// A glTF 2.0 model (.gltf or .glb), or a Smithsonian Voyager folder or its scene.svx.json
+    /// (its best scan present); the default artifact when omitted.
+    model: Option<PathBuf>,
+    /// Fraction of a loaded model's height that stands in front of the glass.
+    #[arg(long, default_value_t = 0.4)]
+    protrude: f32,
+    /// How a loaded model is placed: standing out of the glass, facing the viewer from within
+    /// it (reliefs, tablets), or auto (facing when thin front to back).
+    #[arg(long, value_enum, default_value = "auto")]
+    placement: PlacementArg,
+    /// Leave out the diorama floor under the model (and the shadow cast on it).
+    #[arg(long)]
+    no_floor: bool,
+    /// An equirectangular HDR environment (.hdr or .exr, world frame) to light the artifact;
+    /// a generated neutral studio when omitted.
+    #[arg(long)]
+    environment: Option<PathBuf>,
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum PlacementArg {
+    Auto,
+    Standing,
+    Facing,
+}
+
+impl SceneArgs {
+    /// Checks the settings and makes the engine (files are read before any GPU work, so a bad
+    /// one is reported at once, with or without a GPU). Prints what was loaded and on what.
+    pub fn engine(&self, method: Method, calibration_path: Option<PathBuf>) -> Result<Engine> {
+        if !(0.0..=1.0).contains(&self.protrude) {
+            bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
+        }
+        let config = EngineConfig {
+            method,
+            model_path: self.model.clone(),
+            environment_path: self.environment.clone(),
+            fit: DioramaFit {
+                placement: match self.placement {
+                    PlacementArg::Auto => Placement::Auto,
+                    PlacementArg::Standing => Placement::Standing,
+                    PlacementArg::Facing => Placement::Facing,
+                },
+                protrude_fraction: self.protrude,
+                ..DioramaFit::default()
+            },
+            floor: !self.no_floor,
+            calibration_path,
+            ..EngineConfig::default()
+        };
+        let engine = Engine::new(config)?;
+        if let Some(path) = &self.model {
+            let info = engine.model_info();
+            for w in &info.warnings {
+                eprintln!("warning: {}: {w}", path.display());
+            }
+            // The model's name is its file's: it tells which scan a Voyager scene or folder gave.
+            eprintln!(
+                "{}: {}, {} triangles, {} materials, {} images",
+                path.display(),
+                info.name,
+                info.triangles,
+                info.materials,
+                info.images
+            );
+        }
+        if let Some(w) = engine.calibration_warning() {
+            eprintln!("warning: {w}");
+        }
+        eprintln!("rendering on {}", engine.renderer().gpu().describe());
+        Ok(engine)
+    }
+}
