@@ -338,12 +338,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
         // SAFETY: a direct buffer's memory is valid for `capacity` bytes while `luma` is alive,
         // which it is for this call; we copy before returning.
         let data = unsafe { std::slice::from_raw_parts(address, capacity) };
-        let intrinsics = Intrinsics {
-            fx_px,
-            fy_px,
-            cx_px,
-            cy_px,
-        };
+        let intrinsics = Intrinsics::new(fx_px, fy_px, cx_px, cy_px);
         let frame = OwnedFrame::luma8(
             width,
             height,

@@ -486,12 +486,7 @@ pub unsafe extern "C" fn pg_camera_frame(
         let data = unsafe { std::slice::from_raw_parts(luma, len) };
         let capture_t_ns = crate::timestamp_ns(timestamp_s)
             .ok_or_else(|| Failure::new(PgStatus::InvalidArgument, "time stamp is not finite"))?;
-        let intrinsics = Intrinsics {
-            fx_px,
-            fy_px,
-            cx_px,
-            cy_px,
-        };
+        let intrinsics = Intrinsics::new(fx_px, fy_px, cx_px, cy_px);
         let frame = OwnedFrame::luma8(
             width,
             height,

@@ -355,6 +355,18 @@ fn engine_with_faces(config: phantogram::engine::EngineConfig) -> Option<phantog
     }
 }
 
+/// An engine with face tracking on and the defaults otherwise, and the face images' folder;
+/// `None` (after saying why) without the models, the data or a GPU.
+fn engine_tracking_faces() -> Option<(phantogram::engine::Engine, PathBuf)> {
+    let (_, dir) = setup()?;
+    let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
+    let engine = engine_with_faces(phantogram::engine::EngineConfig {
+        face_models_dir: Some(models_dir),
+        ..phantogram::engine::EngineConfig::default()
+    })?;
+    Some((engine, dir))
+}
+
 /// The viewer's calibrated IPD, from the calibration file the phone keeps, sets the camera's
 /// metric scale: the tracked eyes are exactly that far apart (from the iris alone they are only
 /// within 63 ± 15 mm).
@@ -391,13 +403,7 @@ fn the_calibrated_ipd_reaches_the_face_tracker_through_the_engine() {
 /// tracking goes on: the shells' debug overlays see failures without test-only calls.
 #[test]
 fn face_tracking_failures_show_in_the_engine_stats() {
-    use phantogram::engine::EngineConfig;
-    let Some((_, dir)) = setup() else { return };
-    let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
-    let Some(engine) = engine_with_faces(EngineConfig {
-        face_models_dir: Some(models_dir),
-        ..EngineConfig::default()
-    }) else {
+    let Some((engine, dir)) = engine_tracking_faces() else {
         return;
     };
     assert_eq!(engine.stats().camera_frames_failed, 0);
@@ -436,14 +442,9 @@ fn face_tracking_failures_show_in_the_engine_stats() {
 /// camera (and differ from the tilt-only frame).
 #[test]
 fn camera_frames_through_the_engine_move_the_eyes_to_the_camera() {
-    use phantogram::engine::{EngineConfig, SharedEngine};
+    use phantogram::engine::SharedEngine;
     use phantogram::sensors::SensorEvent;
-    let Some((_, dir)) = setup() else { return };
-    let models_dir = PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked by setup"));
-    let Some(engine) = engine_with_faces(EngineConfig {
-        face_models_dir: Some(models_dir),
-        ..EngineConfig::default()
-    }) else {
+    let Some((engine, dir)) = engine_tracking_faces() else {
         return;
     };
     let shared = Arc::new(SharedEngine::new(engine));

@@ -22,6 +22,15 @@ pub struct Intrinsics {
 }
 
 impl Intrinsics {
+    pub const fn new(fx_px: f32, fy_px: f32, cx_px: f32, cy_px: f32) -> Self {
+        Self {
+            fx_px,
+            fy_px,
+            cx_px,
+            cy_px,
+        }
+    }
+
     /// Square pixels, principal point at the centre, horizontal field of view `hfov_rad`.
     pub fn from_horizontal_fov(width_px: u32, height_px: u32, hfov_rad: f32) -> Self {
         let f = width_px as f32 * 0.5 / (hfov_rad * 0.5).tan();
