@@ -8,6 +8,7 @@ use anyhow::{Context, Result, bail};
 use phantogram::anaglyph::Method;
 use phantogram::engine::Engine;
 use phantogram::sensors::{SensorEvent, SensorInbox};
+use phantogram::surface::DrawOutcome;
 use phantogram_lab::replay::{DriveError, Pace, Replayed, drive};
 
 use crate::scene::SceneArgs;
@@ -128,7 +129,13 @@ impl Replayed for Frames<'_> {
                 .calibrate_flat_angle()
                 .context("flat-angle calibration failed")?;
         }
-        self.engine.draw(Some(t_ns))?;
+        if let DrawOutcome::Skipped(why) = self.engine.draw(Some(t_ns))? {
+            // Never an old frame under a new name.
+            bail!(
+                "the frame at {:.3} s was not drawn ({why})",
+                (t_ns - self.t0) as f64 * 1e-9
+            );
+        }
         let (width, height, pixels) = self.engine.last_frame()?;
         let path = self.out_dir.join(format!("frame_{:05}.png", self.index));
         image::save_buffer(&path, pixels, width, height, image::ExtendedColorType::Rgba8)

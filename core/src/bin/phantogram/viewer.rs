@@ -73,6 +73,8 @@ struct App {
     log: Option<Vec<SensorEvent>>,
     frames: Option<u64>,
     lifecycle_test: bool,
+    /// How many of [`App::lifecycle_step`]'s steps were taken.
+    lifecycle_steps_done: u8,
     window: Option<Arc<Window>>,
     phone: VirtualPhone,
     log_cursor: usize,
@@ -147,19 +149,20 @@ impl App {
             return Ok(());
         };
         let (w, h) = self.size();
-        let stats = self.engine.stats();
-        match stats.frames_drawn {
-            5 if stats.suspended == 0 => {
+        // Each step once, in order, whatever the window system does meanwhile.
+        match (self.engine.stats().frames_drawn, self.lifecycle_steps_done) {
+            (5.., 0) => {
                 self.engine.suspend();
                 if self.engine.draw(Some(t_ns))? == DrawOutcome::Presented {
                     return Err(anyhow!("drew while suspended"));
                 }
                 self.engine.resume_window(window, w, h)?;
             }
-            10 if stats.resized == 0 => self.engine.resize((w / 2).max(1), (h / 2).max(1))?,
-            12 if stats.resized == 1 => self.engine.resize(w, h)?,
-            _ => {}
+            (10.., 1) => self.engine.resize((w / 2).max(1), (h / 2).max(1))?,
+            (12.., 2) => self.engine.resize(w, h)?,
+            _ => return Ok(()),
         }
+        self.lifecycle_steps_done += 1;
         Ok(())
     }
 
@@ -335,6 +338,7 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         log,
         frames,
         lifecycle_test,
+        lifecycle_steps_done: 0,
         window: None,
         phone: VirtualPhone {
             pitch_rad: 35f32.to_radians(),
