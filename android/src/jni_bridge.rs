@@ -381,17 +381,17 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraIntrinsics<'
                 bottom,
             })
         };
-        let active_array = rect(fixed::<_, 4>(env, &active_array, "activeArray")?)
+        let active_array = rect(leading::<_, 4>(env, &active_array, "activeArray", Length::Exactly)?)
             .ok_or_else(|| fail(Kind::IllegalArgument, "activeArray is null"))?;
         let positive = |v: jint| u32::try_from(v).ok().filter(|&v| v > 0);
         let characteristics = Camera2Characteristics {
             active_array,
-            pre_correction_active_array: rect(fixed::<_, 4>(env, &pre_correction, "preCorrection")?),
-            pixel_array_px: fixed::<_, 2>(env, &pixel_array, "pixelArray")?
+            pre_correction_active_array: rect(leading::<_, 4>(env, &pre_correction, "preCorrection", Length::Exactly)?),
+            pixel_array_px: leading::<_, 2>(env, &pixel_array, "pixelArray", Length::Exactly)?
                 .and_then(|[w, h]| Some([positive(w)?, positive(h)?])),
-            physical_size_mm: fixed::<_, 2>(env, &physical_size_mm, "physicalSizeMm")?,
+            physical_size_mm: leading::<_, 2>(env, &physical_size_mm, "physicalSizeMm", Length::Exactly)?,
             focal_length_mm: Some(focal_length_mm).filter(|f| !f.is_nan()),
-            lens_intrinsic_calibration: at_least::<4>(env, &lens_calibration, "lensCalibration")?,
+            lens_intrinsic_calibration: leading::<_, 4>(env, &lens_calibration, "lensCalibration", Length::AtLeast)?,
         };
         let (width, height) = size(width, height)?;
         let k = characteristics
@@ -404,11 +404,19 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraIntrinsics<'
     })
 }
 
-/// A Java array of exactly `N` elements, `None` when it is `null`.
-fn fixed<T, const N: usize>(
+/// How many elements [`leading`] accepts.
+#[derive(Clone, Copy, PartialEq)]
+enum Length {
+    Exactly,
+    AtLeast,
+}
+
+/// The first `N` elements of a Java array of exactly (or at least) `N`; `None` when it is `null`.
+fn leading<T, const N: usize>(
     env: &Env,
     array: &jni::objects::JPrimitiveArray<T>,
     name: &str,
+    length: Length,
 ) -> Result<Option<[T; N]>, Thrown>
 where
     T: jni::objects::TypeArray + Copy + Default,
@@ -417,30 +425,17 @@ where
         return Ok(None);
     }
     let len = array.len(env)?;
-    if len != N {
+    let (ok, rule) = match length {
+        Length::Exactly => (len == N, ""),
+        Length::AtLeast => (len >= N, "at least "),
+    };
+    if !ok {
         return Err(fail(
             Kind::IllegalArgument,
-            format!("{name} must have {N} elements, got {len}"),
+            format!("{name} must have {rule}{N} elements, got {len}"),
         ));
     }
     let mut out = [T::default(); N];
-    array.get_region(env, 0, &mut out)?;
-    Ok(Some(out))
-}
-
-/// The first `N` elements of a float array of at least `N`, `None` when it is `null`.
-fn at_least<const N: usize>(env: &Env, array: &JFloatArray, name: &str) -> Result<Option<[jfloat; N]>, Thrown> {
-    if array.is_null() {
-        return Ok(None);
-    }
-    let len = array.len(env)?;
-    if len < N {
-        return Err(fail(
-            Kind::IllegalArgument,
-            format!("{name} must have at least {N} elements, got {len}"),
-        ));
-    }
-    let mut out = [0.0; N];
     array.get_region(env, 0, &mut out)?;
     Ok(Some(out))
 }

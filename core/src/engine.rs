@@ -459,17 +459,24 @@ impl Engine {
     fn pixels_per_point(&self) -> f32 {
         let screen = self.session.config().screen;
         let density = (screen.panel().xdpi / 160.0).clamp(1.0, 4.0);
-        let target_width_px = match &self.target {
-            Target::Window(host) => match host.state() {
-                crate::surface::SurfaceState::Active { width, .. } => Some(width),
-                _ => None,
-            },
-            Target::Offscreen { width, .. } => Some(*width),
-            Target::Detached => None,
-        };
+        let target_width_px = self.target_size().map(|(w, _)| w);
         match target_width_px.filter(|&w| w > 0) {
             Some(w) => density * (w as f32 / screen.width_px() as f32).clamp(0.1, 10.0),
             None => density,
+        }
+    }
+
+    /// The drawing target's size in physical pixels; `None` while detached or while the window's
+    /// surface is not active.
+    #[cfg(feature = "ui")]
+    fn target_size(&self) -> Option<(u32, u32)> {
+        match &self.target {
+            Target::Detached => None,
+            Target::Window(host) => match host.state() {
+                crate::surface::SurfaceState::Active { width, height } => Some((width, height)),
+                _ => None,
+            },
+            Target::Offscreen { width, height } => Some((*width, *height)),
         }
     }
 
@@ -710,14 +717,7 @@ impl Engine {
     /// since the last, painted over the picture, then what the viewer chose is applied.
     #[cfg(feature = "ui")]
     fn draw_with_screens(&mut self, input: &FrameInput) -> Result<DrawOutcome, EngineError> {
-        let size = match &self.target {
-            Target::Detached => None,
-            Target::Window(host) => match host.state() {
-                crate::surface::SurfaceState::Active { width, height } => Some((width, height)),
-                _ => None,
-            },
-            Target::Offscreen { width, height } => Some((*width, *height)),
-        };
+        let size = self.target_size();
         // Nothing to lay the screens out on: the plain draw skips (and counts) the frame.
         let (w, h) = match size {
             Some((w, h)) if w > 0 && h > 0 => (w, h),

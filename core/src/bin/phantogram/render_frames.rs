@@ -34,8 +34,10 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         flat_at_s,
     } = args;
     let (width, height) = parse_size(size)?;
-    // The engine's screen is the default panel in portrait.
-    let screen = phantogram::screen::Screen::default();
+    // The engine's screen (SceneArgs::engine keeps the default panel and rotation), known before
+    // anything is loaded.
+    let defaults = phantogram::engine::EngineConfig::default();
+    let screen = phantogram::screen::Screen::new(defaults.panel, defaults.rotation)?;
     let aspect = width as f64 / height as f64;
     let screen_aspect = screen.width_m() as f64 / screen.height_m() as f64;
     if (aspect / screen_aspect - 1.0).abs() > 0.02 {

@@ -108,25 +108,25 @@ impl App {
 
     /// Pushes what the sensors said up to now; returns the sensor time of now.
     fn feed_sensors(&mut self) -> i64 {
+        if let Some(events) = &self.log {
+            self.log_t0.get_or_insert(events.first().map_or(0, |e| e.t_ns));
+        }
+        let now_ns = self.now_ns();
         match &self.log {
+            // Real-time replay: every event up to the log time that has elapsed.
             Some(events) => {
-                // Real-time replay: every event up to the log time that has elapsed.
-                let t0 = *self.log_t0.get_or_insert(events.first().map_or(0, |e| e.t_ns));
-                let until = t0 + self.start.elapsed().as_nanos() as i64;
-                while let Some(e) = events.get(self.log_cursor).filter(|e| e.t_ns <= until) {
+                while let Some(e) = events.get(self.log_cursor).filter(|e| e.t_ns <= now_ns) {
                     let _ = self.inbox.push(*e);
                     self.log_cursor += 1;
                 }
-                until
             }
             None => {
-                let now_s = self.start.elapsed().as_secs_f64();
-                for e in self.phone.events(now_s) {
+                for e in self.phone.events(now_ns as f64 * 1e-9) {
                     let _ = self.inbox.push(e);
                 }
-                (now_s * 1e9) as i64
             }
         }
+        now_ns
     }
 
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
