@@ -20,6 +20,7 @@
 //! (no prediction). Another program's estimates (VQF's, for the benchmark) are scored the same way
 //! by replaying its track as an estimator ([`RecordedTrack`]).
 
+use phantogram_sensing::clock::elapsed_s;
 use std::path::Path;
 use std::time::Instant;
 
@@ -263,7 +264,7 @@ pub fn score(trial: &Trial, name: &str, estimator: &mut dyn OrientationEstimator
             },
         };
         let (est, truth) = (est.as_dquat(), truth.as_dquat());
-        let in_convergence = (e.t_ns - t0) as f64 * 1e-9 < CONVERGENCE_S;
+        let in_convergence = elapsed_s(t0, e.t_ns) < CONVERGENCE_S;
         // The inclination error does not depend on the reference's heading (a rotation about the
         // vertical on either side leaves the tilt angle unchanged), so room-frame truth scores it
         // the same way; heading and total are scored there after removing the room's turn.

@@ -14,6 +14,7 @@ use std::time::{Duration, Instant};
 use thiserror::Error;
 
 use crate::sensorlog::LogError;
+use phantogram_sensing::clock::{advance_ns, elapsed_ns, elapsed_s};
 use phantogram_sensing::sensors::{SensorEvent, SensorStats};
 use phantogram_sensing::session::{FrameView, Session, SessionError};
 
@@ -23,10 +24,18 @@ pub const MAX_GAP_NS: i64 = 60_000_000_000;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Pace {
     AsFastAsPossible,
-    /// Sleep so that frames come out at `speed` × the recording's pace.
+    /// Sleep so that frames come out at `speed` × the recording's pace; `speed` within
+    /// [`Pace::SPEEDS`].
     RealTime {
         speed: f64,
     },
+}
+
+impl Pace {
+    /// The real-time speed factors a replay accepts: slower than a thousandth, a second of
+    /// recording would take a quarter of an hour; faster than a thousandfold, pacing means
+    /// nothing next to the time a frame takes.
+    pub const SPEEDS: std::ops::RangeInclusive<f64> = 1e-3..=1e3;
 }
 
 #[derive(Debug, Error)]
@@ -37,6 +46,8 @@ pub enum ReplayError {
     Session(#[from] SessionError),
     #[error("frame interval must be positive, got {0} ns")]
     BadInterval(i64),
+    #[error("real-time speed factor must be within 0.001..=1000, got {0}")]
+    BadSpeed(f64),
 }
 
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -67,6 +78,8 @@ pub enum DriveError<E> {
     Log(#[from] LogError),
     #[error("frame interval must be positive, got {0} ns")]
     BadInterval(i64),
+    #[error("real-time speed factor must be within 0.001..=1000, got {0}")]
+    BadSpeed(f64),
     #[error(transparent)]
     Frame(E),
 }
@@ -86,14 +99,19 @@ where
     if interval_ns <= 0 {
         return Err(DriveError::BadInterval(interval_ns));
     }
+    if let Pace::RealTime { speed } = pace
+        && !Pace::SPEEDS.contains(&speed)
+    {
+        return Err(DriveError::BadSpeed(speed));
+    }
     let mut summary = ReplaySummary::default();
     let mut next_frame_ns: Option<i64> = None;
     let wall_start = Instant::now();
     let emit = |target: &mut T, t_ns: i64, summary: &mut ReplaySummary| -> Result<(), DriveError<T::Error>> {
-        if let (Pace::RealTime { speed }, Some(t0)) = (pace, summary.first_t_ns)
-            && speed > 0.0
-        {
-            let due = Duration::from_secs_f64(((t_ns - t0) as f64 * 1e-9 / speed).max(0.0));
+        if let (Pace::RealTime { speed }, Some(t0)) = (pace, summary.first_t_ns) {
+            // Gaps longer than MAX_GAP_NS are skipped, so `due` stays within hours, but a
+            // damaged stream must not panic the conversion either.
+            let due = Duration::try_from_secs_f64((elapsed_s(t0, t_ns) / speed).max(0.0)).unwrap_or(Duration::ZERO);
             if let Some(wait) = due.checked_sub(wall_start.elapsed()) {
                 std::thread::sleep(wait);
             }
@@ -108,22 +126,23 @@ where
         summary.first_t_ns.get_or_insert(event.t_ns);
         summary.last_t_ns = Some(summary.last_t_ns.map_or(event.t_ns, |t| t.max(event.t_ns)));
         let next = next_frame_ns.get_or_insert(event.t_ns);
-        if event.t_ns - *next > MAX_GAP_NS {
+        if elapsed_ns(*next, event.t_ns) > MAX_GAP_NS {
             *next = event.t_ns;
         }
         while *next < event.t_ns {
             let t = *next;
-            *next += interval_ns;
+            // The grid ends at the last representable time: the event is then the last frame.
+            *next = advance_ns(t, interval_ns).unwrap_or(event.t_ns);
             emit(target, t, &mut summary)?;
         }
         // Rejected events are counted by the target; replay goes on, as the app would.
         target.push(event);
     }
     if let (Some(next), Some(last)) = (next_frame_ns, summary.last_t_ns) {
-        let mut t = next;
-        while t <= last {
-            emit(target, t, &mut summary)?;
-            t += interval_ns;
+        let mut t = Some(next);
+        while let Some(at) = t.filter(|&at| at <= last) {
+            emit(target, at, &mut summary)?;
+            t = advance_ns(at, interval_ns);
         }
     }
     Ok(summary)
@@ -160,6 +179,7 @@ where
     let mut summary = drive(events, &mut target, interval_ns, pace).map_err(|e| match e {
         DriveError::Log(e) => ReplayError::Log(e),
         DriveError::BadInterval(i) => ReplayError::BadInterval(i),
+        DriveError::BadSpeed(v) => ReplayError::BadSpeed(v),
         DriveError::Frame(e) => ReplayError::Session(e),
     })?;
     summary.stats = target.session.stats();
@@ -211,5 +231,56 @@ mod tests {
             replay(events(&[0]), &mut s, 0, Pace::AsFastAsPossible, |_, _, _| {}),
             Err(ReplayError::BadInterval(0))
         ));
+    }
+
+    /// The three-line log that replayed "forever": two stamps 2⁶³ ns apart, whose difference
+    /// wrapped to a negative number and slipped past the gap guard. Any stamps at all give a
+    /// handful of frames.
+    #[test]
+    fn stamps_centuries_apart_give_a_few_frames_not_an_endless_run() {
+        for times in [
+            [-(1i64 << 62), 1i64 << 62],
+            [i64::MIN, i64::MAX],
+            [i64::MAX - 5, i64::MAX],
+            [i64::MIN, i64::MIN + 1],
+        ] {
+            let mut s = Session::new(SessionConfig::default()).unwrap();
+            let mut n = 0u64;
+            let summary = replay(
+                events(&times),
+                &mut s,
+                100_000_000,
+                Pace::AsFastAsPossible,
+                |_, _, _| {
+                    n += 1;
+                    assert!(n < 100, "{times:?}: runaway replay");
+                },
+            )
+            .unwrap();
+            assert!(summary.frames <= 3, "{times:?}: {} frames", summary.frames);
+        }
+    }
+
+    #[test]
+    fn real_time_speeds_outside_the_range_are_refused_not_slept_on() {
+        let mut s = Session::new(SessionConfig::default()).unwrap();
+        for speed in [1e-30, 0.0, -1.0, f64::NAN, f64::INFINITY, 1e9] {
+            let result = replay(
+                events(&[0, 1_000_000]),
+                &mut s,
+                1_000_000,
+                Pace::RealTime { speed },
+                |_, _, _| {},
+            );
+            assert!(matches!(result, Err(ReplayError::BadSpeed(_))), "{speed}: {result:?}");
+        }
+        let ok = replay(
+            events(&[0, 1_000_000]),
+            &mut s,
+            1_000_000,
+            Pace::RealTime { speed: 1000.0 },
+            |_, _, _| {},
+        );
+        assert!(ok.is_ok(), "{ok:?}");
     }
 }

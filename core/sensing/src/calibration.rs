@@ -160,10 +160,15 @@ impl Calibration {
 
     /// Parses the file's text; `Err` names the line that is wrong.
     pub fn from_text(text: &str) -> Result<Self, String> {
-        let mut lines = text.lines();
+        let mut lines = phantogram_files::text::strip_bom(text).lines();
         match lines.next().map(str::trim) {
             Some(CALIBRATION_MAGIC) => {}
-            Some(other) => return Err(format!("line 1: expected {CALIBRATION_MAGIC:?}, found {other:?}")),
+            Some(other) => {
+                return Err(format!(
+                    "line 1: expected {CALIBRATION_MAGIC:?}, found {}",
+                    phantogram_files::text::excerpt(other)
+                ));
+            }
             None => return Err("empty file".into()),
         }
         let mut c = Calibration::default();
@@ -224,7 +229,11 @@ impl Calibration {
     /// run) gives the defaults; an unreadable or damaged one the defaults and a warning to show
     /// the user.
     pub fn load(path: &Path) -> (Self, Option<String>) {
-        match std::fs::read_to_string(path) {
+        // A calibration is a few hundred bytes; a megabyte is not one.
+        let text = phantogram_files::read_regular_file(path, 1 << 20).and_then(|bytes| {
+            String::from_utf8(bytes).map_err(|_| std::io::Error::new(std::io::ErrorKind::InvalidData, "not UTF-8 text"))
+        });
+        match text {
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => (Self::default(), None),
             Ok(text) => match Self::from_text(&text) {
                 Ok(c) => (c, None),
@@ -252,15 +261,15 @@ impl Calibration {
         )
     }
 
-    /// Writes the file atomically (a temporary file renamed over it), so a crash mid-write cannot
-    /// leave a corrupt calibration. Creates the folder if needed.
+    /// Writes the file atomically ([`phantogram_files::AtomicFile`]), so a crash or a full disk
+    /// cannot leave a corrupt calibration. Creates the folder if needed.
     pub fn save(&self, path: &Path) -> std::io::Result<()> {
         if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir)?;
         }
-        let tmp = path.with_extension("tmp");
-        std::fs::write(&tmp, self.to_text())?;
-        std::fs::rename(&tmp, path)
+        let mut file = phantogram_files::AtomicFile::create(path)?;
+        std::io::Write::write_all(file.file(), self.to_text().as_bytes())?;
+        file.commit()
     }
 }
 

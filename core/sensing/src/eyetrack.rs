@@ -24,6 +24,7 @@
 //! Threading: plain data, owned by the render thread; the face worker hands it
 //! [`FaceObservation`]s. Panics: none.
 
+use crate::clock::{elapsed_ns, elapsed_s};
 use glam::{Quat, Vec3};
 use std::collections::VecDeque;
 
@@ -115,7 +116,7 @@ impl OneEuro {
     }
 
     fn update(&mut self, x: Vec3, t_ns: i64, min_cutoff_hz: f32, beta: f32) -> Vec3 {
-        let dt_s = ((t_ns - self.t_ns) as f64 * 1e-9) as f32;
+        let dt_s = elapsed_s(self.t_ns, t_ns) as f32;
         if dt_s <= 0.0 {
             return self.x;
         }
@@ -187,7 +188,11 @@ impl EyeTracker {
         }
         self.history.push_back((t_ns, device_to_world.normalize()));
         let keep_ns = (self.params.history_s as f64 * 1e9) as i64;
-        while self.history.front().is_some_and(|&(t, _)| t < t_ns - keep_ns) {
+        while self
+            .history
+            .front()
+            .is_some_and(|&(t, _)| t < t_ns.saturating_sub(keep_ns))
+        {
             self.history.pop_front();
         }
     }
@@ -197,7 +202,7 @@ impl EyeTracker {
         let i = self.history.partition_point(|&(t, _)| t <= t_ns);
         match (i.checked_sub(1).and_then(|j| self.history.get(j)), self.history.get(i)) {
             (Some(&(t0, q0)), Some(&(t1, q1))) => {
-                let s = ((t_ns - t0) as f64 / (t1 - t0).max(1) as f64) as f32;
+                let s = (elapsed_s(t0, t_ns) / elapsed_s(t0, t1).max(1e-9)) as f32;
                 Some(q0.slerp(q1, s))
             }
             (Some(&(_, q)), None) | (None, Some(&(_, q))) => Some(q),
@@ -256,7 +261,7 @@ impl EyeTracker {
         let stale_ns = (self.params.stale_after_s as f64 * 1e9) as i64;
         let camera = self
             .newest
-            .filter(|&(t, _, _)| self.face_present && t_ns - t <= stale_ns)
+            .filter(|&(t, _, _)| self.face_present && elapsed_ns(t, t_ns) <= stale_ns)
             .map(|(_, at_capture, q_capture)| {
                 match (q_capture, now.or_else(|| self.orientation_at(t_ns))) {
                     (Some(q_c), Some(q_now)) => {
@@ -271,7 +276,7 @@ impl EyeTracker {
             Some(e) => (EyeSource::Camera, e),
             None => (EyeSource::Tilt, tilt_eyes(self.distance_m)),
         };
-        let dt_s = self.last.map_or(0.0, |(t, _)| ((t_ns - t).max(0) as f64 * 1e-9) as f32);
+        let dt_s = self.last.map_or(0.0, |(t, _)| elapsed_s(t, t_ns).max(0.0) as f32);
         if self.source.is_some_and(|s| s != source) {
             if let Some((_, previous)) = self.last {
                 // Keep the output where it was; the offset decays from here.

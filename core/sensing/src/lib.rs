@@ -26,6 +26,7 @@
 pub mod attitude;
 pub mod calibration;
 pub mod camera;
+pub mod clock;
 pub mod eyetrack;
 pub mod fusion;
 pub mod lowpass;

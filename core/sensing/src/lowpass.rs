@@ -58,7 +58,7 @@ impl VectorLowPass {
                 if t_ns <= last {
                     return false;
                 }
-                let dt_s = (t_ns - last) as f64 * 1e-9;
+                let dt_s = crate::clock::elapsed_s(last, t_ns);
                 let c = if self.tau_s == 0.0 {
                     1.0
                 } else {

@@ -63,16 +63,7 @@ impl SensorKind {
     }
 }
 
-/// Largest time stamp magnitude accepted anywhere, ns: 2⁶² ns, about 146 years, so that the
-/// difference of any two accepted stamps fits in an `i64` (the estimators subtract them). Phone
-/// clocks count from boot, exports from 1970 (1.8·10¹⁸ ns in 2026); a larger stamp is damage.
-pub const MAX_ABS_T_NS: i64 = 1 << 62;
-
-/// Whether `t_ns` is within ±[`MAX_ABS_T_NS`]: true of every time stamp the core accepts
-/// (sensor events, camera captures, display times).
-pub fn time_in_range(t_ns: i64) -> bool {
-    t_ns.unsigned_abs() <= MAX_ABS_T_NS as u64
-}
+pub use crate::clock::{MAX_ABS_T_NS, time_in_range};
 
 /// One timestamped sample. Vectors use `value[0..3]` (and `value[3] == 0`); orientations store a
 /// quaternion as `[x, y, z, w]`.
@@ -168,7 +159,7 @@ pub enum Rejection {
     DuplicateTimestamp,
     #[error("time stamp goes backwards for this sensor")]
     BackwardTimestamp,
-    #[error("time stamp is beyond ±2^62 ns (146 years)")]
+    #[error("time stamp is beyond ±(2^62 - 1) ns (146 years)")]
     TimestampOutOfRange,
 }
 

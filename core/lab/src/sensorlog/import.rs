@@ -21,8 +21,21 @@ use std::path::{Path, PathBuf};
 
 use glam::{Mat3, Quat, Vec3};
 
-use super::{Lines, LogError, LogReader, parse_f64, seconds_to_ns};
+use super::{Lines, LogError, LogReader, MAX_EVENTS_IN_MEMORY, MAX_LINE_BYTES, parse_f64, seconds_to_ns};
+use phantogram_files::text::{excerpt, strip_bom};
 use phantogram_sensing::sensors::{SensorEvent, SensorKind};
+
+/// Adds an imported event, refusing beyond [`MAX_EVENTS_IN_MEMORY`] (an import holds the whole
+/// recording, to sort it), before the memory is taken.
+fn push(events: &mut Vec<SensorEvent>, event: SensorEvent) -> Result<(), String> {
+    if events.len() >= MAX_EVENTS_IN_MEMORY {
+        return Err(format!(
+            "more than {MAX_EVENTS_IN_MEMORY} events, more than an import holds in memory; split the recording"
+        ));
+    }
+    events.push(event);
+    Ok(())
+}
 
 /// A whole imported recording.
 #[derive(Clone, Debug, Default, PartialEq)]
@@ -68,8 +81,10 @@ impl SourceFormat {
     }
 }
 
+/// The first line, without a byte-order mark.
 fn first_line(path: &Path) -> Result<String, LogError> {
-    Ok(Lines::open(path)?.next_owned()?.unwrap_or_default())
+    let line = Lines::open(path)?.next_owned()?.unwrap_or_default();
+    Ok(strip_bom(&line).to_owned())
 }
 
 /// `dir/base` or `dir/base.gz`, whichever exists.
@@ -85,7 +100,7 @@ pub fn detect(path: &Path) -> Result<SourceFormat, LogError> {
             return Ok(SourceFormat::AndroidRaw);
         }
         if let Some(acc) = find(path, "Accelerometer.csv") {
-            let header = header_names(&first_line(&acc)?);
+            let header: Vec<String> = first_line(&acc)?.split(',').map(header_name).collect();
             if header.iter().any(|h| h == "seconds_elapsed") {
                 return Ok(SourceFormat::SensorLogger);
             }
@@ -125,7 +140,7 @@ pub fn import(path: &Path) -> Result<ImportedLog, LogError> {
         SourceFormat::Phantogram => {
             let reader = LogReader::open(path)?;
             let meta = reader.meta().to_vec();
-            let events = reader.collect::<Result<Vec<_>, _>>()?;
+            let events = super::read_all(path, reader)?;
             Ok(ImportedLog { meta, events })
         }
         SourceFormat::AndroidRaw => import_android_raw(path),
@@ -177,46 +192,96 @@ fn read_whitespace_rows(
 
 /// Header names, normalised: quotes and units in parentheses dropped, lower case
 /// (`"X (m/s^2)"` → `x`).
-fn header_names(line: &str) -> Vec<String> {
-    line.split(',')
-        .map(|h| {
-            let h = h.trim().trim_matches('"');
-            let h = h.split(" (").next().unwrap_or(h);
-            h.trim().to_lowercase()
-        })
-        .collect()
+fn header_name(h: &str) -> String {
+    let h = strip_bom(h).trim().trim_matches('"');
+    let h = h.split(" (").next().unwrap_or(h);
+    h.trim().to_lowercase()
 }
 
 /// A CSV with a header row: calls `row` with the raw fields of the `wanted` columns, in that order.
+///
+/// Read by the `csv` crate (RFC 4180: quoted fields, CRLF, a byte-order mark): every row must have
+/// as many fields as the header. A row with more is how a decimal comma shows up (`0,5` read as
+/// two fields): it is an error naming its line, never data shifted into the next column. A line
+/// longer than [`MAX_LINE_BYTES`] is an error before it is held in memory.
 fn read_csv(path: &Path, wanted: &[&str], mut row: impl FnMut(&[&str]) -> Result<(), String>) -> Result<(), LogError> {
-    let mut lines = Lines::open(path)?;
-    let Some(header) = lines.next_owned()? else {
-        return Err(LogError::format(path, "empty file: expected a CSV header"));
+    let reader = LineLengthGuard::new(super::open_maybe_gz(path)?);
+    let mut csv = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .flexible(false)
+        .from_reader(reader);
+    let csv_error = |e: csv::Error| -> LogError {
+        let line = e.position().map_or(0, |p| p.line());
+        let message = match e.kind() {
+            csv::ErrorKind::UnequalLengths { expected_len, len, .. } => {
+                format!("{len} fields where the header has {expected_len} (a decimal comma, or a damaged row?)")
+            }
+            csv::ErrorKind::Io(io) => io.to_string(),
+            csv::ErrorKind::Utf8 { .. } => "not UTF-8 text".to_owned(),
+            _ => e.to_string(),
+        };
+        if line > 0 {
+            LogError::parse(path, line, message)
+        } else {
+            LogError::format(path, message)
+        }
     };
-    let names = header_names(&header);
+    let names: Vec<String> = csv.headers().map_err(csv_error)?.iter().map(header_name).collect();
+    if names.iter().all(String::is_empty) {
+        return Err(LogError::format(path, "empty file: expected a CSV header"));
+    }
     let mut index = Vec::with_capacity(wanted.len());
     for w in wanted {
         match names.iter().position(|n| n == w) {
             Some(i) => index.push(i),
-            None => return Err(lines.error(format!("CSV header lacks column {w:?}"))),
+            None => return Err(LogError::parse(path, 1, format!("CSV header lacks column {w:?}"))),
         }
     }
-    let needed = index.iter().max().map_or(0, |m| m + 1);
-    while lines.advance()? {
-        let line = lines.current();
-        if line.trim().is_empty() {
+    let mut record = csv::StringRecord::new();
+    loop {
+        match csv.read_record(&mut record) {
+            Ok(true) => {}
+            Ok(false) => return Ok(()),
+            Err(e) => return Err(csv_error(e)),
+        }
+        let line = record.position().map_or(0, |p| p.line());
+        // A blank line (a trailing newline pair) is no row.
+        if record.len() == 1 && record[0].trim().is_empty() {
             continue;
         }
-        // Per-row vectors: they borrow this line, which the next `advance` replaces.
-        let fields: Vec<&str> = line.split(',').collect();
-        if fields.len() < needed {
-            let m = format!("expected at least {needed} columns, found {}", fields.len());
-            return Err(lines.error(m));
-        }
-        let picked: Vec<&str> = index.iter().map(|&i| fields[i]).collect();
-        row(&picked).map_err(|m| lines.error(m))?;
+        let picked: Vec<&str> = index.iter().map(|&i| &record[i]).collect();
+        row(&picked).map_err(|m| LogError::parse(path, line, m))?;
     }
-    Ok(())
+}
+
+/// Passes bytes through, failing once a line grows past [`MAX_LINE_BYTES`]: what the CSV reader
+/// would otherwise hold of a file that is not text, or of a gzip stream inflating to gigabytes
+/// without a line break.
+struct LineLengthGuard<R> {
+    inner: R,
+    run: usize,
+}
+
+impl<R: std::io::Read> LineLengthGuard<R> {
+    fn new(inner: R) -> Self {
+        Self { inner, run: 0 }
+    }
+}
+
+impl<R: std::io::Read> std::io::Read for LineLengthGuard<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        for &b in &buf[..n] {
+            self.run = if b == b'\n' { 0 } else { self.run + 1 };
+            if self.run > MAX_LINE_BYTES {
+                return Err(std::io::Error::new(
+                    std::io::ErrorKind::InvalidData,
+                    format!("a line longer than {} MiB: not a sensor export", MAX_LINE_BYTES >> 20),
+                ));
+            }
+        }
+        Ok(n)
+    }
 }
 
 fn vec3(v: &[f64]) -> Vec3 {
@@ -252,13 +317,16 @@ pub fn import_android_raw(dir: &Path) -> Result<ImportedLog, LogError> {
         let events = &mut log.events;
         read_whitespace_rows(&path, min, max, |v| {
             let t_ns = seconds_to_ns(v[0])?;
-            events.push(if kind.is_orientation() {
-                // Android's rotation vector: x y z w (w present on API ≥ 18).
-                let q = Quat::from_xyzw(v[1] as f32, v[2] as f32, v[3] as f32, v[4] as f32);
-                SensorEvent::orientation(kind, t_ns, q)
-            } else {
-                SensorEvent::vector(kind, t_ns, vec3(&v[1..4]))
-            });
+            push(
+                events,
+                if kind.is_orientation() {
+                    // Android's rotation vector: x y z w (w present on API ≥ 18).
+                    let q = Quat::from_xyzw(v[1] as f32, v[2] as f32, v[3] as f32, v[4] as f32);
+                    SensorEvent::orientation(kind, t_ns, q)
+                } else {
+                    SensorEvent::vector(kind, t_ns, vec3(&v[1..4]))
+                },
+            )?;
             Ok(())
         })?;
         log.note("read", display_name(&path));
@@ -326,12 +394,10 @@ fn import_mocap(path: &Path, align_s: f64, out: &mut Vec<SensorEvent>) -> Result
             return Err(format!("rotation matrix is not a rotation (determinant {det})"));
         }
         let t_ns = seconds_to_ns(v[0] - align_s)?;
-        out.push(SensorEvent::orientation(
-            SensorKind::GroundTruth,
-            t_ns,
-            Quat::from_mat3(&m).normalize(),
-        ));
-        Ok(())
+        push(
+            out,
+            SensorEvent::orientation(SensorKind::GroundTruth, t_ns, Quat::from_mat3(&m).normalize()),
+        )
     })
 }
 
@@ -362,8 +428,7 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
         read_csv(&path, &["time", "x", "y", "z"], |f| {
             let t_ns = parse_ns(f[0])?;
             let v = parse_fields(&f[1..])?;
-            events.push(SensorEvent::vector(kind, t_ns, vec3(&v)));
-            Ok(())
+            push(events, SensorEvent::vector(kind, t_ns, vec3(&v)))
         })?;
         log.note("read", display_name(&path));
     }
@@ -379,8 +444,7 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
             let t_ns = parse_ns(f[0])?;
             let v = parse_fields(&f[1..])?;
             let q = Quat::from_xyzw(v[0] as f32, v[1] as f32, v[2] as f32, v[3] as f32);
-            events.push(SensorEvent::orientation(SensorKind::RotationVector, t_ns, q));
-            Ok(())
+            push(events, SensorEvent::orientation(SensorKind::RotationVector, t_ns, q))
         })?;
         log.note("read", display_name(&path));
     }
@@ -399,7 +463,7 @@ fn parse_ns(field: &str) -> Result<i64, String> {
     if t.is_finite() && t.abs() <= phantogram_sensing::sensors::MAX_ABS_T_NS as f64 {
         Ok(t.round() as i64)
     } else {
-        Err(format!("time stamp {field:?} is not usable"))
+        Err(format!("time stamp {} is not usable", excerpt(field)))
     }
 }
 
@@ -419,8 +483,7 @@ pub fn import_phyphox(dir: &Path) -> Result<ImportedLog, LogError> {
         let events = &mut log.events;
         read_csv(&path, &["time", "x", "y", "z"], |f| {
             let v = parse_fields(f)?;
-            events.push(SensorEvent::vector(kind, seconds_to_ns(v[0])?, vec3(&v[1..])));
-            Ok(())
+            push(events, SensorEvent::vector(kind, seconds_to_ns(v[0])?, vec3(&v[1..])))
         })?;
         log.note("read", display_name(&path));
     }
@@ -440,12 +503,12 @@ pub fn import_broad(path: &Path) -> Result<ImportedLog, LogError> {
     read_csv(path, &cols, |f| {
         let v = parse_fields(f)?;
         let t_ns = seconds_to_ns(v[0])?;
-        events.push(SensorEvent::accelerometer(t_ns, vec3(&v[1..4])));
-        events.push(SensorEvent::gyroscope(t_ns, vec3(&v[4..7])));
-        events.push(SensorEvent::magnetometer(t_ns, vec3(&v[7..10])));
+        push(events, SensorEvent::accelerometer(t_ns, vec3(&v[1..4])))?;
+        push(events, SensorEvent::gyroscope(t_ns, vec3(&v[4..7])))?;
+        push(events, SensorEvent::magnetometer(t_ns, vec3(&v[7..10])))?;
         let q = Quat::from_xyzw(v[11] as f32, v[12] as f32, v[13] as f32, v[10] as f32);
         if q.is_finite() {
-            events.push(SensorEvent::orientation(SensorKind::GroundTruth, t_ns, q));
+            push(events, SensorEvent::orientation(SensorKind::GroundTruth, t_ns, q))?;
         }
         Ok(())
     })?;
@@ -464,7 +527,7 @@ pub fn read_broad_movement(path: &Path) -> Result<Vec<(i64, bool)>, LogError> {
         let moving = match f[1].trim() {
             "1" | "1.0" | "true" => true,
             "0" | "0.0" | "false" => false,
-            other => return Err(format!("movement flag must be 0 or 1, found {other:?}")),
+            other => return Err(format!("movement flag must be 0 or 1, found {}", excerpt(other))),
         };
         out.push((t_ns, moving));
         Ok(())
@@ -614,5 +677,62 @@ mod tests {
         std::fs::write(&other, "hello\n").unwrap();
         assert_eq!(import(&other).unwrap_err().line(), Some(1));
         assert!(matches!(import(&empty.join("missing")), Err(LogError::Io { .. })));
+    }
+
+    /// A BROAD CSV written with decimal commas has more fields per row than its header: an
+    /// error naming the line, never values shifted into the next column.
+    #[test]
+    fn rows_with_more_fields_than_the_header_are_refused_with_their_line() {
+        let dir = temp_dir("decimal-comma");
+        let header = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,gt_qw,gt_qx,gt_qy,gt_qz\n";
+        let good = "0.01,0.1,0.2,9.8,0,0,0,20,0,-40,1,0,0,0\n";
+        let comma = "0,02,0,1,0,2,9,8,0,0,0,20,0,-40,1,0,0,0\n";
+        let path = dir.join("trial.csv");
+        std::fs::write(&path, format!("{header}{good}{comma}")).unwrap();
+        let err = import(&path).unwrap_err();
+        assert_eq!(err.line(), Some(3), "{err}");
+        assert!(err.to_string().contains("fields where the header has 14"), "{err}");
+        // Quoted fields and CRLF line ends are CSV too.
+        std::fs::write(
+            &path,
+            format!("{}{}", header.replace('\n', "\r\n"), good.replace("0.1,", "\"0.1\",")),
+        )
+        .unwrap();
+        assert_eq!(import(&path).unwrap().events.len(), 4);
+    }
+
+    /// Windows editors and some exporters start text with a byte-order mark.
+    #[test]
+    fn a_byte_order_mark_is_accepted_by_every_text_importer() {
+        let dir = temp_dir("bom");
+        let broad = dir.join("trial.csv");
+        std::fs::write(
+            &broad,
+            "\u{feff}t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,gt_qw,gt_qx,gt_qy,gt_qz\n0.01,0.1,0.2,9.8,0,0,0,20,0,-40,1,0,0,0\n",
+        )
+        .unwrap();
+        assert_eq!(import(&broad).unwrap().events.len(), 4);
+        let log = dir.join("log.pglog");
+        std::fs::write(&log, "\u{feff}phantogram-sensor-log 1\nacc 1 0 0 9.81\n").unwrap();
+        assert_eq!(import(&log).unwrap().events.len(), 1);
+        let phyphox = temp_dir("bom-phyphox");
+        std::fs::write(
+            phyphox.join("Accelerometer.csv"),
+            "\u{feff}\"Time (s)\",\"X (m/s^2)\",\"Y (m/s^2)\",\"Z (m/s^2)\"\n0.5,0,0,9.81\n",
+        )
+        .unwrap();
+        assert_eq!(import(&phyphox).unwrap().events.len(), 1);
+    }
+
+    /// A gzip stream inflating to a line of gigabytes stops at the line limit.
+    #[test]
+    fn an_endless_csv_line_is_an_error_not_gigabytes() {
+        let dir = temp_dir("long-csv");
+        let path = dir.join("trial.csv.gz");
+        let mut text = "t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,gt_qw,gt_qx,gt_qy,gt_qz\n".to_owned();
+        text.push_str(&"1".repeat(MAX_LINE_BYTES + 10));
+        write_gz(&path, &text);
+        let err = import(&path).unwrap_err().to_string();
+        assert!(err.contains("longer than 1 MiB"), "{err}");
     }
 }

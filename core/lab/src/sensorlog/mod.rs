@@ -39,6 +39,8 @@ use flate2::read::MultiGzDecoder;
 use flate2::write::GzEncoder;
 use thiserror::Error;
 
+use phantogram_files::text::{excerpt, strip_bom};
+use phantogram_files::{AtomicFile, open_regular_file};
 use phantogram_sensing::sensors::{SensorEvent, SensorKind};
 
 /// First word of line 1.
@@ -113,7 +115,8 @@ fn kind_of_tag(t: &str) -> Option<SensorKind> {
 
 /// Opens a file for reading, transparently gunzipping it when it starts with the gzip magic.
 pub fn open_maybe_gz(path: &Path) -> Result<Box<dyn BufRead>, LogError> {
-    let mut file = BufReader::new(File::open(path).map_err(|e| LogError::io(path, e))?);
+    // Regular files only: a pipe or a device would block or never end.
+    let mut file = BufReader::new(open_regular_file(path).map_err(|e| LogError::io(path, e))?);
     let head = file.fill_buf().map_err(|e| LogError::io(path, e))?;
     if head.starts_with(&[0x1f, 0x8b]) {
         Ok(Box::new(BufReader::new(MultiGzDecoder::new(file))))
@@ -126,6 +129,39 @@ pub fn open_maybe_gz(path: &Path) -> Result<Box<dyn BufRead>, LogError> {
 /// that is not text (or a gzip stream that inflates to gigabytes without a line break) would make
 /// it hold in memory.
 pub const MAX_LINE_BYTES: usize = 1 << 20;
+
+/// Most `meta` lines a log's header holds, and most bytes of them together: provenance notes,
+/// not data. (Each line is also under [`MAX_LINE_BYTES`].)
+pub const MAX_META_LINES: usize = 1024;
+pub const MAX_META_BYTES: usize = 64 << 10;
+
+/// Most events a log is read into memory with ([`read_all`]): 2²³, 256 MiB of events, an hour
+/// and a half of three sensors at 500 Hz. Replays that stream a log hold none of them.
+pub const MAX_EVENTS_IN_MEMORY: usize = 1 << 23;
+
+/// Collects `events` (from [`LogReader`] or an importer), failing at the first error or beyond
+/// [`MAX_EVENTS_IN_MEMORY`] events, before the memory is taken.
+pub fn read_all(
+    path: &Path,
+    events: impl IntoIterator<Item = Result<SensorEvent, LogError>>,
+) -> Result<Vec<SensorEvent>, LogError> {
+    let mut out = Vec::new();
+    for event in events {
+        if out.len() == MAX_EVENTS_IN_MEMORY {
+            return Err(too_many_events(path));
+        }
+        out.push(event?);
+    }
+    Ok(out)
+}
+
+/// The error for a log beyond [`MAX_EVENTS_IN_MEMORY`].
+pub fn too_many_events(path: &Path) -> LogError {
+    LogError::format(
+        path,
+        format!("more than {MAX_EVENTS_IN_MEMORY} events, more than is read into memory; split the recording"),
+    )
+}
 
 /// Reads numbered lines, naming the file in every error.
 pub struct Lines {
@@ -202,7 +238,7 @@ impl Lines {
 pub fn parse_f64(field: &str) -> Result<f64, String> {
     let f = field.trim().trim_matches('"');
     f.parse::<f64>()
-        .map_err(|_| format!("expected a number, found {field:?}"))
+        .map_err(|_| format!("expected a number, found {}", excerpt(field)))
 }
 
 /// Seconds (as exported) to integer nanoseconds; refuses non-finite or absurd times.
@@ -238,7 +274,7 @@ impl LogReader {
                 "empty file, not a phantogram sensor log",
             ));
         };
-        let mut words = header.split_whitespace();
+        let mut words = strip_bom(&header).split_whitespace();
         if words.next() != Some(MAGIC) {
             return Err(lines.error(format!(
                 "not a phantogram sensor log (line 1 should start with {MAGIC:?})"
@@ -260,9 +296,19 @@ impl LogReader {
             failed: false,
         };
         // Read the header block (meta lines) up to the first event.
+        let mut meta_bytes = 0usize;
         loop {
             match reader.read_record(true)? {
-                Record::Meta(k, v) => reader.meta.push((k, v)),
+                Record::Meta(k, v) => {
+                    meta_bytes += k.len() + v.len();
+                    if reader.meta.len() >= MAX_META_LINES || meta_bytes > MAX_META_BYTES {
+                        return Err(reader.lines.error(format!(
+                            "more meta lines than a log holds ({MAX_META_LINES} lines or {} KiB at most)",
+                            MAX_META_BYTES >> 10
+                        )));
+                    }
+                    reader.meta.push((k, v));
+                }
                 Record::Event(e) => {
                     reader.pending = Some(e);
                     break;
@@ -315,7 +361,7 @@ enum Record {
 }
 
 fn parse_event(tag: &str, rest: &str) -> Result<SensorEvent, String> {
-    let kind = kind_of_tag(tag).ok_or_else(|| format!("unknown record type {tag:?}"))?;
+    let kind = kind_of_tag(tag).ok_or_else(|| format!("unknown record type {}", excerpt(tag)))?;
     let mut fields = rest.split_whitespace();
     let t_ns = fields
         .next()
@@ -323,7 +369,7 @@ fn parse_event(tag: &str, rest: &str) -> Result<SensorEvent, String> {
         .parse::<i64>()
         .ok()
         .filter(|&t| phantogram_sensing::sensors::time_in_range(t))
-        .ok_or("time stamp is not an integer number of nanoseconds within ±2^62")?;
+        .ok_or("time stamp is not an integer number of nanoseconds within ±(2^62 - 1)")?;
     let n = if kind.is_orientation() { 4 } else { 3 };
     let mut value = [0f32; 4];
     for (i, slot) in value.iter_mut().take(n).enumerate() {
@@ -365,8 +411,8 @@ impl Iterator for LogReader {
 /// disk or an interrupted import (a writer dropped unfinished removes its partial file).
 pub struct LogWriter {
     path: PathBuf,
-    partial: PathBuf,
     /// `None` once finished.
+    file: Option<AtomicFile>,
     sink: Option<Sink>,
 }
 
@@ -376,15 +422,10 @@ enum Sink {
 }
 
 impl LogWriter {
+    /// Only a regular file (or nothing) is replaced: see [`AtomicFile`].
     pub fn create(path: &Path, meta: &[(String, String)]) -> Result<Self, LogError> {
-        if path.is_dir() {
-            return Err(LogError::format(path, "is a folder, not a file to write the log to"));
-        }
-        let name = path
-            .file_name()
-            .ok_or_else(|| LogError::format(path, "not a file name"))?;
-        let partial = path.with_file_name(format!(".{}.{}.partial", name.to_string_lossy(), std::process::id()));
-        let file = BufWriter::new(File::create(&partial).map_err(|e| LogError::io(path, e))?);
+        let mut atomic = AtomicFile::create(path).map_err(|e| LogError::io(path, e))?;
+        let file = BufWriter::new(atomic.file().try_clone().map_err(|e| LogError::io(path, e))?);
         let sink = if path.extension().is_some_and(|e| e == "gz") {
             Sink::Gzip(GzEncoder::new(file, Compression::default()))
         } else {
@@ -392,7 +433,7 @@ impl LogWriter {
         };
         let mut w = Self {
             path: path.to_path_buf(),
-            partial,
+            file: Some(atomic),
             sink: Some(sink),
         };
         let mut header = format!("{MAGIC} {VERSION}\n");
@@ -425,28 +466,26 @@ impl LogWriter {
         self.write_text(&line)
     }
 
-    /// Flushes and closes the file and puts it in place; without it nothing is written.
+    /// Flushes and closes the file and puts it in place; without it nothing is written (a writer
+    /// dropped unfinished removes its partial file, and whatever was there stays).
     pub fn finish(mut self) -> Result<(), LogError> {
-        let result = match self.sink.take() {
-            Some(Sink::Plain(f)) => f.into_inner().map_err(|e| e.into_error()),
-            Some(Sink::Gzip(gz)) => gz.finish().and_then(|f| f.into_inner().map_err(|e| e.into_error())),
+        let flushed = match self.sink.take() {
+            Some(Sink::Plain(f)) => f.into_inner().map_err(|e| e.into_error()).map(drop),
+            Some(Sink::Gzip(gz)) => gz
+                .finish()
+                .and_then(|f| f.into_inner().map_err(|e| e.into_error()))
+                .map(drop),
             None => Err(io::Error::other("the log was already finished")),
-        }
-        .and_then(|file| file.sync_all())
-        .and_then(|()| std::fs::rename(&self.partial, &self.path));
-        if result.is_err() {
-            let _ = std::fs::remove_file(&self.partial);
-        }
-        result.map_err(|e| LogError::io(&self.path, e))
-    }
-}
-
-impl Drop for LogWriter {
-    fn drop(&mut self) {
-        if self.sink.take().is_some() {
-            // Unfinished: whatever was there stays, and the partial file goes.
-            let _ = std::fs::remove_file(&self.partial);
-        }
+        };
+        let file = self.file.take();
+        flushed
+            .and_then(|()| {
+                file.map_or(
+                    Err(io::Error::other("the log was already finished")),
+                    AtomicFile::commit,
+                )
+            })
+            .map_err(|e| LogError::io(&self.path, e))
     }
 }
 
@@ -515,7 +554,7 @@ mod tests {
             (
                 "phantogram-sensor-log 1\nacc -9223372036854775808 1 2 3\n",
                 2,
-                "within ±2^62",
+                "within ±(2^62 - 1)",
             ),
             ("phantogram-sensor-log 1\nacc 1 1 2 3\nmeta a b\n", 3, "meta line after"),
             ("phantogram-sensor-log 1\nzzz 1 1 2 3\n", 2, "unknown record"),
@@ -608,5 +647,68 @@ mod tests {
         std::fs::write(&path, &bytes[..bytes.len() / 2]).unwrap();
         let result: Result<Vec<_>, _> = LogReader::open(&path).and_then(|r| r.collect());
         assert!(result.is_err());
+    }
+
+    /// 3,000 one-megabyte `meta` lines would be 3 GB of header: refused at the budget.
+    #[test]
+    fn meta_lines_are_bounded_in_number_and_bytes() {
+        let dir = Scratch::new("unit-log-meta");
+        let many = dir.join("many.pglog");
+        let mut text = "phantogram-sensor-log 1\n".to_owned();
+        for i in 0..MAX_META_LINES + 1 {
+            text.push_str(&format!("meta k{i} v\n"));
+        }
+        std::fs::write(&many, &text).unwrap();
+        let err = LogReader::open(&many).err().expect("refused");
+        assert!(err.to_string().contains("meta lines"), "{err}");
+        let big = dir.join("big.pglog");
+        let line = format!("meta note {}\n", "x".repeat(20 << 10));
+        std::fs::write(&big, format!("phantogram-sensor-log 1\n{}", line.repeat(4))).unwrap();
+        let err = LogReader::open(&big).err().expect("refused");
+        assert_eq!(err.line(), Some(5), "{err}");
+        // The limits leave room for real provenance.
+        std::fs::write(
+            &big,
+            format!("phantogram-sensor-log 1\n{}acc 1 0 0 9.8\n", line.repeat(3)),
+        )
+        .unwrap();
+        assert_eq!(LogReader::open(&big).unwrap().meta().len(), 3);
+    }
+
+    /// A 1 MB tag is quoted in a few dozen characters, control characters escaped.
+    #[test]
+    fn unknown_tags_are_quoted_as_short_excerpts() {
+        let dir = Scratch::new("unit-log-tag");
+        let path = dir.join("tag.pglog");
+        std::fs::write(
+            &path,
+            format!("phantogram-sensor-log 1\n{}\u{1b}[2J 1 0 0 9.8\n", "a".repeat(1 << 19)),
+        )
+        .unwrap();
+        let err = LogReader::open(&path).err().expect("refused").to_string();
+        assert!(
+            err.len() < 200 && err.contains("unknown record type"),
+            "{} bytes: {}",
+            err.len(),
+            &err[..200.min(err.len())]
+        );
+    }
+
+    /// The writer replaces only a regular file: a pipe (or `/dev/full`) stays what it was.
+    #[cfg(unix)]
+    #[test]
+    fn a_log_is_never_written_over_a_device_or_a_pipe() {
+        let dir = Scratch::new("unit-log-fifo");
+        let fifo = dir.join("out.pglog");
+        if std::process::Command::new("mkfifo")
+            .arg(&fifo)
+            .status()
+            .is_ok_and(|s| s.success())
+        {
+            let err = write_log(&fifo, &[], &sample_events()).unwrap_err();
+            assert!(err.to_string().contains("not a regular file"), "{err}");
+            use std::os::unix::fs::FileTypeExt as _;
+            assert!(std::fs::symlink_metadata(&fifo).unwrap().file_type().is_fifo());
+        }
     }
 }

@@ -81,6 +81,7 @@ use glam::{DMat3, DQuat, DVec3, Quat, Vec3};
 
 use self::screen::{Declipper, Pending, Range, RangeVerdict, Reading, Saturation, SpikeWindow};
 use crate::attitude::{LowPassAttitude, OrientationEstimator};
+use crate::clock::elapsed_s;
 use crate::sensors::{SensorEvent, SensorKind};
 
 /// Tuning of [`FusedOrientation`]. The defaults are VQF's published defaults where VQF has the
@@ -418,7 +419,7 @@ fn interval_s(last_t_ns: Option<i64>, t_ns: i64, stats: &mut FusionStats) -> Opt
             stats.ignored_stale_time += 1;
             None
         }
-        Some(last) => Some((t_ns - last) as f64 * 1e-9),
+        Some(last) => Some(elapsed_s(last, t_ns)),
         None => Some(0.0),
     }
 }
@@ -552,7 +553,7 @@ impl FusedOrientation {
 
     fn gyro_is_live(&self, t_ns: i64) -> bool {
         self.last_gyr
-            .is_some_and(|(t, _)| (t_ns - t) as f64 * 1e-9 <= self.params.gyro_timeout_s)
+            .is_some_and(|(t, _)| elapsed_s(t, t_ns) <= self.params.gyro_timeout_s)
     }
 
     fn newest_t_ns(&self) -> Option<i64> {
@@ -590,7 +591,7 @@ impl FusedOrientation {
         let (Some((t_gyr, w)), true) = (self.last_gyr, self.using_gyro()) else {
             return Some(q.as_quat());
         };
-        let ahead_s = ((t_ns - t_gyr) as f64 * 1e-9).clamp(0.0, self.params.max_gap_s);
+        let ahead_s = elapsed_s(t_gyr, t_ns).clamp(0.0, self.params.max_gap_s);
         Some(
             (q * DQuat::from_scaled_axis((w - self.bias) * ahead_s))
                 .normalize()
@@ -603,7 +604,7 @@ impl FusedOrientation {
     fn q_gyr_at(&self, t_ns: i64) -> DQuat {
         match self.last_gyr {
             Some((t, w)) => {
-                let dt = ((t_ns - t) as f64 * 1e-9).clamp(-self.params.max_gap_s, self.params.max_gap_s);
+                let dt = elapsed_s(t, t_ns).clamp(-self.params.max_gap_s, self.params.max_gap_s);
                 (self.q_gyr * DQuat::from_scaled_axis((w - self.bias) * dt)).normalize()
             }
             None => self.q_gyr,
@@ -628,7 +629,7 @@ impl FusedOrientation {
             self.saturation.gyro_saturated();
         }
         if let Some((last_t, _)) = self.last_gyr {
-            let dt = (t_ns - last_t) as f64 * 1e-9;
+            let dt = elapsed_s(last_t, t_ns);
             let prev = self.last_gyr.map_or(w, |(_, p)| p);
             if dt <= self.params.max_gap_s {
                 // The sample stands for the interval ending at its time stamp (trapezoidal

@@ -41,6 +41,7 @@
 
 use std::collections::VecDeque;
 
+use crate::clock::elapsed_s;
 use glam::{DQuat, DVec3};
 
 /// A learnt ceiling counts as the sensor's range once an axis was pinned at it this many times.
@@ -231,7 +232,7 @@ impl Declipper {
         } else {
             self.after.push(r);
         }
-        let span_s = (self.run[self.run.len() - 1].t_ns - self.run[0].t_ns) as f64 * 1e-9;
+        let span_s = elapsed_s(self.run[0].t_ns, self.run[self.run.len() - 1].t_ns);
         if span_s > MAX_DECLIP_RUN_S {
             // Too long to bridge with a curve: let it through as it is.
             self.lost_velocity_m_s = DVec3::INFINITY;
@@ -268,7 +269,7 @@ impl Declipper {
         }
         let (a0, a1) = (self.after[0], self.after[1]);
         let t0 = b1.t_ns;
-        let x = |r: &Reading| (r.t_ns - t0) as f64 * 1e-9;
+        let x = |r: &Reading| elapsed_s(t0, r.t_ns);
         let h = x(&a0);
         if h <= 0.0 {
             return;
@@ -370,7 +371,7 @@ impl SpikeWindow {
                 .iter()
                 .enumerate()
                 .filter(move |(i, _)| *i != h)
-                .map(move |(_, p)| ((p.t_ns - t0) as f64 * 1e-9, p.inertial))
+                .map(move |(_, p)| (elapsed_s(t0, p.t_ns), p.inertial))
         };
         let n = (2 * h) as f64;
         let xm = neighbours().map(|p| p.0).sum::<f64>() / n;
