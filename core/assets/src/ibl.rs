@@ -24,6 +24,10 @@
 
 use glam::Vec3;
 
+/// Widest environment [`Environment::load`] reads: 4096 × 2048 (128 MiB as RGBA floats while
+/// decoding). The image-based light is prefiltered down to a few hundred texels a side.
+pub const MAX_WIDTH_PX: u32 = 4096;
+
 /// An equirectangular environment, linear RGB radiance, world frame (see the module docs).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Environment {
@@ -83,21 +87,42 @@ impl Environment {
         env
     }
 
-    /// Loads a Radiance `.hdr` or OpenEXR file.
+    /// Loads a Radiance `.hdr` or OpenEXR file, equirectangular, at most [`MAX_WIDTH_PX`] wide.
     pub fn load(path: &std::path::Path) -> Result<Self, EnvironmentError> {
         let err = |message: String| EnvironmentError::Load {
             path: path.to_path_buf(),
             message,
         };
-        let reader = image::ImageReader::open(path)
-            .map_err(|e| err(e.to_string()))?
-            .with_guessed_format()
-            .map_err(|e| err(e.to_string()))?;
+        // Regular files only: a pipe would block, a device never end.
+        let open = || {
+            let file = phantogram_files::open_regular_file(path).map_err(|e| err(e.to_string()))?;
+            image::ImageReader::new(std::io::BufReader::new(file))
+                .with_guessed_format()
+                .map_err(|e| err(e.to_string()))
+        };
+        let reader = open()?;
         if reader.format() == Some(image::ImageFormat::OpenExr) {
             // A damaged EXR can otherwise abort the process (see `exr_guard`).
-            let file = std::fs::File::open(path).map_err(|e| err(e.to_string()))?;
+            let file = phantogram_files::open_regular_file(path).map_err(|e| err(e.to_string()))?;
             crate::exr_guard::check(file).map_err(err)?;
         }
+        // The size from the header, checked before anything is decoded.
+        let (w, h) = reader.into_dimensions().map_err(|e| err(e.to_string()))?;
+        if w > MAX_WIDTH_PX || h > MAX_WIDTH_PX / 2 {
+            return Err(err(format!(
+                "{w}×{h} pixels, larger than an environment may be ({MAX_WIDTH_PX}×{}): the light \
+                 prefiltered from it needs no more, and as floats it would take {} MiB; scale it down",
+                MAX_WIDTH_PX / 2,
+                (u64::from(w) * u64::from(h) * 16) >> 20
+            )));
+        }
+        let mut reader = open()?;
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(w);
+        limits.max_image_height = Some(h);
+        // RGBA f32 while decoding, RGB f32 after: room for both.
+        limits.max_alloc = Some(u64::from(w) * u64::from(h) * 32);
+        reader.limits(limits);
         // `exr` is young: its B44 decoder panics on some damaged files. That is this file's
         // error, not the app's end.
         let img = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))

@@ -3,7 +3,8 @@
 //! What a phantogram shows, on the CPU: triangle meshes with metallic–roughness materials and
 //! textures in the device frame ([`model`], with the glTF 2.0 loader: Draco, quantized meshes,
 //! Smithsonian Voyager scenes), the procedural default artifact ([`artifact`]), and the image-based
-//! light's environments and precomputed tables ([`ibl`]). No GPU: the renderer uploads what this
+//! light's environments and precomputed tables ([`ibl`]), within one resource budget checked
+//! before anything is allocated ([`budget`]). No GPU: the renderer uploads what this
 //! crate makes. Frames and units are `phantogram_geometry`'s.
 //!
 //! ## Dependencies (and why each)
@@ -21,6 +22,7 @@
 //! ([`model::ModelError`], [`ibl::EnvironmentError`]).
 
 pub mod artifact;
+pub mod budget;
 mod exr_guard;
 pub mod ibl;
 pub mod model;

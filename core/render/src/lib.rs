@@ -94,6 +94,16 @@ pub enum RenderError {
     Device(String),
     #[error("frame size {width}×{height} is not supported (1 to {max} pixels per side)")]
     BadSize { width: u32, height: u32, max: u32 },
+    /// An offscreen frame is read back through one buffer, whose size the device limits.
+    #[error(
+        "frame size {width}×{height} needs a {bytes}-byte read-back buffer, over this GPU's limit of {max_bytes} bytes"
+    )]
+    FrameTooLarge {
+        width: u32,
+        height: u32,
+        bytes: u64,
+        max_bytes: u64,
+    },
     #[error("the model has nothing to draw")]
     EmptyModel,
     #[error("the GPU rejected {what}: {message}")]
@@ -262,6 +272,12 @@ struct Offscreen {
 }
 
 impl Offscreen {
+    /// Bytes per row of the read-back buffer: RGBA8, padded to wgpu's copy alignment.
+    fn padded_row(width: u32) -> u64 {
+        let align = u64::from(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+        (u64::from(width) * 4).div_ceil(align) * align
+    }
+
     fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
         let output = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("output"),
@@ -278,10 +294,11 @@ impl Offscreen {
             view_formats: &[],
         });
         let output_view = output.create_view(&Default::default());
-        let padded_row = (width * 4).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+        // At most 4 × max_texture_dimension_2d, checked before (`targets`).
+        let padded_row = Self::padded_row(width) as u32;
         let readback = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
-            size: padded_row as u64 * height as u64,
+            size: u64::from(padded_row) * u64::from(height),
             usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
             mapped_at_creation: false,
         });
@@ -1041,6 +1058,16 @@ impl Renderer {
         height: u32,
         overlay: Option<impl FnOnce(&Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2])>,
     ) -> Result<Vec<u8>, RenderError> {
+        let bytes = Offscreen::padded_row(width) * u64::from(height);
+        let max_bytes = self.gpu.device.limits().max_buffer_size;
+        if bytes > max_bytes {
+            return Err(RenderError::FrameTooLarge {
+                width,
+                height,
+                bytes,
+                max_bytes,
+            });
+        }
         self.targets(width, height)?;
         let device = self.gpu.device.clone();
         let targets = self.targets.as_mut().expect("created above");

@@ -230,27 +230,40 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
             }
         })
         .collect();
-    let primitives = model
-        .primitives
-        .iter()
-        .filter(|p| !p.mesh.indices.is_empty())
-        .map(|p| GpuPrimitive {
-            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("vertices"),
-                contents: bytemuck::cast_slice(&p.mesh.vertices),
-                usage: wgpu::BufferUsages::VERTEX,
-            }),
-            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("indices"),
-                contents: bytemuck::cast_slice(&p.mesh.indices),
-                usage: wgpu::BufferUsages::INDEX,
-            }),
-            index_count: p.mesh.indices.len() as u32,
-            material: p.material.min(model.materials.len().saturating_sub(1)),
-            centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
-            is_floor: p.is_floor,
-        })
-        .collect();
+    // A mesh larger than one buffer (the device's `max_buffer_size`) is drawn in pieces.
+    let max_bytes = device.limits().max_buffer_size;
+    let max_vertices = (max_bytes / std::mem::size_of::<phantogram_assets::model::Vertex>() as u64) as usize;
+    let max_indices = (max_bytes / 4) as usize;
+    let piece = |p: &phantogram_assets::model::Primitive, mesh: &phantogram_assets::model::Mesh| GpuPrimitive {
+        vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("vertices"),
+            contents: bytemuck::cast_slice(&mesh.vertices),
+            usage: wgpu::BufferUsages::VERTEX,
+        }),
+        indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("indices"),
+            contents: bytemuck::cast_slice(&mesh.indices),
+            usage: wgpu::BufferUsages::INDEX,
+        }),
+        index_count: mesh.indices.len() as u32,
+        material: p.material.min(model.materials.len().saturating_sub(1)),
+        // The whole primitive's centre, for the transparent pieces' back-to-front order.
+        centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
+        is_floor: p.is_floor,
+    };
+    let mut primitives = Vec::new();
+    for p in model.primitives.iter().filter(|p| !p.mesh.indices.is_empty()) {
+        if p.mesh.vertices.len() <= max_vertices && p.mesh.indices.len() <= max_indices {
+            primitives.push(piece(p, &p.mesh));
+        } else {
+            primitives.extend(
+                p.mesh
+                    .split_to_fit(max_vertices, max_indices)
+                    .iter()
+                    .map(|m| piece(p, m)),
+            );
+        }
+    }
     let fallback = phantogram_geometry::containment::Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05));
     let bounds = model.bounds().unwrap_or(fallback);
     let standing = model.bounds_of(|p| !p.is_floor).unwrap_or(bounds);

@@ -10,10 +10,15 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use super::*;
+use crate::budget::{OverBudget, ResourceBudget, Spending};
+use phantogram_files::text::excerpt;
 
-/// Most values an accessor without a `bufferView` (all zeros, or sparse) may expand to:
-/// 2²⁶ `f32`s, 256 MiB, several times the largest scan we load.
-const MAX_ZERO_FILLED_VALUES: usize = 1 << 26;
+/// Largest Voyager scene read: its JSON lists derivatives and annotations, kilobytes in practice.
+const MAX_SCENE_BYTES: u64 = 16 << 20;
+
+/// Largest coordinate a vertex may have, in the model's units after its node transforms: beyond
+/// it (or non-finite) the bounds and the fit to the screen overflow, and the frame is blank.
+pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load.
 pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
@@ -44,17 +49,54 @@ pub enum ModelError {
     },
     #[error("{}: no triangles to draw", path.display())]
     Empty { path: PathBuf },
+    /// The file asks for more than the device's [`ResourceBudget`] allows.
+    #[error("{}: {error}", path.display())]
+    OverBudget { path: PathBuf, error: OverBudget },
+    /// A Voyager scene (`*.svx.json`) that cannot be read as one.
+    #[error("{}: not a valid Voyager scene: {message}", path.display())]
+    Scene { path: PathBuf, message: String },
     /// A folder or a Voyager scene that names no model file this loader can open.
     #[error("{}: {message}", path.display())]
     NotAModel { path: PathBuf, message: String },
 }
 
+/// The bytes of a buffer view, checked against its buffer.
+fn view_bytes_of<'b>(path: &Path, buffers: &'b [Vec<u8>], view: &gltf::buffer::View) -> Result<&'b [u8], ModelError> {
+    let data = |message: &str| ModelError::Data {
+        path: path.to_path_buf(),
+        what: format!("bufferView {}", view.index()),
+        message: message.to_owned(),
+    };
+    let buf = buffers
+        .get(view.buffer().index())
+        .ok_or_else(|| data("buffer missing"))?;
+    let end = view.offset().checked_add(view.length());
+    end.and_then(|end| buf.get(view.offset()..end))
+        .ok_or_else(|| data("extends past the end of its buffer"))
+}
+
 struct Ctx<'a> {
     path: &'a Path,
     buffers: Vec<Vec<u8>>,
+    spending: std::cell::RefCell<Spending>,
 }
 
 impl Ctx<'_> {
+    fn over_budget(&self, error: OverBudget) -> ModelError {
+        ModelError::OverBudget {
+            path: self.path.to_path_buf(),
+            error,
+        }
+    }
+
+    /// Fails unless a transient buffer of `bytes` fits what is left of the budget.
+    fn check_bytes(&self, what: impl FnOnce() -> String, bytes: u64) -> Result<(), ModelError> {
+        self.spending
+            .borrow()
+            .check_bytes(what, bytes)
+            .map_err(|e| self.over_budget(e))
+    }
+
     fn data(&self, what: impl Into<String>, message: impl Into<String>) -> ModelError {
         ModelError::Data {
             path: self.path.to_path_buf(),
@@ -64,17 +106,7 @@ impl Ctx<'_> {
     }
 
     fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8], ModelError> {
-        let buf = self
-            .buffers
-            .get(view.buffer().index())
-            .ok_or_else(|| self.data(format!("bufferView {}", view.index()), "buffer missing"))?;
-        let end = view.offset().checked_add(view.length());
-        end.and_then(|end| buf.get(view.offset()..end)).ok_or_else(|| {
-            self.data(
-                format!("bufferView {}", view.index()),
-                "extends past the end of its buffer",
-            )
-        })
+        view_bytes_of(self.path, &self.buffers, view)
     }
 
     /// Reads an accessor as `f32` rows of `n` components (normalised integers mapped to
@@ -133,14 +165,12 @@ impl Ctx<'_> {
                 Some((bytes, stride))
             }
             // No data in the file: zeros (plus any sparse values), so the count alone sizes
-            // the output; bound it to what a phone could hold.
-            None if count.saturating_mul(n) > MAX_ZERO_FILLED_VALUES => {
-                return Err(self.data(what(), format!("{count} elements without a bufferView")));
-            }
+            // the output, checked against the budget below.
             None => None,
         };
         // Every size was checked before this allocation: a damaged count must give an
         // error, not an allocation failure (which aborts rather than unwinds).
+        self.check_bytes(what, (count as u64).saturating_mul(n as u64 * 4))?;
         let mut out = vec![0.0f32; count * n];
         if let Some((bytes, stride)) = data {
             let start = accessor.offset();
@@ -152,6 +182,10 @@ impl Ctx<'_> {
             }
         }
         if let Some(sparse) = accessor.sparse() {
+            if sparse.count() == 0 {
+                // glTF 2.0: `accessor.sparse.count` is at least 1.
+                return Err(self.data(what(), "sparse with a count of 0"));
+            }
             let idx_view = sparse.indices().view();
             let idx_bytes = self.view_bytes(&idx_view)?;
             let idx_size = match sparse.indices().index_type() {
@@ -229,6 +263,15 @@ fn check_structure(root: &gltf::json::Root) -> Result<(), String> {
             }
         }
     }
+    // gltf-rs's `Image::source` unwraps these two (glTF 2.0 requires them; its validation does
+    // not check them): found by fuzzing.
+    for (i, image) in root.images.iter().enumerate() {
+        match (&image.buffer_view, &image.uri, &image.mime_type) {
+            (Some(_), _, None) => return Err(format!("images[{i}]: a bufferView without a mimeType")),
+            (None, None, _) => return Err(format!("images[{i}]: neither a uri nor a bufferView")),
+            _ => {}
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path().to_string();
@@ -256,34 +299,87 @@ fn data_uri(uri: &str) -> Option<Result<Vec<u8>, base64::DecodeError>> {
     Some(base64::engine::general_purpose::STANDARD.decode(payload))
 }
 
-fn load_uri(path: &Path, uri: &str) -> Result<Vec<u8>, ModelError> {
+/// The bytes a buffer or image `uri` names: a `data:` URI, or a file inside the model's folder
+/// ([`resolve_inside`]), at most `max_bytes` of it.
+fn load_uri(path: &Path, uri: &str, max_bytes: u64) -> Result<Vec<u8>, ModelError> {
     if let Some(decoded) = data_uri(uri) {
         return decoded.map_err(|e| ModelError::Parse {
             path: path.to_path_buf(),
             message: format!("bad data URI: {e}"),
         });
     }
-    let file = path.parent().unwrap_or(Path::new(".")).join(percent_decode(uri));
-    std::fs::read(&file).map_err(|error| ModelError::Io { path: file, error })
+    let folder = path
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let file = resolve_inside(folder, uri).map_err(|message| ModelError::Data {
+        path: path.to_path_buf(),
+        what: format!("URI {}", excerpt(uri)),
+        message,
+    })?;
+    phantogram_files::read_regular_file(&file, max_bytes).map_err(|error| ModelError::Io { path: file, error })
 }
 
-fn percent_decode(uri: &str) -> String {
+/// Where a relative URI points inside `folder`, or why it may not be followed.
+///
+/// A model may name files only in its own folder and the folders below it: no scheme
+/// (`file:`, `http:`), no absolute path, no `..` (also percent-encoded, `%2e%2e`), no symbolic
+/// link leading out. A downloaded model could otherwise read whatever the app may read (its
+/// private files on a phone, `/etc/passwd`, `/dev/zero`). Regular files only: checked by the
+/// read, [`phantogram_files::read_regular_file`].
+pub fn resolve_inside(folder: &Path, uri: &str) -> Result<PathBuf, String> {
+    let scheme_len = uri.find(':').filter(|&i| {
+        i > 0
+            && uri[..i]
+                .bytes()
+                .all(|b| b.is_ascii_alphanumeric() || b"+-.".contains(&b))
+    });
+    if scheme_len.is_some() {
+        return Err("names another location (a URI scheme); only files beside the model are read".into());
+    }
+    let decoded = percent_decode(uri).ok_or("is not valid percent-encoded UTF-8")?;
+    if decoded.contains(['\0', '\\']) {
+        return Err("holds a NUL or a backslash, which no portable file name has".into());
+    }
+    let relative = Path::new(&decoded);
+    if !relative
+        .components()
+        .all(|c| matches!(c, std::path::Component::Normal(_) | std::path::Component::CurDir))
+    {
+        return Err(
+            "leaves the model's folder (an absolute path or `..`); only files beside the model are read".into(),
+        );
+    }
+    let base = std::fs::canonicalize(folder).map_err(|e| format!("the model's folder: {e}"))?;
+    let resolved = std::fs::canonicalize(base.join(relative)).map_err(|e| e.to_string())?;
+    if !resolved.starts_with(&base) {
+        return Err("is a link leading out of the model's folder; only files beside the model are read".into());
+    }
+    Ok(resolved)
+}
+
+/// RFC 3986 percent-decoding; `None` when the result is not UTF-8. A `%` not followed by two
+/// hex digits stays as it is (file names in the wild hold a bare `%`).
+fn percent_decode(uri: &str) -> Option<String> {
     let bytes = uri.as_bytes();
+    let hex = |b: u8| (b as char).to_digit(16);
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;
     while i < bytes.len() {
         if bytes[i] == b'%'
-            && i + 2 < bytes.len()
-            && let Ok(v) = u8::from_str_radix(&uri[i + 1..i + 3], 16)
+            && let (Some(hi), Some(lo)) = (
+                bytes.get(i + 1).copied().and_then(hex),
+                bytes.get(i + 2).copied().and_then(hex),
+            )
         {
-            out.push(v);
+            out.push((hi * 16 + lo) as u8);
             i += 3;
             continue;
         }
         out.push(bytes[i]);
         i += 1;
     }
-    String::from_utf8_lossy(&out).into_owned()
+    String::from_utf8(out).ok()
 }
 
 fn sampler_of(t: &gltf::Texture) -> Sampler {
@@ -408,9 +504,50 @@ struct Attributes {
     indices: Option<Vec<u32>>,
 }
 
+/// The shapes glTF 2.0 allows each attribute we read ("Meshes", attribute table): a `NORMAL`
+/// pointing at an index accessor, or a scalar `COLOR_0`, is a damaged file, not data to reshape.
+fn allowed_dimensions(semantic: &gltf::Semantic) -> &'static [Dimensions] {
+    use gltf::Semantic;
+    match semantic {
+        Semantic::Positions | Semantic::Normals => &[Dimensions::Vec3],
+        Semantic::Tangents => &[Dimensions::Vec4],
+        Semantic::TexCoords(_) => &[Dimensions::Vec2],
+        Semantic::Colors(_) => &[Dimensions::Vec3, Dimensions::Vec4],
+        _ => &[
+            Dimensions::Scalar,
+            Dimensions::Vec2,
+            Dimensions::Vec3,
+            Dimensions::Vec4,
+            Dimensions::Mat2,
+            Dimensions::Mat3,
+            Dimensions::Mat4,
+        ],
+    }
+}
+
 fn read_plain(ctx: &Ctx, prim: &gltf::Primitive) -> Result<Attributes, ModelError> {
     use gltf::Semantic;
     let mut a = Attributes::default();
+    let what = || format!("mesh primitive {}", prim.index());
+    for (semantic, accessor) in prim.attributes() {
+        let allowed = allowed_dimensions(&semantic);
+        if !allowed.contains(&accessor.dimensions()) {
+            return Err(ctx.data(
+                what(),
+                format!(
+                    "attribute {} is a {:?} accessor (accessor {}); glTF allows {allowed:?}",
+                    semantic.to_string(),
+                    accessor.dimensions(),
+                    accessor.index()
+                ),
+            ));
+        }
+    }
+    // The vertices and indices this primitive will become, before any is read.
+    let count = |a: Option<gltf::Accessor>| a.map_or(0, |a| a.count() as u64);
+    let vertices = count(prim.get(&Semantic::Positions));
+    let indices = prim.indices().map_or(vertices, |i| i.count() as u64);
+    ctx.check_bytes(what, ResourceBudget::mesh_bytes(vertices, indices))?;
     for (semantic, accessor) in prim.attributes() {
         match semantic {
             Semantic::Positions => a.positions = ctx.read_f32(&accessor, 3)?,
@@ -602,8 +739,8 @@ fn smooth_normals(mesh: &mut Mesh) {
 /// this file, or it cannot be read (the model then loads as stored).
 pub fn voyager_rotation(model_path: &Path) -> Option<Quat> {
     let file_name = model_path.file_name()?.to_str()?;
-    let text = std::fs::read_to_string(model_path.parent()?.join("scene.svx.json")).ok()?;
-    let scene: serde_json::Value = serde_json::from_str(&text).ok()?;
+    let text = phantogram_files::read_regular_file(&model_path.parent()?.join(VOYAGER_SCENE), MAX_SCENE_BYTES).ok()?;
+    let scene: serde_json::Value = serde_json::from_slice(&text).ok()?;
     let (model, _, _) = voyager_assets(&scene).find(|(_, _, uri)| *uri == file_name)?;
     let r: Vec<f32> = model
         .get("rotation")?
@@ -663,7 +800,7 @@ pub fn voyager_scan(scene_or_folder: &Path) -> Result<PathBuf, ModelError> {
         path: scene_or_folder.to_path_buf(),
         message,
     };
-    let text = std::fs::read_to_string(&scene_path).map_err(|error| {
+    let text = phantogram_files::read_regular_file(&scene_path, MAX_SCENE_BYTES).map_err(|error| {
         if scene_or_folder.is_dir() && error.kind() == std::io::ErrorKind::NotFound {
             not_a_model(format!(
                 "a folder without a Voyager scene ({VOYAGER_SCENE}): give the .gltf or .glb file"
@@ -675,7 +812,7 @@ pub fn voyager_scan(scene_or_folder: &Path) -> Result<PathBuf, ModelError> {
             }
         }
     })?;
-    let scene: serde_json::Value = serde_json::from_str(&text).map_err(|e| ModelError::Parse {
+    let scene: serde_json::Value = serde_json::from_slice(&text).map_err(|e| ModelError::Scene {
         path: scene_path.clone(),
         message: e.to_string(),
     })?;
@@ -714,7 +851,17 @@ pub fn voyager_scan(scene_or_folder: &Path) -> Result<PathBuf, ModelError> {
 /// Voyager scene beside the file, if any ([`voyager_rotation`]). `path` may also be a Voyager
 /// scene or a folder holding one: its best scan present is loaded ([`voyager_scan`]).
 pub fn load_model(path: &Path) -> Result<Model, ModelError> {
-    let is_scene = path.is_dir() || path.file_name().is_some_and(|n| n == VOYAGER_SCENE);
+    load_model_within(path, ResourceBudget::default())
+}
+
+/// [`load_model`] within `budget` (module docs of [`crate::budget`]).
+pub fn load_model_within(path: &Path, budget: ResourceBudget) -> Result<Model, ModelError> {
+    // Any `*.svx.json` is a Voyager scene (downloads rename them), never a glTF file.
+    let is_scene = path.is_dir()
+        || path
+            .file_name()
+            .and_then(|n| n.to_str())
+            .is_some_and(|n| n.to_ascii_lowercase().ends_with(".svx.json"));
     let scan;
     let path = if is_scene {
         scan = voyager_scan(path)?;
@@ -722,7 +869,7 @@ pub fn load_model(path: &Path) -> Result<Model, ModelError> {
     } else {
         path
     };
-    let mut model = load_gltf(path)?;
+    let mut model = load_gltf_within(path, budget)?;
     if let Some(q) = voyager_rotation(path) {
         model.transform(Mat4::from_quat(q));
         model
@@ -734,7 +881,13 @@ pub fn load_model(path: &Path) -> Result<Model, ModelError> {
 
 /// Loads a `.gltf` or `.glb` file, in the file's own frame.
 pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
-    let bytes = std::fs::read(path).map_err(|error| ModelError::Io {
+    load_gltf_within(path, ResourceBudget::default())
+}
+
+/// [`load_gltf`] within `budget` (module docs of [`crate::budget`]).
+pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, ModelError> {
+    let mut spending = Spending::new(budget);
+    let bytes = phantogram_files::read_regular_file(path, budget.memory_bytes).map_err(|error| ModelError::Io {
         path: path.to_path_buf(),
         error,
     })?;
@@ -769,7 +922,7 @@ pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
                 path: path.to_path_buf(),
                 message: "buffer refers to a GLB binary chunk that is missing".into(),
             })?,
-            gltf::buffer::Source::Uri(uri) => load_uri(path, uri)?,
+            gltf::buffer::Source::Uri(uri) => load_uri(path, uri, budget.memory_bytes)?,
         };
         if data.len() < b.length() {
             return Err(ModelError::Parse {
@@ -784,34 +937,62 @@ pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
         }
         buffers.push(data);
     }
-    let ctx = Ctx { path, buffers };
     let views: Vec<gltf::buffer::View> = doc.views().collect();
+    let over_budget = |error| ModelError::OverBudget {
+        path: path.to_path_buf(),
+        error,
+    };
 
     // Read the encoded images in order, then decode them on every core (the largest part of
     // loading a textured scan); the first failure in file order is the one reported.
+    // Each image's size is read from its header and charged before any is decoded: twelve
+    // images naming one 8192² PNG are twelve textures.
     let mut encoded = Vec::new();
     for img in doc.images() {
+        let buffers = &buffers;
         let (raw, name): (Vec<u8>, String) = match img.source() {
             gltf::image::Source::View { view, .. } => {
-                (ctx.view_bytes(&view)?.to_vec(), format!("image {}", img.index()))
+                let bytes = view_bytes_of(path, buffers, &view)?;
+                (bytes.to_vec(), format!("image {}", img.index()))
             }
-            gltf::image::Source::Uri { uri, .. } => (load_uri(path, uri)?, uri.chars().take(60).collect()),
+            gltf::image::Source::Uri { uri, .. } => (load_uri(path, uri, budget.memory_bytes)?, excerpt(uri)),
         };
-        encoded.push((img.index(), raw, name));
-    }
-    let images = crate::parallel::map(&encoded, |(index, raw, name)| {
-        let what = || format!("image {index} ({name})");
+        let what = || format!("image {} ({name})", img.index());
+        let data_error = |message: String| ModelError::Data {
+            path: path.to_path_buf(),
+            what: what(),
+            message,
+        };
         // glTF images are PNG or JPEG; anything else (an EXR, say) is refused before a
         // decoder meant for other files sees it.
-        let format = match image::guess_format(raw) {
+        let format = match image::guess_format(&raw) {
             Ok(format @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => format,
-            Ok(other) => return Err((what(), format!("{other:?} data; glTF images must be PNG or JPEG"))),
-            Err(_) => return Err((what(), "neither PNG nor JPEG data".to_owned())),
+            Ok(other) => return Err(data_error(format!("{other:?} data; glTF images must be PNG or JPEG"))),
+            Err(_) => return Err(data_error("neither PNG nor JPEG data".to_owned())),
         };
+        let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&raw), format)
+            .into_dimensions()
+            .map_err(|e| data_error(e.to_string()))?;
+        spending.check_image(what, width, height).map_err(over_budget)?;
+        spending
+            .charge_bytes(what, ResourceBudget::texture_bytes(width, height))
+            .map_err(over_budget)?;
+        encoded.push((img.index(), raw, name, format, width, height));
+    }
+    let images = crate::parallel::map(&encoded, |(index, raw, name, format, width, height)| {
+        let what = || format!("image {index} ({name})");
+        let mut reader = image::ImageReader::with_format(std::io::Cursor::new(raw), *format);
+        // The header was checked; the decoder holds to it (a damaged stream claiming more
+        // fails instead of allocating).
+        let mut limits = image::Limits::default();
+        limits.max_image_width = Some(*width);
+        limits.max_image_height = Some(*height);
+        limits.max_alloc = Some(ResourceBudget::texture_bytes(*width, *height).saturating_mul(2));
+        reader.limits(limits);
         // A decoder panic on a damaged image is this file's error, not the app's end.
-        std::panic::catch_unwind(|| image::load_from_memory_with_format(raw, format))
+        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
             .map_err(|_| (what(), "the decoder failed on damaged data".to_owned()))?
-            .map(|decoded| decoded.to_rgba8())
+            .map(|decoded| decoded.into_rgba8())
             .map_err(|e| (what(), e.to_string()))
             .map(|decoded| Image {
                 name: name.clone(),
@@ -822,8 +1003,17 @@ pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
     })
     .into_iter()
     .collect::<Result<Vec<Image>, _>>()
-    .map_err(|(what, why)| ctx.data(what, why))?;
+    .map_err(|(what, message)| ModelError::Data {
+        path: path.to_path_buf(),
+        what,
+        message,
+    })?;
     drop(encoded); // the compressed copies are not needed while the meshes are built
+    let ctx = Ctx {
+        path,
+        buffers,
+        spending: std::cell::RefCell::new(spending),
+    };
 
     let mut warnings = Vec::new();
     let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m, &mut warnings)).collect();
@@ -869,6 +1059,10 @@ pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
         if let Some(mesh) = node.mesh() {
             for prim in mesh.primitives() {
                 let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
+                ctx.spending
+                    .borrow_mut()
+                    .charge_primitive(|| format!("{what} (in node {})", node.index()))
+                    .map_err(|e| ctx.over_budget(e))?;
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     model
                         .warnings
@@ -879,8 +1073,33 @@ pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
                     Some(ext) => read_draco(&ctx, &prim, ext, &views)?,
                     None => read_plain(&ctx, &prim)?,
                 };
+                // Draco's counts are known only now, once decoded.
+                let vertices = (attributes.positions.len() / 3) as u64;
+                let indices = attributes.indices.as_ref().map_or(vertices, |i| i.len() as u64);
+                ctx.check_bytes(|| what.clone(), ResourceBudget::mesh_bytes(vertices, indices))?;
                 let mut m = assemble(&ctx, attributes, &what)?;
                 m.transform(world);
+                // Checked after the node transforms, which can overflow finite positions too.
+                if let Some((i, v)) = m
+                    .vertices
+                    .iter()
+                    .enumerate()
+                    .find(|(_, v)| !v.position.iter().all(|c| c.is_finite() && c.abs() <= MAX_COORDINATE))
+                {
+                    return Err(ctx.data(
+                        what,
+                        format!(
+                            "vertex {i} lies at {:?}, not a finite position within ±{MAX_COORDINATE:e} (in node {})",
+                            v.position,
+                            node.index()
+                        ),
+                    ));
+                }
+                let bytes = ResourceBudget::mesh_bytes(m.vertices.len() as u64, m.indices.len() as u64);
+                ctx.spending
+                    .borrow_mut()
+                    .charge_bytes(|| format!("{what} (in node {})", node.index()), bytes)
+                    .map_err(|e| ctx.over_budget(e))?;
                 model.primitives.push(Primitive {
                     mesh: m,
                     material: prim.material().index().unwrap_or(default_material),

@@ -460,9 +460,13 @@ impl Model {
     }
 }
 
-pub use loader::{ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_model, voyager_rotation, voyager_scan};
+pub use loader::{
+    MAX_COORDINATE, ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_within, load_model, load_model_within,
+    resolve_inside, voyager_rotation, voyager_scan,
+};
 
 mod loader;
+mod split;
 
 #[cfg(test)]
 mod tests {
