@@ -18,6 +18,8 @@
 //!
 //! Plain data, no threads, no panics: events out of order or with unknown pointers are ignored.
 
+use phantogram_sensing::clock::elapsed_ns;
+
 /// What the shell reports for one pointer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TouchPhase {
@@ -135,7 +137,7 @@ impl Gestures {
                 && !self.sequence_moved
                 && !p.moved
                 && !self.long_press_fired
-                && t_ns - p.down_t_ns >= LONG_PRESS_NS =>
+                && elapsed_ns(p.down_t_ns, t_ns) >= LONG_PRESS_NS =>
             {
                 self.long_press_fired = true;
                 self.last_tap_ns = None;
@@ -188,7 +190,7 @@ impl Gestures {
                     return None;
                 }
                 // The whole sequence ended.
-                let duration = t_ns - self.sequence_start_ns;
+                let duration = elapsed_ns(self.sequence_start_ns, t_ns);
                 let tap = !self.sequence_moved && !self.long_press_fired && (0..=TAP_MAX_NS).contains(&duration);
                 if !tap {
                     self.last_tap_ns = None;
@@ -196,7 +198,9 @@ impl Gestures {
                 }
                 match self.sequence_max {
                     1 => match self.last_tap_ns.take() {
-                        Some(prev) if t_ns - prev <= DOUBLE_TAP_GAP_NS + TAP_MAX_NS => Some(Gesture::StraightOn),
+                        Some(prev) if elapsed_ns(prev, t_ns) <= DOUBLE_TAP_GAP_NS + TAP_MAX_NS => {
+                            Some(Gesture::StraightOn)
+                        }
                         _ => {
                             self.last_tap_ns = Some(t_ns);
                             None

@@ -13,12 +13,14 @@
 //! modules under their old paths (`phantogram::screen`, `phantogram::fusion`, …). Dependencies
 //! point down only (see `ARCHITECTURE.md`):
 //!
+//! * `phantogram_files`: [`files`] (regular files read within a size bound, files written whole
+//!   or not at all, untrusted text quoted as short excerpts).
 //! * `phantogram_geometry`: [`screen`], [`eyes`], [`projection`], [`viewpoint`], [`light`],
 //!   [`containment`], [`anaglyph`]. Its crate docs hold the frames-and-units contract every crate
 //!   uses.
 //! * `phantogram_sensing`: [`sensors`], [`lowpass`], [`attitude`], [`fusion`], [`eyetrack`],
-//!   [`calibration`], [`camera`], [`session`], [`synthetic`].
-//! * `phantogram_assets` (feature `models`): `model`, `artifact`, `ibl`, `parallel`.
+//!   [`calibration`], [`camera`], [`session`], [`synthetic`], [`clock`].
+//! * `phantogram_assets` (feature `models`): `model`, `artifact`, `ibl`, `parallel`, `budget`.
 //! * `phantogram_render` (feature `render`): `render` (the crate itself) and `surface`.
 //! * `phantogram_vision` (feature `face`): `face` (the crate itself).
 //! * `phantogram_ui` (feature `ui`): `calibration_ui` (the crate itself).
@@ -39,7 +41,7 @@
 //!
 //! ## Features and dependencies (and why each)
 //!
-//! * always: the geometry and sensing crates, `glam` for small-vector maths (the chosen stack),
+//! * always: the files, geometry and sensing crates, `glam` for small-vector maths (the chosen stack),
 //!   `thiserror` for error types.
 //! * `models`: `phantogram_assets` (gltf-rs, draco-core, MikkTSpace, image; see its docs).
 //! * `render` (implies `models`): `phantogram_render` (wgpu, the chosen stack) and [`engine`].
@@ -53,12 +55,15 @@
 //!   binary, `winit` (the chosen stack) for its window, `image` to write frames, `serde_json` for
 //!   `eval face --json`.
 
+pub use phantogram_files as files;
 pub use phantogram_geometry::{anaglyph, containment, eyes, light, projection, screen, viewpoint};
 pub use phantogram_sensing::storage::face_models_dir;
-pub use phantogram_sensing::{attitude, calibration, camera, eyetrack, fusion, lowpass, sensors, session, synthetic};
+pub use phantogram_sensing::{
+    attitude, calibration, camera, clock, eyetrack, fusion, lowpass, sensors, session, synthetic,
+};
 
 #[cfg(feature = "models")]
-pub use phantogram_assets::{artifact, ibl, model, parallel};
+pub use phantogram_assets::{artifact, budget, ibl, model, parallel};
 #[cfg(feature = "render")]
 pub use phantogram_render as render;
 #[cfg(feature = "render")]

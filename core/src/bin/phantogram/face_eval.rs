@@ -3,6 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
+
+use crate::output::outln;
 use phantogram::face::{CameraFrame, FaceModels, Intrinsics, PixelFormat, UprightImage};
 
 pub struct EvalFaceArgs<'a> {
@@ -19,7 +21,7 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
     };
     let models = FaceModels::load(&dir)?;
     if !args.json {
-        println!(
+        outln!(
             "# distances assume an 11.7 mm iris and, where the image's EXIF gives no 35 mm-equivalent focal length, a {:.0}° horizontal field of view (--hfov-deg)",
             args.hfov_deg
         );
@@ -74,7 +76,7 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
                     })
                 })
                 .collect();
-            println!(
+            outln!(
                 "{}",
                 serde_json::json!({ "image": path.display().to_string(), "faces": faces })
             );
@@ -82,12 +84,12 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
             let camera = focal_35mm.map_or(format!("{:.0}° assumed", args.hfov_deg), |f| {
                 format!("EXIF: {f:.0} mm (35 mm equivalent)")
             });
-            println!("{}: {} face(s) [{camera}]", path.display(), faces.len());
+            outln!("{}: {} face(s) [{camera}]", path.display(), faces.len());
             for (i, f) in faces.iter().enumerate() {
                 let distance = f
                     .distance_m(&intrinsics, None)
                     .map_or("-".to_owned(), |d| format!("{:.0} mm", d * 1000.0));
-                println!(
+                outln!(
                     "  face {}: left eye ({:.1}, {:.1}) px, right eye ({:.1}, {:.1}) px, iris {:.1} px, distance {distance}, confidence {:.2}",
                     i + 1,
                     f.left_eye_px.x,
@@ -110,7 +112,9 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
 /// 0xA405 in the Exif IFD).
 fn open_with_exif_focal(path: &Path) -> Result<(image::RgbaImage, Option<f32>)> {
     use image::ImageDecoder;
-    let reader = image::ImageReader::open(path)?.with_guessed_format()?;
+    // Regular files only: a pipe would block, a device never end.
+    let file = phantogram::files::open_regular_file(path)?;
+    let reader = image::ImageReader::new(std::io::BufReader::new(file)).with_guessed_format()?;
     // Photos: PNG or JPEG. The HDR and EXR decoders are built in for environments only.
     match reader.format() {
         Some(image::ImageFormat::Png | image::ImageFormat::Jpeg) => {}

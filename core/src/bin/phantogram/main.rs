@@ -12,15 +12,18 @@ use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
 mod face_eval;
+mod output;
 mod render_frames;
 mod scene;
 mod viewer;
 
+use output::outln;
 use scene::SceneArgs;
 
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use phantogram::attitude::{LowPassAttitude, OrientationEstimator};
+use phantogram::clock::elapsed_s;
 use phantogram::eyes::EyeModel;
 use phantogram::sensors::{SensorEvent, SensorKind};
 use phantogram::session::EstimatorChoice;
@@ -164,8 +167,9 @@ enum EvalWhat {
         /// "distance_mm", "confidence"}]}.
         #[arg(long)]
         json: bool,
-        /// The camera's horizontal field of view, degrees (images carry no intrinsics).
-        #[arg(long, default_value_t = 60.0)]
+        /// The camera's horizontal field of view, degrees (images carry no intrinsics), more
+        /// than 1 and less than 179.
+        #[arg(long, default_value_t = 60.0, value_parser = field_of_view_deg)]
         hfov_deg: f32,
         /// Folder with the ONNX models (default: where `cargo xtask models` puts them).
         #[arg(long)]
@@ -181,7 +185,11 @@ fn main() {
     if let Some(dir) = runtime_dir {
         let _ = std::fs::remove_dir_all(dir);
     }
-    if let Err(e) = result {
+    // Output cut short by a closed pipe is not a failure (see `output`).
+    let result = result.and_then(|()| output::flush().map_err(anyhow::Error::from));
+    if let Err(e) = result
+        && !output::is_broken_pipe(&e)
+    {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
@@ -246,7 +254,7 @@ fn run(cli: Cli) -> Result<()> {
             calibration,
         } => {
             let log = match log {
-                Some(path) => Some(open_events(&path)?.collect::<Result<Vec<_>, _>>()?),
+                Some(path) => Some(sensorlog::read_all(&path, open_events(&path)?)?),
                 None => None,
             };
             // The calibration is the user's, kept where the desktop tools keep it.
@@ -319,9 +327,13 @@ fn replay_command(
     flat_at_s: Option<f64>,
 ) -> Result<()> {
     if let Some(speed) = realtime
-        && !(speed.is_finite() && speed > 0.0)
+        && !Pace::SPEEDS.contains(&speed)
     {
-        bail!("--realtime must be a positive speed factor, got {speed}");
+        bail!(
+            "--realtime must be a speed factor from {} to {}, got {speed}",
+            Pace::SPEEDS.start(),
+            Pace::SPEEDS.end()
+        );
     }
     let mut config = SessionConfig::default();
     if let Some(tau_s) = tau_s {
@@ -350,7 +362,7 @@ fn replay_command(
     let mut write_error = None;
     let summary = replay(events, &mut session, interval_ns, pace, |session, t_ns, view| {
         let t0 = *t0.get_or_insert(t_ns);
-        let t_s = (t_ns - t0) as f64 * 1e-9;
+        let t_s = elapsed_s(t0, t_ns);
         // Takes effect from the next frame, as a tap on the phone would.
         if flat_pending.is_some_and(|at| t_s >= at) {
             flat_pending = None;
@@ -383,12 +395,11 @@ fn replay_command(
     if let Some(at) = flat_pending {
         bail!("--flat-at-s {at} is beyond the end of the log");
     }
-    if let Some(err) = write_error
-        && err.kind() != std::io::ErrorKind::BrokenPipe
-    {
+    // A closed pipe ends quietly in `main`; any other write error is reported.
+    if let Some(err) = write_error {
         return Err(err.into());
     }
-    out.flush().ok();
+    out.flush()?;
     let s = summary.stats;
     eprintln!(
         "{} events ({} accepted, {} rejected: {} non-finite, {} duplicate, {} backward and {} out-of-range time stamps), {} frames",
@@ -415,12 +426,12 @@ fn info_command(path: &std::path::Path) -> Result<()> {
         non_finite += u64::from(!e.is_finite());
         span[i] = Some(span[i].map_or((e.t_ns, e.t_ns), |(a, b)| (a.min(e.t_ns), b.max(e.t_ns))));
     }
-    println!("{:<20} {:>9} {:>10} {:>9}", "sensor", "events", "duration_s", "rate_hz");
+    outln!("{:<20} {:>9} {:>10} {:>9}", "sensor", "events", "duration_s", "rate_hz");
     for (i, kind) in SensorKind::ALL.iter().enumerate() {
         let Some((a, b)) = span[i] else { continue };
-        let dur = (b - a) as f64 * 1e-9;
+        let dur = elapsed_s(a, b);
         let rate = if dur > 0.0 { (counts[i] - 1) as f64 / dur } else { 0.0 };
-        println!(
+        outln!(
             "{:<20} {:>9} {:>10.3} {:>9.1}",
             format!("{kind:?}"),
             counts[i],
@@ -429,7 +440,7 @@ fn info_command(path: &std::path::Path) -> Result<()> {
         );
     }
     if non_finite > 0 {
-        println!("{non_finite} events hold NaN or infinite values");
+        outln!("{non_finite} events hold NaN or infinite values");
     }
     Ok(())
 }
@@ -509,9 +520,16 @@ fn eval_orientation_command(
             "      -".to_owned()
         }
     };
-    println!(
+    outln!(
         "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7}",
-        "trial", "estimator", "incl", "head", "total", "c.incl", "c.head", "ns/evt"
+        "trial",
+        "estimator",
+        "incl",
+        "head",
+        "total",
+        "c.incl",
+        "c.head",
+        "ns/evt"
     );
     // Per estimator: sums for the means, of the trials where each figure exists.
     #[derive(Default)]
@@ -551,7 +569,7 @@ fn eval_orientation_command(
             }
         }
         for s in scores {
-            println!(
+            outln!(
                 "{:<46} {:<28} {:>6} {:>6} {:>6} | {:>6} {:>6} | {:>7}",
                 trial.name,
                 s.estimator,
@@ -598,15 +616,19 @@ fn eval_orientation_command(
             add(&mut entry.head, s.main.heading_deg);
         }
     }
-    println!();
-    println!("means over trials (main rows: after the first {CONVERGENCE_S} s, movement phases where marked):");
-    println!(
+    outln!();
+    outln!("means over trials (main rows: after the first {CONVERGENCE_S} s, movement phases where marked):");
+    outln!(
         "{:<46} {:>7} {:>6} {:>6} {:>7}",
-        "estimator", "trials", "incl", "head", "ns/evt"
+        "estimator",
+        "trials",
+        "incl",
+        "head",
+        "ns/evt"
     );
     let mean = |(n, sum): (usize, f64)| (n > 0).then(|| sum / n as f64);
     for (key, s) in &sums {
-        println!(
+        outln!(
             "{key:<46} {:>7} {:>6} {:>6} {:>7}",
             s.trials,
             fmt(mean(s.incl)),
@@ -624,7 +646,7 @@ fn eval_orientation_command(
 }
 
 fn orientation_command(log: &std::path::Path, name: EstimatorName, tau_s: f32, csv: bool) -> Result<()> {
-    let events: Vec<SensorEvent> = open_events(log)?.collect::<Result<_, _>>()?;
+    let events: Vec<SensorEvent> = sensorlog::read_all(log, open_events(log)?)?;
     if matches!(name, EstimatorName::RotationVector) && !events.iter().any(|e| e.kind == SensorKind::RotationVector) {
         bail!(
             "{}: the log has no rotation vector (the platform's own orientation) to print",
@@ -700,6 +722,16 @@ fn seconds_into_log(text: &str) -> Result<f64, String> {
         Ok(s) if s.is_finite() && s >= 0.0 => Ok(s),
         _ => Err(format!(
             "expected a number of seconds from the start of the log, got {text:?}"
+        )),
+    }
+}
+
+/// `--hfov-deg`: a camera's horizontal field of view; 0° or 180° make no camera.
+fn field_of_view_deg(text: &str) -> Result<f32, String> {
+    match text.parse::<f32>() {
+        Ok(deg) if deg.is_finite() && deg > 1.0 && deg < 179.0 => Ok(deg),
+        _ => Err(format!(
+            "expected a field of view in degrees, more than 1 and less than 179, got {text:?}"
         )),
     }
 }

@@ -6,6 +6,7 @@ use std::path::Path;
 
 use anyhow::{Context, Result, bail};
 use phantogram::anaglyph::Method;
+use phantogram::clock::{elapsed_ns, elapsed_s};
 use phantogram::engine::Engine;
 use phantogram::sensors::{SensorEvent, SensorInbox};
 use phantogram::surface::DrawOutcome;
@@ -47,16 +48,19 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
             screen.height_px()
         );
     }
-    let events: Vec<SensorEvent> = crate::open_events(log)?.collect::<Result<_, _>>()?;
+    let events: Vec<SensorEvent> = phantogram_lab::sensorlog::read_all(log, crate::open_events(log)?)?;
     let (Some(first), Some(last)) = (events.first(), events.last()) else {
         bail!("{}: the log has no events", log.display());
     };
     let interval_ns = (every_ms * 1e6).round() as i64;
-    if let Some(at) = flat_at_s.filter(|at| *at > (last.t_ns - first.t_ns) as f64 * 1e-9) {
+    if let Some(at) = flat_at_s.filter(|at| *at > elapsed_s(first.t_ns, last.t_ns)) {
         // Known now, before any frame is drawn.
         bail!("--flat-at-s {at} is beyond the end of the log");
     }
-    let frames_expected = ((last.t_ns - first.t_ns) / interval_ns + 1).max(1) as u64;
+    // A progress bar's length only: gaps of more than a minute are skipped by the replay.
+    let frames_expected = (elapsed_ns(first.t_ns, last.t_ns) / interval_ns)
+        .saturating_add(1)
+        .max(1) as u64;
     let t0 = first.t_ns;
     if out_dir.exists() && !out_dir.is_dir() {
         bail!("--out {}: exists and is not a folder", out_dir.display());
@@ -64,7 +68,10 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     // The frames are the defaults' (no calibration file): reproducible on any machine.
     let mut engine = scene.engine(method, None)?;
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
-    remove_earlier_frames(out_dir)?;
+    // The frames go to a folder of their own inside `out_dir` and replace an earlier run's only
+    // once all are written: a run that fails (a GPU error, a full disk) leaves the earlier frames
+    // as they were, and never a truncated PNG among them.
+    let staging = Staging::create(out_dir)?;
     engine.resume_offscreen(width, height)?;
 
     let bar = indicatif::ProgressBar::new(frames_expected);
@@ -75,7 +82,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     let mut frames = Frames {
         inbox: engine.inbox(),
         engine,
-        out_dir,
+        out_dir: &staging.dir,
         index: 0,
         t0,
         flat_pending: flat_at_s,
@@ -97,6 +104,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         bail!("--flat-at-s {at} is beyond the end of the log");
     }
     let index = frames.index;
+    staging.commit(out_dir)?;
     eprintln!(
         "wrote {index} frame{} ({width}x{height}, {method}) to {}",
         if index == 1 { "" } else { "s" },
@@ -125,7 +133,7 @@ impl Replayed for Frames<'_> {
     }
 
     fn frame(&mut self, t_ns: i64) -> Result<()> {
-        if self.flat_pending.is_some_and(|at| (t_ns - self.t0) as f64 * 1e-9 >= at) {
+        if self.flat_pending.is_some_and(|at| elapsed_s(self.t0, t_ns) >= at) {
             self.flat_pending = None;
             self.engine
                 .calibrate_flat_angle()
@@ -133,15 +141,22 @@ impl Replayed for Frames<'_> {
         }
         if let DrawOutcome::Skipped(why) = self.engine.draw(Some(t_ns))? {
             // Never an old frame under a new name.
-            bail!(
-                "the frame at {:.3} s was not drawn ({why})",
-                (t_ns - self.t0) as f64 * 1e-9
-            );
+            bail!("the frame at {:.3} s was not drawn ({why})", elapsed_s(self.t0, t_ns));
         }
         let (width, height, pixels) = self.engine.last_frame()?;
-        let path = self.out_dir.join(format!("frame_{:05}.png", self.index));
-        image::save_buffer(&path, pixels, width, height, image::ExtendedColorType::Rgba8)
-            .with_context(|| format!("writing {}", path.display()))?;
+        let path = self.out_dir.join(frame_name(self.index));
+        let mut png = Vec::new();
+        image::write_buffer_with_format(
+            &mut std::io::Cursor::new(&mut png),
+            pixels,
+            width,
+            height,
+            image::ExtendedColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .context("encoding a frame as PNG")?;
+        // Checked writes (a full disk is an error here, not at the swap).
+        std::fs::write(&path, &png).with_context(|| format!("writing {}", path.display()))?;
         self.index += 1;
         self.bar.inc(1);
         Ok(())
@@ -159,15 +174,62 @@ fn parse_size(text: &str) -> Result<(u32, u32)> {
     }
 }
 
+fn frame_name(index: u64) -> String {
+    format!("frame_{index:05}.png")
+}
+
+/// Whether `name` is one `render` writes (`frame_NNNNN.png`).
+fn is_frame(name: &str) -> bool {
+    name.strip_prefix("frame_")
+        .and_then(|rest| rest.strip_suffix(".png"))
+        .is_some_and(|n| n.len() >= 5 && n.bytes().all(|b| b.is_ascii_digit()))
+}
+
+/// A run's frames while it renders: a hidden folder inside the output folder (the same file
+/// system, so that [`Staging::commit`] only renames), removed with whatever is in it unless
+/// committed.
+struct Staging {
+    dir: std::path::PathBuf,
+}
+
+impl Staging {
+    fn create(out_dir: &Path) -> Result<Self> {
+        let dir = out_dir.join(format!(".phantogram-render-{}", std::process::id()));
+        // A folder of that name is a crashed run's of the same process id: nothing to keep.
+        let _ = std::fs::remove_dir_all(&dir);
+        std::fs::create_dir(&dir).with_context(|| format!("creating {}", dir.display()))?;
+        Ok(Self { dir })
+    }
+
+    /// Puts the new frames in place of an earlier run's.
+    fn commit(&self, out_dir: &Path) -> Result<()> {
+        // Flushed to the disk before anything old goes.
+        for entry in std::fs::read_dir(&self.dir).with_context(|| format!("reading {}", self.dir.display()))? {
+            let path = entry.with_context(|| format!("reading {}", self.dir.display()))?.path();
+            std::fs::File::open(&path)
+                .and_then(|f| f.sync_all())
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+        remove_earlier_frames(out_dir)?;
+        for entry in std::fs::read_dir(&self.dir).with_context(|| format!("reading {}", self.dir.display()))? {
+            let entry = entry.with_context(|| format!("reading {}", self.dir.display()))?;
+            let to = out_dir.join(entry.file_name());
+            std::fs::rename(entry.path(), &to).with_context(|| format!("moving a frame to {}", to.display()))?;
+        }
+        Ok(())
+    }
+}
+
+impl Drop for Staging {
+    fn drop(&mut self) {
+        let _ = std::fs::remove_dir_all(&self.dir);
+    }
+}
+
 /// Removes the frames (`frame_NNNNN.png`, the names `render` writes) of an earlier run from
 /// `dir`: a shorter run would otherwise leave the old run's last frames after its own, and a
 /// video made of the folder would end with them. Other files are left alone.
 fn remove_earlier_frames(dir: &std::path::Path) -> Result<()> {
-    let is_frame = |name: &str| {
-        name.strip_prefix("frame_")
-            .and_then(|rest| rest.strip_suffix(".png"))
-            .is_some_and(|n| n.len() == 5 && n.bytes().all(|b| b.is_ascii_digit()))
-    };
     let mut removed = 0;
     for entry in std::fs::read_dir(dir).with_context(|| format!("reading {}", dir.display()))? {
         let path = entry.with_context(|| format!("reading {}", dir.display()))?.path();
