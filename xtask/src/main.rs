@@ -21,8 +21,13 @@
 //! * `android` — the native libraries for arm64-v8a, armeabi-v7a and x86_64 (cargo-ndk) and the
 //!   APK (Gradle), with the face models as assets; lists what is missing (SDK, NDK, cargo-ndk,
 //!   Rust targets, Gradle, JDK) and how to get it when it cannot build.
-//! * `ios` — the XCFramework of the C-ABI static library (macOS with Xcode only; says why
-//!   elsewhere).
+//! * `ios` — on macOS with Xcode, the XCFramework of the C-ABI static library (device and
+//!   simulator slices). Elsewhere, the device library alone (`aarch64-apple-ios`, built with clang
+//!   and no Apple SDK: a static library is never linked), its exports checked against
+//!   `ios/include/phantogram.h`; lists what is missing (Rust target, clang, llvm) when it cannot.
+//! * `fuzz [TARGET…] [--seconds N] [--record]` — the cargo-fuzz targets in `fuzz/`, seeded,
+//!   with a 1 GiB memory limit and 10 s per input, and a table of executions, coverage and
+//!   findings (`--record`: into `benchmarks/fuzz.md`); see `xtask/src/fuzz.rs`.
 //! * `header` — regenerate `ios/include/phantogram.h` with cbindgen (a test fails while stale).
 //! * `ci` — what `.ci/run` runs after installing packages: fmt check, clippy, the Android
 //!   type-check, the API docs, tests.
@@ -32,6 +37,7 @@ use std::process::Command;
 
 use anyhow::{Context, Result, bail};
 
+mod fuzz;
 mod phone;
 
 fn main() -> Result<()> {
@@ -48,6 +54,7 @@ fn main() -> Result<()> {
         ["android"] => phone::android(),
         ["ios"] => phone::ios(),
         ["header"] => phone::header(),
+        ["fuzz", rest @ ..] => fuzz::fuzz(rest),
         ["ci"] => {
             cargo(&["fmt", "--all", "--check"])?;
             cargo(&["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"])?;
@@ -66,7 +73,7 @@ fn main() -> Result<()> {
         }
         [] | ["help"] | ["--help"] => {
             println!(
-                "usage: cargo xtask <assets | bench core | bench render | bench face | bench orientation | models [--force] | android | ios | header | ci>"
+                "usage: cargo xtask <assets | bench core | bench render | bench face | bench orientation | models [--force] | android | ios | header | fuzz [TARGET…] [--seconds N] [--record] | ci>"
             );
             Ok(())
         }

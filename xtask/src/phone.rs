@@ -165,12 +165,7 @@ pub fn android() -> Result<()> {
 
 pub fn ios() -> Result<()> {
     if !cfg!(target_os = "macos") {
-        bail!(
-            "`cargo xtask ios` packs the core into an XCFramework with Xcode's `xcodebuild` and Apple's iOS SDKs, \
-             which exist only on macOS (this is {}). Here the C ABI is built and tested as the same static library \
-             instead: `cargo test -p phantogram-ios` (header check, a C program replaying a log, the stress test).",
-            std::env::consts::OS
-        );
+        return ios_device_library_elsewhere();
     }
     let root = workspace_root();
     let targets = installed_targets();
@@ -238,4 +233,119 @@ pub fn header() -> Result<()> {
         .current_dir(workspace_root()))?;
     println!("wrote ios/include/phantogram.h");
     Ok(())
+}
+
+/// Away from macOS: the device static library (`aarch64-apple-ios`), built with Debian's clang
+/// for tract's C kernels and an empty `SDKROOT` (a static library is archived, never linked, so
+/// no Apple SDK is needed), and its exported `pg_` functions checked against the header. What
+/// is left for macOS is the simulator slices, the XCFramework and the app.
+fn ios_device_library_elsewhere() -> Result<()> {
+    const TARGET: &str = "aarch64-apple-ios";
+    let root = workspace_root();
+    let mut missing = Vec::new();
+    if !installed_targets().iter().any(|t| t == TARGET) {
+        missing.push(format!("the Rust target: `rustup target add {TARGET}`"));
+    }
+    for (tool, package) in [("clang", "clang"), ("llvm-ar", "llvm"), ("llvm-nm", "llvm")] {
+        if !succeeds(tool, &["--version"]) {
+            missing.push(format!("`{tool}` (`apt-get install {package}`)"));
+        }
+    }
+    if !missing.is_empty() {
+        bail!(
+            "cannot build the iOS device library on {}; missing:\n  - {}",
+            std::env::consts::OS,
+            missing.join("\n  - ")
+        );
+    }
+    let sdkroot = root.join("target/empty-sdkroot");
+    std::fs::create_dir_all(&sdkroot).with_context(|| format!("creating {}", sdkroot.display()))?;
+    let var = TARGET.replace('-', "_");
+    let cargo_bin = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    println!("building the {TARGET} static library (release; tens of minutes on a small machine)");
+    run(Command::new(cargo_bin)
+        .args([
+            "build",
+            "--release",
+            "--lib",
+            "-p",
+            "phantogram-ios",
+            "--target",
+            TARGET,
+        ])
+        .env(format!("CC_{var}"), "clang")
+        .env(format!("CFLAGS_{var}"), "--target=arm64-apple-ios15.0")
+        .env(format!("AR_{var}"), "llvm-ar")
+        .env("SDKROOT", &sdkroot)
+        .current_dir(&root))?;
+    let lib = root.join("target").join(TARGET).join("release/libphantogram_ios.a");
+    let nm = Command::new("llvm-nm")
+        .args(["--extern-only", "--defined-only", "--format=just-symbols"])
+        .arg(&lib)
+        .output()
+        .with_context(|| format!("running llvm-nm on {}", lib.display()))?;
+    if !nm.status.success() {
+        bail!(
+            "llvm-nm failed on {}: {}",
+            lib.display(),
+            String::from_utf8_lossy(&nm.stderr)
+        );
+    }
+    // Mach-O prefixes C symbols with an underscore.
+    let exported: std::collections::BTreeSet<String> = String::from_utf8_lossy(&nm.stdout)
+        .lines()
+        .filter_map(|s| s.trim().strip_prefix("_pg_"))
+        .map(|s| format!("pg_{s}"))
+        .collect();
+    let header_path = root.join("ios/include/phantogram.h");
+    let header = std::fs::read_to_string(&header_path).with_context(|| format!("reading {}", header_path.display()))?;
+    let declared = header_functions(&header);
+    let absent: Vec<&String> = declared.difference(&exported).collect();
+    let undeclared: Vec<&String> = exported.difference(&declared).collect();
+    if !absent.is_empty() || !undeclared.is_empty() {
+        bail!(
+            "{} does not match {}:\n  declared but not exported: {absent:?}\n  exported but not declared: {undeclared:?}",
+            lib.display(),
+            header_path.display()
+        );
+    }
+    println!(
+        "built {} (Mach-O arm64): exports the header's {} functions.\n\
+         The simulator slices, the XCFramework and the app need macOS with Xcode: run `cargo xtask ios` there.",
+        lib.display(),
+        declared.len()
+    );
+    Ok(())
+}
+
+/// The names of the functions a C header declares with the `pg_` prefix (`pg_name(`).
+fn header_functions(header: &str) -> std::collections::BTreeSet<String> {
+    let mut names = std::collections::BTreeSet::new();
+    let mut rest = header;
+    while let Some(at) = rest.find("pg_") {
+        let before_ok = at == 0 || !rest.as_bytes()[at - 1].is_ascii_alphanumeric() && rest.as_bytes()[at - 1] != b'_';
+        let tail = &rest[at..];
+        let len = tail
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or(tail.len());
+        if before_ok && tail[len..].starts_with('(') {
+            names.insert(tail[..len].to_owned());
+        }
+        rest = &tail[len..];
+    }
+    names
+}
+
+#[cfg(test)]
+mod tests {
+    use super::header_functions;
+
+    #[test]
+    fn header_functions_are_the_called_pg_names() {
+        let header = "typedef struct pg_engine pg_engine;\n\
+                      pg_status pg_engine_new(const char *p, pg_engine **out);\n\
+                      void pg_engine_free(pg_engine *e);\n/* see xpg_not(a) */\n";
+        let names: Vec<String> = header_functions(header).into_iter().collect();
+        assert_eq!(names, ["pg_engine_free", "pg_engine_new"]);
+    }
 }

@@ -1,0 +1,136 @@
+//! Random call sequences through the C ABI (`ios/include/phantogram.h`), on one engine made at
+//! start: sensors with any time stamps and values, camera frames of any shape, touches, display
+//! and sensor-range changes, anaglyph names, offscreen lifecycles and draws, read-back into
+//! buffers of any size, stats and error messages. Every call returns a status; none panics,
+//! hangs or corrupts memory. (The JNI bridge drives the same `SharedEngine` and the same
+//! `Engine` calls; its argument conversion is covered by its JVM tests.)
+#![no_main]
+
+use std::ffi::CString;
+use std::sync::OnceLock;
+
+use libfuzzer_sys::fuzz_target;
+use phantogram_ios::ffi::*;
+
+/// The engine every input drives (creating one opens a GPU device: once per process).
+struct Handle(*mut PgEngine);
+// SAFETY: the C ABI allows every call but `pg_engine_destroy` from any thread; the handle is
+// never destroyed.
+unsafe impl Send for Handle {}
+// SAFETY: as above: the engine synchronises internally.
+unsafe impl Sync for Handle {}
+
+fn engine() -> *const PgEngine {
+    static ENGINE: OnceLock<Handle> = OnceLock::new();
+    ENGINE
+        .get_or_init(|| {
+            let mut engine = std::ptr::null_mut();
+            // SAFETY: null config (defaults), valid out pointer.
+            let status = unsafe { pg_engine_create(std::ptr::null(), &mut engine) };
+            assert_eq!(status, PgStatus::Ok, "no engine: is there a GPU adapter (lavapipe)?");
+            Handle(engine)
+        })
+        .0
+}
+
+/// Reads the input as typed fields; past its end, zeros.
+struct Bytes<'a>(&'a [u8]);
+
+impl Bytes<'_> {
+    fn take<const N: usize>(&mut self) -> [u8; N] {
+        let mut out = [0u8; N];
+        let n = N.min(self.0.len());
+        out[..n].copy_from_slice(&self.0[..n]);
+        self.0 = &self.0[n..];
+        out
+    }
+    fn u8(&mut self) -> u8 {
+        self.take::<1>()[0]
+    }
+    fn i32(&mut self) -> i32 {
+        i32::from_le_bytes(self.take())
+    }
+    fn i64(&mut self) -> i64 {
+        i64::from_le_bytes(self.take())
+    }
+    fn f32(&mut self) -> f32 {
+        f32::from_le_bytes(self.take())
+    }
+    fn f64(&mut self) -> f64 {
+        f64::from_le_bytes(self.take())
+    }
+    fn small(&mut self, max: u32) -> u32 {
+        u32::from(u16::from_le_bytes(self.take())) % (max + 1)
+    }
+}
+
+fuzz_target!(|data: &[u8]| {
+    let e = engine();
+    let mut b = Bytes(data);
+    let mut pixels = vec![0u8; 64 * 1024];
+    // At most 64 calls per input.
+    for _ in 0..64 {
+        if b.0.is_empty() {
+            break;
+        }
+        // SAFETY (every call): `e` is a live handle; pointers are null or valid for the sizes
+        // passed; strings are NUL-terminated.
+        unsafe {
+            match b.u8() % 16 {
+                0 => drop(pg_push_accelerometer(e, b.f64(), b.f64(), b.f64(), b.f64())),
+                1 => drop(pg_push_gyroscope(e, b.f64(), b.f64(), b.f64(), b.f64())),
+                2 => drop(pg_push_magnetometer(e, b.f64(), b.f64(), b.f64(), b.f64())),
+                3 => drop(pg_push_device_motion(e, b.f64(), b.f64(), b.f64(), b.f64(), b.f64())),
+                4 => drop(pg_push_sensor_si(e, b.i32(), b.i64(), b.f32(), b.f32(), b.f32())),
+                5 => {
+                    let (w, h) = (b.small(96), b.small(96));
+                    let stride = (w as usize + b.small(16) as usize).max(1);
+                    let luma = vec![b.u8(); stride * h as usize];
+                    drop(pg_camera_frame(
+                        e,
+                        luma.as_ptr(),
+                        w,
+                        h,
+                        stride,
+                        b.small(360),
+                        b.f32(),
+                        b.f32(),
+                        b.f32(),
+                        b.f32(),
+                        b.f64(),
+                    ));
+                }
+                6 => {
+                    let mut gesture = 0i32;
+                    drop(pg_touch(e, b.i32() % 5, b.i32() % 4, b.f32(), b.f32(), b.f64(), &mut gesture));
+                }
+                7 => drop(pg_set_display(e, b.small(4000), b.small(4000), b.f32(), b.f32(), b.i32() % 6)),
+                8 => drop(pg_set_sensor_ranges(e, b.f32(), b.f32())),
+                9 => {
+                    let name: Vec<u8> = (0..b.small(24)).map(|_| b.u8().max(1)).collect();
+                    let name = CString::new(name).expect("no NUL");
+                    drop(pg_set_anaglyph(e, name.as_ptr()));
+                }
+                10 => drop(pg_resume_offscreen(e, b.small(72), b.small(160))),
+                11 => drop(pg_resize(e, b.small(72), b.small(160))),
+                12 => drop(pg_suspend(e)),
+                13 => {
+                    let mut presented = 0u8;
+                    drop(pg_draw(e, b.f64(), &mut presented));
+                }
+                14 => {
+                    let capacity = (b.small(u16::MAX as u32) as usize).min(pixels.len());
+                    let (mut w, mut h) = (0u32, 0u32);
+                    drop(pg_read_frame(e, pixels.as_mut_ptr(), capacity, &mut w, &mut h));
+                }
+                _ => {
+                    let mut stats = std::mem::zeroed::<PgStats>();
+                    drop(pg_stats(e, &mut stats));
+                    let mut message = [0 as std::ffi::c_char; 64];
+                    let capacity = b.small(64) as usize;
+                    pg_last_error(message.as_mut_ptr(), capacity);
+                }
+            }
+        }
+    }
+});

@@ -1,0 +1,31 @@
+//! The glTF 2.0 / Voyager loader on any bytes, as a `.glb`, a `.gltf` or a `scene.svx.json`
+//! (by the first byte), beside a small valid buffer and PNG that URIs may name. Within the phone
+//! budget: an input may fail, never panic, hang or take more than the budget.
+#![no_main]
+
+#[path = "scratch.rs"]
+mod scratch;
+
+use libfuzzer_sys::fuzz_target;
+use phantogram_assets::budget::ResourceBudget;
+use phantogram_assets::model::load_model_within;
+
+fuzz_target!(|data: &[u8]| {
+    let dir = scratch::dir("gltf");
+    if !dir.join("tri.bin").exists() {
+        let tri: Vec<u8> = [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+            .iter()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        scratch::write(dir, "tri.bin", &tri);
+        // A 2×2 RGBA PNG (75 bytes, written by this project).
+        scratch::write(dir, "tex.png", include_bytes!("seeds/tex.png"));
+    }
+    let name = match data.first() {
+        Some(b'{') if data.windows(8).any(|w| w == b"\"models\"") => "scene.svx.json",
+        Some(b'{') => "model.gltf",
+        _ => "model.glb",
+    };
+    let path = scratch::write(dir, name, data);
+    let _ = load_model_within(&path, ResourceBudget::PHONE);
+});

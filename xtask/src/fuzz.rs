@@ -1,0 +1,375 @@
+//! `cargo xtask fuzz [TARGET…] [--seconds N] [--record]`: the cargo-fuzz targets in `fuzz/`, each
+//! seeded and run with the project's limits, and a table of what each run did.
+//!
+//! * Targets: `gltf` (models and Voyager scenes), `import` (every sensor-log importer), `replay`
+//!   (a log through a session), `calibration`, `environment` (HDR/EXR through the guards) and
+//!   `c_abi` (random call sequences through the C ABI; it links the whole engine and needs a
+//!   GPU adapter such as lavapipe). All of them when none is named.
+//! * Limits: resident memory 1 GiB (`-rss_limit_mb=1024`: an input that takes more is a
+//!   finding), 10 s per input (`-timeout=10`: an input that runs longer is a finding), each
+//!   target for `--seconds` (default 30).
+//! * Seeds: small inputs written here (valid files and the hostile cases that were once bugs),
+//!   plus, when `PHANTOGRAM_DATA` is set, the shared models, recordings and environments,
+//!   copied into the corpus folder under `target/fuzz/corpus/TARGET` (never into the
+//!   repository). The corpus grows across runs; findings go to `target/fuzz/artifacts/TARGET`.
+//! * Runs on the stable toolchain without a sanitizer (`--sanitizer none`): safe Rust needs none
+//!   to find panics, hangs and runaway memory. Needs `cargo install cargo-fuzz --locked`.
+//! * `--record` writes the table to `benchmarks/fuzz.md` with the command that made it.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use anyhow::{Context, Result, bail};
+
+use crate::workspace_root;
+
+/// (name, the longest input it is given, needs the `ffi` feature).
+const TARGETS: [(&str, usize, bool); 6] = [
+    ("gltf", 1 << 20, false),
+    ("import", 64 << 10, false),
+    ("replay", 64 << 10, false),
+    ("calibration", 4 << 10, false),
+    ("environment", 1 << 20, false),
+    ("c_abi", 4 << 10, true),
+];
+
+/// What one run did, from libFuzzer's final statistics.
+struct Outcome {
+    target: &'static str,
+    seconds: u64,
+    executions: u64,
+    coverage: u64,
+    corpus: u64,
+    peak_rss_mb: u64,
+    finding: Option<String>,
+}
+
+pub fn fuzz(args: &[&str]) -> Result<()> {
+    let mut seconds = 30u64;
+    let mut record = false;
+    let mut chosen = Vec::new();
+    let mut rest = args.iter();
+    while let Some(&arg) = rest.next() {
+        match arg {
+            "--seconds" => {
+                seconds = rest
+                    .next()
+                    .and_then(|s| s.parse().ok())
+                    .filter(|&s| s > 0)
+                    .context("--seconds needs a whole number of seconds, at least 1")?;
+            }
+            "--record" => record = true,
+            name => match TARGETS.iter().find(|t| t.0 == name) {
+                Some(t) => chosen.push(*t),
+                None => bail!(
+                    "unknown fuzz target {name:?}; the targets: {}",
+                    TARGETS.map(|t| t.0).join(", ")
+                ),
+            },
+        }
+    }
+    if chosen.is_empty() {
+        chosen = TARGETS.to_vec();
+    }
+    let version = Command::new("cargo").args(["fuzz", "--version"]).output();
+    if !version.is_ok_and(|o| o.status.success()) {
+        bail!("cargo-fuzz is not installed: `cargo install cargo-fuzz --locked` (about a minute)");
+    }
+    let root = workspace_root();
+    let mut outcomes = Vec::new();
+    for (target, max_len, ffi) in chosen {
+        let corpus = root.join("target/fuzz/corpus").join(target);
+        let artifacts = root.join("target/fuzz/artifacts").join(target);
+        std::fs::create_dir_all(&corpus).with_context(|| format!("creating {}", corpus.display()))?;
+        std::fs::create_dir_all(&artifacts).with_context(|| format!("creating {}", artifacts.display()))?;
+        seed(target, &corpus, max_len)?;
+        println!("fuzzing {target} for {seconds} s (corpus {})", corpus.display());
+        let mut command = Command::new("cargo");
+        command.args(["fuzz", "run", "--sanitizer", "none", "--release"]);
+        if ffi {
+            command.args(["--features", "ffi"]);
+        }
+        command
+            .arg(target)
+            .arg(&corpus)
+            .arg("--")
+            .arg(format!("-max_total_time={seconds}"))
+            .arg("-rss_limit_mb=1024")
+            .arg("-timeout=10")
+            .arg(format!("-max_len={max_len}"))
+            .arg("-print_final_stats=1")
+            .arg(format!("-artifact_prefix={}/", artifacts.display()))
+            .current_dir(&root);
+        let output = command
+            .output()
+            .with_context(|| format!("running cargo fuzz for {target}"))?;
+        let log = String::from_utf8_lossy(&output.stderr);
+        let stat = |name: &str| {
+            log.lines()
+                .find_map(|l| l.strip_prefix(&format!("stat::{name}:")))
+                .and_then(|v| v.trim().parse::<u64>().ok())
+        };
+        // The last progress line: `#N  DONE  cov: C ft: F corp: K/…`.
+        let field = |name: &str| {
+            log.lines().rev().find_map(|l| {
+                l.split(name)
+                    .nth(1)?
+                    .split_whitespace()
+                    .next()?
+                    .split('/')
+                    .next()?
+                    .parse()
+                    .ok()
+            })
+        };
+        let finding = (!output.status.success()).then(|| {
+            log.lines()
+                .find(|l| l.contains("Test unit written to") || l.contains("panicked at"))
+                .unwrap_or("the run failed; see its log")
+                .trim()
+                .to_owned()
+        });
+        if let Some(f) = &finding {
+            // The whole log, for the one that failed.
+            eprintln!("{log}");
+            eprintln!("{target}: FINDING: {f}");
+        }
+        let Some(executions) = stat("number_of_executed_units") else {
+            bail!("{target}: no statistics from libFuzzer (did it build?):\n{log}");
+        };
+        outcomes.push(Outcome {
+            target,
+            seconds,
+            executions,
+            coverage: field("cov: ").unwrap_or(0),
+            corpus: field("corp: ").unwrap_or(0),
+            peak_rss_mb: stat("peak_rss_mb").unwrap_or(0),
+            finding,
+        });
+    }
+    let table = table(&outcomes);
+    println!("{table}");
+    if record {
+        let command = format!(
+            "cargo xtask fuzz {}--seconds {seconds}",
+            args.iter()
+                .filter(|a| TARGETS.iter().any(|t| t.0 == **a))
+                .map(|a| format!("{a} "))
+                .collect::<String>()
+        );
+        let text = format!(
+            "# Fuzzing\n\nMade by `{command} --record` (`PHANTOGRAM_DATA` set for the seeds), stable Rust, \
+             no sanitizer, 1 GiB RSS limit, 10 s per input, on this project's 2-core machine. \
+             Coverage is libFuzzer's `cov:` (edges reached); corpus, the inputs kept.\n\n{table}\n"
+        );
+        let path = root.join("benchmarks/fuzz.md");
+        std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
+        println!("wrote {}", path.display());
+    }
+    let found: Vec<&str> = outcomes
+        .iter()
+        .filter(|o| o.finding.is_some())
+        .map(|o| o.target)
+        .collect();
+    if !found.is_empty() {
+        bail!("findings in: {} (inputs under target/fuzz/artifacts)", found.join(", "));
+    }
+    Ok(())
+}
+
+fn table(outcomes: &[Outcome]) -> String {
+    let mut t = String::from(
+        "| target | seconds | executions | exec/s | coverage (edges) | corpus | peak RSS (MB) | findings |\n|---|---:|---:|---:|---:|---:|---:|---|\n",
+    );
+    for o in outcomes {
+        t += &format!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
+            o.target,
+            o.seconds,
+            o.executions,
+            o.executions / o.seconds.max(1),
+            o.coverage,
+            o.corpus,
+            o.peak_rss_mb,
+            o.finding.as_deref().unwrap_or("0")
+        );
+    }
+    t
+}
+
+/// Writes the target's seeds into its corpus folder (overwriting earlier seeds of the same name,
+/// leaving what the fuzzer added).
+fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
+    let put = |name: &str, bytes: &[u8]| -> Result<()> {
+        let bytes = &bytes[..bytes.len().min(max_len)];
+        std::fs::write(corpus.join(format!("seed-{name}")), bytes).with_context(|| format!("writing seed {name}"))
+    };
+    let data = std::env::var_os("PHANTOGRAM_DATA").map(PathBuf::from);
+    let shared = |sub: &str, extensions: &[&str]| -> Vec<PathBuf> {
+        let mut found = Vec::new();
+        if let Some(dir) = &data {
+            files_under(&dir.join(sub), &mut found);
+        }
+        found.retain(|p| {
+            let name = p.to_string_lossy().to_lowercase();
+            extensions.iter().any(|e| name.ends_with(e))
+        });
+        found.sort();
+        found
+    };
+    let seed_name = |p: &Path| p.to_string_lossy().replace(['/', ' '], "_");
+    let tri_gltf = r#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"tri.bin"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3","min":[0,0,0],"max":[1,1,0]}],"images":[{"uri":"tex.png"}],"textures":[{"source":0}],"materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}],"meshes":[{"primitives":[{"attributes":{"POSITION":0},"material":0}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}],"scene":0}"#;
+    match target {
+        "gltf" => {
+            put("triangle.gltf", tri_gltf.as_bytes())?;
+            put(
+                "outside.gltf",
+                tri_gltf.replace("tri.bin", "../../etc/passwd").as_bytes(),
+            )?;
+            put(
+                "zero-filled.gltf",
+                br#"{"asset":{"version":"2.0"},"accessors":[{"componentType":5126,"count":22000000,"type":"VEC3"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0}},{"attributes":{"POSITION":0}}]}],"nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]}"#,
+            )?;
+            put(
+                "scene.svx.json",
+                br#"{"models":[{"rotation":[0,0,0,1],"derivatives":[{"usage":"Web3D","quality":"High","assets":[{"uri":"model.glb"}]}]}]}"#,
+            )?;
+            put(
+                "triangle.glb",
+                &glb(tri_gltf.replace(r#","uri":"tri.bin""#, "").as_bytes(), &triangle_bin()),
+            )?;
+            for p in shared("models", &[".glb", ".gltf", ".svx.json"]) {
+                if std::fs::metadata(&p).is_ok_and(|m| m.len() as usize <= max_len) {
+                    put(&seed_name(&p), &std::fs::read(&p)?)?;
+                }
+            }
+        }
+        "import" => {
+            let log = b"phantogram-sensor-log 1\nmeta source seed\nacc 1000000 0 0 9.81\ngyr 2000000 0.1 0 0\nmag 3000000 20 0 -40\nrot 4000000 0 0 0 1\n";
+            put("log", &[&[0u8][..], log].concat())?;
+            put(
+                "broad",
+                &[&[1u8][..], b"t_s,acc_x,acc_y,acc_z,gyr_x,gyr_y,gyr_z,mag_x,mag_y,mag_z,gt_qw,gt_qx,gt_qy,gt_qz,movement\n0.01,0.1,0.2,9.8,0,0,0,20,0,-40,1,0,0,0,0\n0.02,0.1,0.2,9.8,0,0,0,20,0,-40,1,0,0,0,1\n"].concat(),
+            )?;
+            put(
+                "android-raw",
+                &[&[2u8][..], b"0.5 0 0 9.81\n0.51 0 0.1 9.8\n\0t_mocap_s,r00,r01,r02,r10,r11,r12,r20,r21,r22,up_x,up_y,up_z\n1.2,1,0,0,0,1,0,0,0,1,0,0,1\n"].concat(),
+            )?;
+            put(
+                "phyphox",
+                &[
+                    &[3u8][..],
+                    b"\"Time (s)\",\"X (m/s^2)\",\"Y (m/s^2)\",\"Z (m/s^2)\"\n0.5,0,0,9.81\n",
+                ]
+                .concat(),
+            )?;
+            put(
+                "sensor-logger",
+                &[&[4u8][..], b"time,seconds_elapsed,qz,qy,qx,qw\n1000,0,0,0,0,1\n"].concat(),
+            )?;
+            for p in shared("imu", &[".csv", ".csv.gz", ".txt", ".txt.gz", ".pglog", ".pglog.gz"]) {
+                let name = p.to_string_lossy().to_lowercase();
+                let layout = if name.ends_with(".pglog") || name.ends_with(".pglog.gz") {
+                    0
+                } else if name.contains("accelerometer.txt") {
+                    2
+                } else if name.contains("accelerometer.csv") {
+                    3
+                } else {
+                    1
+                };
+                let bytes = std::fs::read(&p)?;
+                put(
+                    &seed_name(&p),
+                    &[&[layout][..], &bytes[..bytes.len().min(max_len - 1)]].concat(),
+                )?;
+            }
+        }
+        "replay" => {
+            let log = std::fs::read(workspace_root().join("assets/logs/tilt-sweep.pglog"))
+                .context("reading the default log")?;
+            put("tilt-sweep", &log)?;
+            put(
+                "centuries",
+                b"phantogram-sensor-log 1\nacc -4611686018427387903 0 0 9.81\nacc 4611686018427387903 0 0 9.81\n",
+            )?;
+        }
+        "calibration" => {
+            put(
+                "full",
+                b"phantogram-calibration 1\nipd_m 0.064\nhead_offset_m 0.01 -0.02\nviewing_distance_m 0.3\ndensity_dpi 420 421\nflat_up_device 0 0.5 0.86\n",
+            )?;
+        }
+        "environment" => {
+            // A 4 × 2 Radiance HDR (flat scanlines: narrower than RLE's minimum of 8).
+            let mut hdr = b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 2 +X 4\n".to_vec();
+            for i in 0..8u8 {
+                hdr.extend([100 + i, 90, 80, 128]);
+            }
+            put("tiny.hdr", &hdr)?;
+            for p in shared("env", &[".hdr", ".exr"]) {
+                if std::fs::metadata(&p).is_ok_and(|m| m.len() as usize <= max_len) {
+                    put(&seed_name(&p), &std::fs::read(&p)?)?;
+                }
+            }
+        }
+        "c_abi" => {
+            // resume_offscreen 54×120, an accelerometer sample, a draw, a read-back, stats.
+            let mut calls = vec![10u8, 54, 0, 120, 0];
+            calls.push(0);
+            for v in [0.01f64, 0.0, 0.0, 9.81] {
+                calls.extend(v.to_le_bytes());
+            }
+            calls.push(13);
+            calls.extend(0.02f64.to_le_bytes());
+            calls.extend([14, 0xff, 0xff, 15]);
+            put("lifecycle", &calls)?;
+        }
+        _ => {}
+    }
+    Ok(())
+}
+
+fn files_under(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else { return };
+    for entry in entries.flatten() {
+        let path = entry.path();
+        if path.is_dir() {
+            files_under(&path, out);
+        } else {
+            out.push(path);
+        }
+    }
+}
+
+fn triangle_bin() -> Vec<u8> {
+    [0.0f32, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+        .iter()
+        .flat_map(|v| v.to_le_bytes())
+        .collect()
+}
+
+/// A GLB container: header, JSON chunk, BIN chunk (each padded to four bytes).
+fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
+    let pad = |b: &[u8], with: u8| {
+        let mut v = b.to_vec();
+        while !v.len().is_multiple_of(4) {
+            v.push(with);
+        }
+        v
+    };
+    let (json, bin) = (pad(json, b' '), pad(bin, 0));
+    // The buffer without a URI is the BIN chunk.
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut out = Vec::with_capacity(total);
+    out.extend(b"glTF");
+    out.extend(2u32.to_le_bytes());
+    out.extend((total as u32).to_le_bytes());
+    out.extend((json.len() as u32).to_le_bytes());
+    out.extend(b"JSON");
+    out.extend(&json);
+    out.extend((bin.len() as u32).to_le_bytes());
+    out.extend(b"BIN\0");
+    out.extend(&bin);
+    out
+}
