@@ -102,9 +102,24 @@ fuzz_target!(|data: &[u8]| {
                 }
                 6 => {
                     let mut gesture = 0i32;
-                    drop(pg_touch(e, b.i32() % 5, b.i32() % 4, b.f32(), b.f32(), b.f64(), &mut gesture));
+                    drop(pg_touch(
+                        e,
+                        b.i32() % 5,
+                        b.i32() % 4,
+                        b.f32(),
+                        b.f32(),
+                        b.f64(),
+                        &mut gesture,
+                    ));
                 }
-                7 => drop(pg_set_display(e, b.small(4000), b.small(4000), b.f32(), b.f32(), b.i32() % 6)),
+                7 => drop(pg_set_display(
+                    e,
+                    b.small(4000),
+                    b.small(4000),
+                    b.f32(),
+                    b.f32(),
+                    b.i32() % 6,
+                )),
                 8 => drop(pg_set_sensor_ranges(e, b.f32(), b.f32())),
                 9 => {
                     let name: Vec<u8> = (0..b.small(24)).map(|_| b.u8().max(1)).collect();

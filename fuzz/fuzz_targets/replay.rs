@@ -17,9 +17,15 @@ fuzz_target!(|data: &[u8]| {
         return;
     };
     let mut frames = 0u64;
-    let _ = replay(reader, &mut session, 10_000_000, Pace::AsFastAsPossible, |_, _, view| {
-        frames += 1;
-        // Frames are finite whatever the input.
-        assert!(view.eyes.cyclopean_m.is_finite(), "non-finite eye at frame {frames}");
-    });
+    let _ = replay(
+        reader,
+        &mut session,
+        10_000_000,
+        Pace::AsFastAsPossible,
+        |_, _, view| {
+            frames += 1;
+            // Frames are finite whatever the input.
+            assert!(view.eyes.cyclopean_m.is_finite(), "non-finite eye at frame {frames}");
+        },
+    );
 });

@@ -280,7 +280,14 @@ fn ios_device_library_elsewhere() -> Result<()> {
         .current_dir(&root))?;
     let lib = root.join("target").join(TARGET).join("release/libphantogram_ios.a");
     let nm = Command::new("llvm-nm")
-        .args(["--extern-only", "--defined-only", "--format=just-symbols"])
+        // `--no-llvm-bc`: the standard library's objects also carry LLVM bitcode, newer than an
+        // older llvm-nm reads; the Mach-O symbol tables are what the linker sees.
+        .args([
+            "--no-llvm-bc",
+            "--extern-only",
+            "--defined-only",
+            "--format=just-symbols",
+        ])
         .arg(&lib)
         .output()
         .with_context(|| format!("running llvm-nm on {}", lib.display()))?;
@@ -291,6 +298,7 @@ fn ios_device_library_elsewhere() -> Result<()> {
             String::from_utf8_lossy(&nm.stderr)
         );
     }
+    check_macho_arm64(&lib)?;
     // Mach-O prefixes C symbols with an underscore.
     let exported: std::collections::BTreeSet<String> = String::from_utf8_lossy(&nm.stdout)
         .lines()
@@ -315,6 +323,35 @@ fn ios_device_library_elsewhere() -> Result<()> {
         lib.display(),
         declared.len()
     );
+    Ok(())
+}
+
+/// Checks that the library's own objects are Mach-O 64-bit arm64 (magic `0xfeedfacf`, CPU type
+/// `CPU_TYPE_ARM64`), reading the first one with `llvm-ar`.
+fn check_macho_arm64(lib: &Path) -> Result<()> {
+    let list = Command::new("llvm-ar")
+        .arg("t")
+        .arg(lib)
+        .output()
+        .context("running llvm-ar")?;
+    let members = String::from_utf8_lossy(&list.stdout);
+    let member = members
+        .lines()
+        .find(|m| m.starts_with("phantogram_ios") && m.ends_with(".o"))
+        .with_context(|| format!("{} holds no phantogram_ios object", lib.display()))?;
+    let object = Command::new("llvm-ar")
+        .arg("p")
+        .arg(lib)
+        .arg(member)
+        .output()
+        .context("running llvm-ar")?;
+    let header = object.stdout.get(..8).unwrap_or_default();
+    if header != [0xcf, 0xfa, 0xed, 0xfe, 0x0c, 0x00, 0x00, 0x01] {
+        bail!(
+            "{member} in {} is not a Mach-O arm64 object (header {header:02x?})",
+            lib.display()
+        );
+    }
     Ok(())
 }
 
