@@ -301,9 +301,17 @@ impl Engine {
             ..SessionConfig::default()
         };
         let session = Session::new(session_config)?;
+        // The GPU first: the model's budget takes the device's texture limit.
+        let gpu = gpu()?;
+        let budget = crate::budget::ResourceBudget {
+            max_image_side_px: crate::budget::ResourceBudget::PHONE
+                .max_image_side_px
+                .min(gpu.device.limits().max_texture_dimension_2d),
+            ..crate::budget::ResourceBudget::PHONE
+        };
         let mut model = match &config.model_path {
             Some(path) => {
-                let mut m = crate::model::load_model(path)?;
+                let mut m = crate::model::load_model_within(path, budget)?;
                 m.fit_to_diorama(&screen, &config.fit);
                 m
             }
@@ -324,7 +332,7 @@ impl Engine {
             Some(path) => Some(crate::ibl::Environment::load(path)?),
             None => None,
         };
-        let renderer = Renderer::with_environment(gpu()?, &model, environment.as_ref())?;
+        let renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
         #[cfg(feature = "face")]
         let face = match &config.face_models_dir {
             Some(dir) => {

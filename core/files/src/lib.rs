@@ -15,12 +15,12 @@
 //! Plain functions and one owned handle; `std::io::Error`s with the reason in their message
 //! (the callers add the path). Nothing here panics.
 
+pub mod atomic;
 pub mod read;
 pub mod text;
-pub mod atomic;
 
-pub use read::{open_regular_file, read_regular_file};
 pub use atomic::AtomicFile;
+pub use read::{open_regular_file, read_regular_file};
 
 #[cfg(test)]
 mod tests;

@@ -435,7 +435,8 @@ impl RecordedTrack {
             error,
         };
         let mut bytes = Vec::new();
-        std::fs::File::open(path)
+        // Regular files only: a pipe would block.
+        phantogram_files::open_regular_file(path)
             .map_err(io)?
             .take(max_bytes + 1)
             .read_to_end(&mut bytes)

@@ -26,8 +26,14 @@
 //!   document's indices and enumerations are checked before gltf-rs (which indexes unchecked)
 //!   follows them, the node hierarchy must be trees, every accessor's extent is checked before its
 //!   output is allocated, and a panic inside the Draco decoder becomes that primitive's error.
-//!   (The decoders of images and Draco streams allocate what their headers ask, within the
-//!   `image` crate's limits and not bounded by us for Draco.)
+//! * Hostile files: a buffer or image URI is followed only to a regular file inside the model's
+//!   folder ([`resolve_inside`]); what a file claims (vertices and indices, decoded texels with
+//!   their mips, drawn primitives after instancing) is charged to a
+//!   [`crate::budget::ResourceBudget`] before it is allocated ([`load_model_within`]; phone-sized
+//!   by default), images checked from their headers and decoded under matching limits; every
+//!   vertex must be finite and within ±[`MAX_COORDINATE`] after its node transforms. A Draco
+//!   stream is decoded before its counts are known (bounded by its own size in the file), then
+//!   charged.
 //!
 //! ## Frames
 //! glTF is +Y up, +Z front, metres. [`Model::fit_to_diorama`] turns a standing object's +Y into
