@@ -25,7 +25,7 @@
 //! * `phantogram_vision` (feature `face`): `face` (the crate itself).
 //! * `phantogram_ui` (feature `ui`): `calibration_ui` (the crate itself).
 //! * `phantogram_lab` (log formats, replay, scoring) is for the desktop and tests and is not
-//!   re-exported: the CLI (feature `cli`) depends on it, the phone libraries do not.
+//!   re-exported: the CLI (`phantogram-cli`) depends on it, the phone libraries do not.
 //!
 //! ## Threading
 //!
@@ -50,10 +50,9 @@
 //! * `ui` (implies `render`): `phantogram_ui` (egui and egui-wgpu draw the calibration screens with
 //!   the renderer's own device, driven by touches through [`engine`], the desktop viewer's mouse
 //!   included) and `egui` for the engine's side of it.
-//! * `cli` (implies the others; on by default, off for the phone crates): `phantogram_lab` (logs,
-//!   replay, scoring), `clap`, `anyhow` and `indicatif` (progress bars) for the `phantogram`
-//!   binary, `winit` (the chosen stack) for its window, `image` to write frames, `serde_json` for
-//!   `eval face --json`.
+//! * The `phantogram` command-line tool and desktop viewer are the `phantogram-cli` crate
+//!   (`core/cli`), which depends on this one with its default features; the phone crates turn
+//!   the defaults off and choose what they embed.
 
 pub use phantogram_files as files;
 pub use phantogram_geometry::{anaglyph, containment, eyes, light, projection, screen, viewpoint};

@@ -13,7 +13,7 @@ fn bin() -> Command {
 }
 
 fn default_log() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/logs/tilt-sweep.pglog")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/logs/tilt-sweep.pglog")
 }
 
 /// Runs `command` to its end, or fails the test (after killing it) when it takes over `limit`.

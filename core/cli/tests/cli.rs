@@ -10,7 +10,7 @@ fn bin() -> Command {
 }
 
 fn default_log() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../assets/logs/tilt-sweep.pglog")
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../assets/logs/tilt-sweep.pglog")
 }
 
 fn rows(stdout: &[u8]) -> Vec<Vec<f64>> {
