@@ -71,7 +71,7 @@ fn main() {
         .push(phantogram::sensors::SensorEvent::accelerometer(1, up * 9.81))
         .expect("valid event");
     let view = session.frame().expect("frame");
-    let input = FrameInput::from_view(&view, Vec3::ZERO);
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
 
     let turtle_path = std::env::var_os("PHANTOGRAM_DATA").map(|d| {
         std::path::PathBuf::from(d).join("models/heritage/smithsonian_nmnh_sea_turtle/sea_turtle-150k-1024-low.glb")

@@ -674,7 +674,7 @@ impl Engine {
         let push = self
             .smoother
             .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s);
-        let input = FrameInput::from_view(&view, Vec3::Z * -push);
+        let input = frame_input(&view, Vec3::Z * -push);
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
         if self.screens.is_some() {
@@ -942,6 +942,20 @@ impl SharedEngine {
         let mut s = self.lock().stats();
         s.camera_frames = self.camera_frames.load(std::sync::atomic::Ordering::Relaxed);
         s
+    }
+}
+
+/// What the renderer draws for a frame the session computed, with the mesh moved by `offset`
+/// (containment's push-back). Without any orientation yet, the device is taken as lying flat
+/// facing north. (Here, not in the renderer: the renderer knows nothing of the sensors.)
+pub fn frame_input(view: &crate::session::FrameView, offset: Vec3) -> FrameInput<'_> {
+    FrameInput {
+        left: &view.left,
+        right: &view.right,
+        mono: &view.mono,
+        toward_light: view.toward_light_device,
+        device_to_world: view.device_to_world.unwrap_or(glam::Quat::IDENTITY),
+        offset,
     }
 }
 

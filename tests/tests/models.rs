@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 
 use phantogram::glam::Vec3;
 use phantogram::model::{ModelError, load_gltf, load_model};
-use phantogram::render::{FrameInput, Gpu, Renderer};
+use phantogram::render::{Gpu, Renderer};
 use phantogram::screen::Screen;
 use phantogram::{Session, SessionConfig};
 use phantogram_integration::{data_subdir, scratch};
@@ -73,7 +73,7 @@ fn every_shared_model_loads_and_renders() {
         };
         let pixels = r
             .render(
-                &FrameInput::from_view(&view, Vec3::ZERO),
+                &phantogram::engine::frame_input(&view, Vec3::ZERO),
                 phantogram::anaglyph::Method::Mono,
                 90,
                 200,

@@ -86,7 +86,7 @@ fn markers_land_on_the_predicted_pixel_in_each_eye() {
         renderer.set_model(&marker_model(p)).unwrap();
         let input = FrameInput {
             toward_light: Vec3::new(0.2, -0.3, 1.0),
-            ..FrameInput::from_view(&view, Vec3::ZERO)
+            ..phantogram::engine::frame_input(&view, Vec3::ZERO)
         };
         let mut centroids = Vec::new();
         for (name, proj) in [("left", &view.left), ("right", &view.right)] {
@@ -166,7 +166,7 @@ fn default_artifact_matches_its_golden_images() {
     let Some(gpu) = gpu() else { return };
     let view = oblique_view();
     let mut renderer = Renderer::new(gpu, &default_model()).unwrap();
-    let input = FrameInput::from_view(&view, Vec3::ZERO);
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
     for (name, method) in [
         ("amphora-mono", Method::Mono),
         ("amphora-dubois", Method::DuboisRedCyan),
@@ -191,7 +191,7 @@ fn shared_models_match_their_golden_images() {
     };
     let Some(gpu) = gpu() else { return };
     let view = oblique_view();
-    let input = FrameInput::from_view(&view, Vec3::ZERO);
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
     let screen = Screen::default();
     let cases = [
         ("duck-mono", "khronos/Duck/glTF-Binary/Duck.glb", Method::Mono),
@@ -609,7 +609,7 @@ fn pipelines_that_skip_missing_textures_draw_the_same_picture() {
     m.occlusion_texture = Some((slot(1), 1.0));
     m.emissive_texture = Some(slot(1));
     let view = oblique_view();
-    let input = FrameInput::from_view(&view, Vec3::ZERO);
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
     let mut renderer = Renderer::new(gpu, &normal_only).unwrap();
     let specialised = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
     renderer.set_model(&every_slot).unwrap();

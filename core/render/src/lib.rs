@@ -4,7 +4,8 @@
 //! the pair (anaglyph or mono) in linear light, into an offscreen target read back as an image or
 //! onto a window surface ([`surface`], the lifecycle the phones and the desktop viewer share).
 //! Depends on `phantogram_geometry` (projections, anaglyph matrices), `phantogram_assets` (what it
-//! uploads) and `phantogram_sensing` (the session's [`FrameInput::from_view`]); `wgpu` (the chosen
+//! uploads), nothing of the sensors (the engine turns a session's frame into a [`FrameInput`]);
+//! `wgpu` (the chosen
 //! stack), `pollster` to wait on its few futures, `bytemuck` for uniform and vertex layouts,
 //! `half` to pack f16 textures.
 //!
@@ -48,7 +49,6 @@ use wgpu::util::DeviceExt;
 use phantogram_assets::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
 use phantogram_geometry::anaglyph::Method;
 use phantogram_geometry::projection::OffAxisProjection;
-use phantogram_sensing::session::FrameView;
 
 mod gpu;
 mod lighting_tables;
@@ -236,19 +236,6 @@ impl<'a> FrameInput<'a> {
             vec![self.left, self.right]
         } else {
             vec![self.mono]
-        }
-    }
-
-    /// The frame a session computed, with the mesh moved by `offset` (containment's push-back).
-    /// Without any orientation yet, the device is taken as lying flat facing north.
-    pub fn from_view(view: &'a FrameView, offset: Vec3) -> Self {
-        Self {
-            left: &view.left,
-            right: &view.right,
-            mono: &view.mono,
-            toward_light: view.toward_light_device,
-            device_to_world: view.device_to_world.unwrap_or(glam::Quat::IDENTITY),
-            offset,
         }
     }
 }
