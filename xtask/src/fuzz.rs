@@ -14,7 +14,8 @@
 //!   repository). The corpus grows across runs; findings go to `target/fuzz/artifacts/TARGET`.
 //! * Runs on the stable toolchain without a sanitizer (`--sanitizer none`): safe Rust needs none
 //!   to find panics, hangs and runaway memory. Needs `cargo install cargo-fuzz --locked`.
-//! * `--record` writes the table to `benchmarks/fuzz.md` with the command that made it.
+//! * `--record` puts each target's row into `benchmarks/fuzz.md` (replacing that target's older
+//!   row, keeping the others').
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -147,22 +148,29 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             finding,
         });
     }
-    let table = table(&outcomes);
-    println!("{table}");
+    let rows: Vec<String> = outcomes.iter().map(row).collect();
+    println!("{TABLE_HEAD}{}", rows.concat());
     if record {
-        let command = format!(
-            "cargo xtask fuzz {}--seconds {seconds}",
-            args.iter()
-                .filter(|a| TARGETS.iter().any(|t| t.0 == **a))
-                .map(|a| format!("{a} "))
-                .collect::<String>()
-        );
-        let text = format!(
-            "# Fuzzing\n\nMade by `{command} --record` (`PHANTOGRAM_DATA` set for the seeds), stable Rust, \
-             no sanitizer, 1 GiB RSS limit, 10 s per input, on this project's 2-core machine. \
-             Coverage is libFuzzer's `cov:` (edges reached); corpus, the inputs kept.\n\n{table}\n"
-        );
         let path = root.join("benchmarks/fuzz.md");
+        // A target's row is replaced by its newest run; the other targets' rows stay.
+        let old = std::fs::read_to_string(&path).unwrap_or_default();
+        let mut kept: Vec<String> = old
+            .lines()
+            .filter(|l| l.starts_with("| ") && !l.starts_with("| target"))
+            .filter(|l| !outcomes.iter().any(|o| l.starts_with(&format!("| {} |", o.target))))
+            .map(|l| format!("{l}\n"))
+            .collect();
+        kept.extend(rows);
+        kept.sort_by_key(|l| TARGETS.iter().position(|t| l.starts_with(&format!("| {} |", t.0))));
+        let text = format!(
+            "# Fuzzing\n\nEach row is the newest `cargo xtask fuzz TARGET --seconds N --record` of its target \
+             (`PHANTOGRAM_DATA` set for the seeds; the corpus under `target/fuzz` kept from earlier runs): \
+             stable Rust, no sanitizer, 1 GiB RSS limit, 10 s per input, on this project's shared 2-core \
+             machine. Coverage is libFuzzer's `cov:` (edges reached); corpus, the inputs kept; findings, \
+             the inputs that panicked, hung or ran out of memory (each fixed and kept as a regression \
+             test).\n\n{TABLE_HEAD}{}",
+            kept.concat()
+        );
         std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
         println!("wrote {}", path.display());
     }
@@ -177,24 +185,26 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
     Ok(())
 }
 
-fn table(outcomes: &[Outcome]) -> String {
-    let mut t = String::from(
-        "| target | seconds | executions | exec/s | coverage (edges) | corpus | peak RSS (MB) | findings |\n|---|---:|---:|---:|---:|---:|---:|---|\n",
-    );
-    for o in outcomes {
-        t += &format!(
-            "| {} | {} | {} | {} | {} | {} | {} | {} |\n",
-            o.target,
-            o.seconds,
-            o.executions,
-            o.executions / o.seconds.max(1),
-            o.coverage,
-            o.corpus,
-            o.peak_rss_mb,
-            o.finding.as_deref().unwrap_or("0")
-        );
-    }
-    t
+const TABLE_HEAD: &str = "| target | date | seconds | executions | exec/s | coverage (edges) | corpus | peak RSS (MB) | findings |\n|---|---|---:|---:|---:|---:|---:|---:|---|\n";
+
+fn row(o: &Outcome) -> String {
+    let date = Command::new("date")
+        .arg("+%Y-%m-%d")
+        .output()
+        .ok()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_owned())
+        .unwrap_or_default();
+    format!(
+        "| {} | {date} | {} | {} | {} | {} | {} | {} | {} |\n",
+        o.target,
+        o.seconds,
+        o.executions,
+        o.executions / o.seconds.max(1),
+        o.coverage,
+        o.corpus,
+        o.peak_rss_mb,
+        o.finding.as_deref().unwrap_or("0")
+    )
 }
 
 /// Writes the target's seeds into its corpus folder (overwriting earlier seeds of the same name,

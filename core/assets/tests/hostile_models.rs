@@ -355,3 +355,27 @@ fn an_oversized_environment_is_refused_by_its_header_with_the_limit() {
         }
     }
 }
+
+/// A file larger than the whole budget is refused by name, before it is read.
+#[test]
+fn a_file_larger_than_the_budget_is_refused_before_it_is_read() {
+    let dir = Scratch::new("hostile-big-file");
+    let path = write(
+        &dir,
+        "big.gltf",
+        &format!(
+            "{}{}",
+            gltf_with_buffer_uri(&data_uri(&triangle_bin(TRIANGLE)), ""),
+            " ".repeat(4096)
+        ),
+    );
+    let budget = ResourceBudget {
+        memory_bytes: 2048,
+        ..ResourceBudget::PHONE
+    };
+    let err = load_gltf_within(&path, budget).unwrap_err().to_string();
+    assert!(
+        err.contains("the file needs") && err.contains("ResourceBudget::memory_bytes"),
+        "{err}"
+    );
+}

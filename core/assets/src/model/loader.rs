@@ -887,6 +887,17 @@ pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
 /// [`load_gltf`] within `budget` (module docs of [`crate::budget`]).
 pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, ModelError> {
     let mut spending = Spending::new(budget);
+    // A file larger than the whole budget is refused by name before it is read.
+    if let Ok(meta) = std::fs::metadata(path)
+        && meta.is_file()
+    {
+        spending
+            .check_bytes(|| "the file".to_owned(), meta.len())
+            .map_err(|error| ModelError::OverBudget {
+                path: path.to_path_buf(),
+                error,
+            })?;
+    }
     let bytes = phantogram_files::read_regular_file(path, budget.memory_bytes).map_err(|error| ModelError::Io {
         path: path.to_path_buf(),
         error,
