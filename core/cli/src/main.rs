@@ -153,8 +153,9 @@ enum EvalWhat {
         /// Score only these of our estimators (repeatable; all when omitted).
         #[arg(long = "estimator", value_enum)]
         estimators: Vec<EstimatorName>,
-        /// Also score another program's orientation tracks: NAME=DIR, with DIR/<trial>.csv
-        /// holding `t_ns,w,x,y,z` rows (what `benchmarks/vqf/vqf_reference.py` writes). Repeatable.
+        /// Also score another program's orientation tracks: NAME=DIR, with DIR/TRIAL.csv (TRIAL:
+        /// the recording's name) holding `t_ns,w,x,y,z` rows (what
+        /// `benchmarks/vqf/vqf_reference.py` writes). Repeatable.
         #[arg(long = "reference", value_name = "NAME=DIR", value_parser = reference_arg)]
         references: Vec<(String, PathBuf)>,
     },
