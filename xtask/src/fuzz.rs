@@ -162,13 +162,20 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .collect();
         kept.extend(rows);
         kept.sort_by_key(|l| TARGETS.iter().position(|t| l.starts_with(&format!("| {} |", t.0))));
+        // Notes written under the table stay.
+        let notes: String = old
+            .lines()
+            .skip_while(|l| !l.starts_with('|'))
+            .skip_while(|l| l.starts_with('|'))
+            .map(|l| format!("{l}\n"))
+            .collect();
         let text = format!(
             "# Fuzzing\n\nEach row is the newest `cargo xtask fuzz TARGET --seconds N --record` of its target \
              (`PHANTOGRAM_DATA` set for the seeds; the corpus under `target/fuzz` kept from earlier runs): \
              stable Rust, no sanitizer, 1 GiB RSS limit, 10 s per input, on this project's shared 2-core \
              machine. Coverage is libFuzzer's `cov:` (edges reached); corpus, the inputs kept; findings, \
              the inputs that panicked, hung or ran out of memory (each fixed and kept as a regression \
-             test).\n\n{TABLE_HEAD}{}",
+             test).\n\n{TABLE_HEAD}{}{notes}",
             kept.concat()
         );
         std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
