@@ -134,8 +134,9 @@ impl Spending {
         Ok(())
     }
 
-    /// Fails unless a `width × height` image fits the side limit and what is left.
-    pub fn check_image(&self, what: impl Fn() -> String, width: u32, height: u32) -> Result<(), OverBudget> {
+    /// Charges a decoded `width × height` texture (with its mips), or fails without charging when
+    /// a side is over the limit or its bytes over what is left.
+    pub fn charge_image(&mut self, what: impl Fn() -> String, width: u32, height: u32) -> Result<(), OverBudget> {
         let side = width.max(height);
         if side > self.budget.max_image_side_px {
             return Err(OverBudget {
@@ -147,7 +148,7 @@ impl Spending {
                 unit: "pixels a side",
             });
         }
-        self.check_bytes(
+        self.charge_bytes(
             || format!("{} ({width}×{height})", what()),
             ResourceBudget::texture_bytes(width, height),
         )
@@ -177,10 +178,12 @@ mod tests {
         s.charge_primitive(|| "p".into()).unwrap();
         s.charge_primitive(|| "p".into()).unwrap();
         assert!(s.charge_primitive(|| "p".into()).is_err());
-        let e = s.check_image(|| "image 0".into(), 17, 1).unwrap_err();
+        let e = s.charge_image(|| "image 0".into(), 17, 1).unwrap_err();
         assert!(e.to_string().contains("max_image_side_px"), "{e}");
-        // 8×8 RGBA with mips: 256 + 85 bytes, more than the 400 − 0 left? No: 341 fits.
-        s.check_image(|| "image 1".into(), 8, 8).unwrap();
+        // 8×8 RGBA with mips: 256 + 85 = 341 bytes of the 400 left; a second does not fit.
+        s.charge_image(|| "image 1".into(), 8, 8).unwrap();
         assert_eq!(ResourceBudget::texture_bytes(8, 8), 341);
+        let e = s.charge_image(|| "image 2".into(), 8, 8).unwrap_err();
+        assert_eq!((e.needed, e.left), (341, 59));
     }
 }

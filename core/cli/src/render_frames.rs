@@ -155,8 +155,14 @@ impl Replayed for Frames<'_> {
             image::ImageFormat::Png,
         )
         .context("encoding a frame as PNG")?;
-        // Checked writes (a full disk is an error here, not at the swap).
-        std::fs::write(&path, &png).with_context(|| format!("writing {}", path.display()))?;
+        // Written and flushed to the disk now: a full disk is an error here, and the swap in
+        // `Staging::commit` only renames.
+        std::fs::File::create(&path)
+            .and_then(|mut f| {
+                std::io::Write::write_all(&mut f, &png)?;
+                f.sync_all()
+            })
+            .with_context(|| format!("writing {}", path.display()))?;
         self.index += 1;
         self.bar.inc(1);
         Ok(())
@@ -201,15 +207,8 @@ impl Staging {
         Ok(Self { dir })
     }
 
-    /// Puts the new frames in place of an earlier run's.
+    /// Puts the new frames (each already on the disk) in place of an earlier run's.
     fn commit(&self, out_dir: &Path) -> Result<()> {
-        // Flushed to the disk before anything old goes.
-        for entry in std::fs::read_dir(&self.dir).with_context(|| format!("reading {}", self.dir.display()))? {
-            let path = entry.with_context(|| format!("reading {}", self.dir.display()))?.path();
-            std::fs::File::open(&path)
-                .and_then(|f| f.sync_all())
-                .with_context(|| format!("writing {}", path.display()))?;
-        }
         remove_earlier_frames(out_dir)?;
         for entry in std::fs::read_dir(&self.dir).with_context(|| format!("reading {}", self.dir.display()))? {
             let entry = entry.with_context(|| format!("reading {}", self.dir.display()))?;

@@ -60,6 +60,13 @@ pub enum ModelError {
     NotAModel { path: PathBuf, message: String },
 }
 
+fn over_budget(path: &Path, error: OverBudget) -> ModelError {
+    ModelError::OverBudget {
+        path: path.to_path_buf(),
+        error,
+    }
+}
+
 /// The bytes of a buffer view, checked against its buffer.
 fn view_bytes_of<'b>(path: &Path, buffers: &'b [Vec<u8>], view: &gltf::buffer::View) -> Result<&'b [u8], ModelError> {
     let data = |message: &str| ModelError::Data {
@@ -82,19 +89,12 @@ struct Ctx<'a> {
 }
 
 impl Ctx<'_> {
-    fn over_budget(&self, error: OverBudget) -> ModelError {
-        ModelError::OverBudget {
-            path: self.path.to_path_buf(),
-            error,
-        }
-    }
-
     /// Fails unless a transient buffer of `bytes` fits what is left of the budget.
     fn check_bytes(&self, what: impl FnOnce() -> String, bytes: u64) -> Result<(), ModelError> {
         self.spending
             .borrow()
             .check_bytes(what, bytes)
-            .map_err(|e| self.over_budget(e))
+            .map_err(|e| over_budget(self.path, e))
     }
 
     fn data(&self, what: impl Into<String>, message: impl Into<String>) -> ModelError {
@@ -893,10 +893,7 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
     {
         spending
             .check_bytes(|| "the file".to_owned(), meta.len())
-            .map_err(|error| ModelError::OverBudget {
-                path: path.to_path_buf(),
-                error,
-            })?;
+            .map_err(|e| over_budget(path, e))?;
     }
     let bytes = phantogram_files::read_regular_file(path, budget.memory_bytes).map_err(|error| ModelError::Io {
         path: path.to_path_buf(),
@@ -949,10 +946,6 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
         buffers.push(data);
     }
     let views: Vec<gltf::buffer::View> = doc.views().collect();
-    let over_budget = |error| ModelError::OverBudget {
-        path: path.to_path_buf(),
-        error,
-    };
 
     // Read the encoded images in order, then decode them on every core (the largest part of
     // loading a textured scan); the first failure in file order is the one reported.
@@ -960,10 +953,9 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
     // images naming one 8192² PNG are twelve textures.
     let mut encoded = Vec::new();
     for img in doc.images() {
-        let buffers = &buffers;
         let (raw, name): (Vec<u8>, String) = match img.source() {
             gltf::image::Source::View { view, .. } => {
-                let bytes = view_bytes_of(path, buffers, &view)?;
+                let bytes = view_bytes_of(path, &buffers, &view)?;
                 (bytes.to_vec(), format!("image {}", img.index()))
             }
             gltf::image::Source::Uri { uri, .. } => (load_uri(path, uri, budget.memory_bytes)?, excerpt(uri)),
@@ -984,10 +976,9 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
         let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&raw), format)
             .into_dimensions()
             .map_err(|e| data_error(e.to_string()))?;
-        spending.check_image(what, width, height).map_err(over_budget)?;
         spending
-            .charge_bytes(what, ResourceBudget::texture_bytes(width, height))
-            .map_err(over_budget)?;
+            .charge_image(what, width, height)
+            .map_err(|e| over_budget(path, e))?;
         encoded.push((img.index(), raw, name, format, width, height));
     }
     let images = crate::parallel::map(&encoded, |(index, raw, name, format, width, height)| {
@@ -1073,7 +1064,7 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
                 ctx.spending
                     .borrow_mut()
                     .charge_primitive(|| format!("{what} (in node {})", node.index()))
-                    .map_err(|e| ctx.over_budget(e))?;
+                    .map_err(|e| over_budget(path, e))?;
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     model
                         .warnings
@@ -1084,10 +1075,16 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
                     Some(ext) => read_draco(&ctx, &prim, ext, &views)?,
                     None => read_plain(&ctx, &prim)?,
                 };
-                // Draco's counts are known only now, once decoded.
+                // Charged before the mesh is built (for Draco, its counts are known only now).
                 let vertices = (attributes.positions.len() / 3) as u64;
                 let indices = attributes.indices.as_ref().map_or(vertices, |i| i.len() as u64);
-                ctx.check_bytes(|| what.clone(), ResourceBudget::mesh_bytes(vertices, indices))?;
+                ctx.spending
+                    .borrow_mut()
+                    .charge_bytes(
+                        || format!("{what} (in node {})", node.index()),
+                        ResourceBudget::mesh_bytes(vertices, indices),
+                    )
+                    .map_err(|e| over_budget(path, e))?;
                 let mut m = assemble(&ctx, attributes, &what)?;
                 m.transform(world);
                 // Checked after the node transforms, which can overflow finite positions too.
@@ -1106,11 +1103,6 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
                         ),
                     ));
                 }
-                let bytes = ResourceBudget::mesh_bytes(m.vertices.len() as u64, m.indices.len() as u64);
-                ctx.spending
-                    .borrow_mut()
-                    .charge_bytes(|| format!("{what} (in node {})", node.index()), bytes)
-                    .map_err(|e| ctx.over_budget(e))?;
                 model.primitives.push(Primitive {
                     mesh: m,
                     material: prim.material().index().unwrap_or(default_material),

@@ -29,9 +29,7 @@ use phantogram_sensing::sensors::{SensorEvent, SensorKind};
 /// recording, to sort it), before the memory is taken.
 fn push(events: &mut Vec<SensorEvent>, event: SensorEvent) -> Result<(), String> {
     if events.len() >= MAX_EVENTS_IN_MEMORY {
-        return Err(format!(
-            "more than {MAX_EVENTS_IN_MEMORY} events, more than an import holds in memory; split the recording"
-        ));
+        return Err(super::too_many_events_message());
     }
     events.push(event);
     Ok(())

@@ -156,11 +156,13 @@ pub fn read_all(
 }
 
 /// The error for a log beyond [`MAX_EVENTS_IN_MEMORY`].
-pub fn too_many_events(path: &Path) -> LogError {
-    LogError::format(
-        path,
-        format!("more than {MAX_EVENTS_IN_MEMORY} events, more than is read into memory; split the recording"),
-    )
+fn too_many_events(path: &Path) -> LogError {
+    LogError::format(path, too_many_events_message())
+}
+
+/// Why a log beyond [`MAX_EVENTS_IN_MEMORY`] is refused, whether read ([`read_all`]) or imported.
+fn too_many_events_message() -> String {
+    format!("more than {MAX_EVENTS_IN_MEMORY} events, more than is read into memory; split the recording")
 }
 
 /// Reads numbered lines, naming the file in every error.
