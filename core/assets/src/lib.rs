@@ -23,7 +23,10 @@
 
 pub mod artifact;
 pub mod budget;
+pub mod builtin;
 mod exr_guard;
 pub mod ibl;
+pub mod library;
 pub mod model;
 pub mod parallel;
+pub mod progress;

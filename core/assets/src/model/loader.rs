@@ -11,6 +11,7 @@ use thiserror::Error;
 
 use super::*;
 use crate::budget::{OverBudget, ResourceBudget, Spending};
+use crate::progress::{Progress, Span};
 use phantogram_files::text::excerpt;
 
 /// Largest Voyager scene read: its JSON lists derivatives and annotations, kilobytes in practice.
@@ -58,6 +59,9 @@ pub enum ModelError {
     /// A folder or a Voyager scene that names no model file this loader can open.
     #[error("{}: {message}", path.display())]
     NotAModel { path: PathBuf, message: String },
+    /// The load was given up ([`Progress::cancel`]).
+    #[error("{}: loading was cancelled", path.display())]
+    Cancelled { path: PathBuf },
 }
 
 fn over_budget(path: &Path, error: OverBudget) -> ModelError {
@@ -856,6 +860,12 @@ pub fn load_model(path: &Path) -> Result<Model, ModelError> {
 
 /// [`load_model`] within `budget` (module docs of [`crate::budget`]).
 pub fn load_model_within(path: &Path, budget: ResourceBudget) -> Result<Model, ModelError> {
+    load_model_with(path, budget, &Progress::new())
+}
+
+/// [`load_model_within`], reporting to `progress` and giving up when it is cancelled
+/// ([`ModelError::Cancelled`]).
+pub fn load_model_with(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
     // Any `*.svx.json` is a Voyager scene (downloads rename them), never a glTF file.
     let is_scene = path.is_dir()
         || path
@@ -869,7 +879,7 @@ pub fn load_model_within(path: &Path, budget: ResourceBudget) -> Result<Model, M
     } else {
         path
     };
-    let mut model = load_gltf_within(path, budget)?;
+    let mut model = load_gltf_with(path, budget, progress)?;
     if let Some(q) = voyager_rotation(path) {
         model.transform(Mat4::from_quat(q));
         model
@@ -886,6 +896,22 @@ pub fn load_gltf(path: &Path) -> Result<Model, ModelError> {
 
 /// [`load_gltf`] within `budget` (module docs of [`crate::budget`]).
 pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, ModelError> {
+    load_gltf_with(path, budget, &Progress::new())
+}
+
+/// Shares of a load's progress: reading the file and its buffers, decoding the images, building
+/// the meshes (Draco decoding, tangents). The rest is the caller's (fitting, uploading).
+const READ_SHARE: [f32; 2] = [0.0, 0.1];
+const IMAGES_SHARE: [f32; 2] = [0.1, 0.5];
+const MESHES_SHARE: [f32; 2] = [0.5, 0.9];
+
+/// [`load_gltf_within`], reporting to `progress` and giving up when it is cancelled.
+pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
+    let cancelled = |_| ModelError::Cancelled {
+        path: path.to_path_buf(),
+    };
+    let read = Span::new(progress, READ_SHARE[0], READ_SHARE[1]);
+    read.step(0.0).map_err(cancelled)?;
     let mut spending = Spending::new(budget);
     // A file larger than the whole budget is refused by name before it is read.
     if let Ok(meta) = std::fs::metadata(path)
@@ -899,6 +925,7 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
         path: path.to_path_buf(),
         error,
     })?;
+    read.step(0.5).map_err(cancelled)?;
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| ModelError::Parse {
         path: path.to_path_buf(),
         // A glTF 1.0 file fails here on its different layout: say so rather than how.
@@ -946,6 +973,7 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
         buffers.push(data);
     }
     let views: Vec<gltf::buffer::View> = doc.views().collect();
+    read.step(1.0).map_err(cancelled)?;
 
     // Read the encoded images in order, then decode them on every core (the largest part of
     // loading a textured scan); the first failure in file order is the one reported.
@@ -981,8 +1009,15 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
             .map_err(|e| over_budget(path, e))?;
         encoded.push((img.index(), raw, name, format, width, height));
     }
+    let images_share = Span::new(progress, IMAGES_SHARE[0], IMAGES_SHARE[1]);
+    let decoded_count = std::sync::atomic::AtomicUsize::new(0);
+    let image_count = encoded.len().max(1) as f32;
     let images = crate::parallel::map(&encoded, |(index, raw, name, format, width, height)| {
         let what = || format!("image {index} ({name})");
+        // A cancelled load skips the images not yet begun (the error is reported below).
+        if progress.is_cancelled() {
+            return Err((what(), "cancelled".to_owned()));
+        }
         let mut reader = image::ImageReader::with_format(std::io::Cursor::new(raw), *format);
         // The header was checked; the decoder holds to it (a damaged stream claiming more
         // fails instead of allocating).
@@ -996,20 +1031,35 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
             .map_err(|_| (what(), "the decoder failed on damaged data".to_owned()))?
             .map(|decoded| decoded.into_rgba8())
             .map_err(|e| (what(), e.to_string()))
-            .map(|decoded| Image {
-                name: name.clone(),
-                width: decoded.width(),
-                height: decoded.height(),
-                rgba8: decoded.into_raw(),
+            .map(|decoded| {
+                let done = decoded_count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+                images_share
+                    .progress
+                    .advance_to(images_share.from + (images_share.to - images_share.from) * done as f32 / image_count);
+                Image {
+                    name: name.clone(),
+                    width: decoded.width(),
+                    height: decoded.height(),
+                    rgba8: decoded.into_raw(),
+                }
             })
     })
     .into_iter()
     .collect::<Result<Vec<Image>, _>>()
-    .map_err(|(what, message)| ModelError::Data {
-        path: path.to_path_buf(),
-        what,
-        message,
+    .map_err(|(what, message)| {
+        if progress.is_cancelled() {
+            ModelError::Cancelled {
+                path: path.to_path_buf(),
+            }
+        } else {
+            ModelError::Data {
+                path: path.to_path_buf(),
+                what,
+                message,
+            }
+        }
     })?;
+    images_share.step(1.0).map_err(cancelled)?;
     drop(encoded); // the compressed copies are not needed while the meshes are built
     let ctx = Ctx {
         path,
@@ -1046,6 +1096,10 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
     // The hierarchy must be disjoint strict trees (glTF 2.0, "Nodes and Hierarchy"); a
     // node met twice would loop forever or draw twice.
     let mut visited = vec![false; doc.nodes().len()];
+    let meshes_share = Span::new(progress, MESHES_SHARE[0], MESHES_SHARE[1]);
+    // The primitives the file declares: drawn ones may be more (instancing) or fewer.
+    let declared_primitives = doc.meshes().map(|m| m.primitives().len()).sum::<usize>().max(1) as f32;
+    let mut built_primitives = 0usize;
     let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut visited[node.index()], true) {
@@ -1086,6 +1140,10 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
                     )
                     .map_err(|e| over_budget(path, e))?;
                 let mut m = assemble(&ctx, attributes, &what)?;
+                built_primitives += 1;
+                meshes_share
+                    .step(built_primitives as f32 / declared_primitives)
+                    .map_err(cancelled)?;
                 m.transform(world);
                 // Checked after the node transforms, which can overflow finite positions too.
                 if let Some((i, v)) = m
@@ -1124,6 +1182,7 @@ pub fn load_gltf_within(path: &Path, budget: ResourceBudget) -> Result<Model, Mo
         }
     }
     model.materials = materials;
+    meshes_share.step(1.0).map_err(cancelled)?;
     if model.triangle_count() == 0 {
         return Err(ModelError::Empty {
             path: path.to_path_buf(),

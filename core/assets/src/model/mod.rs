@@ -467,8 +467,8 @@ impl Model {
 }
 
 pub use loader::{
-    MAX_COORDINATE, ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_within, load_model, load_model_within,
-    resolve_inside, voyager_rotation, voyager_scan,
+    MAX_COORDINATE, ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with, load_gltf_within, load_model,
+    load_model_with, load_model_within, resolve_inside, voyager_rotation, voyager_scan,
 };
 
 mod loader;
