@@ -242,6 +242,10 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
             fit: Default::default(),
             floor: true,
             calibration_path: optional_string(env, &calibration_path)?.map(Into::into),
+            // TODO(issue 18): the shells pass their storage and saved artifact (next step).
+            artifact: None,
+            library_dir: None,
+            bundled_dir: None,
         };
         let engine = Engine::new(config)?;
         Ok(Box::into_raw(Box::new(SharedEngine::new(engine))) as usize as jlong)

@@ -69,8 +69,17 @@ pub struct EngineConfig {
     pub panel: PanelSpec,
     pub rotation: DisplayRotation,
     pub method: Method,
-    /// A glTF 2.0 file to show; `None`: the default artifact.
+    /// A glTF 2.0 file to show (the desktop's command line); `None`: [`Self::artifact`].
     pub model_path: Option<PathBuf>,
+    /// The library's artifact to show first (what the shell saved last time); `None`: the
+    /// default artifact. An id no longer in the library falls back to the default with
+    /// [`Engine::loading_status`] saying so.
+    pub artifact: Option<crate::library::ArtifactId>,
+    /// Where imported artifacts are kept (a folder in the app's private storage); `None`:
+    /// nothing can be imported.
+    pub library_dir: Option<PathBuf>,
+    /// Artifacts shipped with the app (glTF/GLB files or Voyager folders), read-only.
+    pub bundled_dir: Option<PathBuf>,
     /// An equirectangular HDR/EXR environment; `None`: the generated studio.
     pub environment_path: Option<PathBuf>,
     /// The folder with the face-tracking models; `None`: tilt only (no camera, or permission
@@ -96,6 +105,9 @@ impl Default for EngineConfig {
             rotation: DisplayRotation::Deg0,
             method: Method::default(),
             model_path: None,
+            artifact: None,
+            library_dir: None,
+            bundled_dir: None,
             environment_path: None,
             face_models_dir: None,
             camera_position_m: None,
@@ -112,6 +124,8 @@ pub enum EngineError {
     Render(#[from] RenderError),
     #[error(transparent)]
     Model(#[from] crate::model::ModelError),
+    #[error(transparent)]
+    Library(#[from] crate::library::LibraryError),
     #[error(transparent)]
     Environment(#[from] crate::ibl::EnvironmentError),
     #[error(transparent)]
@@ -154,7 +168,8 @@ impl EngineError {
             Self::Face(crate::face::FaceError::BadFrame(_)) => ErrorKind::InvalidArgument,
             #[cfg(feature = "face")]
             Self::Face(_) => ErrorKind::Load,
-            Self::Model(_) | Self::Environment(_) => ErrorKind::Load,
+            Self::Library(crate::library::LibraryError::BadId { .. }) => ErrorKind::InvalidArgument,
+            Self::Model(_) | Self::Environment(_) | Self::Library(_) => ErrorKind::Load,
             Self::Render(_) => ErrorKind::Render,
             Self::NoFrame => ErrorKind::InvalidState,
             Self::NoFaceSupport => ErrorKind::Unsupported,
@@ -169,17 +184,7 @@ enum Target {
     Offscreen { width: u32, height: u32 },
 }
 
-/// What was loaded, for logs and the desktop tools.
-#[derive(Clone, Debug, PartialEq)]
-pub struct ModelInfo {
-    /// The model's name (a loaded file's stem: it tells which scan a Voyager folder gave).
-    pub name: String,
-    pub triangles: usize,
-    pub materials: usize,
-    pub images: usize,
-    /// What the loader could not honour but worked around (an unsupported extension, …).
-    pub warnings: Vec<String>,
-}
+pub use crate::artifacts::{LoadStatus, ModelInfo};
 
 /// Counters, for logs, the shells' debug overlays and tests.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -210,6 +215,10 @@ pub struct Engine {
     renderer: Renderer,
     model_info: ModelInfo,
     bounds: Aabb,
+    loader: crate::artifacts::Loader,
+    /// How loaded files are fitted and floored (the configuration's).
+    fit: crate::model::DioramaFit,
+    floor: bool,
     smoother: ContainmentSmoother,
     method: Method,
     /// The method to return to when stereo is toggled back on.
@@ -253,6 +262,14 @@ impl std::fmt::Debug for Engine {
             .field("method", &self.method)
             .field("stats", &self.stats)
             .finish_non_exhaustive()
+    }
+}
+
+fn load_error(e: crate::artifacts::LoadError) -> EngineError {
+    match e {
+        crate::artifacts::LoadError::Library(e) => EngineError::Library(e),
+        crate::artifacts::LoadError::Render(e) => EngineError::Render(e),
+        crate::artifacts::LoadError::Cancelled => EngineError::InvalidArgument("loading was cancelled".into()),
     }
 }
 
@@ -309,25 +326,38 @@ impl Engine {
                 .min(gpu.device.limits().max_texture_dimension_2d),
             ..crate::budget::ResourceBudget::PHONE
         };
-        let mut model = match &config.model_path {
-            Some(path) => {
-                let mut m = crate::model::load_model_within(path, budget)?;
-                m.fit_to_diorama(&screen, &config.fit);
-                m
+        let library = crate::library::Library::new(config.library_dir.clone(), config.bundled_dir.clone());
+        let mut loader = crate::artifacts::Loader::new(library, budget);
+        let placing = crate::artifacts::Placing {
+            screen,
+            fit: config.fit,
+            floor: config.floor,
+        };
+        let prepared = match (&config.model_path, &config.artifact) {
+            (Some(path), _) => {
+                let model = crate::model::load_model_within(path, budget)?;
+                crate::artifacts::prepare(model, None, false, &placing)?
             }
-            None => crate::artifact::default_model(),
+            (None, Some(id)) => match loader.load_now(id, &placing) {
+                Ok(p) => p,
+                // What the shell saved may have been removed or damaged since: the default
+                // artifact, and the reason on screen.
+                Err(e) => {
+                    loader.fail(id.to_string(), e.to_string());
+                    loader
+                        .load_now(&crate::library::ArtifactId::default_artifact(), &placing)
+                        .map_err(load_error)?
+                }
+            },
+            (None, None) => loader
+                .load_now(&crate::library::ArtifactId::default_artifact(), &placing)
+                .map_err(load_error)?,
         };
-        let model_info = ModelInfo {
-            name: model.name.clone(),
-            triangles: model.triangle_count(),
-            materials: model.materials.len(),
-            images: model.images.len(),
-            warnings: model.warnings.clone(),
-        };
-        let bounds = model.bounds().ok_or(RenderError::EmptyModel)?;
-        if config.floor {
-            model.add_floor(&screen, crate::model::Model::FLOOR_REACH);
-        }
+        let crate::artifacts::Prepared {
+            model,
+            bounds,
+            info: model_info,
+        } = prepared;
         let environment = match &config.environment_path {
             Some(path) => Some(crate::ibl::Environment::load(path)?),
             None => None,
@@ -359,6 +389,9 @@ impl Engine {
             renderer,
             model_info,
             bounds,
+            loader,
+            fit: config.fit,
+            floor: config.floor,
             smoother: ContainmentSmoother::default(),
             method: config.method,
             stereo_method: if config.method == Method::Mono {
@@ -488,9 +521,92 @@ impl Engine {
         }
     }
 
-    /// What was loaded ([`EngineConfig::model_path`], or the default artifact).
+    /// What is on screen ([`EngineConfig::model_path`], or the library's artifact).
     pub fn model_info(&self) -> &ModelInfo {
         &self.model_info
+    }
+
+    /// Every artifact the library offers (built in, bundled, imported), for the gallery.
+    pub fn artifacts(&self) -> Vec<crate::library::ArtifactEntry> {
+        self.loader.library().list()
+    }
+
+    /// Starts showing an artifact of the library: loaded in the background (see
+    /// [`crate::artifacts`]); the artifact on screen stays until it is ready. Progress and
+    /// failure: [`Self::loading_status`].
+    pub fn select_artifact(&mut self, id: crate::library::ArtifactId) {
+        let placing = self.placing();
+        self.loader.start(crate::artifacts::Request::Select(id), placing);
+    }
+
+    /// Imports a file the user opened (its display name and bytes: a `.glb`, `.gltf` or `.zip`)
+    /// into the library and shows it when loaded, in the background as [`Self::select_artifact`].
+    pub fn import_artifact(&mut self, name: &str, bytes: Vec<u8>) {
+        let placing = self.placing();
+        self.loader.start(
+            crate::artifacts::Request::Import {
+                name: name.to_owned(),
+                bytes: Arc::new(bytes),
+            },
+            placing,
+        );
+    }
+
+    /// Removes an imported artifact from the library (if it is on screen, it stays there until
+    /// another is chosen).
+    pub fn remove_artifact(&mut self, id: &crate::library::ArtifactId) -> Result<(), EngineError> {
+        Ok(self.loader.library().remove(id)?)
+    }
+
+    /// Gives up the load under way; the artifact on screen stays.
+    pub fn cancel_loading(&mut self) {
+        self.loader.cancel();
+    }
+
+    /// Loading progress, or why the last load failed (until [`Self::dismiss_message`]).
+    pub fn loading_status(&self) -> LoadStatus {
+        self.loader.status()
+    }
+
+    /// The user has read the failure message.
+    pub fn dismiss_message(&mut self) {
+        self.loader.dismiss();
+    }
+
+    /// Waits up to `timeout` for the load under way and shows its artifact (for the desktop
+    /// tools and tests; the shells just keep drawing, which takes finished loads in turn).
+    /// Returns whether a new artifact is now on screen.
+    pub fn wait_for_artifact(&mut self, timeout: std::time::Duration) -> bool {
+        match self.loader.wait(timeout) {
+            Some(prepared) => self.install(prepared),
+            None => false,
+        }
+    }
+
+    fn placing(&self) -> crate::artifacts::Placing {
+        crate::artifacts::Placing {
+            screen: self.session.config().screen,
+            fit: self.fit,
+            floor: self.floor,
+        }
+    }
+
+    /// Uploads a loaded artifact in place of the one on screen; on failure the old one stays
+    /// and the reason goes to [`Self::loading_status`].
+    fn install(&mut self, prepared: crate::artifacts::Prepared) -> bool {
+        match self.renderer.set_model(&prepared.model) {
+            Ok(()) => {
+                self.bounds = prepared.bounds;
+                self.model_info = prepared.info;
+                self.smoother = ContainmentSmoother::default();
+                true
+            }
+            Err(e) => {
+                let title = prepared.info.artifact.map_or(prepared.info.name, |a| a.title);
+                self.loader.fail(title, e.to_string());
+                false
+            }
+        }
     }
 
     /// The session's sensor inbox: push events from any thread.
@@ -655,6 +771,9 @@ impl Engine {
     /// Draws one frame that will be on screen at `display_t_ns` (sensor clock; `None`: for the
     /// newest sensor state, no prediction).
     pub fn draw(&mut self, display_t_ns: Option<i64>) -> Result<DrawOutcome, EngineError> {
+        if let Some(prepared) = self.loader.poll() {
+            self.install(prepared);
+        }
         if let Some(g) = display_t_ns.and_then(|t| self.gestures.poll(t)) {
             self.apply_gesture(g);
         }

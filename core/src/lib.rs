@@ -9,7 +9,8 @@
 //! ## Layers
 //!
 //! This crate is the top of the library's layers and the one the shells and users depend on: it
-//! holds [`engine`] (the one embedding API) and [`gesture`], and re-exports the lower crates'
+//! holds [`engine`] (the one embedding API), [`artifacts`] (switching artifacts while it runs)
+//! and [`gesture`], and re-exports the lower crates'
 //! modules under their old paths (`phantogram::screen`, `phantogram::fusion`, …). Dependencies
 //! point down only (see `ARCHITECTURE.md`):
 //!
@@ -20,7 +21,8 @@
 //!   uses.
 //! * `phantogram_sensing`: [`sensors`], [`lowpass`], [`attitude`], [`fusion`], [`eyetrack`],
 //!   [`calibration`], [`camera`], [`session`], [`synthetic`], [`clock`].
-//! * `phantogram_assets` (feature `models`): `model`, `artifact`, `ibl`, `parallel`, `budget`.
+//! * `phantogram_assets` (feature `models`): `model`, `artifact`, `builtin`, `library`, `ibl`,
+//!   `parallel`, `progress`, `budget`.
 //! * `phantogram_render` (feature `render`): `render` (the crate itself) and `surface`.
 //! * `phantogram_vision` (feature `face`): `face` (the crate itself).
 //! * `phantogram_ui` (feature `ui`): `calibration_ui` (the crate itself).
@@ -62,7 +64,7 @@ pub use phantogram_sensing::{
 };
 
 #[cfg(feature = "models")]
-pub use phantogram_assets::{artifact, budget, ibl, model, parallel};
+pub use phantogram_assets::{artifact, budget, builtin, ibl, library, model, parallel, progress};
 #[cfg(feature = "render")]
 pub use phantogram_render as render;
 #[cfg(feature = "render")]
@@ -72,6 +74,8 @@ pub use phantogram_ui as calibration_ui;
 #[cfg(feature = "face")]
 pub use phantogram_vision as face;
 
+#[cfg(feature = "render")]
+pub mod artifacts;
 #[cfg(feature = "render")]
 pub mod engine;
 pub mod gesture;

@@ -327,6 +327,10 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             fit: Default::default(),
             floor: c.floor != 0,
             calibration_path: calibration.map(PathBuf::from),
+            // TODO(issue 18): the shells pass their storage and saved artifact (next step).
+            artifact: None,
+            library_dir: None,
+            bundled_dir: None,
         };
         let engine = Engine::new(config)?;
         let handle = Box::new(PgEngine {

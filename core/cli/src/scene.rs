@@ -16,6 +16,9 @@ pub struct SceneArgs {
     /// A glTF 2.0 model (.gltf or .glb), or a Smithsonian Voyager folder or its scene.svx.json
     /// (its best scan present); the default artifact when omitted.
     model: Option<PathBuf>,
+    /// One of the built-in artifacts instead: amphora (the default), medal or tablet.
+    #[arg(long, value_name = "NAME", conflicts_with = "model")]
+    artifact: Option<String>,
     /// Fraction of a loaded model's height that stands in front of the glass.
     #[arg(long, default_value_t = 0.4)]
     protrude: f32,
@@ -46,9 +49,23 @@ impl SceneArgs {
         if !(0.0..=1.0).contains(&self.protrude) {
             bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
         }
+        let artifact = match &self.artifact {
+            Some(name) => {
+                let known: Vec<&str> = phantogram::builtin::BUILT_INS.iter().map(|b| b.key).collect();
+                if !known.contains(&name.as_str()) {
+                    bail!(
+                        "--artifact {name:?} is not a built-in artifact (choose from {})",
+                        known.join(", ")
+                    );
+                }
+                Some(phantogram::library::ArtifactId::built_in(name))
+            }
+            None => None,
+        };
         let config = EngineConfig {
             method,
             model_path: self.model.clone(),
+            artifact,
             environment_path: self.environment.clone(),
             fit: DioramaFit {
                 placement: match self.placement {

@@ -1,4 +1,4 @@
-//! Scratch folders for tests: the crates' unit tests, the CLI tests and the workspace's
+//! Scratch folders and a small valid GLB for tests: the crates' unit tests, the CLI tests and the workspace's
 //! integration tests share this one piece, as a dev-dependency only: no library writes temporary
 //! files.
 //!
@@ -42,4 +42,48 @@ impl Drop for Scratch {
             let _ = std::fs::remove_dir_all(&self.0);
         }
     }
+}
+
+/// A small valid GLB for tests: a tetrahedron `size_m` across (unindexed, positions only), with
+/// `asset_extra` spliced into its `asset` object (e.g. `"copyright":"A museum"`; empty for none).
+/// Different sizes give different files.
+pub fn tetrahedron_glb(size_m: f32, asset_extra: &str) -> Vec<u8> {
+    let s = size_m;
+    let [a, b, c, d] = [[0.0, 0.0, 0.0], [s, 0.0, 0.0], [0.0, s, 0.0], [0.0, 0.0, s]];
+    // Counter-clockwise from outside.
+    let triangles = [[a, c, b], [a, b, d], [a, d, c], [b, c, d]];
+    let mut bin = Vec::new();
+    for p in triangles.iter().flatten().flatten() {
+        bin.extend_from_slice(&f32::to_le_bytes(*p));
+    }
+    let sep = if asset_extra.is_empty() { "" } else { "," };
+    let json = format!(
+        concat!(
+            r#"{{"asset":{{"version":"2.0"{sep}{extra}}},"scene":0,"scenes":[{{"nodes":[0]}}],"#,
+            r#""nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{{"attributes":{{"POSITION":0}}}}]}}],"#,
+            r#""accessors":[{{"bufferView":0,"componentType":5126,"count":12,"type":"VEC3","#,
+            r#""min":[0,0,0],"max":[{s},{s},{s}]}}],"#,
+            r#""bufferViews":[{{"buffer":0,"byteLength":{len}}}],"buffers":[{{"byteLength":{len}}}]}}"#
+        ),
+        sep = sep,
+        extra = asset_extra,
+        s = s,
+        len = bin.len()
+    );
+    let mut json = json.into_bytes();
+    while json.len() % 4 != 0 {
+        json.push(b' ');
+    }
+    let total = 12 + 8 + json.len() + 8 + bin.len();
+    let mut glb = Vec::with_capacity(total);
+    glb.extend_from_slice(b"glTF");
+    glb.extend_from_slice(&2u32.to_le_bytes());
+    glb.extend_from_slice(&(total as u32).to_le_bytes());
+    glb.extend_from_slice(&(json.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"JSON");
+    glb.extend_from_slice(&json);
+    glb.extend_from_slice(&(bin.len() as u32).to_le_bytes());
+    glb.extend_from_slice(b"BIN\0");
+    glb.extend_from_slice(&bin);
+    glb
 }

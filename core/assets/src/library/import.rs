@@ -1,0 +1,174 @@
+//! Turning bytes the user opened (a file picker's document, an "Open with" intent, a share) into a
+//! folder of the library: a `.glb`, a self-contained `.gltf`, or a zip holding either or a
+//! Smithsonian Voyager download (`scene.svx.json` beside its scans).
+//!
+//! Zip archives are unpacked with the same care as any file from outside: names only inside the
+//! folder (`..`, absolute paths and links are refused), at most [`MAX_ZIP_ENTRIES`] entries, and
+//! no more bytes written than the budget's memory — counted as they are inflated, not as the
+//! archive claims, so a zip bomb stops at the budget.
+
+use std::io::{Read, Write};
+use std::path::{Path, PathBuf};
+
+use super::LibraryError;
+
+/// Most entries unpacked from one archive (a Voyager download has a dozen).
+pub const MAX_ZIP_ENTRIES: usize = 4096;
+
+/// What an opened file's bytes are.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Format {
+    Glb,
+    GltfJson,
+    Zip,
+}
+
+/// Recognises a file by its first bytes (names lie: shares often arrive as `document.bin`).
+pub fn sniff(bytes: &[u8]) -> Option<Format> {
+    if bytes.starts_with(b"glTF") {
+        return Some(Format::Glb);
+    }
+    if bytes.starts_with(b"PK\x03\x04") || bytes.starts_with(b"PK\x05\x06") {
+        return Some(Format::Zip);
+    }
+    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let first = text.iter().find(|b| !b.is_ascii_whitespace());
+    (first == Some(&b'{')).then_some(Format::GltfJson)
+}
+
+/// Writes `bytes` as one model file `stem` in `folder`, with its format's extension.
+pub fn write_single(folder: &Path, stem: &str, format: Format, bytes: &[u8]) -> Result<PathBuf, LibraryError> {
+    let extension = match format {
+        Format::Glb => "glb",
+        _ => "gltf",
+    };
+    let path = folder.join(format!("{stem}.{extension}"));
+    std::fs::write(&path, bytes).map_err(|error| LibraryError::io(&path, error))?;
+    Ok(path)
+}
+
+/// Unpacks a zip archive into `folder` (see the module docs for the limits).
+pub fn unzip(folder: &Path, bytes: &[u8], max_bytes: u64, source: &str) -> Result<(), LibraryError> {
+    let bad = |message: String| LibraryError::Archive {
+        name: source.to_owned(),
+        message,
+    };
+    let mut archive = zip::ZipArchive::new(std::io::Cursor::new(bytes)).map_err(|e| bad(e.to_string()))?;
+    if archive.len() > MAX_ZIP_ENTRIES {
+        return Err(bad(format!(
+            "{} entries; at most {MAX_ZIP_ENTRIES} are unpacked",
+            archive.len()
+        )));
+    }
+    let mut left = max_bytes;
+    for i in 0..archive.len() {
+        let mut entry = archive.by_index(i).map_err(|e| bad(e.to_string()))?;
+        if entry.is_dir() || entry.is_symlink() {
+            continue;
+        }
+        let Some(name) = entry.enclosed_name() else {
+            return Err(bad(format!(
+                "entry {} ({}) names a place outside the archive's folder",
+                i,
+                phantogram_files::text::excerpt(&entry.name().unwrap_or_default())
+            )));
+        };
+        // macOS's resource forks are not part of the download.
+        if name.components().any(|c| c.as_os_str() == "__MACOSX") {
+            continue;
+        }
+        let path = folder.join(&name);
+        if let Some(parent) = path.parent() {
+            std::fs::create_dir_all(parent).map_err(|error| LibraryError::io(parent, error))?;
+        }
+        let mut out = std::fs::File::create(&path).map_err(|error| LibraryError::io(&path, error))?;
+        // One byte more than is left tells an archive over the budget from one exactly at it.
+        let mut limited = (&mut entry).take(left.saturating_add(1));
+        let written = copy(&mut limited, &mut out).map_err(|e| bad(format!("{}: {e}", name.display())))?;
+        if written > left {
+            return Err(LibraryError::TooLarge {
+                name: source.to_owned(),
+                max_bytes,
+            });
+        }
+        left -= written;
+    }
+    Ok(())
+}
+
+/// `std::io::copy`, with the write errors told apart from the archive's read errors by message.
+fn copy(from: &mut impl Read, to: &mut std::fs::File) -> std::io::Result<u64> {
+    let mut buf = vec![0u8; 64 << 10];
+    let mut total = 0u64;
+    loop {
+        let n = from.read(&mut buf)?;
+        if n == 0 {
+            break;
+        }
+        to.write_all(&buf[..n])
+            .map_err(|e| std::io::Error::new(e.kind(), format!("writing: {e}")))?;
+        total += n as u64;
+    }
+    to.sync_all()?;
+    Ok(total)
+}
+
+/// The model an unpacked folder holds: the shallowest Voyager scene's folder, else its only
+/// `.glb`/`.gltf` file.
+pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> {
+    let mut scenes = Vec::new();
+    let mut models = Vec::new();
+    let mut stack = vec![(folder.to_path_buf(), 0usize)];
+    while let Some((dir, depth)) = stack.pop() {
+        let entries = std::fs::read_dir(&dir).map_err(|error| LibraryError::io(&dir, error))?;
+        for entry in entries.flatten() {
+            let path = entry.path();
+            let Ok(kind) = entry.file_type() else { continue };
+            let name = entry.file_name().to_string_lossy().to_ascii_lowercase();
+            if kind.is_dir() && depth < 8 {
+                stack.push((path, depth + 1));
+            } else if kind.is_file() && name.ends_with(".svx.json") {
+                scenes.push((depth, path));
+            } else if kind.is_file() && (name.ends_with(".glb") || name.ends_with(".gltf")) {
+                models.push(path);
+            }
+        }
+    }
+    scenes.sort();
+    if let Some((_, scene)) = scenes.into_iter().next() {
+        // The scene's folder: the loader picks its best scan present.
+        return Ok(scene.parent().unwrap_or(folder).to_path_buf());
+    }
+    match models.len() {
+        1 => Ok(models.remove(0)),
+        0 => Err(LibraryError::NoModel {
+            name: source.to_owned(),
+        }),
+        _ => {
+            let mut names: Vec<String> = models
+                .iter()
+                .filter_map(|p| p.strip_prefix(folder).ok())
+                .map(|p| p.display().to_string())
+                .collect();
+            names.sort();
+            Err(LibraryError::SeveralModels {
+                name: source.to_owned(),
+                models: names,
+            })
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn formats_are_told_by_their_first_bytes() {
+        assert_eq!(sniff(b"glTF\x02\0\0\0"), Some(Format::Glb));
+        assert_eq!(sniff(b"PK\x03\x04rest"), Some(Format::Zip));
+        assert_eq!(sniff(b"\xEF\xBB\xBF \n {\"asset\":{}}"), Some(Format::GltfJson));
+        assert_eq!(sniff(b"\x89PNG\r\n"), None);
+        assert_eq!(sniff(b""), None);
+    }
+}

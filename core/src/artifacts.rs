@@ -1,0 +1,313 @@
+//! Changing the artifact on screen while the engine runs: the [`crate::library`] on a worker
+//! thread, with progress and cancel, and the result handed to the render thread.
+//!
+//! * One load at a time: a new request cancels the one under way (its result, if it still
+//!   comes, is dropped by its generation number).
+//! * The artifact on screen stays until the new one is ready: the worker loads, fits and floors
+//!   the model (CPU work) into a [`Prepared`]; the render thread only uploads it.
+//! * A failure (a damaged file, an unknown id, over the budget) becomes
+//!   [`LoadStatus::Failed`] with a message for the screen; a cancelled load becomes
+//!   [`LoadStatus::Idle`] again, not an error.
+//!
+//! **Threading**: a [`Loader`] lives on the render thread (inside the engine's mutex); each
+//! load runs on a thread of its own named `artifact-loader`, sharing only the request, an
+//! `Arc<Progress>` and a channel. **Panics**: a panic inside a load (a bug) is caught on its
+//! thread and reported as that load's failure.
+
+use std::sync::Arc;
+use std::sync::mpsc::{Receiver, Sender, channel};
+use std::time::Duration;
+
+use crate::budget::ResourceBudget;
+use crate::containment::Aabb;
+use crate::library::{ArtifactEntry, ArtifactId, Library, LibraryError, LoadedArtifact};
+use crate::model::{DioramaFit, Model};
+use crate::progress::Progress;
+use crate::screen::Screen;
+
+/// What was loaded, for the gallery, logs and the desktop tools.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ModelInfo {
+    /// The model's name (a loaded file's stem: it tells which scan a Voyager folder gave).
+    pub name: String,
+    pub triangles: usize,
+    pub materials: usize,
+    pub images: usize,
+    /// What the loader could not honour but worked around (an unsupported extension, …).
+    pub warnings: Vec<String>,
+    /// The library's entry (title, credit, licence); `None` for a file given by path.
+    pub artifact: Option<ArtifactEntry>,
+}
+
+/// A model ready to upload: fitted into the diorama, floored, its bounds known.
+#[derive(Debug)]
+pub struct Prepared {
+    pub model: Model,
+    /// The artifact's bounds without the floor (what containment keeps in the front frustum).
+    pub bounds: Aabb,
+    pub info: ModelInfo,
+}
+
+/// How the worker places what it loads (the engine's settings when the load starts).
+#[derive(Clone, Copy, Debug)]
+pub struct Placing {
+    pub screen: Screen,
+    pub fit: DioramaFit,
+    pub floor: bool,
+}
+
+/// Fits (unless the artifact comes placed), measures and floors a loaded model.
+pub fn prepare(
+    mut model: Model,
+    entry: Option<ArtifactEntry>,
+    placed: bool,
+    placing: &Placing,
+) -> Result<Prepared, crate::render::RenderError> {
+    if !placed {
+        model.fit_to_diorama(&placing.screen, &placing.fit);
+    }
+    let bounds = model.bounds().ok_or(crate::render::RenderError::EmptyModel)?;
+    let info = ModelInfo {
+        name: model.name.clone(),
+        triangles: model.triangle_count(),
+        materials: model.materials.len(),
+        images: model.images.len(),
+        warnings: model.warnings.clone(),
+        artifact: entry,
+    };
+    if placing.floor {
+        model.add_floor(&placing.screen, Model::FLOOR_REACH);
+    }
+    Ok(Prepared { model, bounds, info })
+}
+
+/// What the shells show about loading.
+#[derive(Clone, Debug, PartialEq)]
+pub enum LoadStatus {
+    /// Nothing under way, nothing to report.
+    Idle,
+    /// Loading `title` (or the file's name while importing): `fraction` 0 to 1.
+    Loading { title: String, fraction: f32 },
+    /// The last load failed; the previous artifact is still on screen.
+    Failed { title: String, message: String },
+}
+
+/// What to load.
+#[derive(Clone, Debug)]
+pub enum Request {
+    /// An artifact of the library.
+    Select(ArtifactId),
+    /// A file the user opened: its display name and bytes, imported into the library.
+    Import { name: String, bytes: Arc<Vec<u8>> },
+}
+
+type Outcome = (u64, Result<Prepared, String>);
+
+struct Job {
+    generation: u64,
+    title: String,
+    progress: Arc<Progress>,
+}
+
+/// Loads artifacts off the render thread (see the module docs).
+pub struct Loader {
+    library: Library,
+    budget: ResourceBudget,
+    generation: u64,
+    job: Option<Job>,
+    failed: Option<(String, String)>,
+    tx: Sender<Outcome>,
+    rx: Receiver<Outcome>,
+}
+
+impl std::fmt::Debug for Loader {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Loader")
+            .field("generation", &self.generation)
+            .field("loading", &self.job.as_ref().map(|j| &j.title))
+            .finish_non_exhaustive()
+    }
+}
+
+impl Loader {
+    pub fn new(library: Library, budget: ResourceBudget) -> Self {
+        let (tx, rx) = channel();
+        Self {
+            library,
+            budget,
+            generation: 0,
+            job: None,
+            failed: None,
+            tx,
+            rx,
+        }
+    }
+
+    pub fn library(&self) -> &Library {
+        &self.library
+    }
+
+    pub fn budget(&self) -> ResourceBudget {
+        self.budget
+    }
+
+    /// Loads synchronously, on the calling thread (the engine's first artifact).
+    pub fn load_now(&self, id: &ArtifactId, placing: &Placing) -> Result<Prepared, LoadError> {
+        let loaded = self.library.load(id, self.budget, &Progress::new())?;
+        Ok(prepare(loaded.model, Some(loaded.entry), loaded.placed, placing)?)
+    }
+
+    /// Starts loading `request`, cancelling a load under way.
+    pub fn start(&mut self, request: Request, placing: Placing) {
+        self.cancel();
+        self.failed = None;
+        self.generation += 1;
+        let generation = self.generation;
+        let title = match &request {
+            Request::Select(id) => self
+                .library
+                .entry(id)
+                .map(|e| e.title)
+                .unwrap_or_else(|_| id.to_string()),
+            Request::Import { name, .. } => display_name(name),
+        };
+        let progress = Arc::new(Progress::new());
+        let (library, budget, tx) = (self.library.clone(), self.budget, self.tx.clone());
+        let worker_progress = Arc::clone(&progress);
+        let spawned = std::thread::Builder::new()
+            .name("artifact-loader".into())
+            .spawn(move || {
+                let run = || -> Result<Prepared, LoadError> {
+                    let loaded: LoadedArtifact = match &request {
+                        Request::Select(id) => library.load(id, budget, &worker_progress)?,
+                        Request::Import { name, bytes } => library.import(name, bytes, budget, &worker_progress)?,
+                    };
+                    if worker_progress.is_cancelled() {
+                        return Err(LoadError::Cancelled);
+                    }
+                    let prepared = prepare(loaded.model, Some(loaded.entry), loaded.placed, &placing)?;
+                    worker_progress.advance_to(0.95);
+                    Ok(prepared)
+                };
+                let outcome = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+                    Ok(Ok(p)) => Ok(p),
+                    Ok(Err(e)) if e.is_cancelled() => return,
+                    Ok(Err(e)) => Err(e.to_string()),
+                    Err(_) => Err("the loader failed unexpectedly (a bug); the artifact stays as it was".into()),
+                };
+                // The engine may be gone: then nobody wants the result.
+                let _ = tx.send((generation, outcome));
+            });
+        match spawned {
+            Ok(_) => {
+                self.job = Some(Job {
+                    generation,
+                    title,
+                    progress,
+                })
+            }
+            Err(e) => self.failed = Some((title, format!("could not start loading: {e}"))),
+        }
+    }
+
+    /// Gives up the load under way, if any; the artifact on screen stays.
+    pub fn cancel(&mut self) {
+        if let Some(job) = self.job.take() {
+            job.progress.cancel();
+        }
+    }
+
+    /// Forgets a failure once the user has read it.
+    pub fn dismiss(&mut self) {
+        self.failed = None;
+    }
+
+    /// The newest finished load of the current request, if one finished: `Ok` to upload, or
+    /// `Err` (already kept for [`Self::status`]).
+    pub fn poll(&mut self) -> Option<Prepared> {
+        self.take(None)
+    }
+
+    /// As [`Self::poll`], waiting up to `timeout` for the load under way.
+    pub fn wait(&mut self, timeout: Duration) -> Option<Prepared> {
+        self.take(Some(timeout))
+    }
+
+    fn take(&mut self, timeout: Option<Duration>) -> Option<Prepared> {
+        let deadline = timeout.map(|t| std::time::Instant::now() + t);
+        loop {
+            let received = match deadline {
+                Some(d) if self.job.is_some() => self
+                    .rx
+                    .recv_timeout(d.saturating_duration_since(std::time::Instant::now()))
+                    .ok(),
+                _ => self.rx.try_recv().ok(),
+            };
+            let (generation, outcome) = received?;
+            let Some(job) = self.job.as_ref().filter(|j| j.generation == generation) else {
+                continue; // a superseded or cancelled load's result
+            };
+            let title = job.title.clone();
+            self.job = None;
+            return match outcome {
+                Ok(p) => Some(p),
+                Err(message) => {
+                    self.failed = Some((title, message));
+                    None
+                }
+            };
+        }
+    }
+
+    /// Records a failure found after the worker (uploading the model).
+    pub fn fail(&mut self, title: String, message: String) {
+        self.failed = Some((title, message));
+    }
+
+    pub fn status(&self) -> LoadStatus {
+        if let Some(job) = &self.job {
+            return LoadStatus::Loading {
+                title: job.title.clone(),
+                fraction: job.progress.fraction(),
+            };
+        }
+        match &self.failed {
+            Some((title, message)) => LoadStatus::Failed {
+                title: title.clone(),
+                message: message.clone(),
+            },
+            None => LoadStatus::Idle,
+        }
+    }
+}
+
+/// A file name as a title on screen: control characters dropped, at most 80 characters.
+fn display_name(name: &str) -> String {
+    let clean: String = name.chars().filter(|c| !c.is_control()).collect();
+    match clean.char_indices().nth(80) {
+        Some((end, _)) => format!("{}…", &clean[..end]),
+        None if clean.trim().is_empty() => "a file".to_owned(),
+        None => clean,
+    }
+}
+
+/// Why a load failed.
+#[derive(Debug, thiserror::Error)]
+pub enum LoadError {
+    #[error(transparent)]
+    Library(#[from] LibraryError),
+    #[error(transparent)]
+    Render(#[from] crate::render::RenderError),
+    #[error("cancelled")]
+    Cancelled,
+}
+
+impl LoadError {
+    fn is_cancelled(&self) -> bool {
+        match self {
+            Self::Cancelled => true,
+            Self::Library(e) => e.is_cancelled(),
+            Self::Render(_) => false,
+        }
+    }
+}
