@@ -236,24 +236,50 @@ pub struct Engine {
     calibration_warning: Option<String>,
     /// The panel as the platform reports it; a calibrated density goes over it.
     platform_panel: PanelSpec,
-    /// The calibration screens, while open.
+    /// The screens drawn over the picture (menu, calibration, status banner); made when first
+    /// needed and kept, so egui's fonts are uploaded once.
     #[cfg(feature = "ui")]
-    screens: Option<Box<CalibrationScreens>>,
+    screens: Option<Box<Screens>>,
+    /// What the core asks of the shell (a file picker), until taken.
+    requests: Vec<ShellRequest>,
+}
+
+/// Something only the platform can do, asked for by the core's screens: the shell takes these
+/// with [`Engine::take_shell_requests`] after each frame and answers through the engine's
+/// calls (for a file: [`Engine::import_artifact`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ShellRequest {
+    /// Show the system's document picker for a `.glb`, `.gltf` or `.zip`.
+    OpenFile,
 }
 
 /// Paints over a composed frame: the GPU, the frame's view, its format and size.
 type OverlayPaint<'a> = dyn FnMut(&Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]) + 'a;
 
-/// The calibration screens' state on the render thread: egui's context, the touches waiting for
-/// the next frame, and the overlay painter (made with the first frame drawn).
+/// Which full screen is open over the picture.
 #[cfg(feature = "ui")]
-struct CalibrationScreens {
-    ui: crate::calibration_ui::CalibrationUi,
+enum Page {
+    Menu(crate::calibration_ui::menu::MenuUi),
+    Calibration(crate::calibration_ui::CalibrationUi),
+}
+
+/// The screens' state on the render thread: the page open (if any), egui's context, the touches
+/// waiting for the next frame, and the overlay painter (made with the first frame drawn).
+#[cfg(feature = "ui")]
+struct Screens {
+    page: Option<Page>,
+    /// The gallery's items, read from the library when the menu opens and after a change.
+    items: Vec<crate::calibration_ui::menu::MenuItem>,
     ctx: egui::Context,
     events: Vec<egui::Event>,
     overlay: crate::calibration_ui::OverlayHost,
     /// The finger that drives the screens: the first one down; others are ignored.
     pointer: Option<i32>,
+    /// The status banner's rectangle in the last frame (points), while one shows: a touch that
+    /// starts there is the banner's, any other the gestures'.
+    banner_pt: Option<egui::Rect>,
+    /// The banner's button (Cancel or OK) in the last frame, points.
+    banner_button_pt: Option<egui::Rect>,
 }
 
 impl std::fmt::Debug for Engine {
@@ -413,6 +439,7 @@ impl Engine {
             platform_panel: config.panel,
             #[cfg(feature = "ui")]
             screens: None,
+            requests: Vec::new(),
         };
         engine.apply_calibration();
         Ok(engine)
@@ -458,14 +485,26 @@ impl Engine {
     pub fn open_calibration(&mut self) -> bool {
         #[cfg(feature = "ui")]
         {
-            if self.screens.is_none() {
-                self.screens = Some(Box::new(CalibrationScreens {
-                    ui: crate::calibration_ui::CalibrationUi::with_calibration(self.calibration),
-                    ctx: egui::Context::default(),
-                    events: Vec::new(),
-                    overlay: crate::calibration_ui::OverlayHost::new(),
-                    pointer: None,
-                }));
+            let calibration = self.calibration;
+            let page = Page::Calibration(crate::calibration_ui::CalibrationUi::with_calibration(calibration));
+            let screens = self.screens();
+            if !matches!(screens.page, Some(Page::Calibration(_))) {
+                screens.page = Some(page);
+            }
+            true
+        }
+        #[cfg(not(feature = "ui"))]
+        false
+    }
+
+    /// Opens the menu: the artifact gallery, opening a file, the way to the calibration (also a
+    /// single tap). Returns `false` when this build has no screens (feature `ui` off).
+    pub fn open_menu(&mut self) -> bool {
+        #[cfg(feature = "ui")]
+        {
+            if !self.menu_open() {
+                self.screens().page = Some(Page::Menu(crate::calibration_ui::menu::MenuUi::new()));
+                self.refresh_menu_items();
             }
             true
         }
@@ -476,9 +515,58 @@ impl Engine {
     /// Whether the calibration screens are showing (touches then drive them, not gestures).
     pub fn calibration_open(&self) -> bool {
         #[cfg(feature = "ui")]
-        return self.screens.is_some();
+        return matches!(
+            self.screens.as_ref().and_then(|s| s.page.as_ref()),
+            Some(Page::Calibration(_))
+        );
         #[cfg(not(feature = "ui"))]
         false
+    }
+
+    /// Whether the menu is showing (touches then drive it, not gestures).
+    pub fn menu_open(&self) -> bool {
+        #[cfg(feature = "ui")]
+        return matches!(self.screens.as_ref().and_then(|s| s.page.as_ref()), Some(Page::Menu(_)));
+        #[cfg(not(feature = "ui"))]
+        false
+    }
+
+    /// What the core's screens asked of the shell since the last call (see [`ShellRequest`]).
+    pub fn take_shell_requests(&mut self) -> Vec<ShellRequest> {
+        std::mem::take(&mut self.requests)
+    }
+
+    #[cfg(feature = "ui")]
+    fn screens(&mut self) -> &mut Screens {
+        self.screens.get_or_insert_with(|| {
+            Box::new(Screens {
+                page: None,
+                items: Vec::new(),
+                ctx: egui::Context::default(),
+                events: Vec::new(),
+                overlay: crate::calibration_ui::OverlayHost::new(),
+                pointer: None,
+                banner_pt: None,
+                banner_button_pt: None,
+            })
+        })
+    }
+
+    /// Reads the gallery's items from the library again.
+    #[cfg(feature = "ui")]
+    fn refresh_menu_items(&mut self) {
+        let items = self
+            .artifacts()
+            .into_iter()
+            .map(|a| crate::calibration_ui::menu::MenuItem {
+                removable: a.id.origin == crate::library::Origin::Imported,
+                id: a.id.to_string(),
+                title: a.title,
+                credit: a.credit,
+                licence: a.licence,
+            })
+            .collect();
+        self.screens().items = items;
     }
 
     /// The centre of a control of the calibration screens in the last frame drawn, in physical
@@ -486,10 +574,27 @@ impl Engine {
     /// automation.
     #[cfg(feature = "ui")]
     pub fn calibration_control_px(&self, name: &str) -> Option<[f32; 2]> {
-        let screens = self.screens.as_ref()?;
-        let centre = screens.ui.widget_rect(name)?.center();
+        let Some(Page::Calibration(ui)) = self.screens.as_ref()?.page.as_ref() else {
+            return None;
+        };
+        let centre = ui.widget_rect(name)?.center();
         let ppp = self.pixels_per_point();
         Some([centre.x * ppp, centre.y * ppp])
+    }
+
+    /// As [`Self::calibration_control_px`] for the menu (names as
+    /// [`crate::calibration_ui::menu::MenuUi::widget_rect`]) and, with `banner`, the status
+    /// banner's button (Cancel or OK).
+    #[cfg(feature = "ui")]
+    pub fn menu_control_px(&self, name: &str) -> Option<[f32; 2]> {
+        let screens = self.screens.as_ref()?;
+        let rect = match (&screens.page, name) {
+            (_, "banner") => screens.banner_button_pt?,
+            (Some(Page::Menu(menu)), _) => menu.widget_rect(name)?,
+            _ => return None,
+        };
+        let ppp = self.pixels_per_point();
+        Some([rect.center().x * ppp, rect.center().y * ppp])
     }
 
     /// Physical pixels per egui point on this display: Android's density (dpi / 160), which iOS's
@@ -712,12 +817,22 @@ impl Engine {
     /// it completes and returns it.
     pub fn touch(&mut self, phase: TouchPhase, pointer_id: i32, x_px: f32, y_px: f32, t_ns: i64) -> Option<Gesture> {
         #[cfg(feature = "ui")]
-        if self.screens.is_some() {
+        {
             let ppp = self.pixels_per_point();
+            let gestures_idle = self.gestures.is_idle();
             if let Some(screens) = self.screens.as_mut() {
-                screens.touch(phase, pointer_id, x_px / ppp, y_px / ppp);
+                let (x_pt, y_pt) = (x_px / ppp, y_px / ppp);
+                // A page takes every touch; the banner only those that start on it while no
+                // gesture is under way.
+                let on_banner = phase == TouchPhase::Down
+                    && gestures_idle
+                    && screens.pointer.is_none()
+                    && screens.banner_pt.is_some_and(|r| r.contains(egui::pos2(x_pt, y_pt)));
+                if screens.page.is_some() || screens.pointer == Some(pointer_id) || on_banner {
+                    screens.touch(phase, pointer_id, x_pt, y_pt);
+                    return None;
+                }
             }
-            return None;
         }
         let g = self.gestures.touch(phase, pointer_id, x_px, y_px, t_ns)?;
         self.apply_gesture(g);
@@ -734,6 +849,9 @@ impl Engine {
             }
             Gesture::Calibrate => {
                 self.open_calibration();
+            }
+            Gesture::Menu => {
+                self.open_menu();
             }
             Gesture::AnchorLight => {
                 let _ = self.session.recalibrate_light();
@@ -796,8 +914,15 @@ impl Engine {
         let input = frame_input(&view, Vec3::Z * -push);
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
-        if self.screens.is_some() {
-            return self.draw_with_screens(&input);
+        {
+            let page_open = self.screens.as_ref().is_some_and(|s| s.page.is_some());
+            let status = self.loader.status();
+            if page_open || status != LoadStatus::Idle {
+                return self.draw_with_screens(&input, status);
+            } else if let Some(screens) = self.screens.as_mut() {
+                screens.banner_pt = None;
+                screens.banner_button_pt = None;
+            }
         }
         self.present(&input, None)
     }
@@ -840,10 +965,12 @@ impl Engine {
         Ok(outcome)
     }
 
-    /// [`Self::draw`] with the calibration screens over the frame: one egui frame with the touches
-    /// since the last, painted over the picture, then what the viewer chose is applied.
+    /// [`Self::draw`] with the screens over the frame: one egui frame with the touches since the
+    /// last (the open page, then the status banner over it), painted over the picture, then what
+    /// the viewer chose is applied.
     #[cfg(feature = "ui")]
-    fn draw_with_screens(&mut self, input: &FrameInput) -> Result<DrawOutcome, EngineError> {
+    fn draw_with_screens(&mut self, input: &FrameInput, status: LoadStatus) -> Result<DrawOutcome, EngineError> {
+        use crate::calibration_ui::menu::{Banner, BannerAction, show_banner};
         let size = self.target_size();
         // Nothing to lay the screens out on: the plain draw skips (and counts) the frame.
         let (w, h) = match size {
@@ -852,6 +979,8 @@ impl Engine {
         };
         let ppp = self.pixels_per_point();
         let screen = self.session.config().screen;
+        let current = self.model_info.artifact.as_ref().map(|a| a.id.to_string());
+        self.screens();
         // Out of `self` while the frame is drawn, which the painter needs them for.
         let Some(mut screens) = self.screens.take() else {
             return self.present(input, None);
@@ -865,9 +994,31 @@ impl Engine {
             events: std::mem::take(&mut screens.events),
             ..Default::default()
         };
-        let mut actions = Vec::new();
-        let ui = &mut screens.ui;
-        let mut output = screens.ctx.run_ui(raw, |root| actions = ui.show(root, &screen, ppp));
+        let banner = match status {
+            LoadStatus::Idle => None,
+            LoadStatus::Loading { title, fraction } => Some(Banner::Loading { title, fraction }),
+            LoadStatus::Failed { title, message } => Some(Banner::Failed { title, message }),
+        };
+        let (mut calibration_actions, mut menu_actions) = (Vec::new(), Vec::new());
+        let mut banner_action = None;
+        let mut banner_pt = None;
+        let mut banner_button_pt = None;
+        let (page, items) = (&mut screens.page, &screens.items);
+        let mut output = screens.ctx.run_ui(raw, |root| {
+            match page {
+                Some(Page::Calibration(ui)) => calibration_actions = ui.show(root, &screen, ppp),
+                Some(Page::Menu(menu)) => menu_actions = menu.show(root, items, current.as_deref()),
+                None => {}
+            }
+            if let Some(b) = &banner {
+                let (action, area, button) = show_banner(root.ctx(), b);
+                banner_action = action;
+                banner_pt = Some(area);
+                banner_button_pt = Some(button);
+            }
+        });
+        screens.banner_pt = banner_pt;
+        screens.banner_button_pt = banner_button_pt;
         screens.overlay.begin(&mut output);
         let drawn = {
             let ctx = screens.ctx.clone();
@@ -883,10 +1034,57 @@ impl Engine {
         }
         self.screens = Some(screens);
         let outcome = drawn?;
-        for action in actions {
+        for action in calibration_actions {
             self.apply_calibration_action(action);
         }
+        for action in menu_actions {
+            self.apply_menu_action(action);
+        }
+        match banner_action {
+            Some(BannerAction::Cancel) => self.cancel_loading(),
+            Some(BannerAction::Dismiss) => self.dismiss_message(),
+            None => {}
+        }
         Ok(outcome)
+    }
+
+    #[cfg(feature = "ui")]
+    fn set_page(&mut self, page: Option<Page>) {
+        self.screens().page = page;
+    }
+
+    #[cfg(feature = "ui")]
+    fn apply_menu_action(&mut self, action: crate::calibration_ui::menu::MenuAction) {
+        use crate::calibration_ui::menu::MenuAction as A;
+        match action {
+            A::Select(id) => {
+                match id.parse() {
+                    Ok(id) => self.select_artifact(id),
+                    Err(e) => self.loader.fail(id, format!("{e}")),
+                }
+                // Back to the picture, where the banner shows the progress.
+                self.set_page(None);
+            }
+            A::Remove(id) => {
+                let removed = id
+                    .parse()
+                    .map_err(EngineError::from)
+                    .and_then(|id| self.remove_artifact(&id));
+                if let Err(e) = removed {
+                    self.loader.fail(id, e.to_string());
+                }
+                self.refresh_menu_items();
+            }
+            A::OpenFile => {
+                self.requests.push(ShellRequest::OpenFile);
+                self.set_page(None);
+            }
+            A::Calibrate => {
+                self.set_page(None);
+                self.open_calibration();
+            }
+            A::Close => self.set_page(None),
+        }
     }
 
     #[cfg(feature = "ui")]
@@ -909,7 +1107,7 @@ impl Engine {
                 self.apply_calibration();
                 self.save_calibration();
             }
-            A::Closed => self.screens = None,
+            A::Closed => self.set_page(None),
         }
     }
 
@@ -962,7 +1160,7 @@ impl Engine {
 }
 
 #[cfg(feature = "ui")]
-impl CalibrationScreens {
+impl Screens {
     /// One touch, in points, as egui's pointer: the first finger down drives it.
     fn touch(&mut self, phase: TouchPhase, pointer_id: i32, x_pt: f32, y_pt: f32) {
         if !(x_pt.is_finite() && y_pt.is_finite()) {

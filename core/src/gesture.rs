@@ -1,6 +1,9 @@
 //! Touch gestures of the phone app: the few commands a phantogram needs without any on-screen
 //! control (the artifact fills the screen, and buttons would sit in the picture).
 //!
+//! * **single tap** (one finger, no second tap following) → [`Gesture::Menu`]: open the menu
+//!   (the artifact gallery, opening a file, calibration); recognised once the double tap's time
+//!   has passed, at the next [`Gestures::poll`] or touch;
 //! * **double tap** (one finger) → [`Gesture::StraightOn`]: the current holding pose counts as
 //!   straight on (the flat-angle calibration);
 //! * **long press** (one finger held still) → [`Gesture::AnchorLight`]: tie the light to the room
@@ -50,11 +53,12 @@ pub enum Gesture {
     AnchorLight,
     ToggleStereo,
     Calibrate,
+    Menu,
 }
 
 impl Gesture {
     /// The number the C ABI and the JNI bridge report for a touch's outcome: 0 none, 1 straight
-    /// on, 2 light re-anchored, 3 stereo toggled, 4 calibration screens opened.
+    /// on, 2 light re-anchored, 3 stereo toggled, 4 calibration screens opened, 5 menu opened.
     pub fn code(gesture: Option<Gesture>) -> i32 {
         match gesture {
             None => 0,
@@ -62,6 +66,7 @@ impl Gesture {
             Some(Gesture::AnchorLight) => 2,
             Some(Gesture::ToggleStereo) => 3,
             Some(Gesture::Calibrate) => 4,
+            Some(Gesture::Menu) => 5,
         }
     }
 }
@@ -117,6 +122,11 @@ impl Gestures {
         }
     }
 
+    /// Whether no finger is down (a touch starting now begins a new sequence).
+    pub fn is_idle(&self) -> bool {
+        self.down.is_empty()
+    }
+
     /// Feeds one pointer event; returns the gesture it completes, if any.
     pub fn touch(&mut self, phase: TouchPhase, pointer_id: i32, x_px: f32, y_px: f32, t_ns: i64) -> Option<Gesture> {
         if !(x_px.is_finite() && y_px.is_finite()) {
@@ -130,8 +140,16 @@ impl Gestures {
         self.apply(phase, pointer_id, [x_px, y_px], t_ns)
     }
 
-    /// Checks for a long press at `t_ns` (call once a frame while touches are down).
+    /// Checks for a long press, or a single tap that no second tap followed, at `t_ns` (call once
+    /// a frame).
     pub fn poll(&mut self, t_ns: i64) -> Option<Gesture> {
+        if let Some(prev) = self.last_tap_ns
+            && self.down.is_empty()
+            && elapsed_ns(prev, t_ns) > DOUBLE_TAP_GAP_NS + TAP_MAX_NS
+        {
+            self.last_tap_ns = None;
+            return Some(Gesture::Menu);
+        }
         match self.down.as_slice() {
             [p] if self.sequence_max == 1
                 && !self.sequence_moved
@@ -236,16 +254,27 @@ mod tests {
     }
 
     #[test]
-    fn double_tap_makes_the_pose_straight_on_and_a_single_tap_does_nothing() {
+    fn double_tap_makes_the_pose_straight_on_and_a_single_tap_opens_the_menu() {
         let mut g = Gestures::new(420.0);
         assert_eq!(tap(&mut g, 0, 500.0), None);
+        assert_eq!(g.poll(300 * MS), None, "a second tap may still come");
         assert_eq!(tap(&mut g, 250, 505.0), Some(Gesture::StraightOn));
+        assert_eq!(g.poll(5000 * MS), None, "a double tap is no single tap");
         // A third tap starts afresh rather than completing another double tap.
-        assert_eq!(tap(&mut g, 500, 505.0), None);
-        // Taps too far apart in time are two single taps.
+        assert_eq!(tap(&mut g, 6000, 505.0), None);
+        assert_eq!(g.poll(6300 * MS), None);
+        assert_eq!(g.poll(6800 * MS), Some(Gesture::Menu));
+        assert_eq!(g.poll(9000 * MS), None, "once");
+        // Taps too far apart in time are two single taps: the next touch reports the first.
         let mut g = Gestures::new(420.0);
         assert_eq!(tap(&mut g, 0, 500.0), None);
-        assert_eq!(tap(&mut g, 2000, 500.0), None);
+        assert_eq!(
+            g.touch(TouchPhase::Down, 0, 500.0, 100.0, 2000 * MS),
+            Some(Gesture::Menu)
+        );
+        assert_eq!(g.touch(TouchPhase::Up, 0, 500.0, 100.0, 2080 * MS), None);
+        assert_eq!(g.poll(3000 * MS), Some(Gesture::Menu));
+        assert_eq!(Gesture::code(Some(Gesture::Menu)), 5);
     }
 
     #[test]

@@ -514,7 +514,8 @@ pub unsafe extern "C" fn pg_camera_frame(
 /// per finger; position in physical pixels (points × scale); time stamp in seconds. `*gesture`
 /// (if not null) receives the gesture completed: 0 none, 1 straight on (double tap), 2 light
 /// re-anchored (long press), 3 stereo toggled (two-finger tap), 4 calibration screens opened
-/// (three-finger tap; touches then drive the screens until they are closed).
+/// (three-finger tap; touches then drive the screens until they are closed), 5 menu opened (a
+/// single tap, reported once the double tap's time has passed; touches then drive the menu).
 ///
 /// # Safety
 /// `engine` is a live handle; `gesture` is null or valid for a write.

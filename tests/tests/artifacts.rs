@@ -155,3 +155,107 @@ fn a_hundred_switches_leave_resident_memory_flat() {
         "resident memory grew {growth_mib:.1} MiB over 80 switches"
     );
 }
+
+#[path = "support/golden.rs"]
+mod golden;
+
+/// Taps at `px` as a finger does: down, a frame, up, frames to settle.
+fn tap_at(e: &mut Engine, px: [f32; 2], t_ms: &mut i64) {
+    use phantogram::gesture::TouchPhase;
+    let ms = 1_000_000;
+    e.touch(TouchPhase::Down, 0, px[0], px[1], *t_ms * ms);
+    e.draw(Some((*t_ms + 16) * ms)).unwrap();
+    e.touch(TouchPhase::Up, 0, px[0], px[1], (*t_ms + 80) * ms);
+    for k in 0..3 {
+        e.draw(Some((*t_ms + 96 + 16 * k) * ms)).unwrap();
+    }
+    *t_ms += 1000;
+}
+
+/// The menu a single tap opens and the status banner, driven by simulated taps: choose an
+/// artifact, see a failure, dismiss it. Each screen is compared with its golden image.
+#[test]
+fn the_menu_and_the_banner_are_driven_by_taps() {
+    use phantogram::anaglyph::Method;
+    let dir = Scratch::new("engine-menu");
+    let config = EngineConfig {
+        library_dir: Some(dir.to_path_buf()),
+        method: Method::Mono,
+        ..EngineConfig::default()
+    };
+    let mut e = match Engine::new(config) {
+        Ok(e) => e,
+        Err(err) if std::env::var_os("CI").is_none() => {
+            eprintln!("no engine ({err}): skipping");
+            return;
+        }
+        Err(err) => panic!("{err}"),
+    };
+    let (w, h) = (360, 800);
+    e.resume_offscreen(w, h).unwrap();
+    e.import_artifact(
+        "votive_figure.glb",
+        tetrahedron_glb(0.1, r#""copyright":"(c) Test museum","extras":{"license":"CC0"}"#),
+    );
+    assert!(e.wait_for_artifact(WAIT));
+    e.select_artifact(ArtifactId::built_in("amphora"));
+    assert!(e.wait_for_artifact(WAIT));
+    let ms = 1_000_000;
+    let mut t = 100;
+    // One tap in the middle: the menu, once the double tap's time has passed.
+    let centre = [w as f32 / 2.0, h as f32 / 2.0];
+    {
+        use phantogram::gesture::TouchPhase;
+        e.touch(TouchPhase::Down, 0, centre[0], centre[1], t * ms);
+        assert_eq!(e.touch(TouchPhase::Up, 0, centre[0], centre[1], (t + 80) * ms), None);
+    }
+    e.draw(Some((t + 200) * ms)).unwrap();
+    assert!(!e.menu_open(), "not before a second tap could have come");
+    e.draw(Some((t + 800) * ms)).unwrap();
+    assert!(e.menu_open());
+    e.draw(Some((t + 816) * ms)).unwrap();
+    e.draw(Some((t + 832) * ms)).unwrap();
+    t += 1000;
+    let menu = e.last_frame().unwrap().2.to_vec();
+    golden::check("menu-gallery", w, h, &menu, 3, 0.003);
+
+    // Choose the medal: the menu closes and the medal is loaded.
+    let medal = e.menu_control_px("item:builtin:medal").expect("the medal's entry");
+    tap_at(&mut e, medal, &mut t);
+    assert!(!e.menu_open());
+    assert!(e.wait_for_artifact(WAIT) || e.model_info().name == "medal");
+    assert_eq!(e.model_info().name, "medal");
+
+    // A damaged file: the banner says so over the medal; its OK button dismisses it.
+    let mut broken = tetrahedron_glb(0.3, "");
+    broken.truncate(60);
+    e.import_artifact("broken.glb", broken);
+    assert!(!e.wait_for_artifact(WAIT));
+    e.draw(Some(t * ms)).unwrap();
+    e.draw(Some((t + 16) * ms)).unwrap();
+    t += 100;
+    let banner = e.last_frame().unwrap().2.to_vec();
+    golden::check("banner-failure", w, h, &banner, 3, 0.003);
+    let ok = e.menu_control_px("banner").expect("the banner is showing");
+    // A tap elsewhere is the picture's (no menu while a gesture window is open), the banner's
+    // own is the banner's.
+    tap_at(&mut e, ok, &mut t);
+    assert_eq!(e.loading_status(), LoadStatus::Idle, "dismissed");
+    e.draw(Some((t + 1000) * ms)).unwrap();
+    assert!(
+        !e.menu_open(),
+        "the banner's tap was not also a single tap on the picture"
+    );
+    if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
+        for (name, px) in [("menu-gallery", &menu), ("banner-failure", &banner)] {
+            image::save_buffer(
+                std::path::Path::new(&dir).join(format!("{name}.png")),
+                px,
+                w,
+                h,
+                image::ExtendedColorType::Rgba8,
+            )
+            .unwrap();
+        }
+    }
+}

@@ -8,7 +8,8 @@
 //! `NAME-difference.png` beside the golden image (git-ignored). `PHANTOGRAM_BLESS=1` rewrites the
 //! golden images from the current output; look at them before committing.
 
-use std::path::PathBuf;
+#[path = "support/golden.rs"]
+mod golden;
 
 use phantogram::anaglyph::Method;
 use phantogram::artifact::default_model;
@@ -117,48 +118,9 @@ fn markers_land_on_the_predicted_pixel_in_each_eye() {
     }
 }
 
-fn golden_path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("golden")
-        .join(format!("{name}.png"))
-}
-
-/// Compares with `tests/golden/NAME.png`: fails if more than `max_fraction` of the pixels differ
-/// by more than `tolerance` in any channel; writes actual and difference images on failure.
+/// Compares with `tests/golden/NAME.png` (see the `golden` module).
 fn check_golden(name: &str, pixels: &[u8], tolerance: u8, max_fraction: f64) {
-    let path = golden_path(name);
-    let save = |p: &PathBuf, data: &[u8]| image::save_buffer(p, data, W, H, image::ExtendedColorType::Rgba8).unwrap();
-    if std::env::var_os("PHANTOGRAM_BLESS").is_some() {
-        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-        save(&path, pixels);
-        return;
-    }
-    let golden = image::open(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (run with PHANTOGRAM_BLESS=1 to create it)", path.display()))
-        .to_rgba8();
-    assert_eq!(golden.dimensions(), (W, H), "{name}: golden image size");
-    let mut diff = vec![0u8; pixels.len()];
-    let mut bad = 0usize;
-    for (i, (a, b)) in pixels.chunks(4).zip(golden.as_raw().chunks(4)).enumerate() {
-        let d = (0..3).map(|c| a[c].abs_diff(b[c])).max().unwrap_or(0);
-        if d > tolerance {
-            bad += 1;
-        }
-        let v = d.saturating_mul(8);
-        diff[i * 4..i * 4 + 4].copy_from_slice(&[v, v, v, 255]);
-    }
-    let fraction = bad as f64 / (W * H) as f64;
-    if fraction > max_fraction {
-        let stem = path.with_extension("");
-        save(&PathBuf::from(format!("{}-actual.png", stem.display())), pixels);
-        save(&PathBuf::from(format!("{}-difference.png", stem.display())), &diff);
-        panic!(
-            "{name}: {bad} pixels ({:.3} %) differ by more than {tolerance} (allowed {:.3} %); see {}-actual.png and -difference.png",
-            fraction * 100.0,
-            max_fraction * 100.0,
-            stem.display()
-        );
-    }
+    golden::check(name, W, H, pixels, tolerance, max_fraction);
 }
 
 #[test]

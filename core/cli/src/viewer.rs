@@ -199,6 +199,9 @@ impl App {
                 "c" => {
                     self.engine.open_calibration();
                 }
+                "a" => {
+                    self.engine.open_menu();
+                }
                 _ => {}
             },
             _ => {}
@@ -300,6 +303,25 @@ impl ApplicationHandler for App {
                 if let Err(e) = self.frame(event_loop) {
                     self.fail(event_loop, e);
                 }
+                // The desktop's answer to the menu's "Open a file": a file dropped on the window.
+                for request in self.engine.take_shell_requests() {
+                    match request {
+                        phantogram::engine::ShellRequest::OpenFile => {
+                            eprintln!("drop a .glb, .gltf or .zip file on the window to open it")
+                        }
+                    }
+                }
+            }
+            WindowEvent::DroppedFile(path) => {
+                let name = path
+                    .file_name()
+                    .map_or_else(|| path.display().to_string(), |n| n.to_string_lossy().into_owned());
+                let max = phantogram::budget::ResourceBudget::PHONE.memory_bytes;
+                match phantogram::files::read_regular_file(&path, max) {
+                    // Loaded and shown in the background, with the banner saying how far.
+                    Ok(bytes) => self.engine.import_artifact(&name, bytes),
+                    Err(e) => eprintln!("{}: {e}", path.display()),
+                }
             }
             _ => {}
         }
@@ -318,7 +340,7 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         EventLoop::new().context("no display to open a window on (set DISPLAY, or use `phantogram render`)")?;
     event_loop.set_control_flow(ControlFlow::Poll);
     eprintln!(
-        "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, c calibration screens, Esc quit"
+        "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, c calibration screens, a artifacts menu (or click once), Esc quit"
     );
     let ViewerArgs {
         mut engine,

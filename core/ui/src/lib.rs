@@ -1,3 +1,6 @@
+//! The screens the core draws with egui: the menu and status banner ([`menu`]) and the
+//! calibration screens (this module).
+//!
 //! The calibration screens, drawn by the core with egui so that the phones and the desktop viewer
 //! show the same thing: the eye-reflection slider (IPD and head offset), the blind-spot distance
 //! test, the ID-1 card check of the pixel density, "this is straight on" (flat angle) and the
@@ -13,6 +16,8 @@
 //! pixels by [`phantogram_geometry::screen::Screen`] and divided by `pixels_per_point` to draw.
 //!
 //! **Threading**: lives on the render thread with the egui context. **Panics**: none.
+
+pub mod menu;
 
 use egui::{Align2, Color32, Pos2, Rect, Stroke, Vec2 as EVec2};
 use glam::{Vec2, Vec3};

@@ -48,6 +48,10 @@ pub enum LibraryError {
     Io { path: PathBuf, error: std::io::Error },
     #[error(transparent)]
     Model(#[from] ModelError),
+    /// An opened file's model failed to load: `message` names it as the user knows it (its
+    /// name inside the file or archive), not by the folder it was unpacked into.
+    #[error("{message}")]
+    Invalid { message: String, error: Box<ModelError> },
     #[error("{name}: not a model this app opens (a .glb, .gltf, or a .zip holding one)")]
     UnknownFormat { name: String },
     #[error("{name}: a damaged or unsupported zip archive: {message}")]
@@ -385,7 +389,17 @@ impl Library {
             }
             single => import::write_single(&staging.0, &slug(source_name), single, bytes)?,
         };
-        let model = crate::model::load_model_with(&model_path, budget, progress)?;
+        // The user knows the file by its name, not by the staging folder it was unpacked in.
+        let model = crate::model::load_model_with(&model_path, budget, progress).map_err(|e| {
+            if matches!(e, ModelError::Cancelled { .. }) {
+                return LibraryError::Model(e);
+            }
+            let inside = format!("{}{}", staging.0.display(), std::path::MAIN_SEPARATOR);
+            LibraryError::Invalid {
+                message: e.to_string().replace(&inside, ""),
+                error: Box::new(e),
+            }
+        })?;
         let meta = describe(&model_path);
         let rel = model_path
             .strip_prefix(&staging.0)

@@ -80,7 +80,11 @@ fn a_damaged_or_foreign_file_is_an_error_and_leaves_nothing_behind() {
     let mut glb = tetrahedron_glb(0.05, "");
     glb.truncate(glb.len() - 20);
     let e = lib.import("broken.glb", &glb, budget(), &Progress::new()).unwrap_err();
-    assert!(matches!(e, LibraryError::Model(_)), "{e}");
+    assert!(matches!(e, LibraryError::Invalid { .. }), "{e}");
+    assert!(
+        e.to_string().starts_with("broken.glb: "),
+        "named as the user knows it: {e}"
+    );
     let e = lib
         .import("photo.png", b"\x89PNG\r\n\x1a\n", budget(), &Progress::new())
         .unwrap_err();

@@ -38,6 +38,8 @@ public final class NativeBridge {
     public static final int GESTURE_STEREO_TOGGLED = 3;
     /** Three-finger tap: the calibration screens opened; touches drive them until closed. */
     public static final int GESTURE_CALIBRATION_OPENED = 4;
+    /** Single tap: the menu (artifacts, calibration) opened; touches drive it until closed. */
+    public static final int GESTURE_MENU_OPENED = 5;
 
     /** Touch phases for nativeTouch. */
     public static final int TOUCH_DOWN = 0;
