@@ -141,6 +141,17 @@ pub enum EngineError {
     InvalidArgument(String),
     #[error("no offscreen frame to read: resume an offscreen target and draw first")]
     NoFrame,
+    #[error("the picture could not be encoded: {0}")]
+    Share(String),
+}
+
+/// What [`Engine::snapshot`] makes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Snapshot {
+    /// The frame as on screen: the anaglyph (or mono) composition.
+    Composed,
+    /// The stereo pair side by side for parallel viewing: left eye's image on the left.
+    SideBySide,
 }
 
 /// The one classification of [`EngineError`]s that both bridges map onto their platform's errors
@@ -170,7 +181,7 @@ impl EngineError {
             Self::Face(_) => ErrorKind::Load,
             Self::Library(crate::library::LibraryError::BadId { .. }) => ErrorKind::InvalidArgument,
             Self::Model(_) | Self::Environment(_) | Self::Library(_) => ErrorKind::Load,
-            Self::Render(_) => ErrorKind::Render,
+            Self::Render(_) | Self::Share(_) => ErrorKind::Render,
             Self::NoFrame => ErrorKind::InvalidState,
             Self::NoFaceSupport => ErrorKind::Unsupported,
         }
@@ -225,6 +236,8 @@ pub struct Engine {
     stereo_method: Method,
     target: Target,
     last_display_t_ns: Option<i64>,
+    /// Containment's push-back in the last frame, metres (snapshots show that frame's view).
+    last_push_m: f32,
     #[cfg(feature = "face")]
     face: Option<Arc<crate::face::FaceWorker>>,
     last_face_t_ns: Option<i64>,
@@ -427,6 +440,7 @@ impl Engine {
             },
             target: Target::Detached,
             last_display_t_ns: None,
+            last_push_m: 0.0,
             #[cfg(feature = "face")]
             face,
             last_face_t_ns: None,
@@ -534,6 +548,11 @@ impl Engine {
     /// What the core's screens asked of the shell since the last call (see [`ShellRequest`]).
     pub fn take_shell_requests(&mut self) -> Vec<ShellRequest> {
         std::mem::take(&mut self.requests)
+    }
+
+    /// The oldest request not yet taken (for bridges that hand over one at a time).
+    pub fn take_shell_request(&mut self) -> Option<ShellRequest> {
+        (!self.requests.is_empty()).then(|| self.requests.remove(0))
     }
 
     #[cfg(feature = "ui")]
@@ -911,6 +930,7 @@ impl Engine {
         let push = self
             .smoother
             .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s);
+        self.last_push_m = push;
         let input = frame_input(&view, Vec3::Z * -push);
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
@@ -1123,6 +1143,42 @@ impl Engine {
     #[cfg(not(feature = "face"))]
     fn take_face_result(&mut self) {
         let _ = self.last_face_t_ns;
+    }
+
+    /// The current view as a picture to share, at the target's size (the screen's when
+    /// detached), without the screens drawn over it: width, height and sRGB RGBA pixels.
+    pub fn snapshot(&mut self, kind: Snapshot) -> Result<(u32, u32, Vec<u8>), EngineError> {
+        let screen = self.session.config().screen;
+        let (w, h) = match &self.target {
+            Target::Window(host) => match host.state() {
+                crate::surface::SurfaceState::Active { width, height } if width > 0 && height > 0 => (width, height),
+                _ => (screen.width_px(), screen.height_px()),
+            },
+            Target::Offscreen { width, height } if *width > 0 && *height > 0 => (*width, *height),
+            _ => (screen.width_px(), screen.height_px()),
+        };
+        let view = self.session.frame_at(self.last_display_t_ns)?;
+        let input = frame_input(&view, Vec3::Z * -self.last_push_m);
+        Ok(match kind {
+            Snapshot::Composed => (w, h, self.renderer.render(&input, self.method, w, h)?),
+            Snapshot::SideBySide => (w * 2, h, self.renderer.render_side_by_side(&input, w, h)?),
+        })
+    }
+
+    /// [`Self::snapshot`] as a PNG file's bytes, for the platform's share sheet.
+    pub fn snapshot_png(&mut self, kind: Snapshot) -> Result<Vec<u8>, EngineError> {
+        let (w, h, pixels) = self.snapshot(kind)?;
+        let mut png = Vec::new();
+        image::write_buffer_with_format(
+            &mut std::io::Cursor::new(&mut png),
+            &pixels,
+            w,
+            h,
+            image::ExtendedColorType::Rgba8,
+            image::ImageFormat::Png,
+        )
+        .map_err(|e| EngineError::Share(e.to_string()))?;
+        Ok(png)
     }
 
     /// The last offscreen frame: width, height and 8-bit sRGB RGBA pixels, rows top to bottom.

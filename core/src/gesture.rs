@@ -285,7 +285,15 @@ mod tests {
         g.touch(TouchPhase::Move, 0, 200.0, 100.0, 40 * MS);
         assert_eq!(g.touch(TouchPhase::Up, 0, 200.0, 100.0, 80 * MS), None);
         assert_eq!(tap(&mut g, 200, 100.0), None, "the drag does not count as a first tap");
-        assert_eq!(g.poll(10_000 * MS), None);
+        assert_eq!(
+            g.poll(10_000 * MS),
+            Some(Gesture::Menu),
+            "the tap after the drag is a single tap"
+        );
+        g.touch(TouchPhase::Down, 0, 100.0, 100.0, 11_000 * MS);
+        g.touch(TouchPhase::Move, 0, 200.0, 100.0, 11_040 * MS);
+        g.touch(TouchPhase::Up, 0, 200.0, 100.0, 11_080 * MS);
+        assert_eq!(g.poll(20_000 * MS), None, "a drag alone opens nothing");
     }
 
     #[test]

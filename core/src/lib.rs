@@ -46,7 +46,8 @@
 //! * always: the files, geometry and sensing crates, `glam` for small-vector maths (the chosen stack),
 //!   `thiserror` for error types.
 //! * `models`: `phantogram_assets` (gltf-rs, draco-core, MikkTSpace, image; see its docs).
-//! * `render` (implies `models`): `phantogram_render` (wgpu, the chosen stack) and [`engine`].
+//! * `render` (implies `models`): `phantogram_render` (wgpu, the chosen stack) and [`engine`];
+//!   `image` to encode the pictures it shares as PNG (the version the assets decode with).
 //! * `face`: `phantogram_vision` (tract-onnx runs MediaPipe's networks in pure Rust: no native
 //!   inference runtime to cross-build for the phones).
 //! * `ui` (implies `render`): `phantogram_ui` (egui and egui-wgpu draw the calibration screens with

@@ -59,6 +59,16 @@ typedef struct PgConfig {
   // Where the viewer's calibration is kept (a file in Application Support); null: defaults,
   // nothing saved. The calibration screens open with a three-finger tap.
   const char *calibration_path;
+  // Where imported artifacts are kept (a folder in Application Support); null: nothing can
+  // be imported.
+  const char *library_dir;
+  // Artifacts shipped in the app bundle (a folder of `.glb`/`.gltf` files or Voyager
+  // folders); null: none.
+  const char *bundled_dir;
+  // The artifact to show first (`builtin:medal`, `imported:…`: what the app saved last time
+  // from `pg_current_artifact`); null: the default. One no longer in the library gives the
+  // default, and the on-screen banner says why.
+  const char *artifact;
 } PgConfig;
 
 // Counters, for logs and debug overlays.
@@ -187,7 +197,8 @@ enum PgStatus pg_camera_frame(const struct PgEngine *engine,
 // per finger; position in physical pixels (points × scale); time stamp in seconds. `*gesture`
 // (if not null) receives the gesture completed: 0 none, 1 straight on (double tap), 2 light
 // re-anchored (long press), 3 stereo toggled (two-finger tap), 4 calibration screens opened
-// (three-finger tap; touches then drive the screens until they are closed).
+// (three-finger tap; touches then drive the screens until they are closed), 5 menu opened (a
+// single tap, reported once the double tap's time has passed; touches then drive the menu).
 //
 // # Safety
 // `engine` is a live handle; `gesture` is null or valid for a write.
@@ -278,6 +289,72 @@ enum PgStatus pg_read_frame(const struct PgEngine *engine,
                             size_t capacity,
                             uint32_t *width,
                             uint32_t *height);
+
+// Imports a file the user opened (`UIDocumentPickerViewController`, "Open in"): its display
+// `name` and `len` bytes (copied before returning), a `.glb`, `.gltf` or `.zip` (a Voyager
+// download included). It is loaded in the background and shown when ready, with a banner on
+// screen meanwhile; a damaged file is reported there and the artifact on screen stays. Needs
+// `PgConfig::library_dir`.
+//
+// # Safety
+// `engine` is a live handle; `name` a NUL-terminated string; `bytes` valid for `len` bytes of
+// reads (or null when `len` is 0).
+enum PgStatus pg_import_artifact(const struct PgEngine *engine,
+                                 const char *name,
+                                 const uint8_t *bytes,
+                                 size_t len);
+
+// Starts showing an artifact of the library by id (`builtin:amphora`, `imported:…`), loaded in
+// the background as `pg_import_artifact`.
+//
+// # Safety
+// `engine` is a live handle; `id` a NUL-terminated string.
+enum PgStatus pg_select_artifact(const struct PgEngine *engine, const char *id);
+
+// Copies the id of the artifact on screen (to save for `PgConfig::artifact` next time) into
+// `buffer` of `capacity` bytes, NUL-terminated, as `pg_last_error` copies its message, and
+// returns the length the whole id needs, NUL included (1: no library artifact on screen, a
+// file given by path; 0: a null handle).
+//
+// # Safety
+// `engine` is a live handle; `buffer` is null or valid for `capacity` bytes of writes.
+size_t pg_current_artifact(const struct PgEngine *engine, char *buffer, size_t capacity);
+
+// Opens the menu (the artifact gallery, opening a file, calibration), as a single tap does.
+//
+// # Safety
+// `engine` is a live handle.
+enum PgStatus pg_open_menu(const struct PgEngine *engine);
+
+// Takes the oldest thing the core's screens asked of the app since the last call: `*request`
+// receives 0 (nothing), or 1 (show the document picker for a `.glb`, `.gltf` or `.zip`, then
+// `pg_import_artifact`). Call after each `pg_draw`.
+//
+// # Safety
+// `engine` is a live handle; `request` is valid for a write.
+enum PgStatus pg_take_shell_request(const struct PgEngine *engine, int32_t *request);
+
+// Loading state, for the app's own use (the core draws the banner): `*state` 0 idle, 1
+// loading (`*fraction` 0 to 1), 2 the last load failed (the banner says why). Either pointer
+// may be null.
+//
+// # Safety
+// `engine` is a live handle; `state` and `fraction` are null or valid for a write.
+enum PgStatus pg_loading_state(const struct PgEngine *engine, int32_t *state, float *fraction);
+
+// The current view as a PNG file's bytes for the share sheet: `kind` 0 the anaglyph as on
+// screen, 1 the stereo pair side by side (left eye on the left). Copies it into `buffer` of
+// `capacity` bytes and writes its length to `*len`; with a null `buffer` only the length is
+// written (the picture is rendered by each call: ask for the length, then the bytes).
+//
+// # Safety
+// `engine` is a live handle; `buffer` is null or valid for `capacity` bytes of writes; `len` is
+// valid for a write.
+enum PgStatus pg_snapshot_png(const struct PgEngine *engine,
+                              int32_t kind,
+                              uint8_t *buffer,
+                              size_t capacity,
+                              size_t *len);
 
 // Fills `*out` with the engine's counters.
 //

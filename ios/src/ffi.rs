@@ -88,6 +88,16 @@ pub struct PgConfig {
     /// Where the viewer's calibration is kept (a file in Application Support); null: defaults,
     /// nothing saved. The calibration screens open with a three-finger tap.
     pub calibration_path: *const c_char,
+    /// Where imported artifacts are kept (a folder in Application Support); null: nothing can
+    /// be imported.
+    pub library_dir: *const c_char,
+    /// Artifacts shipped in the app bundle (a folder of `.glb`/`.gltf` files or Voyager
+    /// folders); null: none.
+    pub bundled_dir: *const c_char,
+    /// The artifact to show first (`builtin:medal`, `imported:…`: what the app saved last time
+    /// from `pg_current_artifact`); null: the default. One no longer in the library gives the
+    /// default, and the on-screen banner says why.
+    pub artifact: *const c_char,
 }
 
 /// Counters, for logs and debug overlays.
@@ -285,6 +295,9 @@ pub extern "C" fn pg_config_default() -> PgConfig {
         face_models_dir: std::ptr::null(),
         floor: 1,
         calibration_path: std::ptr::null(),
+        library_dir: std::ptr::null(),
+        bundled_dir: std::ptr::null(),
+        artifact: std::ptr::null(),
     }
 }
 
@@ -306,16 +319,20 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
         let c = unsafe { config.as_ref() }
             .copied()
             .unwrap_or_else(|| pg_config_default());
-        // SAFETY (all five): the caller promises null or NUL-terminated strings.
-        let (anaglyph, model, environment, face, calibration) = unsafe {
+        // SAFETY (all eight): the caller promises null or NUL-terminated strings.
+        let (anaglyph, model, environment, face, calibration, library, bundled, artifact) = unsafe {
             (
                 optional_str(c.anaglyph, "anaglyph")?,
                 optional_str(c.model_path, "model_path")?,
                 optional_str(c.environment_path, "environment_path")?,
                 optional_str(c.face_models_dir, "face_models_dir")?,
                 optional_str(c.calibration_path, "calibration_path")?,
+                optional_str(c.library_dir, "library_dir")?,
+                optional_str(c.bundled_dir, "bundled_dir")?,
+                optional_str(c.artifact, "artifact")?,
             )
         };
+        let artifact = artifact.map(|id| id.parse()).transpose().map_err(EngineError::from)?;
         let config = EngineConfig {
             panel: panel(c.panel_width_px, c.panel_height_px, c.xdpi, c.ydpi),
             rotation: rotation(c.rotation_quarter_turns)?,
@@ -327,10 +344,9 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             fit: Default::default(),
             floor: c.floor != 0,
             calibration_path: calibration.map(PathBuf::from),
-            // TODO(issue 18): the shells pass their storage and saved artifact (next step).
-            artifact: None,
-            library_dir: None,
-            bundled_dir: None,
+            artifact,
+            library_dir: library.map(PathBuf::from),
+            bundled_dir: bundled.map(PathBuf::from),
         };
         let engine = Engine::new(config)?;
         let handle = Box::new(PgEngine {
@@ -748,6 +764,196 @@ pub unsafe extern "C" fn pg_read_frame(
         // SAFETY: `capacity ≥ len` writable bytes at `rgba`, as the caller promises; the frame is
         // our own allocation, so they do not overlap.
         unsafe { std::ptr::copy_nonoverlapping(pixels.as_ptr(), rgba, pixels.len()) };
+        Ok(())
+    })
+}
+
+/// Imports a file the user opened (`UIDocumentPickerViewController`, "Open in"): its display
+/// `name` and `len` bytes (copied before returning), a `.glb`, `.gltf` or `.zip` (a Voyager
+/// download included). It is loaded in the background and shown when ready, with a banner on
+/// screen meanwhile; a damaged file is reported there and the artifact on screen stays. Needs
+/// `PgConfig::library_dir`.
+///
+/// # Safety
+/// `engine` is a live handle; `name` a NUL-terminated string; `bytes` valid for `len` bytes of
+/// reads (or null when `len` is 0).
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_import_artifact(
+    engine: *const PgEngine,
+    name: *const c_char,
+    bytes: *const u8,
+    len: usize,
+) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let engine = unsafe { engine_ref(engine) }?;
+        // SAFETY: the caller promises a NUL-terminated string (null is reported).
+        let name = unsafe { optional_str(name, "name") }?
+            .ok_or_else(|| Failure::new(PgStatus::NullPointer, "`name` is null"))?;
+        if bytes.is_null() || len == 0 {
+            return Err(Failure::new(PgStatus::InvalidArgument, "the file is empty"));
+        }
+        // SAFETY: non-null, and the caller promises `len` readable bytes.
+        let data = unsafe { std::slice::from_raw_parts(bytes, len) }.to_vec();
+        engine.shared.lock().import_artifact(&name, data);
+        Ok(())
+    })
+}
+
+/// Starts showing an artifact of the library by id (`builtin:amphora`, `imported:…`), loaded in
+/// the background as `pg_import_artifact`.
+///
+/// # Safety
+/// `engine` is a live handle; `id` a NUL-terminated string.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_select_artifact(engine: *const PgEngine, id: *const c_char) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promises.
+        let engine = unsafe { engine_ref(engine) }?;
+        // SAFETY: the caller promises a NUL-terminated string (null is reported).
+        let id =
+            unsafe { optional_str(id, "id") }?.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`id` is null"))?;
+        let id = id.parse().map_err(EngineError::from)?;
+        engine.shared.lock().select_artifact(id);
+        Ok(())
+    })
+}
+
+/// Copies the id of the artifact on screen (to save for `PgConfig::artifact` next time) into
+/// `buffer` of `capacity` bytes, NUL-terminated, as `pg_last_error` copies its message, and
+/// returns the length the whole id needs, NUL included (1: no library artifact on screen, a
+/// file given by path; 0: a null handle).
+///
+/// # Safety
+/// `engine` is a live handle; `buffer` is null or valid for `capacity` bytes of writes.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_current_artifact(engine: *const PgEngine, buffer: *mut c_char, capacity: usize) -> usize {
+    let mut id = String::new();
+    let status = guard(|| {
+        // SAFETY: forwarded caller promise.
+        let engine = unsafe { engine_ref(engine) }?;
+        if let Some(a) = &engine.shared.lock().model_info().artifact {
+            id = a.id.to_string();
+        }
+        Ok(())
+    });
+    if status != PgStatus::Ok {
+        return 0;
+    }
+    // SAFETY: forwarded caller promise about `buffer`.
+    unsafe { copy_c_string(&id, buffer, capacity) }
+}
+
+/// Opens the menu (the artifact gallery, opening a file, calibration), as a single tap does.
+///
+/// # Safety
+/// `engine` is a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_open_menu(engine: *const PgEngine) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        unsafe { engine_ref(engine) }?.shared.lock().open_menu();
+        Ok(())
+    })
+}
+
+/// Takes the oldest thing the core's screens asked of the app since the last call: `*request`
+/// receives 0 (nothing), or 1 (show the document picker for a `.glb`, `.gltf` or `.zip`, then
+/// `pg_import_artifact`). Call after each `pg_draw`.
+///
+/// # Safety
+/// `engine` is a live handle; `request` is valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_take_shell_request(engine: *const PgEngine, request: *mut i32) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let engine = unsafe { engine_ref(engine) }?;
+        let first = match engine.shared.lock().take_shell_request() {
+            None => 0,
+            Some(phantogram::engine::ShellRequest::OpenFile) => 1,
+        };
+        // SAFETY: the caller promises a writable `request` (null is reported).
+        let out =
+            unsafe { request.as_mut() }.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`request` is null"))?;
+        *out = first;
+        Ok(())
+    })
+}
+
+/// Loading state, for the app's own use (the core draws the banner): `*state` 0 idle, 1
+/// loading (`*fraction` 0 to 1), 2 the last load failed (the banner says why). Either pointer
+/// may be null.
+///
+/// # Safety
+/// `engine` is a live handle; `state` and `fraction` are null or valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_loading_state(engine: *const PgEngine, state: *mut i32, fraction: *mut f32) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let status = unsafe { engine_ref(engine) }?.shared.lock().loading_status();
+        let (s, f) = match status {
+            phantogram::engine::LoadStatus::Idle => (0, 0.0),
+            phantogram::engine::LoadStatus::Loading { fraction, .. } => (1, fraction),
+            phantogram::engine::LoadStatus::Failed { .. } => (2, 0.0),
+        };
+        // SAFETY: each is null or writable, as the caller promises.
+        unsafe {
+            if let Some(p) = state.as_mut() {
+                *p = s;
+            }
+            if let Some(p) = fraction.as_mut() {
+                *p = f;
+            }
+        }
+        Ok(())
+    })
+}
+
+/// The current view as a PNG file's bytes for the share sheet: `kind` 0 the anaglyph as on
+/// screen, 1 the stereo pair side by side (left eye on the left). Copies it into `buffer` of
+/// `capacity` bytes and writes its length to `*len`; with a null `buffer` only the length is
+/// written (the picture is rendered by each call: ask for the length, then the bytes).
+///
+/// # Safety
+/// `engine` is a live handle; `buffer` is null or valid for `capacity` bytes of writes; `len` is
+/// valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_snapshot_png(
+    engine: *const PgEngine,
+    kind: i32,
+    buffer: *mut u8,
+    capacity: usize,
+    len: *mut usize,
+) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let engine = unsafe { engine_ref(engine) }?;
+        let kind = match kind {
+            0 => phantogram::engine::Snapshot::Composed,
+            1 => phantogram::engine::Snapshot::SideBySide,
+            other => {
+                return Err(Failure::new(
+                    PgStatus::InvalidArgument,
+                    format!("snapshot kind {other}: expected 0 (anaglyph) or 1 (side by side)"),
+                ));
+            }
+        };
+        let png = engine.shared.lock().snapshot_png(kind)?;
+        // SAFETY: the caller promises a writable `len` (null is reported).
+        let out = unsafe { len.as_mut() }.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`len` is null"))?;
+        *out = png.len();
+        if buffer.is_null() {
+            return Ok(());
+        }
+        if capacity < png.len() {
+            return Err(Failure::new(
+                PgStatus::BufferTooSmall,
+                format!("the picture needs {} bytes, the buffer has {capacity}", png.len()),
+            ));
+        }
+        // SAFETY: `capacity ≥ len` writable bytes at `buffer`, as the caller promises; `png` is
+        // our own allocation.
+        unsafe { std::ptr::copy_nonoverlapping(png.as_ptr(), buffer, png.len()) };
         Ok(())
     })
 }

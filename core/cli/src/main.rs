@@ -111,6 +111,10 @@ enum Command {
         /// Anaglyph method: dubois, dubois-green-magenta, dubois-amber-blue, half-color, optimized, gray, color, mono.
         #[arg(long, default_value = "dubois")]
         anaglyph: phantogram::anaglyph::Method,
+        /// Write the stereo pair side by side instead (left eye's image on the left, each of
+        /// --size: frames twice as wide), for parallel viewing and stereo tools.
+        #[arg(long, conflicts_with = "anaglyph")]
+        side_by_side: bool,
         /// Interval between frames, milliseconds of sensor time (at least 1).
         #[arg(long, default_value_t = 100.0, value_parser = interval_ms)]
         every: f64,
@@ -274,6 +278,7 @@ fn run(cli: Cli) -> Result<()> {
             out,
             size,
             anaglyph,
+            side_by_side,
             every,
             flat_at_s,
         } => render_frames::render_command(render_frames::RenderArgs {
@@ -282,6 +287,7 @@ fn run(cli: Cli) -> Result<()> {
             out_dir: &out,
             size: &size,
             method: anaglyph,
+            side_by_side,
             every_ms: every,
             flat_at_s,
         }),

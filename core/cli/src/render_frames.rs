@@ -20,6 +20,8 @@ pub struct RenderArgs<'a> {
     pub out_dir: &'a Path,
     pub size: &'a str,
     pub method: Method,
+    /// The stereo pair side by side instead of `method`'s composition.
+    pub side_by_side: bool,
     pub every_ms: f64,
     pub flat_at_s: Option<f64>,
 }
@@ -31,9 +33,13 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         out_dir,
         size,
         method,
+        side_by_side,
         every_ms,
         flat_at_s,
     } = args;
+    // Side by side, the engine's own frame is only the containment's and gestures' clock: mono is
+    // the cheapest to draw.
+    let method = if side_by_side { Method::Mono } else { method };
     let (width, height) = parse_size(size)?;
     // The engine's screen (SceneArgs::engine keeps the default panel and rotation), known before
     // anything is loaded.
@@ -86,6 +92,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         index: 0,
         t0,
         flat_pending: flat_at_s,
+        side_by_side,
         bar,
     };
     let replayed = drive(
@@ -105,8 +112,13 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
     }
     let index = frames.index;
     staging.commit(out_dir)?;
+    let what = if side_by_side {
+        format!("{}x{height}, left and right eye side by side", width * 2)
+    } else {
+        format!("{width}x{height}, {method}")
+    };
     eprintln!(
-        "wrote {index} frame{} ({width}x{height}, {method}) to {}",
+        "wrote {index} frame{} ({what}) to {}",
         if index == 1 { "" } else { "s" },
         out_dir.display()
     );
@@ -121,6 +133,7 @@ struct Frames<'a> {
     index: u64,
     t0: i64,
     flat_pending: Option<f64>,
+    side_by_side: bool,
     bar: indicatif::ProgressBar,
 }
 
@@ -143,7 +156,13 @@ impl Replayed for Frames<'_> {
             // Never an old frame under a new name.
             bail!("the frame at {:.3} s was not drawn ({why})", elapsed_s(self.t0, t_ns));
         }
-        let (width, height, pixels) = self.engine.last_frame()?;
+        let pair;
+        let (width, height, pixels) = if self.side_by_side {
+            pair = self.engine.snapshot(phantogram::engine::Snapshot::SideBySide)?;
+            (pair.0, pair.1, pair.2.as_slice())
+        } else {
+            self.engine.last_frame()?
+        };
         let path = self.out_dir.join(frame_name(self.index));
         let mut png = Vec::new();
         image::write_buffer_with_format(

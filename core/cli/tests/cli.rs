@@ -521,3 +521,59 @@ fn render_replaces_an_earlier_runs_frames_and_nothing_else() {
     expected.extend(["frame_1.png".to_owned(), "notes.txt".to_owned()]);
     assert_eq!(names, expected, "0 to 12 s every second, and the user's files");
 }
+
+/// `render --side-by-side`: frames twice as wide, the left eye's image on the left. Checked
+/// against the plain colour anaglyph of the same frame, which carries the left eye in its red
+/// channel and the right eye in green and blue.
+#[test]
+fn render_side_by_side_puts_each_eye_in_its_half() {
+    let dir = Scratch::new("cli-side-by-side");
+    let render = |args: &[&str], out: &std::path::Path| {
+        let run = bin()
+            .arg("render")
+            .args(args)
+            .args(["--every", "6000", "--size", "180x400", "--log"])
+            .arg(default_log())
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+        assert!(run.status.success() || stderr.contains("no GPU adapter"), "{stderr}");
+        stderr
+    };
+    let stderr = render(&["--side-by-side"], &dir.join("pair"));
+    if stderr.contains("no GPU adapter") && std::env::var_os("CI").is_none() {
+        eprintln!("no GPU adapter: skipping the render test");
+        return;
+    }
+    assert!(stderr.contains("360x400, left and right eye side by side"), "{stderr}");
+    render(&["--anaglyph", "color"], &dir.join("anaglyph"));
+    let pair = image::open(dir.join("pair/frame_00000.png")).unwrap().to_rgb8();
+    let anaglyph = image::open(dir.join("anaglyph/frame_00000.png")).unwrap().to_rgb8();
+    assert_eq!(pair.dimensions(), (360, 400));
+    // Mean difference of one channel between the anaglyph and a half of the pair.
+    let mismatch = |channel: usize, x0: u32| {
+        let mut sum = 0u64;
+        for y in 0..400 {
+            for x in 0..180 {
+                sum += u64::from(anaglyph.get_pixel(x, y).0[channel].abs_diff(pair.get_pixel(x0 + x, y).0[channel]));
+            }
+        }
+        sum as f64 / (180.0 * 400.0)
+    };
+    let (red_left, red_right) = (mismatch(0, 0), mismatch(0, 180));
+    let (green_left, green_right) = (mismatch(1, 0), mismatch(1, 180));
+    assert!(
+        red_left < 0.5 && green_right < 0.5,
+        "halves not the eyes: {red_left:.2} / {green_right:.2}"
+    );
+    assert!(
+        red_right > 4.0 * red_left.max(0.05) && green_left > 4.0 * green_right.max(0.05),
+        "the eyes' images hardly differ: {red_right:.2} / {green_left:.2}"
+    );
+    assert!(
+        failed_render(&["--side-by-side", "--anaglyph", "gray"], &dir.join("x")).contains("--anaglyph"),
+        "side by side is no anaglyph"
+    );
+}

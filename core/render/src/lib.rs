@@ -1010,6 +1010,21 @@ impl Renderer {
         self.render_views(&[projection], input, Method::Mono, width, height)
     }
 
+    /// The stereo pair side by side for parallel viewing (and stereo tools): the left eye's
+    /// image on the left, the right eye's on the right, each `width × height`; returns
+    /// `2·width × height` sRGB RGBA pixels, rows top to bottom.
+    pub fn render_side_by_side(&mut self, input: &FrameInput, width: u32, height: u32) -> Result<Vec<u8>, RenderError> {
+        let left = self.render_single(input.left, input, width, height)?;
+        let right = self.render_single(input.right, input, width, height)?;
+        let row = width as usize * 4;
+        let mut pair = Vec::with_capacity(left.len() * 2);
+        for (l, r) in left.chunks_exact(row).zip(right.chunks_exact(row)) {
+            pair.extend_from_slice(l);
+            pair.extend_from_slice(r);
+        }
+        Ok(pair)
+    }
+
     /// As [`Self::render`], with `overlay` painting over the composed frame before it is read back
     /// (the calibration screens): it gets the device, the frame's view, format and size, and
     /// submits its own work.

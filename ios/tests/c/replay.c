@@ -192,6 +192,70 @@ int main(int argc, char **argv) {
     printf("ok: damaged calibration file -> \"%s\"\n", whole);
     free(whole);
     pg_engine_destroy(engine);
+
+    /* The artifact library as the Swift shell uses it: start on a saved artifact, open a file,
+     * choose another, share the view. Loads run in the background: draw until they end. */
+    char library_dir[4096];
+    snprintf(library_dir, sizeof library_dir, "%s.library", out_path);
+    config = pg_config_default();
+    config.library_dir = library_dir;
+    config.artifact = "builtin:medal";
+    check(pg_engine_create(&config, &engine), PG_STATUS_OK, "create on the medal", NULL);
+    char id[64] = {0};
+    if (pg_current_artifact(engine, id, sizeof id) != strlen("builtin:medal") + 1 || strcmp(id, "builtin:medal")) {
+        fprintf(stderr, "current artifact \"%s\", want builtin:medal\n", id);
+        return 1;
+    }
+    check(pg_select_artifact(engine, "medal"), PG_STATUS_INVALID_ARGUMENT, "select a bare name", "artifact id");
+    check(pg_import_artifact(engine, "empty.glb", NULL, 0), PG_STATUS_INVALID_ARGUMENT, "import nothing", "empty");
+    check(pg_resume_offscreen(engine, 90, 200), PG_STATUS_OK, "resume offscreen", NULL);
+    static const uint8_t damaged_glb[] = "glTF\x02\0\0\0 not really a model";
+    check(pg_import_artifact(engine, "damaged.glb", damaged_glb, sizeof damaged_glb), PG_STATUS_OK, "import", NULL);
+    int state = 1;
+    float fraction = 0.0f;
+    for (int i = 0; i < 100000 && state == 1; i++) {
+        check(pg_draw(engine, -1.0, NULL), PG_STATUS_OK, "draw while importing", NULL);
+        check(pg_loading_state(engine, &state, &fraction), PG_STATUS_OK, "loading state", NULL);
+    }
+    if (state != 2) {
+        fprintf(stderr, "a damaged file ended in loading state %d, want 2 (failed)\n", state);
+        return 1;
+    }
+    check(pg_select_artifact(engine, "builtin:tablet"), PG_STATUS_OK, "select the tablet", NULL);
+    for (int i = 0; i < 100000 && state != 0; i++) {
+        check(pg_draw(engine, -1.0, NULL), PG_STATUS_OK, "draw while loading", NULL);
+        check(pg_loading_state(engine, &state, NULL), PG_STATUS_OK, "loading state", NULL);
+    }
+    check(pg_draw(engine, -1.0, NULL), PG_STATUS_OK, "draw the tablet", NULL);
+    pg_current_artifact(engine, id, sizeof id);
+    if (state != 0 || strcmp(id, "builtin:tablet")) {
+        fprintf(stderr, "after selecting the tablet: state %d, on screen \"%s\"\n", state, id);
+        return 1;
+    }
+    check(pg_open_menu(engine), PG_STATUS_OK, "open the menu", NULL);
+    int request = -1;
+    check(pg_take_shell_request(engine, &request), PG_STATUS_OK, "shell request", NULL);
+    check(pg_take_shell_request(engine, NULL), PG_STATUS_NULL_POINTER, "shell request to null", "request");
+    if (request != 0) {
+        fprintf(stderr, "shell request %d before anything was asked\n", request);
+        return 1;
+    }
+    size_t png_len = 0;
+    check(pg_snapshot_png(engine, 5, NULL, 0, &png_len), PG_STATUS_INVALID_ARGUMENT, "snapshot kind 5", "kind");
+    check(pg_snapshot_png(engine, 1, NULL, 0, &png_len), PG_STATUS_OK, "side-by-side size", NULL);
+    uint8_t *png = malloc(png_len);
+    check(pg_snapshot_png(engine, 1, png, png_len - 1, &png_len), PG_STATUS_BUFFER_TOO_SMALL, "short buffer", "needs");
+    check(pg_snapshot_png(engine, 1, png, png_len, &png_len), PG_STATUS_OK, "side-by-side picture", NULL);
+    /* A PNG 180 pixels wide (two eyes of 90) and 200 high: the IHDR chunk's big-endian sizes. */
+    uint32_t png_w = (uint32_t)png[16] << 24 | (uint32_t)png[17] << 16 | (uint32_t)png[18] << 8 | png[19];
+    uint32_t png_h = (uint32_t)png[20] << 24 | (uint32_t)png[21] << 16 | (uint32_t)png[22] << 8 | png[23];
+    if (memcmp(png + 1, "PNG", 3) || png_w != 180 || png_h != 200) {
+        fprintf(stderr, "side-by-side PNG: %ux%u\n", png_w, png_h);
+        return 1;
+    }
+    free(png);
+    printf("ok: library: damaged import reported, tablet shown, side-by-side PNG %zu bytes\n", png_len);
+    pg_engine_destroy(engine);
     printf("done\n");
     return 0;
 }
