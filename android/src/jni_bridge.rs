@@ -225,6 +225,9 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
     rotation_value: jint,
     anaglyph: JString<'local>,
     calibration_path: JString<'local>,
+    library_dir: JString<'local>,
+    bundled_dir: JString<'local>,
+    artifact: JString<'local>,
 ) -> jlong {
     run(&mut env, |env| {
         let config = EngineConfig {
@@ -242,10 +245,12 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
             fit: Default::default(),
             floor: true,
             calibration_path: optional_string(env, &calibration_path)?.map(Into::into),
-            // TODO(issue 18): the shells pass their storage and saved artifact (next step).
-            artifact: None,
-            library_dir: None,
-            bundled_dir: None,
+            artifact: optional_string(env, &artifact)?
+                .map(|id| id.parse())
+                .transpose()
+                .map_err(EngineError::from)?,
+            library_dir: optional_string(env, &library_dir)?.map(Into::into),
+            bundled_dir: optional_string(env, &bundled_dir)?.map(Into::into),
         };
         let engine = Engine::new(config)?;
         Ok(Box::into_raw(Box::new(SharedEngine::new(engine))) as usize as jlong)
@@ -689,9 +694,170 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCalibrationWarning
     })
 }
 
+/// Imports a file the user opened (its display name and bytes: `.glb`, `.gltf` or `.zip`), in
+/// the background; see `nativeImportArtifactFd` for large files.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeImportArtifact<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    name: JString<'local>,
+    bytes: jni::objects::JByteArray<'local>,
+) {
+    run(&mut env, |env| {
+        let engine = engine(handle)?;
+        let name = optional_string(env, &name)?.ok_or_else(|| fail(Kind::IllegalArgument, "the name is null"))?;
+        if bytes.is_null() {
+            return Err(fail(Kind::IllegalArgument, "the bytes are null"));
+        }
+        let data = env.convert_byte_array(&bytes)?;
+        if data.is_empty() {
+            return Err(fail(Kind::IllegalArgument, "the file is empty"));
+        }
+        engine.lock().import_artifact(&name, data);
+        Ok(())
+    })
+}
+
+/// Imports the file behind `fd` (`ParcelFileDescriptor.detachFd()` of a `content://` document:
+/// the library takes the descriptor over and closes it), read on the loader's thread so that a
+/// large scan never passes through the Java heap nor blocks the caller; at most the phone
+/// budget's bytes.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeImportArtifactFd<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    name: JString<'local>,
+    fd: jint,
+) {
+    run(&mut env, |env| {
+        let engine = engine(handle)?;
+        let name = optional_string(env, &name)?.ok_or_else(|| fail(Kind::IllegalArgument, "the name is null"))?;
+        let file = crate::owned_fd_file(fd).map_err(|e| fail(Kind::IllegalArgument, format!("{name}: {e}")))?;
+        engine
+            .lock()
+            .import_artifact_from(&name, phantogram::artifacts::FileSource::Reader(Box::new(file)));
+        Ok(())
+    })
+}
+
+/// Starts showing an artifact of the library by id (`builtin:amphora`, `imported:…`).
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSelectArtifact<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    id: JString<'local>,
+) {
+    run(&mut env, |env| {
+        let engine = engine(handle)?;
+        let id = optional_string(env, &id)?.ok_or_else(|| fail(Kind::IllegalArgument, "the id is null"))?;
+        let id = id.parse().map_err(EngineError::from)?;
+        engine.lock().select_artifact(id);
+        Ok(())
+    })
+}
+
+/// The id of the artifact on screen, to save for `nativeCreate` next time; `null` for a file
+/// given by path.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCurrentArtifact<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jni::sys::jstring {
+    run(&mut env, |env| {
+        let id = engine(handle)?
+            .lock()
+            .model_info()
+            .artifact
+            .as_ref()
+            .map(|a| a.id.to_string());
+        Ok(match id {
+            Some(id) => env.new_string(id)?.into_raw(),
+            None => std::ptr::null_mut(),
+        })
+    })
+}
+
+/// Opens the menu (the artifact gallery, opening a file, calibration), as a single tap does.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeOpenMenu<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) {
+    run(&mut env, |_| {
+        engine(handle)?.lock().open_menu();
+        Ok(())
+    })
+}
+
+/// The oldest request of the core's screens not yet taken: 0 none, 1 open a file (start
+/// `ACTION_OPEN_DOCUMENT`, then `nativeImportArtifactFd`). Call after each frame.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeTakeShellRequest<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jint {
+    run(&mut env, |_| {
+        Ok(match engine(handle)?.lock().take_shell_request() {
+            None => 0,
+            Some(phantogram::engine::ShellRequest::OpenFile) => 1,
+        })
+    })
+}
+
+/// `[state, fraction]`: state 0 idle, 1 loading (fraction 0 to 1), 2 the last load failed (the
+/// core's banner says why).
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeLoadingState<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jni::sys::jfloatArray {
+    run(&mut env, |env| {
+        let values = match engine(handle)?.lock().loading_status() {
+            phantogram::engine::LoadStatus::Idle => [0.0, 0.0],
+            phantogram::engine::LoadStatus::Loading { fraction, .. } => [1.0, fraction],
+            phantogram::engine::LoadStatus::Failed { .. } => [2.0, 0.0],
+        };
+        let array = jni::objects::JFloatArray::new(env, values.len())?;
+        array.set_region(env, 0, &values)?;
+        Ok(array.into_raw())
+    })
+}
+
+/// The current view as PNG bytes for the share sheet: kind 0 the anaglyph as on screen, 1 the
+/// stereo pair side by side (left eye on the left).
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSnapshotPng<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    kind: jint,
+) -> jni::sys::jbyteArray {
+    run(&mut env, |env| {
+        let kind = match kind {
+            0 => phantogram::engine::Snapshot::Composed,
+            1 => phantogram::engine::Snapshot::SideBySide,
+            other => {
+                return Err(fail(
+                    Kind::IllegalArgument,
+                    format!("snapshot kind {other}: expected 0 (anaglyph) or 1 (side by side)"),
+                ));
+            }
+        };
+        let png = engine(handle)?.lock().snapshot_png(kind)?;
+        Ok(env.byte_array_from_slice(&png)?.into_raw())
+    })
+}
+
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 17] = [
+pub const NATIVE_METHODS: [&str; 25] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
@@ -709,4 +875,12 @@ pub const NATIVE_METHODS: [&str; 17] = [
     "nativeReadFrame",
     "nativeStats",
     "nativeCalibrationWarning",
+    "nativeImportArtifact",
+    "nativeImportArtifactFd",
+    "nativeSelectArtifact",
+    "nativeCurrentArtifact",
+    "nativeOpenMenu",
+    "nativeTakeShellRequest",
+    "nativeLoadingState",
+    "nativeSnapshotPng",
 ];

@@ -28,6 +28,22 @@ mod platform;
 #[path = "platform_other.rs"]
 mod platform;
 
+/// The file behind a descriptor the shell hands over (`ParcelFileDescriptor.detachFd()`): the
+/// descriptor is owned from here on and closed when the file is dropped.
+#[cfg(unix)]
+pub fn owned_fd_file(fd: i32) -> std::io::Result<std::fs::File> {
+    use std::os::fd::{FromRawFd, OwnedFd};
+    if fd < 0 {
+        return Err(std::io::Error::new(
+            std::io::ErrorKind::InvalidInput,
+            format!("file descriptor {fd} is not open"),
+        ));
+    }
+    // SAFETY: the caller's contract (`nativeImportArtifactFd`): `fd` is an open descriptor that
+    // the caller detached and no longer uses or closes; it is owned by the `File` from here on.
+    Ok(std::fs::File::from(unsafe { OwnedFd::from_raw_fd(fd) }))
+}
+
 /// `android.hardware.Sensor.TYPE_*` values the shell forwards.
 pub mod sensor_type {
     pub const ACCELEROMETER: i32 = 1;
@@ -77,6 +93,20 @@ pub fn event_from_android(android_type: i32, timestamp_ns: i64, values: &[f32]) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_handed_over_descriptor_is_read_and_a_negative_one_refused() {
+        use std::io::Read;
+        use std::os::fd::IntoRawFd;
+        let path = std::env::temp_dir().join(format!("phantogram-fd-{}", std::process::id()));
+        std::fs::write(&path, b"glTF bytes").unwrap();
+        let fd = std::fs::File::open(&path).unwrap().into_raw_fd();
+        let mut text = String::new();
+        owned_fd_file(fd).unwrap().read_to_string(&mut text).unwrap();
+        assert_eq!(text, "glTF bytes");
+        let _ = std::fs::remove_file(&path);
+        assert!(owned_fd_file(-1).unwrap_err().to_string().contains("not open"));
+    }
 
     #[test]
     fn maps_types_and_values() {

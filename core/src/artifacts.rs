@@ -93,12 +93,61 @@ pub enum LoadStatus {
 }
 
 /// What to load.
-#[derive(Clone, Debug)]
+#[derive(Debug)]
 pub enum Request {
     /// An artifact of the library.
     Select(ArtifactId),
-    /// A file the user opened: its display name and bytes, imported into the library.
-    Import { name: String, bytes: Arc<Vec<u8>> },
+    /// A file the user opened: its display name and content, imported into the library.
+    Import { name: String, source: FileSource },
+}
+
+/// The content of an opened file.
+pub enum FileSource {
+    Bytes(Vec<u8>),
+    /// Read on the loader's thread, at most the budget's memory: an Android `content://`
+    /// document's descriptor, read without passing through the Java heap. **Important:** a
+    /// source that blocks forever (a stalled pipe) holds its loader thread until the process
+    /// ends; a newer request still runs on a thread of its own.
+    Reader(Box<dyn std::io::Read + Send>),
+}
+
+impl std::fmt::Debug for FileSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::Bytes(b) => write!(f, "Bytes({} bytes)", b.len()),
+            Self::Reader(_) => f.write_str("Reader"),
+        }
+    }
+}
+
+impl FileSource {
+    /// The content, at most `max_bytes` (more is [`LibraryError::TooLarge`]).
+    fn into_bytes(self, name: &str, max_bytes: u64) -> Result<Vec<u8>, LoadError> {
+        let too_large = || {
+            LoadError::Library(LibraryError::TooLarge {
+                name: phantogram_files::text::excerpt(name),
+                max_bytes,
+            })
+        };
+        match self {
+            Self::Bytes(b) if b.len() as u64 > max_bytes => Err(too_large()),
+            Self::Bytes(b) => Ok(b),
+            Self::Reader(r) => {
+                use std::io::Read;
+                let mut bytes = Vec::new();
+                r.take(max_bytes.saturating_add(1))
+                    .read_to_end(&mut bytes)
+                    .map_err(|error| LoadError::Read {
+                        name: phantogram_files::text::excerpt(name),
+                        error,
+                    })?;
+                if bytes.len() as u64 > max_bytes {
+                    return Err(too_large());
+                }
+                Ok(bytes)
+            }
+        }
+    }
 }
 
 type Outcome = (u64, Result<Prepared, String>);
@@ -178,9 +227,12 @@ impl Loader {
             .name("artifact-loader".into())
             .spawn(move || {
                 let run = || -> Result<Prepared, LoadError> {
-                    let loaded: LoadedArtifact = match &request {
-                        Request::Select(id) => library.load(id, budget, &worker_progress)?,
-                        Request::Import { name, bytes } => library.import(name, bytes, budget, &worker_progress)?,
+                    let loaded: LoadedArtifact = match request {
+                        Request::Select(id) => library.load(&id, budget, &worker_progress)?,
+                        Request::Import { name, source } => {
+                            let bytes = source.into_bytes(&name, budget.memory_bytes)?;
+                            library.import(&name, &bytes, budget, &worker_progress)?
+                        }
                     };
                     if worker_progress.is_cancelled() {
                         return Err(LoadError::Cancelled);
@@ -300,6 +352,8 @@ pub enum LoadError {
     Render(#[from] crate::render::RenderError),
     #[error("cancelled")]
     Cancelled,
+    #[error("{name}: {error}")]
+    Read { name: String, error: std::io::Error },
 }
 
 impl LoadError {
@@ -307,7 +361,7 @@ impl LoadError {
         match self {
             Self::Cancelled => true,
             Self::Library(e) => e.is_cancelled(),
-            Self::Render(_) => false,
+            Self::Render(_) | Self::Read { .. } => false,
         }
     }
 }

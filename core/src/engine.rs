@@ -309,6 +309,7 @@ fn load_error(e: crate::artifacts::LoadError) -> EngineError {
         crate::artifacts::LoadError::Library(e) => EngineError::Library(e),
         crate::artifacts::LoadError::Render(e) => EngineError::Render(e),
         crate::artifacts::LoadError::Cancelled => EngineError::InvalidArgument("loading was cancelled".into()),
+        crate::artifacts::LoadError::Read { name, error } => EngineError::InvalidArgument(format!("{name}: {error}")),
     }
 }
 
@@ -666,11 +667,17 @@ impl Engine {
     /// Imports a file the user opened (its display name and bytes: a `.glb`, `.gltf` or `.zip`)
     /// into the library and shows it when loaded, in the background as [`Self::select_artifact`].
     pub fn import_artifact(&mut self, name: &str, bytes: Vec<u8>) {
+        self.import_artifact_from(name, crate::artifacts::FileSource::Bytes(bytes));
+    }
+
+    /// As [`Self::import_artifact`], the content read on the loader's thread when it is a
+    /// reader (see [`crate::artifacts::FileSource`]).
+    pub fn import_artifact_from(&mut self, name: &str, source: crate::artifacts::FileSource) {
         let placing = self.placing();
         self.loader.start(
             crate::artifacts::Request::Import {
                 name: name.to_owned(),
-                bytes: Arc::new(bytes),
+                source,
             },
             placing,
         );

@@ -8,11 +8,16 @@ struct PhantogramApp: App {
     var body: some Scene {
         WindowGroup {
             PhantogramScreen().ignoresSafeArea().statusBarHidden(true)
+                // "Open in" / a shared glTF or zip: handed to the view, which hands it to the core.
+                .onOpenURL { url in PhantogramScreen.view?.open(url) }
         }
     }
 }
 
 struct PhantogramScreen: UIViewRepresentable {
+    /// The one view, for files opened from other apps.
+    static weak var view: PhantogramView?
+
     func makeUIView(context: Context) -> UIView {
         let screen = UIScreen.main
         let size = screen.nativeBounds.size // portrait, physical pixels
@@ -22,7 +27,9 @@ struct PhantogramScreen: UIViewRepresentable {
         do {
             let engine = try Engine(panelWidthPx: UInt32(size.width), panelHeightPx: UInt32(size.height),
                                     pixelsPerInch: ppi)
-            return PhantogramView(engine: engine)
+            let view = PhantogramView(engine: engine)
+            PhantogramScreen.view = view
+            return view
         } catch {
             let label = UILabel()
             label.numberOfLines = 0

@@ -58,9 +58,13 @@ fn an_opened_file_is_imported_listed_shown_and_a_damaged_one_keeps_the_previous(
         Some("builtin:amphora")
     );
 
-    // Opened as a shell hands it over: a name and the bytes.
+    // Opened as a shell hands it over: a name and the content, here read on the loader's
+    // thread as Android's content:// descriptors are.
     let glb = tetrahedron_glb(0.2, r#""copyright":"(c) Test museum","extras":{"title":"Tetrahedron"}"#);
-    e.import_artifact("tetra.glb", glb);
+    e.import_artifact_from(
+        "tetra.glb",
+        phantogram::artifacts::FileSource::Reader(Box::new(std::io::Cursor::new(glb))),
+    );
     assert!(matches!(
         e.loading_status(),
         LoadStatus::Loading { .. } | LoadStatus::Idle

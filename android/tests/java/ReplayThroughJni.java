@@ -36,9 +36,9 @@ public final class ReplayThroughJni {
         int height = Integer.parseInt(args[4]);
 
         expect(IllegalArgumentException.class, "sepia",
-                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "sepia", null));
+                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "sepia", null, null, null, null));
         expect(IllegalArgumentException.class, "rotation",
-                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 7, null, null));
+                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 7, null, null, null, null, null));
         expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeDrawFrame(0, -1));
         expect(IllegalStateException.class, "destroyed", () -> NativeBridge.nativeSetSensorRanges(0, 78.4532f, 34.9f));
 
@@ -69,7 +69,7 @@ public final class ReplayThroughJni {
         expect(IllegalArgumentException.class, "activeArray is null",
                 () -> NativeBridge.nativeCameraIntrinsics(null, null, null, null, 4.2f, null, 640, 480));
 
-        long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois", null);
+        long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois", null, null, null, null);
         try {
             expect(IllegalStateException.class, "no offscreen frame", () -> NativeBridge.nativeReadFrame(h));
             expect(UnsupportedOperationException.class, "only on Android",
@@ -162,7 +162,8 @@ public final class ReplayThroughJni {
         // A damaged calibration file: the engine starts with the defaults and says why.
         java.nio.file.Path damaged = java.nio.file.Paths.get(out + ".calibration.txt");
         java.nio.file.Files.write(damaged, "not a calibration\n".getBytes(java.nio.charset.StandardCharsets.UTF_8));
-        long c = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, null, damaged.toString());
+        long c = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, null, damaged.toString(), null,
+                null, null);
         try {
             String warning = NativeBridge.nativeCalibrationWarning(c);
             if (warning == null || !warning.contains(damaged.getFileName().toString())) {
@@ -171,6 +172,57 @@ public final class ReplayThroughJni {
             System.out.println("ok: damaged calibration file: " + warning);
         } finally {
             NativeBridge.nativeDestroy(c);
+        }
+
+        // The artifact library as the Kotlin shell uses it: start on a saved id, open a file,
+        // choose another, share the view. Loads run in the background: draw until they end.
+        expect(IllegalArgumentException.class, "not an artifact id",
+                () -> NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, null, null, null, null,
+                        "medal"));
+        String library = out + ".library";
+        long a = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "mono", null, library, null,
+                "builtin:medal");
+        try {
+            if (!"builtin:medal".equals(NativeBridge.nativeCurrentArtifact(a))) {
+                throw new AssertionError("on screen: " + NativeBridge.nativeCurrentArtifact(a));
+            }
+            NativeBridge.nativeResumeOffscreen(a, 90, 200);
+            expect(IllegalArgumentException.class, "empty", () -> NativeBridge.nativeImportArtifact(a, "x.glb",
+                    new byte[0]));
+            expect(IllegalArgumentException.class, "not open", () -> NativeBridge.nativeImportArtifactFd(a, "x.glb",
+                    -1));
+            NativeBridge.nativeImportArtifact(a, "damaged.glb",
+                    "glTF\u0002\u0000\u0000\u0000 not a model".getBytes(java.nio.charset.StandardCharsets.ISO_8859_1));
+            float[] state = NativeBridge.nativeLoadingState(a);
+            for (int i = 0; i < 100000 && state[0] == 1f; i++) {
+                NativeBridge.nativeDrawFrame(a, -1);
+                state = NativeBridge.nativeLoadingState(a);
+            }
+            if (state[0] != 2f) {
+                throw new AssertionError("a damaged file ended in loading state " + state[0]);
+            }
+            NativeBridge.nativeSelectArtifact(a, "builtin:tablet");
+            for (int i = 0; i < 100000 && NativeBridge.nativeLoadingState(a)[0] != 0f; i++) {
+                NativeBridge.nativeDrawFrame(a, -1);
+            }
+            NativeBridge.nativeDrawFrame(a, -1);
+            if (!"builtin:tablet".equals(NativeBridge.nativeCurrentArtifact(a))) {
+                throw new AssertionError("after selecting the tablet: " + NativeBridge.nativeCurrentArtifact(a));
+            }
+            NativeBridge.nativeOpenMenu(a);
+            if (NativeBridge.nativeTakeShellRequest(a) != NativeBridge.REQUEST_NONE) {
+                throw new AssertionError("a shell request before anything was asked");
+            }
+            byte[] png = NativeBridge.nativeSnapshotPng(a, 1);
+            int pngWidth = java.nio.ByteBuffer.wrap(png, 16, 4).getInt();
+            if (png[1] != 'P' || pngWidth != 180) {
+                throw new AssertionError("side-by-side PNG " + pngWidth + " wide");
+            }
+            expect(IllegalArgumentException.class, "snapshot kind", () -> NativeBridge.nativeSnapshotPng(a, 5));
+            System.out.println("ok: library: damaged import reported, tablet shown, side-by-side PNG "
+                    + png.length + " bytes");
+        } finally {
+            NativeBridge.nativeDestroy(a);
         }
         System.out.println("done");
     }

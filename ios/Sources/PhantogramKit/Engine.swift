@@ -41,12 +41,25 @@ public final class Engine {
         let support = try? FileManager.default.url(for: .applicationSupportDirectory, in: .userDomainMask,
                                                    appropriateFor: nil, create: true)
         let calibration = support?.appendingPathComponent("calibration.txt").path
+        // Imported artifacts live beside it; the one last on screen comes back.
+        let library = support?.appendingPathComponent("artifacts").path
+        let bundled = Bundle.main.resourceURL?.appendingPathComponent("artifacts").path
+        let saved = UserDefaults.standard.string(forKey: Engine.savedArtifactKey)
         var out: OpaquePointer?
         let status: PgStatus = (hasFaces ? faces! : "").withCString { facesPtr in
             (calibration ?? "").withCString { calibrationPtr in
-                config.face_models_dir = hasFaces ? facesPtr : nil
-                config.calibration_path = calibration != nil ? calibrationPtr : nil
-                return pg_engine_create(&config, &out)
+                (library ?? "").withCString { libraryPtr in
+                    (bundled ?? "").withCString { bundledPtr in
+                        (saved ?? "").withCString { savedPtr in
+                            config.face_models_dir = hasFaces ? facesPtr : nil
+                            config.calibration_path = calibration != nil ? calibrationPtr : nil
+                            config.library_dir = library != nil ? libraryPtr : nil
+                            config.bundled_dir = bundled != nil ? bundledPtr : nil
+                            config.artifact = saved != nil ? savedPtr : nil
+                            return pg_engine_create(&config, &out)
+                        }
+                    }
+                }
             }
         }
         try check(status)
@@ -63,5 +76,31 @@ public final class Engine {
 
     deinit {
         pg_engine_destroy(handle)
+    }
+
+    static let savedArtifactKey = "artifact"
+
+    /// Saves the artifact on screen for the next start.
+    public func saveCurrentArtifact() {
+        let needed = pg_current_artifact(handle, nil, 0)
+        guard needed > 1 else { return }
+        var text = [CChar](repeating: 0, count: needed)
+        _ = pg_current_artifact(handle, &text, needed)
+        UserDefaults.standard.set(String(cString: text), forKey: Engine.savedArtifactKey)
+    }
+
+    /// Hands a document the user opened to the core (copied there; loaded in the background, the
+    /// core's banner shows progress or why it failed).
+    public func importArtifact(name: String, data: Data) throws {
+        try data.withUnsafeBytes { (raw: UnsafeRawBufferPointer) in
+            let bytes = raw.bindMemory(to: UInt8.self)
+            try check(pg_import_artifact(handle, name, bytes.baseAddress, bytes.count))
+        }
+    }
+
+    /// What the core's screens ask of the app: `true` when it wants the document picker.
+    func wantsDocumentPicker() -> Bool {
+        var request: Int32 = 0
+        return pg_take_shell_request(handle, &request) == PG_STATUS_OK && request == 1
     }
 }

@@ -1,5 +1,6 @@
 import UIKit
 import QuartzCore
+import UniformTypeIdentifiers
 import PhantogramCore
 
 /// The phantogram on screen: a view backed by a `CAMetalLayer` that the core draws into.
@@ -8,7 +9,7 @@ import PhantogramCore
 /// `pg_resize` in physical pixels (bounds × native scale, so nothing is drawn blurry); out of the
 /// window or the app in the background → `pg_suspend` (the GPU device and sensor state stay).
 /// Frames come from a `CADisplayLink` on the main run loop, paused in the background.
-public final class PhantogramView: UIView {
+public final class PhantogramView: UIView, UIDocumentPickerDelegate {
     public override class var layerClass: AnyClass { CAMetalLayer.self }
 
     private let engine: Engine
@@ -81,6 +82,7 @@ public final class PhantogramView: UIView {
     }
 
     private func background() {
+        engine.saveCurrentArtifact()
         link?.invalidate()
         link = nil
         motion.stop()
@@ -95,6 +97,35 @@ public final class PhantogramView: UIView {
         // targetTimestamp: when this frame will be on screen (the core predicts the pose to it).
         do { try check(pg_draw(engine.handle, link.targetTimestamp, &presented)) } catch {
             NSLog("phantogram: %@", String(describing: error))
+        }
+        if engine.wantsDocumentPicker() { presentDocumentPicker() }
+    }
+
+    /// The core's menu asked for a file: the system's document browser for glTF and zip files.
+    private func presentDocumentPicker() {
+        var types: [UTType] = [.zip]
+        for ext in ["glb", "gltf"] {
+            if let t = UTType(filenameExtension: ext) { types.append(t) }
+        }
+        let picker = UIDocumentPickerViewController(forOpeningContentTypes: types, asCopy: true)
+        picker.delegate = self
+        window?.rootViewController?.present(picker, animated: true)
+    }
+
+    public func documentPicker(_ controller: UIDocumentPickerViewController, didPickDocumentsAt urls: [URL]) {
+        guard let url = urls.first else { return }
+        open(url)
+    }
+
+    /// Opens a file given to the app ("Open in", the picker's copy): its bytes go to the core.
+    public func open(_ url: URL) {
+        let scoped = url.startAccessingSecurityScopedResource()
+        defer { if scoped { url.stopAccessingSecurityScopedResource() } }
+        do {
+            let data = try Data(contentsOf: url, options: .mappedIfSafe)
+            try engine.importArtifact(name: url.lastPathComponent, data: data)
+        } catch {
+            NSLog("phantogram: cannot open %@: %@", url.lastPathComponent, String(describing: error))
         }
     }
 

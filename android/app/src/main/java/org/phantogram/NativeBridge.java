@@ -48,10 +48,12 @@ public final class NativeBridge {
     public static final int TOUCH_CANCEL = 3;
 
     /** Opens the GPU device and loads the scene; call off the UI thread. Null strings: defaults
-     *  (a null calibrationPath: the viewer's calibration is neither read nor saved). */
+     *  (a null calibrationPath: the viewer's calibration is neither read nor saved; a null
+     *  libraryDir: nothing can be imported; artifactId: the id saved from nativeCurrentArtifact
+     *  last time, or null for the default artifact). */
     public static native long nativeCreate(String modelPath, String faceModelsDir, int panelWidthPx,
             int panelHeightPx, float xdpi, float ydpi, int rotation, String anaglyph,
-            String calibrationPath);
+            String calibrationPath, String libraryDir, String bundledDir, String artifactId);
 
     public static native void nativeDestroy(long handle);
 
@@ -104,4 +106,35 @@ public final class NativeBridge {
     /** Why the calibration file could not be read, applied or saved, for the log; null when all is
      *  well. The engine runs on regardless. */
     public static native String nativeCalibrationWarning(long handle);
+
+    /** Requests of the core's screens, from nativeTakeShellRequest. */
+    public static final int REQUEST_NONE = 0;
+    /** Show ACTION_OPEN_DOCUMENT for a .glb, .gltf or .zip, then nativeImportArtifactFd. */
+    public static final int REQUEST_OPEN_FILE = 1;
+
+    /** Imports a file the user opened (display name, bytes); loaded in the background, the
+     *  core's banner shows progress or the reason it failed. */
+    public static native void nativeImportArtifact(long handle, String name, byte[] bytes);
+
+    /** As nativeImportArtifact from ParcelFileDescriptor.detachFd(): the library owns and closes
+     *  the descriptor and reads it off the calling thread. */
+    public static native void nativeImportArtifactFd(long handle, String name, int fd);
+
+    /** Shows an artifact of the library by id ("builtin:medal", "imported:..."). */
+    public static native void nativeSelectArtifact(long handle, String id);
+
+    /** The id of the artifact on screen (save it for nativeCreate); null for a file by path. */
+    public static native String nativeCurrentArtifact(long handle);
+
+    /** Opens the menu (gallery, open a file, calibration), as a single tap does. */
+    public static native void nativeOpenMenu(long handle);
+
+    /** The oldest request of the core's screens (REQUEST_*); call after each frame. */
+    public static native int nativeTakeShellRequest(long handle);
+
+    /** [state, fraction]: 0 idle, 1 loading (fraction 0..1), 2 the last load failed. */
+    public static native float[] nativeLoadingState(long handle);
+
+    /** The current view as PNG bytes for the share sheet: 0 anaglyph, 1 side by side. */
+    public static native byte[] nativeSnapshotPng(long handle, int kind);
 }

@@ -1,11 +1,15 @@
 package org.phantogram
 
 import android.Manifest
+import android.content.Context
+import android.content.Intent
 import android.content.pm.PackageManager
 import android.content.res.Configuration
 import android.hardware.SensorManager
+import android.net.Uri
 import android.os.Build
 import android.os.Bundle
+import android.provider.OpenableColumns
 import android.util.DisplayMetrics
 import android.util.Log
 import android.view.MotionEvent
@@ -30,13 +34,21 @@ import java.io.File
  * (configChanges), so the engine survives it.
  */
 class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
-    private val render = RenderLoop { t -> Log.e(TAG, "phantogram", t) }
+    private val render = RenderLoop(
+        onError = { t -> Log.e(TAG, "phantogram", t) },
+        // The core's menu asked for a file: the system's document picker, on the UI thread.
+        onOpenFile = { runOnUiThread { openDocument.launch(MODEL_TYPES) } }
+    )
     private lateinit var sensors: SensorForwarder
     private var camera: CameraForwarder? = null
     private var surfaceReady = false
 
     private val askCamera = registerForActivityResult(ActivityResultContracts.RequestPermission()) { granted ->
         if (granted) startCamera() else Toast.makeText(this, R.string.tilt_only, Toast.LENGTH_LONG).show()
+    }
+
+    private val openDocument = registerForActivityResult(ActivityResultContracts.OpenDocument()) { uri: Uri? ->
+        if (uri != null) import(uri)
     }
 
     override fun onCreate(savedInstanceState: Bundle?) {
@@ -47,7 +59,10 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         val view = SurfaceView(this)
         view.holder.addCallback(this)
         setContentView(view)
-        render.create(extractFaceModels(), panel(), "dubois", File(filesDir, "calibration.txt").path)
+        val prefs = getSharedPreferences(PREFS, Context.MODE_PRIVATE)
+        render.create(extractFaceModels(), panel(), "dubois", File(filesDir, "calibration.txt").path,
+            File(filesDir, "artifacts").path, prefs.getString(PREF_ARTIFACT, null))
+        intent?.let { openedWith(it) }
         sensors = SensorForwarder(getSystemService(SensorManager::class.java)) { render.engine }
         if (checkSelfPermission(Manifest.permission.CAMERA) == PackageManager.PERMISSION_GRANTED) {
             startCamera()
@@ -62,7 +77,15 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         render.start()
     }
 
+    override fun onNewIntent(intent: Intent) {
+        super.onNewIntent(intent)
+        openedWith(intent)
+    }
+
     override fun onPause() {
+        // The artifact on screen comes back at the next start.
+        val prefs = getSharedPreferences(PREFS, Context.MODE_PRIVATE)
+        render.reportArtifact { id -> if (id != null) prefs.edit().putString(PREF_ARTIFACT, id).apply() }
         render.stop()
         sensors.stop()
         super.onPause()
@@ -136,6 +159,41 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         }
     }
 
+    /** "Open with" (ACTION_VIEW) or a share (ACTION_SEND) of a model file. (The typed
+     *  getParcelableExtra needs API 33; minSdk is 26.) */
+    @Suppress("DEPRECATION")
+    private fun openedWith(intent: Intent) {
+        val uri: Uri? = when (intent.action) {
+            Intent.ACTION_VIEW -> intent.data
+            Intent.ACTION_SEND -> intent.getParcelableExtra(Intent.EXTRA_STREAM)
+            else -> null
+        }
+        if (uri != null) import(uri)
+    }
+
+    /** Hands a document to the core: its descriptor (read there, off the Java heap) and its
+     *  display name. Errors in the file itself appear on the core's banner. */
+    private fun import(uri: Uri) {
+        val name = displayName(uri) ?: uri.lastPathSegment ?: "model"
+        try {
+            val pfd = contentResolver.openFileDescriptor(uri, "r")
+            if (pfd == null) {
+                Toast.makeText(this, getString(R.string.cannot_open, name), Toast.LENGTH_LONG).show()
+                return
+            }
+            render.importFd(name, pfd.detachFd())
+        } catch (e: java.io.FileNotFoundException) {
+            Toast.makeText(this, getString(R.string.cannot_open, name), Toast.LENGTH_LONG).show()
+        } catch (e: SecurityException) {
+            Toast.makeText(this, getString(R.string.cannot_open, name), Toast.LENGTH_LONG).show()
+        }
+    }
+
+    private fun displayName(uri: Uri): String? =
+        contentResolver.query(uri, arrayOf(OpenableColumns.DISPLAY_NAME), null, null, null)?.use { c ->
+            if (c.moveToFirst()) c.getString(c.getColumnIndex(OpenableColumns.DISPLAY_NAME)) else null
+        }
+
     private fun startCamera() {
         if (camera == null) camera = CameraForwarder(this) { render.engine }.also { it.start(this) }
     }
@@ -176,5 +234,10 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
 
     private companion object {
         const val TAG = "Phantogram"
+        const val PREFS = "phantogram"
+        const val PREF_ARTIFACT = "artifact"
+        /** What the document picker offers: glTF binary and JSON, zip (Voyager downloads), and
+         *  octet-stream, as which many providers report a .glb. */
+        val MODEL_TYPES = arrayOf("model/gltf-binary", "model/gltf+json", "application/zip", "application/octet-stream")
     }
 }

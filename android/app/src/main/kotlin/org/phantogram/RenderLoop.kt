@@ -16,7 +16,11 @@ import java.util.concurrent.TimeUnit
  * Sensor and camera calls do not go through here: they call NativeBridge directly from their
  * own threads (the bridge never makes them wait for a frame).
  */
-class RenderLoop(private val onError: (Throwable) -> Unit) : Choreographer.FrameCallback {
+class RenderLoop(
+    private val onError: (Throwable) -> Unit,
+    /** The core's menu asked for a file (called on the render thread). */
+    private val onOpenFile: () -> Unit
+) : Choreographer.FrameCallback {
     private val thread = HandlerThread("phantogram-render").apply { start() }
     private val handler = Handler(thread.looper)
 
@@ -28,11 +32,25 @@ class RenderLoop(private val onError: (Throwable) -> Unit) : Choreographer.Frame
     private var running = false // render thread only
     private var refreshPeriodNs = 16_666_667L
 
-    fun create(facesDir: String?, panel: Panel, anaglyph: String, calibrationPath: String) = post {
+    fun create(
+        facesDir: String?, panel: Panel, anaglyph: String, calibrationPath: String,
+        libraryDir: String, artifact: String?
+    ) = post {
         refreshPeriodNs = periodNs(panel)
         engine = NativeBridge.nativeCreate(null, facesDir, panel.widthPx, panel.heightPx,
-            panel.xdpi, panel.ydpi, panel.rotation, anaglyph, calibrationPath)
+            panel.xdpi, panel.ydpi, panel.rotation, anaglyph, calibrationPath, libraryDir, null, artifact)
         NativeBridge.nativeCalibrationWarning(engine)?.let { Log.w("Phantogram", it) }
+    }
+
+    /** A document the user opened: the engine takes the descriptor over (and closes it). */
+    fun importFd(name: String, fd: Int) = post {
+        if (engine != 0L) NativeBridge.nativeImportArtifactFd(engine, name, fd)
+    }
+
+    /** Hands the id of the artifact on screen to [onArtifact] (on the render thread), to be
+     *  saved for the next start. */
+    fun reportArtifact(onArtifact: (String?) -> Unit) = post {
+        if (engine != 0L) onArtifact(NativeBridge.nativeCurrentArtifact(engine))
     }
 
     fun surfaceCreated(surface: Surface, width: Int, height: Int) = post {
@@ -89,7 +107,11 @@ class RenderLoop(private val onError: (Throwable) -> Unit) : Choreographer.Frame
         // render, one to scan out): the core predicts the orientation to then.
         val displayNs = Clock.monotonicToSensorNs(frameTimeNanos + 2 * refreshPeriodNs)
         try {
-            if (engine != 0L) NativeBridge.nativeDrawFrame(engine, displayNs)
+            if (engine != 0L) {
+                NativeBridge.nativeDrawFrame(engine, displayNs)
+                // What the core's screens ask of the platform (the document picker).
+                if (NativeBridge.nativeTakeShellRequest(engine) == NativeBridge.REQUEST_OPEN_FILE) onOpenFile()
+            }
         } catch (t: RuntimeException) {
             onError(t)
         }

@@ -1,0 +1,3 @@
+// Host stub of the Android/AndroidX API surface the shell uses; see android/stubs/README.md.
+package android.content; public class Intent { public static final String ACTION_VIEW = "android.intent.action.VIEW"; public static final String ACTION_SEND = "android.intent.action.SEND"; public static final String EXTRA_STREAM = "android.intent.extra.STREAM";
+  public String getAction() { return null; } public android.net.Uri getData() { return null; } @Deprecated public <T extends android.os.Parcelable> T getParcelableExtra(String name) { return null; } }
