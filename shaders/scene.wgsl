@@ -33,7 +33,8 @@ struct Material {
     params: vec4<f32>,
     // UV set (0 or 1) of the base colour, metallic-roughness, normal and occlusion textures.
     uv_sets: vec4<f32>,
-    // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended.
+    // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended; w: 1 if
+    // unlit (KHR_materials_unlit).
     flags: vec4<f32>,
     // KHR_texture_transform rows for the five slots, in the order above plus emissive.
     transforms: array<vec4<f32>, 10>,
@@ -261,6 +262,14 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     if (ALPHA_MASK && material.params.z >= 0.0 && base_rgba.a < material.params.z) {
         discard;
     }
+    var out_alpha = 1.0;
+    if (material.flags.z > 0.5) {
+        out_alpha = base_rgba.a;
+    }
+    // KHR_materials_unlit: the base colour as it is (lighting baked into a scan's colour).
+    if (material.flags.w > 0.5) {
+        return vec4<f32>(base_rgba.rgb, out_alpha);
+    }
 
     // Open and double-sided surfaces are lit from the side that faces the eye.
     var n = normalize(in.normal);
@@ -312,10 +321,5 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     let specular_ambient = prefiltered * (f0 * scale_bias.x + vec3<f32>(scale_bias.y));
     let ambient = eye.light.w * occlusion * (diffuse_ambient + specular_ambient);
     let emissive = material.emissive.rgb * emissive_sample.rgb;
-
-    var out_alpha = 1.0;
-    if (material.flags.z > 0.5) {
-        out_alpha = base_rgba.a;
-    }
     return vec4<f32>(direct + ambient + emissive, out_alpha);
 }

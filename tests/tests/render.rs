@@ -750,3 +750,43 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     // Bilinear weights are quantised (8 fractional bits on lavapipe, as on most GPUs).
     assert!(worst < 0.01, "largest difference {worst}");
 }
+
+/// `KHR_materials_unlit`: an unlit surface shows its base colour whatever the light does; the
+/// same surface lit changes with the light's direction.
+#[test]
+fn unlit_materials_ignore_the_light() {
+    let Some(gpu) = gpu() else { return };
+    let view = oblique_view();
+    let mut mesh = Mesh::default();
+    mesh.push_cube(Vec3::new(0.0, 0.0, 0.005), 0.012, [1.0; 4]);
+    let mut model = Model::from_painted_mesh("cube", mesh);
+    model.materials[0].base_color = [0.5, 0.25, 0.1, 1.0];
+    model.materials[0].metallic = 0.0;
+    let centre = |pixels: &[u8]| {
+        let i = ((H / 2) * W + W / 2) as usize * 4;
+        [pixels[i], pixels[i + 1], pixels[i + 2]]
+    };
+    let mut renderer = Renderer::new(gpu, &model).unwrap();
+    let colours = |renderer: &mut Renderer| {
+        [Vec3::new(0.2, 0.3, 1.0), Vec3::new(-1.0, -0.6, 0.3)].map(|light| {
+            let mut input = phantogram::engine::frame_input(&view, Vec3::ZERO);
+            input.toward_light = light.normalize();
+            centre(&renderer.render(&input, Method::Mono, W, H).unwrap())
+        })
+    };
+    let [lit_a, lit_b] = colours(&mut renderer);
+    let differs = |a: [u8; 3], b: [u8; 3]| a.iter().zip(b).map(|(x, y)| x.abs_diff(y)).max().unwrap_or(0);
+    assert!(
+        differs(lit_a, lit_b) > 10,
+        "the lit cube did not change with the light: {lit_a:?} {lit_b:?}"
+    );
+    model.materials[0].unlit = true;
+    renderer.set_model(&model).unwrap();
+    let [unlit_a, unlit_b] = colours(&mut renderer);
+    assert!(
+        differs(unlit_a, unlit_b) <= 1,
+        "the unlit cube changed with the light: {unlit_a:?} {unlit_b:?}"
+    );
+    // Its colour is the base colour's hue: red over green over blue.
+    assert!(unlit_a[0] > unlit_a[1] && unlit_a[1] > unlit_a[2], "{unlit_a:?}");
+}

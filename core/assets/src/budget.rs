@@ -15,13 +15,31 @@
 
 use crate::model::Vertex;
 
+/// Largest image side decoded at all, pixels (a 16384² RGBA image is 1 GiB): larger images are
+/// refused by their header. Images within it but over [`ResourceBudget::max_image_side_px`] are
+/// decoded and scaled down to fit the device.
+pub const MAX_DECODED_SIDE_PX: u32 = 16384;
+
+/// `width × height` scaled down, aspect kept, so that neither side exceeds `max_side` (at least
+/// one pixel each); unchanged when it fits.
+pub fn fit_within(width: u32, height: u32, max_side: u32) -> (u32, u32) {
+    let side = width.max(height);
+    if side <= max_side || side == 0 {
+        return (width, height);
+    }
+    let scale = f64::from(max_side) / f64::from(side);
+    let shrink = |v: u32| ((f64::from(v) * scale).round() as u32).clamp(1, max_side);
+    (shrink(width), shrink(height))
+}
+
 /// What one artifact may take. See the module docs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ResourceBudget {
     /// Bytes of one copy of the artifact in memory: vertices, indices and decoded textures
     /// (with their mip chains) together. Also the largest file read for it.
     pub memory_bytes: u64,
-    /// Largest image side, pixels: the GPU's `max_texture_dimension_2d`.
+    /// Largest texture side, pixels: the GPU's `max_texture_dimension_2d`. Larger images (up to
+    /// [`MAX_DECODED_SIDE_PX`]) are scaled down to it on load.
     pub max_image_side_px: u32,
     /// Most primitives drawn (meshes × the nodes that instance them): each is a draw call per
     /// eye and pass.
@@ -136,22 +154,33 @@ impl Spending {
 
     /// Charges a decoded `width × height` texture (with its mips), or fails without charging when
     /// a side is over the limit or its bytes over what is left.
-    pub fn charge_image(&mut self, what: impl Fn() -> String, width: u32, height: u32) -> Result<(), OverBudget> {
+    pub fn charge_image(
+        &mut self,
+        what: impl Fn() -> String,
+        width: u32,
+        height: u32,
+    ) -> Result<(u32, u32), OverBudget> {
         let side = width.max(height);
-        if side > self.budget.max_image_side_px {
+        if side > MAX_DECODED_SIDE_PX {
             return Err(OverBudget {
                 what: format!("{} ({width}×{height})", what()),
                 needed: u64::from(side),
-                left: u64::from(self.budget.max_image_side_px),
-                limit: u64::from(self.budget.max_image_side_px),
-                limit_name: "ResourceBudget::max_image_side_px",
+                left: u64::from(MAX_DECODED_SIDE_PX),
+                limit: u64::from(MAX_DECODED_SIDE_PX),
+                limit_name: "budget::MAX_DECODED_SIDE_PX",
                 unit: "pixels a side",
             });
         }
-        self.charge_bytes(
-            || format!("{} ({width}×{height})", what()),
-            ResourceBudget::texture_bytes(width, height),
-        )
+        let (w, h) = fit_within(width, height, self.budget.max_image_side_px);
+        if (w, h) != (width, height) {
+            // Decoded whole, then scaled down: both held for a moment.
+            self.check_bytes(
+                || format!("{} ({width}×{height}) while it is scaled down to {w}×{h}", what()),
+                (u64::from(width) * u64::from(height) * 4).saturating_add(ResourceBudget::texture_bytes(w, h)),
+            )?;
+        }
+        self.charge_bytes(|| format!("{} ({w}×{h})", what()), ResourceBudget::texture_bytes(w, h))?;
+        Ok((w, h))
     }
 }
 
@@ -178,12 +207,30 @@ mod tests {
         s.charge_primitive(|| "p".into()).unwrap();
         s.charge_primitive(|| "p".into()).unwrap();
         assert!(s.charge_primitive(|| "p".into()).is_err());
-        let e = s.charge_image(|| "image 0".into(), 17, 1).unwrap_err();
-        assert!(e.to_string().contains("max_image_side_px"), "{e}");
+        let e = s.charge_image(|| "image 0".into(), 20000, 1).unwrap_err();
+        assert!(e.to_string().contains("MAX_DECODED_SIDE_PX"), "{e}");
         // 8×8 RGBA with mips: 256 + 85 = 341 bytes of the 400 left; a second does not fit.
-        s.charge_image(|| "image 1".into(), 8, 8).unwrap();
+        assert_eq!(s.charge_image(|| "image 1".into(), 8, 8), Ok((8, 8)));
         assert_eq!(ResourceBudget::texture_bytes(8, 8), 341);
         let e = s.charge_image(|| "image 2".into(), 8, 8).unwrap_err();
         assert_eq!((e.needed, e.left), (341, 59));
+    }
+
+    #[test]
+    fn images_over_the_device_limit_are_charged_at_the_size_they_are_scaled_to() {
+        let mut s = Spending::new(ResourceBudget {
+            memory_bytes: 10_000,
+            max_image_side_px: 16,
+            max_primitives: 2,
+        });
+        // 32×8 becomes 16×4: 256 + 85 bytes charged; the 1024-byte original only checked.
+        assert_eq!(s.charge_image(|| "image 0".into(), 32, 8), Ok((16, 4)));
+        assert_eq!(s.bytes_left(), 10_000 - ResourceBudget::texture_bytes(16, 4));
+        // Decoding a 64×64 original needs 16 KiB for a moment: over what is left.
+        let e = s.charge_image(|| "image 1".into(), 64, 64).unwrap_err();
+        assert!(e.to_string().contains("scaled down to 16×16"), "{e}");
+        assert_eq!(fit_within(17, 1, 16), (16, 1));
+        assert_eq!(fit_within(3, 1000, 16), (1, 16));
+        assert_eq!(fit_within(8, 8, 16), (8, 8));
     }
 }

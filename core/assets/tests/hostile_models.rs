@@ -185,7 +185,7 @@ fn an_image_header_claiming_too_many_pixels_is_refused_before_decoding() {
     let path = write(&dir, "jpeg.gltf", &gltf_with_buffer_uri("tri.bin", extra));
     let err = load_gltf(&path).unwrap_err().to_string();
     assert!(
-        err.contains("23000×23000") && err.contains("max_image_side_px"),
+        err.contains("23000×23000") && err.contains("MAX_DECODED_SIDE_PX"),
         "{err}"
     );
 }

@@ -185,7 +185,7 @@ impl MaterialUniform {
                 set(slots[4]),
                 f32::from(u8::from(m.normal_texture.is_some())),
                 f32::from(u8::from(m.alpha == AlphaMode::Blend)),
-                0.0,
+                f32::from(u8::from(m.unlit)),
             ],
             transforms,
         }

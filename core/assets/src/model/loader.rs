@@ -21,12 +21,14 @@ const MAX_SCENE_BYTES: u64 = 16 << 20;
 /// it (or non-finite) the bounds and the fit to the screen overflow, and the frame is blank.
 pub const MAX_COORDINATE: f32 = 1e9;
 
-/// Extensions this loader implements; a file requiring any other fails to load.
-pub const SUPPORTED_EXTENSIONS: [&str; 4] = [
+/// Extensions this loader implements; a file requiring any other fails to load, one merely
+/// using another loads with a warning naming it.
+pub const SUPPORTED_EXTENSIONS: [&str; 5] = [
     "KHR_draco_mesh_compression",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
+    "KHR_materials_unlit",
 ];
 
 #[derive(Debug, Error)]
@@ -38,7 +40,7 @@ pub enum ModelError {
     #[error("{}: not a valid glTF file: {message}", path.display())]
     Parse { path: PathBuf, message: String },
     #[error(
-            "{}: requires the glTF extension {name}, which is not supported (supported: KHR_draco_mesh_compression, KHR_mesh_quantization, KHR_texture_transform, KHR_materials_emissive_strength)",
+            "{}: requires the glTF extension {name}, which is not supported (supported: KHR_draco_mesh_compression, KHR_mesh_quantization, KHR_texture_transform, KHR_materials_emissive_strength, KHR_materials_unlit)",
             path.display()
         )]
     UnsupportedExtension { path: PathBuf, name: String },
@@ -488,6 +490,7 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
             gltf::material::AlphaMode::Blend => AlphaMode::Blend,
         },
         double_sided: m.double_sided(),
+        unlit: m.unlit(),
         base_color_texture: pbr.base_color_texture().map(info),
         metallic_roughness_texture: pbr.metallic_roughness_texture().map(info),
         normal_texture,
@@ -1004,15 +1007,15 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&raw), format)
             .into_dimensions()
             .map_err(|e| data_error(e.to_string()))?;
-        spending
+        let fitted = spending
             .charge_image(what, width, height)
             .map_err(|e| over_budget(path, e))?;
-        encoded.push((img.index(), raw, name, format, width, height));
+        encoded.push((img.index(), raw, name, format, width, height, fitted));
     }
     let images_share = Span::new(progress, IMAGES_SHARE[0], IMAGES_SHARE[1]);
     let decoded_count = std::sync::atomic::AtomicUsize::new(0);
     let image_count = encoded.len().max(1) as f32;
-    let images = crate::parallel::map(&encoded, |(index, raw, name, format, width, height)| {
+    let images = crate::parallel::map(&encoded, |(index, raw, name, format, width, height, fitted)| {
         let what = || format!("image {index} ({name})");
         // A cancelled load skips the images not yet begun (the error is reported below).
         if progress.is_cancelled() {
@@ -1024,7 +1027,11 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         let mut limits = image::Limits::default();
         limits.max_image_width = Some(*width);
         limits.max_image_height = Some(*height);
-        limits.max_alloc = Some(ResourceBudget::texture_bytes(*width, *height).saturating_mul(2));
+        limits.max_alloc = Some(
+            ResourceBudget::texture_bytes(*width, *height)
+                .saturating_mul(2)
+                .min(budget.memory_bytes),
+        );
         reader.limits(limits);
         // A decoder panic on a damaged image is this file's error, not the app's end.
         std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
@@ -1036,16 +1043,34 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                 images_share
                     .progress
                     .advance_to(images_share.from + (images_share.to - images_share.from) * done as f32 / image_count);
-                Image {
-                    name: name.clone(),
-                    width: decoded.width(),
-                    height: decoded.height(),
-                    rgba8: decoded.into_raw(),
-                }
+                // Larger than the device's textures: scaled down (a triangle filter averages
+                // the texels each new one covers), and the user told.
+                let (fw, fh) = *fitted;
+                let (decoded, note) = if (fw, fh) != (decoded.width(), decoded.height()) {
+                    let note = format!(
+                        "{} ({width}×{height}) scaled down to {fw}×{fh}, the largest texture this device draws",
+                        what()
+                    );
+                    (
+                        image::imageops::resize(&decoded, fw, fh, image::imageops::FilterType::Triangle),
+                        Some(note),
+                    )
+                } else {
+                    (decoded, None)
+                };
+                (
+                    Image {
+                        name: name.clone(),
+                        width: decoded.width(),
+                        height: decoded.height(),
+                        rgba8: decoded.into_raw(),
+                    },
+                    note,
+                )
             })
     })
     .into_iter()
-    .collect::<Result<Vec<Image>, _>>()
+    .collect::<Result<Vec<(Image, Option<String>)>, _>>()
     .map_err(|(what, message)| {
         if progress.is_cancelled() {
             ModelError::Cancelled {
@@ -1059,6 +1084,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
             }
         }
     })?;
+    let (images, image_notes): (Vec<Image>, Vec<Option<String>>) = images.into_iter().unzip();
     images_share.step(1.0).map_err(cancelled)?;
     drop(encoded); // the compressed copies are not needed while the meshes are built
     let ctx = Ctx {
@@ -1067,7 +1093,18 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         spending: std::cell::RefCell::new(spending),
     };
 
-    let mut warnings = Vec::new();
+    // Extensions used but not required: the file is meant to be viewable without them.
+    let mut warnings: Vec<String> = doc
+        .extensions_used()
+        .filter(|e| !SUPPORTED_EXTENSIONS.contains(e))
+        .map(|e| {
+            format!(
+                "uses the glTF extension {}, which this viewer does not implement: shown without it",
+                excerpt(e)
+            )
+        })
+        .chain(image_notes.into_iter().flatten())
+        .collect();
     let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m, &mut warnings)).collect();
     let default_material = materials.len();
     materials.push(Material::default());

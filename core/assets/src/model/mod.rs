@@ -228,6 +228,9 @@ pub struct Material {
     pub normal_texture: Option<(TextureRef, f32)>,
     pub occlusion_texture: Option<(TextureRef, f32)>,
     pub emissive_texture: Option<TextureRef>,
+    /// `KHR_materials_unlit`: shown in its base colour, without lighting (scans whose lighting
+    /// is baked into their colour).
+    pub unlit: bool,
 }
 
 impl Default for Material {
@@ -246,6 +249,7 @@ impl Default for Material {
             normal_texture: None,
             occlusion_texture: None,
             emissive_texture: None,
+            unlit: false,
         }
     }
 }
