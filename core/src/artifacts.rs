@@ -37,6 +37,9 @@ pub struct ModelInfo {
     pub warnings: Vec<String>,
     /// The library's entry (title, credit, licence); `None` for a file given by path.
     pub artifact: Option<ArtifactEntry>,
+    /// The publisher's points of interest, in the device frame (fitted with the model); each is
+    /// drawn as a marker ([`Model::add_annotation_pins`]) and read by tapping it.
+    pub annotations: Vec<crate::model::Annotation>,
 }
 
 /// A model ready to upload: fitted into the diorama, floored, its bounds known.
@@ -74,10 +77,12 @@ pub fn prepare(
         images: model.images.len(),
         warnings: model.warnings.clone(),
         artifact: entry,
+        annotations: model.annotations.clone(),
     };
     if placing.floor {
         model.add_floor(&placing.screen, Model::FLOOR_REACH);
     }
+    model.add_annotation_pins();
     Ok(Prepared { model, bounds, info })
 }
 

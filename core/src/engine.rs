@@ -238,6 +238,8 @@ pub struct Engine {
     last_display_t_ns: Option<i64>,
     /// Containment's push-back in the last frame, metres (snapshots show that frame's view).
     last_push_m: f32,
+    /// The cyclopean eye's projection in the last frame: what a tap on the picture points at.
+    last_mono: Option<crate::projection::OffAxisProjection>,
     #[cfg(feature = "face")]
     face: Option<Arc<crate::face::FaceWorker>>,
     last_face_t_ns: Option<i64>,
@@ -274,6 +276,8 @@ type OverlayPaint<'a> = dyn FnMut(&Gpu, &wgpu::TextureView, wgpu::TextureFormat,
 enum Page {
     Menu(crate::calibration_ui::menu::MenuUi),
     Calibration(crate::calibration_ui::CalibrationUi),
+    /// The card of the annotation with this index in [`ModelInfo::annotations`].
+    Annotation(usize),
 }
 
 /// The screens' state on the render thread: the page open (if any), egui's context, the touches
@@ -442,6 +446,7 @@ impl Engine {
             target: Target::Detached,
             last_display_t_ns: None,
             last_push_m: 0.0,
+            last_mono: None,
             #[cfg(feature = "face")]
             face,
             last_face_t_ns: None,
@@ -536,6 +541,72 @@ impl Engine {
         );
         #[cfg(not(feature = "ui"))]
         false
+    }
+
+    /// Where annotation `index`'s marker was in the last frame drawn, physical pixels of the
+    /// target (the cyclopean eye's view: between the two the eyes see); `None` before a frame
+    /// or for no such annotation.
+    pub fn annotation_px(&self, index: usize) -> Option<[f32; 2]> {
+        let a = self.model_info.annotations.get(index)?;
+        let mono = self.last_mono?;
+        let centre = crate::model::Model::pin_centre(a) - Vec3::Z * self.last_push_m;
+        let p = mono.project(centre)?.pixel;
+        let k = self.target_scale();
+        Some([p.x * k, p.y * k])
+    }
+
+    /// Target pixels per screen pixel: 1 on a phone; less in the desktop viewer's window.
+    fn target_scale(&self) -> f32 {
+        let screen = self.session.config().screen;
+        let width = match &self.target {
+            Target::Offscreen { width, .. } => *width,
+            Target::Window(host) => match host.state() {
+                crate::surface::SurfaceState::Active { width, .. } => width,
+                _ => 0,
+            },
+            Target::Detached => 0,
+        };
+        if width > 0 {
+            width as f32 / screen.width_px() as f32
+        } else {
+            1.0
+        }
+    }
+
+    /// The annotation whose marker is nearest `px` (physical pixels), within 6 mm on the glass
+    /// (a fingertip).
+    fn annotation_at(&self, px: [f32; 2]) -> Option<usize> {
+        let screen = self.session.config().screen;
+        let reach_px = 0.006 / 0.0254 * screen.panel().xdpi * self.target_scale();
+        (0..self.model_info.annotations.len())
+            .filter_map(|i| {
+                let [x, y] = self.annotation_px(i)?;
+                let d = (x - px[0]).hypot(y - px[1]);
+                (d <= reach_px).then_some((i, d))
+            })
+            .min_by(|a, b| a.1.total_cmp(&b.1))
+            .map(|(i, _)| i)
+    }
+
+    /// Shows annotation `index`'s card (as a tap on its marker does). Returns `false` for no
+    /// such annotation or without screens (feature `ui` off).
+    pub fn open_annotation(&mut self, index: usize) -> bool {
+        #[cfg(feature = "ui")]
+        if index < self.model_info.annotations.len() {
+            self.screens().page = Some(Page::Annotation(index));
+            return true;
+        }
+        let _ = index;
+        false
+    }
+
+    /// The annotation whose card is showing, if one is.
+    pub fn open_annotation_index(&self) -> Option<usize> {
+        #[cfg(feature = "ui")]
+        if let Some(Page::Annotation(i)) = self.screens.as_ref().and_then(|s| s.page.as_ref()) {
+            return Some(*i);
+        }
+        None
     }
 
     /// Whether the menu is showing (touches then drive it, not gestures).
@@ -877,7 +948,15 @@ impl Engine {
                 self.open_calibration();
             }
             Gesture::Menu => {
-                self.open_menu();
+                // A tap on an annotation's marker reads it; anywhere else opens the menu.
+                match self.gestures.last_tap_px().and_then(|px| self.annotation_at(px)) {
+                    Some(i) => {
+                        self.open_annotation(i);
+                    }
+                    None => {
+                        self.open_menu();
+                    }
+                }
             }
             Gesture::AnchorLight => {
                 let _ = self.session.recalibrate_light();
@@ -938,6 +1017,7 @@ impl Engine {
             .smoother
             .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s);
         self.last_push_m = push;
+        self.last_mono = Some(view.mono);
         let input = frame_input(&view, Vec3::Z * -push);
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
@@ -1027,6 +1107,8 @@ impl Engine {
             LoadStatus::Failed { title, message } => Some(Banner::Failed { title, message }),
         };
         let (mut calibration_actions, mut menu_actions) = (Vec::new(), Vec::new());
+        let mut card_closed = false;
+        let annotations = &self.model_info.annotations;
         let mut banner_action = None;
         let mut banner_pt = None;
         let mut banner_button_pt = None;
@@ -1035,6 +1117,12 @@ impl Engine {
             match page {
                 Some(Page::Calibration(ui)) => calibration_actions = ui.show(root, &screen, ppp),
                 Some(Page::Menu(menu)) => menu_actions = menu.show(root, items, current.as_deref()),
+                Some(Page::Annotation(i)) => match annotations.get(*i) {
+                    Some(a) => {
+                        card_closed = crate::calibration_ui::menu::show_annotation(root.ctx(), &a.title, &a.lead).0
+                    }
+                    None => card_closed = true,
+                },
                 None => {}
             }
             if let Some(b) = &banner {
@@ -1066,6 +1154,9 @@ impl Engine {
         }
         for action in menu_actions {
             self.apply_menu_action(action);
+        }
+        if card_closed {
+            self.set_page(None);
         }
         match banner_action {
             Some(BannerAction::Cancel) => self.cancel_loading(),

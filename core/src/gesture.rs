@@ -100,6 +100,8 @@ pub struct Gestures {
     long_press_fired: bool,
     /// End time of a single tap awaiting its second.
     last_tap_ns: Option<i64>,
+    /// Where the last single tap was, physical pixels.
+    last_tap_px: Option<[f32; 2]>,
 }
 
 impl Gestures {
@@ -119,7 +121,13 @@ impl Gestures {
             sequence_start_ns: 0,
             long_press_fired: false,
             last_tap_ns: None,
+            last_tap_px: None,
         }
+    }
+
+    /// Where the last single tap ([`Gesture::Menu`]) was, physical pixels: what it was on.
+    pub fn last_tap_px(&self) -> Option<[f32; 2]> {
+        self.last_tap_px
     }
 
     /// Whether no finger is down (a touch starting now begins a new sequence).
@@ -221,6 +229,7 @@ impl Gestures {
                         }
                         _ => {
                             self.last_tap_ns = Some(t_ns);
+                            self.last_tap_px = Some(at);
                             None
                         }
                     },

@@ -275,3 +275,54 @@ fn the_menu_and_the_banner_are_driven_by_taps() {
         }
     }
 }
+
+/// The Smithsonian turtle with five Voyager annotations (shared data): markers drawn, and a tap
+/// on one reads it; the card closes with its button.
+#[test]
+fn a_tap_on_an_annotation_marker_reads_it() {
+    use phantogram::gesture::TouchPhase;
+    let _serial = serial();
+    let Some(data) = std::env::var_os("PHANTOGRAM_DATA") else {
+        eprintln!("PHANTOGRAM_DATA not set: skipping");
+        return;
+    };
+    let scene =
+        std::path::Path::new(&data).join("models/heritage/smithsonian_nmnh_sea_turtle/scene-annotated.svx.json");
+    let config = EngineConfig {
+        model_path: Some(scene),
+        method: phantogram::anaglyph::Method::Mono,
+        ..EngineConfig::default()
+    };
+    let mut e = match Engine::new(config) {
+        Ok(e) => e,
+        Err(err) if std::env::var_os("CI").is_none() && err.to_string().contains("adapter") => return,
+        Err(err) => panic!("{err}"),
+    };
+    let titles: Vec<String> = e.model_info().annotations.iter().map(|a| a.title.clone()).collect();
+    assert_eq!(titles, ["Head", "Carapace", "Front flipper", "Front flipper", "Rear"]);
+    let (w, h) = (360, 800);
+    e.resume_offscreen(w, h).unwrap();
+    let ms = 1_000_000;
+    e.draw(Some(10 * ms)).unwrap();
+    let carapace = e.annotation_px(1).expect("the carapace's marker");
+    assert!(carapace[0] > 0.0 && carapace[0] < w as f32 && carapace[1] > 0.0 && carapace[1] < h as f32);
+    e.touch(TouchPhase::Down, 0, carapace[0], carapace[1], 100 * ms);
+    e.touch(TouchPhase::Up, 0, carapace[0] + 2.0, carapace[1], 160 * ms);
+    e.draw(Some(900 * ms)).unwrap();
+    assert_eq!(e.open_annotation_index(), Some(1), "the tap on the carapace read it");
+    assert!(!e.menu_open());
+    e.draw(Some(916 * ms)).unwrap();
+    e.draw(Some(932 * ms)).unwrap();
+    let card = e.last_frame().unwrap().2.to_vec();
+    golden::check("annotation-card", w, h, &card, 3, 0.003);
+    if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
+        image::save_buffer(
+            std::path::Path::new(&dir).join("annotation-card.png"),
+            &card,
+            w,
+            h,
+            image::ExtendedColorType::Rgba8,
+        )
+        .unwrap();
+    }
+}

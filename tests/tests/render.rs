@@ -790,3 +790,77 @@ fn unlit_materials_ignore_the_light() {
     // Its colour is the base colour's hue: red over green over blue.
     assert!(unlit_a[0] > unlit_a[1] && unlit_a[1] > unlit_a[2], "{unlit_a:?}");
 }
+
+/// Centroid of the annotation markers' amber pixels (unlit: the same in any light).
+fn amber_centroid(pixels: &[u8]) -> Option<(f32, f32, usize)> {
+    let (mut sx, mut sy, mut n) = (0.0, 0.0, 0usize);
+    for (i, px) in pixels.chunks(4).enumerate() {
+        let (r, g, b) = (px[0] as i32, px[1] as i32, px[2] as i32);
+        if r > 150 && r - b > 90 && g > b + 30 {
+            sx += (i as u32 % W) as f32 + 0.5;
+            sy += (i as u32 / W) as f32 + 0.5;
+            n += 1;
+        }
+    }
+    (n > 0).then(|| (sx / n as f32, sy / n as f32, n))
+}
+
+/// Annotation markers are drawn with the artifact: at their true depth in each eye (on the pixel
+/// the eye's projection predicts, within a pixel), and hidden where the artifact is in front.
+#[test]
+fn annotation_markers_land_on_their_pixel_in_each_eye_and_hide_behind_the_artifact() {
+    use phantogram::model::Annotation;
+    let Some(gpu) = gpu() else { return };
+    let screen = Screen::default();
+    let view = oblique_view();
+    let scale = W as f32 / screen.width_px() as f32;
+    let model_with = |position: Vec3, direction: Vec3| {
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::new(0.0, 0.0, 0.005), 0.012, [0.5, 0.5, 0.5, 1.0]);
+        let mut model = Model::from_painted_mesh("cube", mesh);
+        model.annotations.push(Annotation {
+            id: "a".into(),
+            title: "A".into(),
+            lead: String::new(),
+            position,
+            direction,
+        });
+        model.add_annotation_pins();
+        model
+    };
+    let visible = [
+        (Vec3::new(0.004, 0.003, 0.017), Vec3::Z),  // on the top, in front of the glass
+        (Vec3::new(-0.003, 0.012, 0.0), Vec3::Y),   // on the face towards the eyes, at the glass
+        (Vec3::new(0.006, 0.012, -0.004), Vec3::Y), // on the same face, behind the glass
+    ];
+    // The eyes are above the glass towards its top edge (+y, +z).
+    assert!(view.left.eye_m.y > 0.05 && view.left.eye_m.z > 0.05);
+    let mut renderer = Renderer::new(gpu, &model_with(visible[0].0, visible[0].1)).unwrap();
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
+    for (position, direction) in visible {
+        renderer.set_model(&model_with(position, direction)).unwrap();
+        let centre = position + direction * Model::PIN_RADIUS_M * 1.5;
+        for (name, proj) in [("left", &view.left), ("right", &view.right)] {
+            let pixels = renderer.render_single(proj, &input, W, H).unwrap();
+            let (x, y, n) =
+                amber_centroid(&pixels).unwrap_or_else(|| panic!("marker at {position} not visible ({name} eye)"));
+            let want = proj.project(centre).unwrap().pixel * scale;
+            let err = ((x - want.x).powi(2) + (y - want.y).powi(2)).sqrt();
+            println!("marker at {position}, {name} eye: {n} px at ({x:.2}, {y:.2}), predicted {want}, error {err:.3}");
+            assert!(err < 1.0, "marker at {position}, {name} eye: {err} px from its pixel");
+        }
+    }
+    // Under the cube (its far side from the viewer): hidden in both eyes. (A marker on a side
+    // face is seen by one eye only, as a real mark would be.)
+    renderer
+        .set_model(&model_with(Vec3::new(0.0, 0.004, -0.007), -Vec3::Z))
+        .unwrap();
+    for proj in [&view.left, &view.right] {
+        let pixels = renderer.render_single(proj, &input, W, H).unwrap();
+        assert_eq!(
+            amber_centroid(&pixels).map(|c| c.2),
+            None,
+            "a marker behind the artifact shows"
+        );
+    }
+}

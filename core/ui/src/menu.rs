@@ -165,6 +165,29 @@ impl MenuUi {
     }
 }
 
+/// Draws an annotation's card (its title and text) at the bottom of the screen; returns `true`
+/// when the viewer closed it, and the card's rectangle (points).
+pub fn show_annotation(ctx: &egui::Context, title: &str, lead: &str) -> (bool, Rect) {
+    let mut closed = false;
+    let width = (ctx.content_rect().width() - 24.0).max(100.0);
+    let area = egui::Area::new(egui::Id::unique("annotation card"))
+        .anchor(Align2::CENTER_BOTTOM, [0.0, -12.0])
+        .order(egui::Order::Foreground)
+        .fade_in(false)
+        .show(ctx, |ui| {
+            egui::Frame::popup(ui.style()).show(ui, |ui| {
+                ui.set_width(width - 16.0);
+                ui.label(RichText::new(title).size(20.0).color(Color32::from_rgb(255, 190, 90)));
+                if !lead.is_empty() {
+                    ui.label(RichText::new(lead).size(16.0));
+                }
+                let r = ui.add_sized([ui.available_width(), CONTROL_HEIGHT_PT], egui::Button::new("Close"));
+                closed = r.clicked();
+            });
+        });
+    (closed, area.response.rect)
+}
+
 /// What the banner shows.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Banner {

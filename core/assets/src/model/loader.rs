@@ -760,6 +760,63 @@ pub fn voyager_rotation(model_path: &Path) -> Option<Quat> {
     (q.is_finite() && q.length() > 0.5).then(|| q.normalize())
 }
 
+/// Most annotations read from one scene, and the longest title and text kept (characters).
+const MAX_ANNOTATIONS: usize = 256;
+const MAX_TITLE_CHARS: usize = 120;
+const MAX_LEAD_CHARS: usize = 1000;
+
+/// The annotations a Voyager scene gives the model it lists as `model_path`'s file
+/// (`models[].annotations[]`: `id`, `title`, `lead`, `position` and `direction` in the model's
+/// own coordinates, as Voyager's `IAnnotation` defines them). None when there is no such scene
+/// or it cannot be read (the model then loads without them); an annotation without a finite
+/// position is skipped.
+pub fn voyager_annotations(scene: &Path, model_path: &Path) -> Vec<Annotation> {
+    let Some(file_name) = model_path.file_name().and_then(|n| n.to_str()) else {
+        return Vec::new();
+    };
+    let Ok(text) = phantogram_files::read_regular_file(scene, MAX_SCENE_BYTES) else {
+        return Vec::new();
+    };
+    let Ok(json) = serde_json::from_slice::<serde_json::Value>(&text) else {
+        return Vec::new();
+    };
+    let Some((model, _, _)) = voyager_assets(&json).find(|(_, _, uri)| *uri == file_name) else {
+        return Vec::new();
+    };
+    let cut = |v: Option<&serde_json::Value>, max: usize| -> String {
+        let s = v.and_then(|v| v.as_str()).unwrap_or("").trim();
+        match s.char_indices().nth(max) {
+            Some((end, _)) => format!("{}…", &s[..end]),
+            None => s.to_owned(),
+        }
+    };
+    let vec3 = |v: Option<&serde_json::Value>| -> Option<Vec3> {
+        let a = v?.as_array()?;
+        let f = |i: usize| a.get(i)?.as_f64().map(|x| x as f32);
+        let p = Vec3::new(f(0)?, f(1)?, f(2)?);
+        (p.is_finite() && p.abs().max_element() <= MAX_COORDINATE).then_some(p)
+    };
+    model
+        .get("annotations")
+        .and_then(|a| a.as_array())
+        .into_iter()
+        .flatten()
+        .filter(|a| a.get("visible").and_then(|v| v.as_bool()) != Some(false))
+        .filter_map(|a| {
+            Some(Annotation {
+                id: cut(a.get("id"), MAX_TITLE_CHARS),
+                title: cut(a.get("title"), MAX_TITLE_CHARS),
+                lead: cut(a.get("lead"), MAX_LEAD_CHARS),
+                position: vec3(a.get("position"))?,
+                direction: vec3(a.get("direction"))
+                    .and_then(|d| d.try_normalize())
+                    .unwrap_or(Vec3::Y),
+            })
+        })
+        .take(MAX_ANNOTATIONS)
+        .collect()
+}
+
 /// Why `version` (a glTF `asset.version`) is not one this loader reads, if it is not.
 fn not_gltf2_version(version: &str) -> Option<String> {
     (version.split('.').next() != Some("2")).then(|| format!("asset version {version:?}; this loader reads glTF 2.0"))
@@ -876,6 +933,14 @@ pub fn load_model_with(path: &Path, budget: ResourceBudget, progress: &Progress)
             .and_then(|n| n.to_str())
             .is_some_and(|n| n.to_ascii_lowercase().ends_with(".svx.json"));
     let scan;
+    // The scene the annotations come from: the one given, or the one beside the scan.
+    let scene = if path.is_dir() {
+        path.join(VOYAGER_SCENE)
+    } else if is_scene {
+        path.to_path_buf()
+    } else {
+        path.parent().unwrap_or(Path::new(".")).join(VOYAGER_SCENE)
+    };
     let path = if is_scene {
         scan = voyager_scan(path)?;
         &scan
@@ -883,6 +948,8 @@ pub fn load_model_with(path: &Path, budget: ResourceBudget, progress: &Progress)
         path
     };
     let mut model = load_gltf_with(path, budget, progress)?;
+    // In the scan's own coordinates, like its vertices: turned and fitted with them.
+    model.annotations = voyager_annotations(&scene, path);
     if let Some(q) = voyager_rotation(path) {
         model.transform(Mat4::from_quat(q));
         model

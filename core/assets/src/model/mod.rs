@@ -307,6 +307,22 @@ pub struct Model {
     pub images: Vec<Image>,
     /// Things in the file that were skipped (non-triangle primitives, …), for the user to see.
     pub warnings: Vec<String>,
+    /// Points of interest the publisher marked on the artifact (Voyager annotations), in the
+    /// model's frame: they move with [`Model::transform`].
+    pub annotations: Vec<Annotation>,
+}
+
+/// A point of interest on the artifact: where it is, which way its surface faces, what it says.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Annotation {
+    pub id: String,
+    pub title: String,
+    /// The short text shown when it is tapped.
+    pub lead: String,
+    /// A point on the surface, in the model's frame.
+    pub position: Vec3,
+    /// The direction the marker stands out in (the surface's outward side), unit length.
+    pub direction: Vec3,
 }
 
 /// Which way a glTF model (+Y up, +Z front) is turned into the diorama.
@@ -378,6 +394,7 @@ impl Model {
             materials: vec![Material::vertex_painted()],
             images: Vec::new(),
             warnings: Vec::new(),
+            annotations: Vec::new(),
         }
     }
 
@@ -444,6 +461,48 @@ impl Model {
         for p in &mut self.primitives {
             p.mesh.transform(m);
         }
+        let linear = Mat3::from_mat4(m);
+        let normal_m = linear.inverse().transpose();
+        for a in &mut self.annotations {
+            a.position = m.transform_point3(a.position);
+            a.direction = (normal_m * a.direction).normalize_or(Vec3::Z);
+        }
+    }
+
+    /// Radius of an annotation's marker, metres on the diorama's scale (what a finger finds on a
+    /// phone held at 30 cm, and small beside the artifact).
+    pub const PIN_RADIUS_M: f32 = 0.0012;
+
+    /// Where an annotation's marker is drawn: a little out from the surface along its direction,
+    /// so that it is not buried in it.
+    pub fn pin_centre(a: &Annotation) -> Vec3 {
+        a.position + a.direction * Self::PIN_RADIUS_M * 1.5
+    }
+
+    /// Adds a marker for each annotation: a small amber ball, unlit so that it reads the same in
+    /// any light, drawn with the artifact (so it has the artifact's depth in both eyes and is
+    /// hidden where the artifact is in front of it).
+    pub fn add_annotation_pins(&mut self) {
+        if self.annotations.is_empty() {
+            return;
+        }
+        let mut mesh = Mesh::default();
+        for a in &self.annotations {
+            push_ball(&mut mesh, Self::pin_centre(a), Self::PIN_RADIUS_M, 12, 8);
+        }
+        self.materials.push(Material {
+            name: "annotation markers".into(),
+            base_color: [1.0, 0.62, 0.12, 1.0],
+            metallic: 0.0,
+            roughness: 1.0,
+            unlit: true,
+            ..Material::default()
+        });
+        self.primitives.push(Primitive {
+            mesh,
+            material: self.materials.len() - 1,
+            is_floor: false,
+        });
     }
 
     /// Turns a glTF (+Y up, +Z front) model into the device frame as `fit.placement` says, scales
@@ -470,9 +529,38 @@ impl Model {
     }
 }
 
+/// Appends a UV sphere of `radius` at `centre`: `segments` round, `rings` from pole to pole.
+fn push_ball(mesh: &mut Mesh, centre: Vec3, radius: f32, segments: u32, rings: u32) {
+    let base = mesh.vertices.len() as u32;
+    for i in 0..=rings {
+        let theta = std::f32::consts::PI * i as f32 / rings as f32;
+        for j in 0..=segments {
+            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+            let n = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+            mesh.vertices.push(Vertex {
+                position: (centre + n * radius).to_array(),
+                normal: n.to_array(),
+                tangent: [-phi.sin(), phi.cos(), 0.0, 1.0],
+                uv: [j as f32 / segments as f32, i as f32 / rings as f32, 0.0, 0.0],
+                color: [1.0; 4],
+                material: [1.0, 1.0],
+            });
+        }
+    }
+    let row = segments + 1;
+    for i in 0..rings {
+        for j in 0..segments {
+            let a = base + i * row + j;
+            let b = a + row;
+            // Counter-clockwise seen from outside (θ grows towards −z, φ anticlockwise about z).
+            mesh.indices.extend_from_slice(&[a, b, a + 1, a + 1, b, b + 1]);
+        }
+    }
+}
+
 pub use loader::{
     MAX_COORDINATE, ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with, load_gltf_within, load_model,
-    load_model_with, load_model_within, resolve_inside, voyager_rotation, voyager_scan,
+    load_model_with, load_model_within, resolve_inside, voyager_annotations, voyager_rotation, voyager_scan,
 };
 
 mod loader;
