@@ -94,7 +94,9 @@ pub struct EngineConfig {
     /// Draw the diorama's floor under the artifact.
     pub floor: bool,
     /// Where the viewer's calibration is kept (a file in the app's private storage); `None`: the
-    /// defaults, and nothing saved.
+    /// defaults, and nothing saved. **Important:** with a path whose calibration does not say
+    /// the first run is done, the engine opens on the first-run screens (how to hold the phone,
+    /// the glasses check, "Start"); the desktop's `render` passes none.
     pub calibration_path: Option<PathBuf>,
 }
 
@@ -278,6 +280,7 @@ enum Page {
     Calibration(crate::calibration_ui::CalibrationUi),
     /// The card of the annotation with this index in [`ModelInfo::annotations`].
     Annotation(usize),
+    Welcome(crate::calibration_ui::welcome::WelcomeUi),
 }
 
 /// The screens' state on the render thread: the page open (if any), egui's context, the touches
@@ -462,6 +465,10 @@ impl Engine {
             requests: Vec::new(),
         };
         engine.apply_calibration();
+        #[cfg(feature = "ui")]
+        if engine.calibration_path.is_some() && !engine.calibration.introduced {
+            engine.screens().page = Some(Page::Welcome(crate::calibration_ui::welcome::WelcomeUi::new()));
+        }
         Ok(engine)
     }
 
@@ -620,6 +627,26 @@ impl Engine {
     /// What the core's screens asked of the shell since the last call (see [`ShellRequest`]).
     pub fn take_shell_requests(&mut self) -> Vec<ShellRequest> {
         std::mem::take(&mut self.requests)
+    }
+
+    /// Each eye's image to the filter that is really in front of it: swapped when the glasses
+    /// check found the glasses on the other way round.
+    fn oriented<'a>(&self, mut input: FrameInput<'a>) -> FrameInput<'a> {
+        if self.calibration.glasses_swapped {
+            std::mem::swap(&mut input.left, &mut input.right);
+        }
+        input
+    }
+
+    /// Whether the first-run screens are showing.
+    pub fn welcome_open(&self) -> bool {
+        #[cfg(feature = "ui")]
+        return matches!(
+            self.screens.as_ref().and_then(|s| s.page.as_ref()),
+            Some(Page::Welcome(_))
+        );
+        #[cfg(not(feature = "ui"))]
+        false
     }
 
     /// The oldest request not yet taken (for bridges that hand over one at a time).
@@ -1018,7 +1045,7 @@ impl Engine {
             .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s);
         self.last_push_m = push;
         self.last_mono = Some(view.mono);
-        let input = frame_input(&view, Vec3::Z * -push);
+        let input = self.oriented(frame_input(&view, Vec3::Z * -push));
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
         {
@@ -1107,6 +1134,8 @@ impl Engine {
             LoadStatus::Failed { title, message } => Some(Banner::Failed { title, message }),
         };
         let (mut calibration_actions, mut menu_actions) = (Vec::new(), Vec::new());
+        let mut welcome_actions = Vec::new();
+        let filters = filter_colours(self.method);
         let mut card_closed = false;
         let annotations = &self.model_info.annotations;
         let mut banner_action = None;
@@ -1117,6 +1146,7 @@ impl Engine {
             match page {
                 Some(Page::Calibration(ui)) => calibration_actions = ui.show(root, &screen, ppp),
                 Some(Page::Menu(menu)) => menu_actions = menu.show(root, items, current.as_deref()),
+                Some(Page::Welcome(welcome)) => welcome_actions = welcome.show(root, filters),
                 Some(Page::Annotation(i)) => match annotations.get(*i) {
                     Some(a) => {
                         card_closed = crate::calibration_ui::menu::show_annotation(root.ctx(), &a.title, &a.lead).0
@@ -1158,6 +1188,9 @@ impl Engine {
         if card_closed {
             self.set_page(None);
         }
+        for action in welcome_actions {
+            self.apply_welcome_action(action);
+        }
         match banner_action {
             Some(BannerAction::Cancel) => self.cancel_loading(),
             Some(BannerAction::Dismiss) => self.dismiss_message(),
@@ -1169,6 +1202,43 @@ impl Engine {
     #[cfg(feature = "ui")]
     fn set_page(&mut self, page: Option<Page>) {
         self.screens().page = page;
+    }
+
+    #[cfg(feature = "ui")]
+    fn apply_welcome_action(&mut self, action: crate::calibration_ui::welcome::WelcomeAction) {
+        use crate::calibration_ui::welcome::WelcomeAction as A;
+        match action {
+            A::Start => {
+                // The pose held now is straight on (without gravity yet, lying flat stays it).
+                let _ = self.session.calibrate_flat_angle();
+                self.calibration.flat_up_device = self.session.flat_up_device().or(self.calibration.flat_up_device);
+                self.calibration.introduced = true;
+                self.save_calibration();
+                self.set_page(None);
+            }
+            A::GlassesSwapped(swapped) => {
+                self.calibration.glasses_swapped = swapped;
+                self.save_calibration();
+            }
+            A::Calibrate => {
+                self.calibration.introduced = true;
+                self.save_calibration();
+                self.set_page(None);
+                self.open_calibration();
+            }
+        }
+    }
+
+    /// As [`Self::calibration_control_px`] for the first-run screens (names as
+    /// [`crate::calibration_ui::welcome::WelcomeUi::widget_rect`]).
+    #[cfg(feature = "ui")]
+    pub fn welcome_control_px(&self, name: &str) -> Option<[f32; 2]> {
+        let Some(Page::Welcome(w)) = self.screens.as_ref()?.page.as_ref() else {
+            return None;
+        };
+        let centre = w.widget_rect(name)?.center();
+        let ppp = self.pixels_per_point();
+        Some([centre.x * ppp, centre.y * ppp])
     }
 
     #[cfg(feature = "ui")]
@@ -1220,6 +1290,8 @@ impl Engine {
                 // The screens do not set the flat angle; the session holds the current one.
                 self.calibration = Calibration {
                     flat_up_device: self.calibration.flat_up_device,
+                    glasses_swapped: self.calibration.glasses_swapped,
+                    introduced: self.calibration.introduced,
                     ..c
                 };
                 self.apply_calibration();
@@ -1256,7 +1328,7 @@ impl Engine {
             _ => (screen.width_px(), screen.height_px()),
         };
         let view = self.session.frame_at(self.last_display_t_ns)?;
-        let input = frame_input(&view, Vec3::Z * -self.last_push_m);
+        let input = self.oriented(frame_input(&view, Vec3::Z * -self.last_push_m));
         Ok(match kind {
             Snapshot::Composed => (w, h, self.renderer.render(&input, self.method, w, h)?),
             Snapshot::SideBySide => (w * 2, h, self.renderer.render_side_by_side(&input, w, h)?),
@@ -1413,6 +1485,20 @@ impl SharedEngine {
         let mut s = self.lock().stats();
         s.camera_frames = self.camera_frames.load(std::sync::atomic::Ordering::Relaxed);
         s
+    }
+}
+
+/// The sRGB colours of a method's two filters, left eye's first, for the glasses check: each
+/// passes through its own filter only. `None` for mono (no glasses).
+#[cfg(feature = "ui")]
+fn filter_colours(method: Method) -> Option<([u8; 3], [u8; 3])> {
+    match method {
+        Method::Mono => None,
+        Method::DuboisGreenMagenta => Some(([0, 255, 0], [255, 0, 255])),
+        Method::DuboisAmberBlue => Some(([255, 190, 0], [0, 0, 255])),
+        Method::DuboisRedCyan | Method::HalfColor | Method::Optimized | Method::Gray | Method::Color => {
+            Some(([255, 0, 0], [0, 255, 255]))
+        }
     }
 }
 

@@ -165,6 +165,8 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
 
     let dir = phantogram_integration::scratch("engine-calibration");
     let path = dir.join("calibration.txt");
+    // The first-run screens were seen (they have a test of their own below).
+    std::fs::write(&path, "phantogram-calibration 1\nintroduced 1\n").unwrap();
     // A half-resolution panel of the same physical size: fewer pixels to shade on lavapipe.
     let panel = PanelSpec {
         width_px: 540,
@@ -186,7 +188,12 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
         }
         Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
     };
-    assert_eq!(engine.calibration_warning(), None, "no file yet is no problem");
+    assert_eq!(
+        engine.calibration_warning(),
+        None,
+        "a file with the first run only is no problem"
+    );
+    assert!(!engine.welcome_open(), "the first run is done");
     // Held 35° from flat, top edge raised.
     let tilt = 35f32.to_radians();
     let up = phantogram::glam::Vec3::new(0.0, tilt.sin(), tilt.cos());
@@ -341,4 +348,109 @@ fn the_screens_keep_the_phones_layout_on_a_smaller_target() {
         !engine.calibration_open(),
         "the tap at {small:?} missed the close button"
     );
+}
+
+#[path = "support/golden.rs"]
+mod golden;
+
+/// The first run, driven by taps as a new user would: the screens open by themselves, the
+/// glasses check swaps the eyes when the glasses are on the other way round, Start takes the
+/// pose held as straight on, and they do not open again.
+#[test]
+fn the_first_run_screens_check_the_glasses_and_take_the_pose() {
+    use phantogram::engine::{Engine, EngineConfig, Snapshot};
+    use phantogram::gesture::TouchPhase;
+    use phantogram::sensors::SensorEvent;
+
+    let dir = phantogram_integration::scratch("engine-first-run");
+    let path = dir.join("calibration.txt");
+    let config = |path: &std::path::Path| EngineConfig {
+        method: phantogram::anaglyph::Method::DuboisRedCyan,
+        calibration_path: Some(path.to_path_buf()),
+        ..EngineConfig::default()
+    };
+    let mut engine = match Engine::new(config(&path)) {
+        Ok(e) => e,
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no engine ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    };
+    assert!(engine.welcome_open(), "a first run opens on the welcome screens");
+    // Held 40° from flat.
+    let tilt = 40f32.to_radians();
+    let up = phantogram::glam::Vec3::new(0.0, tilt.sin(), tilt.cos());
+    let push = |engine: &Engine| {
+        for k in 0..20 {
+            engine
+                .inbox()
+                .push(SensorEvent::accelerometer(k * 10_000_000, up * 9.81))
+                .unwrap();
+        }
+    };
+    push(&engine);
+    let (w, h) = (360, 800);
+    engine.resume_offscreen(w, h).unwrap();
+    let ms = 1_000_000;
+    let mut t = 200;
+    let frames = |engine: &mut Engine, n: i64, t: &mut i64| {
+        for _ in 0..n {
+            engine.draw(Some(*t * ms)).unwrap();
+            *t += 16;
+        }
+    };
+    frames(&mut engine, 3, &mut t);
+    golden::check("welcome-intro", w, h, engine.last_frame().unwrap().2, 3, 0.003);
+    let tap = |engine: &mut Engine, name: &str, t: &mut i64| {
+        let p = engine
+            .welcome_control_px(name)
+            .unwrap_or_else(|| panic!("no {name} on the first-run screen"));
+        engine.touch(TouchPhase::Down, 0, p[0], p[1], *t * ms);
+        frames(engine, 1, t);
+        engine.touch(TouchPhase::Up, 0, p[0], p[1], *t * ms);
+        frames(engine, 3, t);
+    };
+    tap(&mut engine, "glasses", &mut t);
+    golden::check("welcome-glasses", w, h, engine.last_frame().unwrap().2, 3, 0.003);
+    // The right eye (left closed) sees the left ring: the red filter is on the right eye.
+    tap(&mut engine, "left-ring", &mut t);
+    assert!(engine.calibration().glasses_swapped);
+    tap(&mut engine, "continue", &mut t);
+    tap(&mut engine, "start", &mut t);
+    assert!(!engine.welcome_open(), "Start closes the first-run screens");
+    let straight_on = engine.session().flat_up_device().expect("Start took the pose");
+    assert!(straight_on.distance(up) < 1e-3, "{straight_on} vs {up}");
+    let text = std::fs::read_to_string(&path).unwrap();
+    assert!(
+        text.contains("introduced 1") && text.contains("glasses_swapped 1"),
+        "{text}"
+    );
+
+    // Each eye's image went to the other filter: the pair is this engine's halves swapped, as
+    // an engine with the glasses the right way round shows the same pose.
+    let other = dir.join("other.txt");
+    std::fs::write(&other, "phantogram-calibration 1\nintroduced 1\n").unwrap();
+    let mut plain = Engine::new(config(&other)).unwrap();
+    push(&plain);
+    plain.resume_offscreen(w, h).unwrap();
+    plain.draw(Some(t * ms)).unwrap();
+    plain.calibrate_flat_angle().unwrap();
+    engine.draw(Some(t * ms)).unwrap();
+    let swapped_now = engine.snapshot(Snapshot::SideBySide).unwrap();
+    let normal = plain.snapshot(Snapshot::SideBySide).unwrap();
+    assert_eq!((swapped_now.0, swapped_now.1), (2 * w, h));
+    let row = (2 * w * 4) as usize;
+    let half = (w * 4) as usize;
+    let mut same = 0usize;
+    for y in 0..h as usize {
+        let s = &swapped_now.2[y * row..(y + 1) * row];
+        let n = &normal.2[y * row..(y + 1) * row];
+        same += usize::from(s[..half] == n[half..] && s[half..] == n[..half]);
+    }
+    assert!(same > h as usize * 99 / 100, "only {same} of {h} rows swapped");
+
+    // Not shown again.
+    drop(engine);
+    assert!(!Engine::new(config(&path)).unwrap().welcome_open());
 }

@@ -131,6 +131,11 @@ pub struct Calibration {
     pub density_dpi: Option<Vec2>,
     /// "Up" in the device frame in the pose calibrated as straight on.
     pub flat_up_device: Option<Vec3>,
+    /// The viewer's glasses have the left eye's filter on the right (found by the glasses
+    /// check): each eye's image goes to the other filter's colour.
+    pub glasses_swapped: bool,
+    /// The first-run screens were completed (they are not shown again).
+    pub introduced: bool,
 }
 
 /// First line of a calibration file.
@@ -154,6 +159,12 @@ impl Calibration {
         }
         if let Some(v) = self.flat_up_device {
             s += &format!("flat_up_device {} {} {}\n", v.x, v.y, v.z);
+        }
+        if self.glasses_swapped {
+            s += "glasses_swapped 1\n";
+        }
+        if self.introduced {
+            s += "introduced 1\n";
         }
         s
     }
@@ -217,6 +228,14 @@ impl Calibration {
                 "flat_up_device" => {
                     want(3)?;
                     c.flat_up_device = Some(Vec3::new(values[0], values[1], values[2]));
+                }
+                "glasses_swapped" => {
+                    want(1)?;
+                    c.glasses_swapped = values[0] != 0.0;
+                }
+                "introduced" => {
+                    want(1)?;
+                    c.introduced = values[0] != 0.0;
                 }
                 // Keys from newer versions are skipped, so a downgrade keeps what it understands.
                 _ => {}
@@ -342,6 +361,8 @@ mod tests {
             viewing_distance_m: Some(0.33),
             density_dpi: Some(Vec2::new(401.5, 402.0)),
             flat_up_device: Some(Vec3::new(0.0, 0.57, 0.82)),
+            glasses_swapped: true,
+            introduced: true,
         };
         c.save(&path).unwrap();
         assert_eq!(Calibration::load(&path), (c, None));

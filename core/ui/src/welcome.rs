@@ -1,0 +1,326 @@
+//! The first-run screens: what a phantogram is and how to hold the phone (with a picture drawn
+//! here), the glasses check that finds which filter is on which eye, and "Start", which makes the
+//! pose the phone is held in now count as straight on.
+//!
+//! The glasses check shows two rings on black, each in one filter's colour: through a filter
+//! only the ring of its own colour shows. With the left eye closed, the right eye sees the ring of
+//! the right filter's colour — unless the glasses are on the other way round, and then the
+//! engine swaps the eyes' images. "Both" or "neither" means no glasses, or glasses of other
+//! colours than the chosen method's.
+//!
+//! **Threading**: the render thread. **Panics**: none.
+
+use egui::{Align2, Color32, FontId, Pos2, Rect, RichText, Stroke, Vec2};
+
+use crate::menu::CONTROL_HEIGHT_PT;
+
+/// Which first-run screen is showing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WelcomePage {
+    Intro,
+    Glasses,
+    /// The check's outcome, in words, until "Continue".
+    GlassesResult(GlassesFinding),
+}
+
+/// What the glasses check found.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum GlassesFinding {
+    RightWayRound,
+    Swapped,
+    /// Both rings or neither: not on, or other colours.
+    Unclear,
+}
+
+/// What the host must do after a frame of the first-run screens.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum WelcomeAction {
+    /// Take the current pose as straight on, note the first run as done, close.
+    Start,
+    /// The glasses are on the other way round (`true`) or not.
+    GlassesSwapped(bool),
+    /// Note the first run as done and open the calibration screens.
+    Calibrate,
+}
+
+/// The two filters' colours, left eye's first (sRGB), for the rings.
+pub type FilterColours = ([u8; 3], [u8; 3]);
+
+/// The first-run screens' state.
+#[derive(Clone, Debug)]
+pub struct WelcomeUi {
+    pub page: WelcomePage,
+    widget_rects: Vec<(&'static str, Rect)>,
+}
+
+impl Default for WelcomeUi {
+    fn default() -> Self {
+        Self {
+            page: WelcomePage::Intro,
+            widget_rects: Vec::new(),
+        }
+    }
+}
+
+impl WelcomeUi {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The rectangle (points) of a control drawn last frame: `start`, `glasses`, `calibrate`,
+    /// `left-ring`, `right-ring`, `unclear`, `continue`; and the rings themselves, `ring-left`
+    /// and `ring-right`.
+    pub fn widget_rect(&self, name: &str) -> Option<Rect> {
+        self.widget_rects.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
+    }
+
+    fn remember(&mut self, name: &'static str, rect: Rect) {
+        self.widget_rects.retain(|(n, _)| *n != name);
+        self.widget_rects.push((name, rect));
+    }
+
+    fn button(&mut self, ui: &mut egui::Ui, name: &'static str, label: &str) -> bool {
+        let r = ui.add_sized(
+            [ui.available_width(), CONTROL_HEIGHT_PT],
+            egui::Button::new(RichText::new(label).size(17.0)),
+        );
+        self.remember(name, r.rect);
+        r.clicked()
+    }
+
+    /// Draws the current page into the root `ui`; `filters` are the chosen method's filter
+    /// colours (`None`: mono, no glasses to check).
+    pub fn show(&mut self, ui: &mut egui::Ui, filters: Option<FilterColours>) -> Vec<WelcomeAction> {
+        let mut actions = Vec::new();
+        let black = egui::Frame::central_panel(ui.style()).fill(Color32::BLACK);
+        match self.page {
+            WelcomePage::Intro => {
+                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                    ui.heading(RichText::new("A window onto the artifact").size(24.0));
+                    ui.add_space(6.0);
+                    let (rect, _) =
+                        ui.allocate_exact_size(Vec2::new(ui.available_width(), 170.0), egui::Sense::hover());
+                    pose_picture(ui.painter(), rect);
+                    ui.add_space(6.0);
+                    let glasses = match filters {
+                        Some(_) => "Put on the coloured glasses. ",
+                        None => "",
+                    };
+                    ui.label(
+                        RichText::new(format!(
+                            "{glasses}Hold the phone about 30 cm from your eyes, tilted back like a picture \
+                             lying on a table, and look down into it: the artifact stands on the screen as if \
+                             it were really there. Tilt the phone to look around it."
+                        ))
+                        .size(16.0),
+                    );
+                    ui.label(
+                        RichText::new(
+                            "When you hold it comfortably, tap Start: that pose becomes \"straight on\". \
+                             Tap the picture once for the artifacts and settings.",
+                        )
+                        .size(16.0),
+                    );
+                    ui.add_space(8.0);
+                    if filters.is_some() && self.button(ui, "glasses", "Check my glasses") {
+                        self.page = WelcomePage::Glasses;
+                    }
+                    if self.button(ui, "start", "Start") {
+                        actions.push(WelcomeAction::Start);
+                    }
+                    if self.button(ui, "calibrate", "Calibrate for my eyes (optional)") {
+                        actions.push(WelcomeAction::Calibrate);
+                    }
+                });
+            }
+            WelcomePage::Glasses => {
+                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                    ui.heading(RichText::new("Which way are the glasses on?").size(22.0));
+                    ui.label(
+                        RichText::new("Close your LEFT eye. Which ring do you see with your right eye?").size(17.0),
+                    );
+                    let (rect, _) =
+                        ui.allocate_exact_size(Vec2::new(ui.available_width(), 180.0), egui::Sense::hover());
+                    let (left, right) = filters.unwrap_or(([255, 0, 0], [0, 255, 255]));
+                    let rgb = |c: [u8; 3]| Color32::from_rgb(c[0], c[1], c[2]);
+                    let r = (rect.height() * 0.35).min(rect.width() * 0.18);
+                    for (name, x, colour) in [("ring-left", 0.27, left), ("ring-right", 0.73, right)] {
+                        let centre = Pos2::new(rect.left() + rect.width() * x, rect.center().y);
+                        ui.painter()
+                            .circle_stroke(centre, r, Stroke::new(r * 0.28, rgb(colour)));
+                        self.remember(name, Rect::from_center_size(centre, Vec2::splat(2.0 * r)));
+                    }
+                    ui.add_space(6.0);
+                    if self.button(ui, "left-ring", "The ring on the left") {
+                        self.page = WelcomePage::GlassesResult(GlassesFinding::Swapped);
+                        actions.push(WelcomeAction::GlassesSwapped(true));
+                    }
+                    if self.button(ui, "right-ring", "The ring on the right") {
+                        self.page = WelcomePage::GlassesResult(GlassesFinding::RightWayRound);
+                        actions.push(WelcomeAction::GlassesSwapped(false));
+                    }
+                    if self.button(ui, "unclear", "Both, or neither") {
+                        self.page = WelcomePage::GlassesResult(GlassesFinding::Unclear);
+                    }
+                });
+            }
+            WelcomePage::GlassesResult(finding) => {
+                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                    let text = match finding {
+                        GlassesFinding::RightWayRound => "Your glasses are the right way round.",
+                        GlassesFinding::Swapped => {
+                            "Your glasses are on the other way round (or made that way): the picture is now \
+                             swapped to match them."
+                        }
+                        GlassesFinding::Unclear => {
+                            "Each eye should see one ring only. Check that the glasses are on, and that their \
+                             colours are the ones chosen in the menu (tap the picture once, then Settings)."
+                        }
+                    };
+                    ui.label(RichText::new(text).size(18.0));
+                    ui.add_space(8.0);
+                    if self.button(ui, "continue", "Continue") {
+                        self.page = WelcomePage::Intro;
+                    }
+                });
+            }
+        }
+        actions
+    }
+}
+
+/// The holding pose, side on: the eye, the sight line of about 30 cm, and the phone tilted back
+/// on its lower edge with the artifact standing on it.
+fn pose_picture(painter: &egui::Painter, rect: Rect) {
+    let ink = Color32::from_gray(210);
+    let accent = Color32::from_rgb(255, 190, 90);
+    let stroke = Stroke::new(2.0, ink);
+    let s = (rect.width() / 300.0).min(rect.height() / 170.0);
+    let at = |x: f32, y: f32| {
+        Pos2::new(
+            rect.left() + (rect.width() - 300.0 * s) * 0.5 + x * s,
+            rect.top() + y * s,
+        )
+    };
+    // The eye, upper left: an almond and its pupil, looking down to the right.
+    let eye = at(40.0, 40.0);
+    painter.circle_stroke(eye, 12.0 * s, stroke);
+    painter.circle_filled(eye + Vec2::new(4.0, 3.0) * s, 4.5 * s, ink);
+    // The phone: its lower edge, nearer the eye, resting on the table, its top raised 35° away
+    // from the eye, so that the glass faces up towards the eye.
+    let foot = at(120.0, 150.0);
+    let tilt = 35f32.to_radians();
+    let length = 120.0 * s;
+    let along = Vec2::new(tilt.cos(), -tilt.sin());
+    let top = foot + along * length;
+    painter.line_segment([foot, top], Stroke::new(6.0 * s, ink));
+    painter.line_segment(
+        [at(90.0, 152.0), at(290.0, 152.0)],
+        Stroke::new(1.0, Color32::from_gray(120)),
+    );
+    // The artifact standing out of the glass, towards the eye.
+    let mid = foot + along * length * 0.5;
+    let normal = Vec2::new(-tilt.sin(), -tilt.cos());
+    let base = mid + normal * 3.0 * s;
+    painter.add(egui::Shape::convex_polygon(
+        vec![base - along * 9.0 * s, base + along * 9.0 * s, base + normal * 26.0 * s],
+        accent,
+        Stroke::NONE,
+    ));
+    // The sight line with its length.
+    let target = mid + normal * 12.0 * s;
+    let dashes = 12;
+    for k in 0..dashes {
+        if k % 2 == 0 {
+            let a = eye + (target - eye) * (k as f32 / dashes as f32);
+            let b = eye + (target - eye) * ((k + 1) as f32 / dashes as f32);
+            painter.line_segment([a, b], Stroke::new(1.5, ink));
+        }
+    }
+    let label = eye + (target - eye) * 0.5 + Vec2::new(8.0, -14.0) * s;
+    painter.text(
+        label,
+        Align2::LEFT_BOTTOM,
+        "about 30 cm",
+        FontId::proportional(14.0),
+        ink,
+    );
+    painter.text(
+        foot + Vec2::new(70.0, 14.0) * s,
+        Align2::CENTER_TOP,
+        "phone tilted back, like a picture on a table",
+        FontId::proportional(12.0),
+        Color32::from_gray(170),
+    );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn frame(ctx: &egui::Context, ui_state: &mut WelcomeUi, events: Vec<egui::Event>) -> Vec<WelcomeAction> {
+        let input = egui::RawInput {
+            screen_rect: Some(Rect::from_min_size(Pos2::ZERO, Vec2::new(390.0, 844.0))),
+            events,
+            ..Default::default()
+        };
+        let mut actions = Vec::new();
+        let filters = Some(([255, 0, 0], [0, 255, 255]));
+        let mut out = ctx.run_ui(input, |ui| actions = ui_state.show(ui, filters));
+        out.textures_delta.clear();
+        actions
+    }
+
+    fn tap(ctx: &egui::Context, ui_state: &mut WelcomeUi, name: &str) -> Vec<WelcomeAction> {
+        let pos = ui_state
+            .widget_rect(name)
+            .unwrap_or_else(|| panic!("no {name}"))
+            .center();
+        let button = |pressed| egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Default::default(),
+        };
+        let mut a = frame(ctx, ui_state, vec![egui::Event::PointerMoved(pos), button(true)]);
+        a.extend(frame(ctx, ui_state, vec![button(false), egui::Event::PointerGone]));
+        a.extend(frame(ctx, ui_state, vec![]));
+        a
+    }
+
+    #[test]
+    fn the_glasses_check_reports_which_way_round_and_start_takes_the_pose() {
+        let ctx = egui::Context::default();
+        let mut w = WelcomeUi::new();
+        frame(&ctx, &mut w, vec![]);
+        tap(&ctx, &mut w, "glasses");
+        assert_eq!(w.page, WelcomePage::Glasses);
+        let (l, r) = (
+            w.widget_rect("ring-left").unwrap(),
+            w.widget_rect("ring-right").unwrap(),
+        );
+        assert!(l.center().x < r.center().x && !l.intersects(r), "two separate rings");
+        // The right eye sees the left ring: its filter is the left one's colour.
+        assert_eq!(
+            tap(&ctx, &mut w, "left-ring"),
+            vec![WelcomeAction::GlassesSwapped(true)]
+        );
+        assert_eq!(w.page, WelcomePage::GlassesResult(GlassesFinding::Swapped));
+        tap(&ctx, &mut w, "continue");
+        tap(&ctx, &mut w, "glasses");
+        assert_eq!(
+            tap(&ctx, &mut w, "right-ring"),
+            vec![WelcomeAction::GlassesSwapped(false)]
+        );
+        tap(&ctx, &mut w, "continue");
+        tap(&ctx, &mut w, "glasses");
+        assert_eq!(tap(&ctx, &mut w, "unclear"), vec![], "no glasses: nothing changes");
+        tap(&ctx, &mut w, "continue");
+        assert_eq!(w.page, WelcomePage::Intro);
+        assert_eq!(tap(&ctx, &mut w, "start"), vec![WelcomeAction::Start]);
+        assert_eq!(tap(&ctx, &mut w, "calibrate"), vec![WelcomeAction::Calibrate]);
+        for name in ["start", "glasses", "calibrate"] {
+            assert!(w.widget_rect(name).unwrap().height() >= CONTROL_HEIGHT_PT - 0.5);
+        }
+    }
+}
