@@ -8,6 +8,11 @@
 //! * stereo (Dubois) / mono frame time at 1080×2400 for the default artifact (alone, and on the
 //!   diorama floor as the app draws it) and the turtle, as the median of 11 frames each, mono
 //!   and stereo alternating;
+//! * choosing the turtle in the gallery of a running engine (a bundled Voyager folder, as a
+//!   museum ships it): from the tap to the first frame that shows it, the engine drawing
+//!   1080×2400 stereo frames with the progress banner meanwhile as the app does, and how many
+//!   frames showed progress; also the same load waited for without drawing (load, fit, upload
+//!   and one frame);
 //! * peak resident memory of the process (VmHWM).
 //!
 //! Frame times include reading the frame back to the CPU, as `phantogram render` does.
@@ -121,7 +126,62 @@ fn main() {
             stereo / mono
         );
     }
+    if let Some(data) = std::env::var_os("PHANTOGRAM_DATA") {
+        select_from_gallery(&std::path::PathBuf::from(data).join("models/heritage"));
+    }
     if let Some(mib) = peak_rss_mib() {
         println!("peak resident memory: {mib:.0} MiB");
     }
+}
+
+/// The turtle chosen in the gallery of a running engine (see the module docs).
+fn select_from_gallery(bundled: &std::path::Path) {
+    use phantogram::engine::{Engine, EngineConfig, LoadStatus};
+    let id: phantogram::library::ArtifactId = "bundled:smithsonian_nmnh_sea_turtle".parse().expect("an id");
+    let config = || EngineConfig {
+        bundled_dir: Some(bundled.to_path_buf()),
+        ..EngineConfig::default()
+    };
+    let mut engine = Engine::new(config()).expect("engine");
+    engine.resume_offscreen(W, H).expect("target");
+    engine.draw(None).expect("a frame of the amphora");
+    let start = Instant::now();
+    engine.select_artifact(id.clone());
+    let mut progress_frames = 0;
+    loop {
+        let loading = matches!(engine.loading_status(), LoadStatus::Loading { .. });
+        engine.draw(None).expect("frame");
+        if engine.model_info().artifact.as_ref().map(|a| &a.id) == Some(&id) {
+            break;
+        }
+        assert!(
+            loading || matches!(engine.loading_status(), LoadStatus::Loading { .. }),
+            "the load ended without the turtle: {:?}",
+            engine.loading_status()
+        );
+        progress_frames += 1;
+    }
+    let drawn = start.elapsed();
+    println!(
+        "sea turtle chosen in the gallery ({}, {} triangles): first frame showing it {:.0} ms after the tap, {progress_frames} frames of progress meanwhile ({W}x{H} stereo)",
+        engine.model_info().name,
+        engine.model_info().triangles,
+        drawn.as_secs_f64() * 1e3
+    );
+    // The same with nothing drawn meanwhile (as a phone's 16 ms frames nearly are).
+    let mut fresh = Engine::new(config()).expect("engine");
+    fresh.resume_offscreen(W, H).expect("target");
+    fresh.draw(None).expect("a frame of the amphora");
+    let start = Instant::now();
+    fresh.select_artifact(id);
+    assert!(
+        fresh.wait_for_artifact(std::time::Duration::from_secs(60)),
+        "{:?}",
+        fresh.loading_status()
+    );
+    fresh.draw(None).expect("frame");
+    println!(
+        "  without frames meanwhile: load, fit, upload and first frame {:.0} ms",
+        start.elapsed().as_secs_f64() * 1e3
+    );
 }

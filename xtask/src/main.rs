@@ -3,8 +3,9 @@
 //! * `assets` — regenerate what the project generates itself into `assets/` (the synthetic tilt
 //!   log). Deterministic: running it twice gives identical files.
 //! * `bench core` — run the core benchmark (ns per sensor update and per frame).
-//! * `bench render` — cold load-to-first-frame of the Draco turtle, stereo/mono frame-time ratio
-//!   at 1080×2400, peak memory (`PHANTOGRAM_DATA` for the turtle).
+//! * `bench render` — cold load-to-first-frame of the Draco turtle, the turtle chosen in a running
+//!   engine's gallery (tap to first frame), stereo/mono frame-time ratio at 1080×2400, peak
+//!   memory (`PHANTOGRAM_DATA` for the turtle).
 //! * `bench face` — ms per 640×480 camera frame in detection and tracking modes (needs the
 //!   models from `models` and `PHANTOGRAM_DATA` for a face photograph).
 //! * `bench orientation` — score the orientation estimators on the recordings in
