@@ -52,8 +52,10 @@ fn main() -> Result<()> {
         ["bench", "face"] => cargo(&["bench", "-p", "phantogram", "--bench", "face"]),
         ["models"] => models(false),
         ["models", "--force"] => models(true),
-        ["android"] => phone::android(),
-        ["ios"] => phone::ios(),
+        ["android"] => phone::android(None),
+        ["android", "--artifacts", dir] => phone::android(Some(Path::new(dir))),
+        ["ios"] => phone::ios(None),
+        ["ios", "--artifacts", dir] => phone::ios(Some(Path::new(dir))),
         ["header"] => phone::header(),
         ["fuzz", rest @ ..] => fuzz::fuzz(rest),
         ["ci"] => {

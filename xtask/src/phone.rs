@@ -79,8 +79,80 @@ fn copy_face_models(to: &Path) -> Result<()> {
     Ok(())
 }
 
-pub fn android() -> Result<()> {
+/// A museum's own scans (`--artifacts DIR`: `.glb`/`.gltf` files and Voyager folders), each
+/// loaded as the phone will load it (the phone budget) and copied to `to`, where the app bundles
+/// them; without a folder, `to` is emptied (no artifacts of an earlier build linger).
+fn copy_artifacts(from: Option<&Path>, to: &Path) -> Result<()> {
+    use phantogram::library::{Library, Origin};
+    if to.exists() {
+        std::fs::remove_dir_all(to).with_context(|| format!("removing {}", to.display()))?;
+    }
+    let Some(from) = from else { return Ok(()) };
+    if !from.is_dir() {
+        bail!("--artifacts {}: not a folder", from.display());
+    }
+    let library = Library::new(None, Some(from.to_path_buf()));
+    let entries: Vec<_> = library
+        .list()
+        .into_iter()
+        .filter(|e| e.id.origin == Origin::Bundled)
+        .collect();
+    if entries.is_empty() {
+        bail!(
+            "--artifacts {}: no .glb or .gltf file, nor a folder holding one or a Voyager scene",
+            from.display()
+        );
+    }
+    for e in &entries {
+        let loaded = library
+            .load(
+                &e.id,
+                phantogram::budget::ResourceBudget::PHONE,
+                &phantogram::progress::Progress::new(),
+            )
+            .with_context(|| format!("{} would not open on a phone", e.id))?;
+        println!(
+            "checked {} ({}): {} triangles, {} images{}",
+            e.title,
+            e.id,
+            loaded.model.triangle_count(),
+            loaded.model.images.len(),
+            if loaded.model.annotations.is_empty() {
+                String::new()
+            } else {
+                format!(", {} annotations", loaded.model.annotations.len())
+            }
+        );
+        copy_tree(&from.join(&e.id.key), &to.join(&e.id.key))?;
+    }
+    println!("{} artifacts copied into {}", entries.len(), to.display());
+    Ok(())
+}
+
+/// Copies a file, or a folder with everything in it but hidden files.
+fn copy_tree(from: &Path, to: &Path) -> Result<()> {
+    if from.is_dir() {
+        std::fs::create_dir_all(to).with_context(|| format!("creating {}", to.display()))?;
+        for entry in std::fs::read_dir(from).with_context(|| format!("reading {}", from.display()))? {
+            let entry = entry?;
+            if entry.file_name().to_string_lossy().starts_with('.') {
+                continue;
+            }
+            copy_tree(&entry.path(), &to.join(entry.file_name()))?;
+        }
+    } else {
+        if let Some(parent) = to.parent() {
+            std::fs::create_dir_all(parent).with_context(|| format!("creating {}", parent.display()))?;
+        }
+        std::fs::copy(from, to).with_context(|| format!("copying {}", from.display()))?;
+    }
+    Ok(())
+}
+
+pub fn android(artifacts: Option<&Path>) -> Result<()> {
     let root = workspace_root();
+    // First, so that a curator learns whether the scans will open before any SDK is needed.
+    copy_artifacts(artifacts, &root.join("android/app/src/main/assets/artifacts"))?;
     let sdk = env_dir(&["ANDROID_HOME", "ANDROID_SDK_ROOT"]);
     let ndk = android_ndk(sdk.as_deref());
     let targets = installed_targets();
@@ -163,7 +235,8 @@ pub fn android() -> Result<()> {
     Ok(())
 }
 
-pub fn ios() -> Result<()> {
+pub fn ios(artifacts: Option<&Path>) -> Result<()> {
+    copy_artifacts(artifacts, &workspace_root().join("ios/build/artifacts"))?;
     if !cfg!(target_os = "macos") {
         return ios_device_library_elsewhere();
     }

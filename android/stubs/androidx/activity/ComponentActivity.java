@@ -7,6 +7,7 @@ package androidx.activity; public class ComponentActivity extends android.conten
   public <T> T getSystemService(Class<T> c) { return null; } public android.content.res.AssetManager getAssets() { return null; }
   public java.io.File getFilesDir() { return null; } public android.content.ContentResolver getContentResolver() { return null; }
   public android.content.SharedPreferences getSharedPreferences(String name, int mode) { return null; } public android.content.Intent getIntent() { return null; }
+  public android.content.pm.PackageManager getPackageManager() { return null; } public String getPackageName() { return null; }
   protected void onNewIntent(android.content.Intent intent) {} public final void runOnUiThread(Runnable r) {}
   public final String getString(int resId, Object... formatArgs) { return null; } public int checkSelfPermission(String p) { return 0; } public android.content.res.Resources getResources() { return null; }
   public final <I, O> androidx.activity.result.ActivityResultLauncher<I> registerForActivityResult(androidx.activity.result.contract.ActivityResultContract<I, O> c, androidx.activity.result.ActivityResultCallback<O> cb) { return null; } }

@@ -3,6 +3,7 @@ package org.phantogram
 import android.Manifest
 import android.content.Context
 import android.content.Intent
+import android.content.SharedPreferences
 import android.content.pm.PackageManager
 import android.content.res.Configuration
 import android.hardware.SensorManager
@@ -60,8 +61,9 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         view.holder.addCallback(this)
         setContentView(view)
         val prefs = getSharedPreferences(PREFS, Context.MODE_PRIVATE)
+        refreshBundledAssets(prefs)
         render.create(extractFaceModels(), panel(), "dubois", File(filesDir, "calibration.txt").path,
-            File(filesDir, "artifacts").path, prefs.getString(PREF_ARTIFACT, null))
+            File(filesDir, "artifacts").path, File(filesDir, BUNDLED).path, prefs.getString(PREF_ARTIFACT, null))
         intent?.let { openedWith(it) }
         sensors = SensorForwarder(getSystemService(SensorManager::class.java)) { render.engine }
         if (checkSelfPermission(Manifest.permission.CAMERA) == PackageManager.PERMISSION_GRANTED) {
@@ -218,6 +220,35 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
     }
 
     /** Copies the face models from the APK's assets to app storage once; null without them. */
+    /** The APK's face models and bundled artifacts are copied out once per install or update
+     *  (an update may bring new ones: the copies of the last are removed first). */
+    private fun refreshBundledAssets(prefs: SharedPreferences) {
+        val stamp = packageManager.getPackageInfo(packageName, 0).lastUpdateTime
+        if (prefs.getLong(PREF_ASSETS_STAMP, -1L) == stamp) return
+        File(filesDir, "models").deleteRecursively()
+        File(filesDir, BUNDLED).deleteRecursively()
+        copyAssets(BUNDLED, File(filesDir, BUNDLED))
+        prefs.edit().putLong(PREF_ASSETS_STAMP, stamp).apply()
+    }
+
+    /** Copies an asset file, or an asset folder with everything in it (the museum's scans). */
+    private fun copyAssets(from: String, to: File) {
+        val names = assets.list(from) ?: return
+        if (names.isEmpty()) {
+            to.parentFile?.mkdirs()
+            val partial = File(to.path + ".part")
+            try {
+                assets.open(from).use { input -> partial.outputStream().use { input.copyTo(it) } }
+                partial.renameTo(to)
+            } catch (e: java.io.IOException) {
+                Log.w(TAG, "cannot copy $from", e)
+            }
+            return
+        }
+        to.mkdirs()
+        for (name in names) copyAssets("$from/$name", File(to, name))
+    }
+
     private fun extractFaceModels(): String? {
         val names = assets.list("models")?.filter { it.endsWith(".onnx") } ?: return null
         if (names.size < 3) return null
@@ -236,6 +267,9 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         const val TAG = "Phantogram"
         const val PREFS = "phantogram"
         const val PREF_ARTIFACT = "artifact"
+        const val PREF_ASSETS_STAMP = "assets_stamp"
+        /** The APK's assets folder of bundled artifacts, and its copy in the app's files. */
+        const val BUNDLED = "artifacts"
         /** What the document picker offers: glTF binary and JSON, zip (Voyager downloads), and
          *  octet-stream, as which many providers report a .glb. */
         val MODEL_TYPES = arrayOf("model/gltf-binary", "model/gltf+json", "application/zip", "application/octet-stream")

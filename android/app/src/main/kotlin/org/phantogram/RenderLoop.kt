@@ -34,11 +34,11 @@ class RenderLoop(
 
     fun create(
         facesDir: String?, panel: Panel, anaglyph: String, calibrationPath: String,
-        libraryDir: String, artifact: String?
+        libraryDir: String, bundledDir: String, artifact: String?
     ) = post {
         refreshPeriodNs = periodNs(panel)
         engine = NativeBridge.nativeCreate(null, facesDir, panel.widthPx, panel.heightPx,
-            panel.xdpi, panel.ydpi, panel.rotation, anaglyph, calibrationPath, libraryDir, null, artifact)
+            panel.xdpi, panel.ydpi, panel.rotation, anaglyph, calibrationPath, libraryDir, bundledDir, artifact)
         NativeBridge.nativeCalibrationWarning(engine)?.let { Log.w("Phantogram", it) }
     }
 
