@@ -281,6 +281,7 @@ enum Page {
     /// The card of the annotation with this index in [`ModelInfo::annotations`].
     Annotation(usize),
     Welcome(crate::calibration_ui::welcome::WelcomeUi),
+    Settings(crate::calibration_ui::settings::SettingsUi),
 }
 
 /// The screens' state on the render thread: the page open (if any), egui's context, the touches
@@ -365,6 +366,18 @@ impl Engine {
             ..SessionConfig::default()
         };
         let session = Session::new(session_config)?;
+        let (calibration, calibration_warning) = match &config.calibration_path {
+            Some(path) => Calibration::load(path),
+            None => (Calibration::default(), None),
+        };
+        // What the viewer chose in the settings screen wins over the shell's defaults.
+        let method = calibration.method.unwrap_or(config.method);
+        let floor = calibration.floor.unwrap_or(config.floor);
+        let fit = crate::model::DioramaFit {
+            protrude_fraction: calibration.protrude_fraction.unwrap_or(config.fit.protrude_fraction),
+            true_size: config.fit.true_size || calibration.true_size,
+            ..config.fit
+        };
         // The GPU first: the model's budget takes the device's texture limit.
         let gpu = gpu()?;
         let budget = crate::budget::ResourceBudget {
@@ -375,11 +388,7 @@ impl Engine {
         };
         let library = crate::library::Library::new(config.library_dir.clone(), config.bundled_dir.clone());
         let mut loader = crate::artifacts::Loader::new(library, budget);
-        let placing = crate::artifacts::Placing {
-            screen,
-            fit: config.fit,
-            floor: config.floor,
-        };
+        let placing = crate::artifacts::Placing { screen, fit, floor };
         let prepared = match (&config.model_path, &config.artifact) {
             (Some(path), _) => {
                 let model = crate::model::load_model_within(path, budget)?;
@@ -427,24 +436,20 @@ impl Engine {
         if config.face_models_dir.is_some() {
             return Err(EngineError::NoFaceSupport);
         }
-        let (calibration, calibration_warning) = match &config.calibration_path {
-            Some(path) => Calibration::load(path),
-            None => (Calibration::default(), None),
-        };
         let mut engine = Self {
             session,
             renderer,
             model_info,
             bounds,
             loader,
-            fit: config.fit,
-            floor: config.floor,
+            fit,
+            floor,
             smoother: ContainmentSmoother::default(),
-            method: config.method,
-            stereo_method: if config.method == Method::Mono {
+            method,
+            stereo_method: if method == Method::Mono {
                 Method::default()
             } else {
-                config.method
+                method
             },
             target: Target::Detached,
             last_display_t_ns: None,
@@ -1135,6 +1140,7 @@ impl Engine {
         };
         let (mut calibration_actions, mut menu_actions) = (Vec::new(), Vec::new());
         let mut welcome_actions = Vec::new();
+        let mut settings_actions = Vec::new();
         let filters = filter_colours(self.method);
         let mut card_closed = false;
         let annotations = &self.model_info.annotations;
@@ -1147,6 +1153,7 @@ impl Engine {
                 Some(Page::Calibration(ui)) => calibration_actions = ui.show(root, &screen, ppp),
                 Some(Page::Menu(menu)) => menu_actions = menu.show(root, items, current.as_deref()),
                 Some(Page::Welcome(welcome)) => welcome_actions = welcome.show(root, filters),
+                Some(Page::Settings(settings)) => settings_actions = settings.show(root),
                 Some(Page::Annotation(i)) => match annotations.get(*i) {
                     Some(a) => {
                         card_closed = crate::calibration_ui::menu::show_annotation(root.ctx(), &a.title, &a.lead).0
@@ -1191,6 +1198,9 @@ impl Engine {
         for action in welcome_actions {
             self.apply_welcome_action(action);
         }
+        for action in settings_actions {
+            self.apply_settings_action(action);
+        }
         match banner_action {
             Some(BannerAction::Cancel) => self.cancel_loading(),
             Some(BannerAction::Dismiss) => self.dismiss_message(),
@@ -1202,6 +1212,45 @@ impl Engine {
     #[cfg(feature = "ui")]
     fn set_page(&mut self, page: Option<Page>) {
         self.screens().page = page;
+    }
+
+    /// Applies and saves what the settings screen changed; a new floor, protrusion or size shows
+    /// the artifact on screen again with it (loaded anew from the library in the background).
+    #[cfg(feature = "ui")]
+    fn apply_settings_action(&mut self, action: crate::calibration_ui::settings::SettingsAction) {
+        use crate::calibration_ui::settings::SettingsAction as A;
+        match action {
+            A::Changed(s) => {
+                self.set_method(s.method);
+                let placing_changed = s.floor != self.floor
+                    || s.protrude_fraction != self.fit.protrude_fraction
+                    || s.true_size != self.fit.true_size;
+                self.floor = s.floor;
+                self.fit.protrude_fraction = s.protrude_fraction;
+                self.fit.true_size = s.true_size;
+                self.calibration.method = Some(s.method);
+                self.calibration.floor = Some(s.floor);
+                self.calibration.protrude_fraction = Some(s.protrude_fraction);
+                self.calibration.true_size = s.true_size;
+                self.save_calibration();
+                if placing_changed && let Some(id) = self.model_info.artifact.as_ref().map(|a| a.id.clone()) {
+                    self.select_artifact(id);
+                }
+            }
+            A::Close => self.set_page(None),
+        }
+    }
+
+    /// As [`Self::calibration_control_px`] for the settings screen (names as
+    /// [`crate::calibration_ui::settings::SettingsUi::widget_rect`]).
+    #[cfg(feature = "ui")]
+    pub fn settings_control_px(&self, name: &str) -> Option<[f32; 2]> {
+        let Some(Page::Settings(s)) = self.screens.as_ref()?.page.as_ref() else {
+            return None;
+        };
+        let centre = s.widget_rect(name)?.center();
+        let ppp = self.pixels_per_point();
+        Some([centre.x * ppp, centre.y * ppp])
     }
 
     #[cfg(feature = "ui")]
@@ -1270,6 +1319,17 @@ impl Engine {
             A::Calibrate => {
                 self.set_page(None);
                 self.open_calibration();
+            }
+            A::Settings => {
+                let settings = crate::calibration_ui::settings::Settings {
+                    method: self.method,
+                    floor: self.floor,
+                    protrude_fraction: self.fit.protrude_fraction,
+                    true_size: self.fit.true_size,
+                };
+                self.set_page(Some(Page::Settings(crate::calibration_ui::settings::SettingsUi::new(
+                    settings,
+                ))));
             }
             A::Close => self.set_page(None),
         }

@@ -136,6 +136,13 @@ pub struct Calibration {
     pub glasses_swapped: bool,
     /// The first-run screens were completed (they are not shown again).
     pub introduced: bool,
+    /// Settings chosen in the menu (`None`: the app's default): the glasses' colours (the
+    /// anaglyph method; mono for none), the diorama floor, the fraction of a loaded model in
+    /// front of the glass, and whether loaded models keep their true size.
+    pub method: Option<phantogram_geometry::anaglyph::Method>,
+    pub floor: Option<bool>,
+    pub protrude_fraction: Option<f32>,
+    pub true_size: bool,
 }
 
 /// First line of a calibration file.
@@ -166,6 +173,18 @@ impl Calibration {
         if self.introduced {
             s += "introduced 1\n";
         }
+        if let Some(m) = self.method {
+            s += &format!("anaglyph {m}\n");
+        }
+        if let Some(f) = self.floor {
+            s += &format!("floor {}\n", u8::from(f));
+        }
+        if let Some(p) = self.protrude_fraction {
+            s += &format!("protrude_fraction {p}\n");
+        }
+        if self.true_size {
+            s += "true_size 1\n";
+        }
         s
     }
 
@@ -191,6 +210,12 @@ impl Calibration {
             }
             let mut words = line.split_whitespace();
             let key = words.next().unwrap_or_default();
+            // The one setting that is a word, not numbers.
+            if key == "anaglyph" {
+                let name = words.next().unwrap_or_default();
+                c.method = Some(name.parse().map_err(|e| format!("line {line_no}: {e}"))?);
+                continue;
+            }
             let values: Vec<f32> = words
                 .map(|w| w.parse::<f32>().ok().filter(|v| v.is_finite()))
                 .collect::<Option<_>>()
@@ -236,6 +261,21 @@ impl Calibration {
                 "introduced" => {
                     want(1)?;
                     c.introduced = values[0] != 0.0;
+                }
+                "floor" => {
+                    want(1)?;
+                    c.floor = Some(values[0] != 0.0);
+                }
+                "protrude_fraction" => {
+                    want(1)?;
+                    if !(0.0..=1.0).contains(&values[0]) {
+                        return Err(format!("line {line_no}: protrude_fraction must be between 0 and 1"));
+                    }
+                    c.protrude_fraction = Some(values[0]);
+                }
+                "true_size" => {
+                    want(1)?;
+                    c.true_size = values[0] != 0.0;
                 }
                 // Keys from newer versions are skipped, so a downgrade keeps what it understands.
                 _ => {}
@@ -363,6 +403,10 @@ mod tests {
             flat_up_device: Some(Vec3::new(0.0, 0.57, 0.82)),
             glasses_swapped: true,
             introduced: true,
+            method: Some(phantogram_geometry::anaglyph::Method::DuboisAmberBlue),
+            floor: Some(false),
+            protrude_fraction: Some(0.25),
+            true_size: true,
         };
         c.save(&path).unwrap();
         assert_eq!(Calibration::load(&path), (c, None));

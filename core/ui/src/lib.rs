@@ -1,5 +1,6 @@
-//! The screens the core draws with egui: the menu and status banner ([`menu`]), the first-run
-//! screens ([`welcome`]) and the calibration screens (this module).
+//! The screens the core draws with egui: the menu and status banner ([`menu`]), the settings
+//! ([`settings`]), the first-run screens ([`welcome`]) and the calibration screens (this
+//! module).
 //!
 //! The calibration screens, drawn by the core with egui so that the phones and the desktop viewer
 //! show the same thing: the eye-reflection slider (IPD and head offset), the blind-spot distance
@@ -18,6 +19,7 @@
 //! **Threading**: lives on the render thread with the egui context. **Panics**: none.
 
 pub mod menu;
+pub mod settings;
 pub mod welcome;
 
 use egui::{Align2, Color32, Pos2, Rect, Stroke, Vec2 as EVec2};

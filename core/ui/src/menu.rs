@@ -37,6 +37,8 @@ pub enum MenuAction {
     OpenFile,
     /// Open the calibration screens instead.
     Calibrate,
+    /// Open the settings screen instead.
+    Settings,
     Close,
 }
 
@@ -53,7 +55,7 @@ impl MenuUi {
     }
 
     /// The rectangle (points) of a control drawn last frame: `item:<id>`, `remove:<id>`,
-    /// `open`, `calibrate`, `close`.
+    /// `open`, `settings`, `calibrate`, `close`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.iter().find(|(n, _)| n == name).map(|(_, r)| *r)
     }
@@ -70,6 +72,7 @@ impl MenuUi {
             ui.add_space(6.0);
             let buttons = [
                 ("open", "Open a file of your own…"),
+                ("settings", "Settings (glasses, size, floor)"),
                 ("calibrate", "Calibration"),
                 ("close", "Done"),
             ];
@@ -83,6 +86,7 @@ impl MenuUi {
                     actions.push(match name {
                         "open" => MenuAction::OpenFile,
                         "calibrate" => MenuAction::Calibrate,
+                        "settings" => MenuAction::Settings,
                         _ => MenuAction::Close,
                     });
                 }
@@ -333,6 +337,7 @@ mod tests {
         );
         assert_eq!(tap(&ctx, &mut menu, "open"), vec![MenuAction::OpenFile]);
         assert_eq!(tap(&ctx, &mut menu, "calibrate"), vec![MenuAction::Calibrate]);
+        assert_eq!(tap(&ctx, &mut menu, "settings"), vec![MenuAction::Settings]);
         assert_eq!(tap(&ctx, &mut menu, "close"), vec![MenuAction::Close]);
     }
 

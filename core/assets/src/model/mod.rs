@@ -366,6 +366,9 @@ pub struct DioramaFit {
     pub max_width_fraction: f32,
     /// Fraction of the model's height that stands in front of the glass.
     pub protrude_fraction: f32,
+    /// Keep the file's size (glTF metres) instead of scaling it into the diorama; it is still
+    /// turned and placed straddling the glass.
+    pub true_size: bool,
 }
 
 impl Default for DioramaFit {
@@ -377,6 +380,7 @@ impl Default for DioramaFit {
             max_height_m: 0.062,
             max_width_fraction: 0.7,
             protrude_fraction: 0.4,
+            true_size: false,
         }
     }
 }
@@ -518,7 +522,11 @@ impl Model {
             .into_iter()
             .filter(|s| s.is_finite() && *s > 0.0)
             .fold(f32::INFINITY, f32::min);
-        let scale = if scale.is_finite() { scale } else { 1.0 };
+        let scale = if scale.is_finite() && !fit.true_size {
+            scale
+        } else {
+            1.0
+        };
         let centre = (b.min + b.max) * 0.5;
         let base_z = -size.z * scale * (1.0 - fit.protrude_fraction);
         let m = Mat4::from_translation(Vec3::new(0.0, 0.0, base_z))

@@ -1,0 +1,216 @@
+//! The settings screen, opened from the menu: which glasses (red/cyan, green/magenta,
+//! amber/blue, or none for a plain picture), the diorama's floor, how much of a loaded model
+//! stands in front of the glass, and whether loaded models keep their true size.
+//!
+//! The host gives the current settings when it opens the screen and applies (and saves) each
+//! [`SettingsAction::Changed`]. **Threading**: the render thread. **Panics**: none.
+
+use egui::{Rect, RichText};
+use phantogram_geometry::anaglyph::Method;
+
+use crate::menu::CONTROL_HEIGHT_PT;
+
+/// What the screen sets.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Settings {
+    pub method: Method,
+    pub floor: bool,
+    /// Fraction of a loaded model's height in front of the glass, 0 to 1.
+    pub protrude_fraction: f32,
+    pub true_size: bool,
+}
+
+/// What the host must do after a frame of the settings screen.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum SettingsAction {
+    Changed(Settings),
+    Close,
+}
+
+/// The glasses the screen offers, with the method each means.
+pub const GLASSES: [(&str, &str, Method); 4] = [
+    ("red-cyan", "Red / cyan", Method::DuboisRedCyan),
+    ("green-magenta", "Green / magenta", Method::DuboisGreenMagenta),
+    ("amber-blue", "Amber / blue", Method::DuboisAmberBlue),
+    ("none", "No glasses (flat picture)", Method::Mono),
+];
+
+/// The settings screen's state.
+#[derive(Clone, Debug)]
+pub struct SettingsUi {
+    pub settings: Settings,
+    widget_rects: Vec<(&'static str, Rect)>,
+}
+
+impl SettingsUi {
+    pub fn new(settings: Settings) -> Self {
+        Self {
+            settings,
+            widget_rects: Vec::new(),
+        }
+    }
+
+    /// The rectangle (points) of a control drawn last frame: the glasses by key (`red-cyan`,
+    /// `green-magenta`, `amber-blue`, `none`), `floor`, `protrude`, `true-size`, `done`.
+    pub fn widget_rect(&self, name: &str) -> Option<Rect> {
+        self.widget_rects.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
+    }
+
+    fn remember(&mut self, name: &'static str, rect: Rect) {
+        self.widget_rects.retain(|(n, _)| *n != name);
+        self.widget_rects.push((name, rect));
+    }
+
+    pub fn show(&mut self, ui: &mut egui::Ui) -> Vec<SettingsAction> {
+        let before = self.settings;
+        let mut actions = Vec::new();
+        egui::CentralPanel::default().show(ui, |ui| {
+            // One width for every control (a slider's own layout may widen the rest).
+            let full = ui.available_width();
+            ui.heading(RichText::new("Settings").size(24.0));
+            ui.add_space(6.0);
+            ui.label(RichText::new("Glasses").size(18.0));
+            for (key, label, method) in GLASSES {
+                let chosen = self.settings.method == method
+                    || (key == "red-cyan" && !GLASSES.iter().any(|g| g.2 == self.settings.method));
+                let r = ui.add_sized(
+                    [full, CONTROL_HEIGHT_PT],
+                    egui::Button::new(RichText::new(label).size(17.0)).selected(chosen),
+                );
+                self.remember(key, r.rect);
+                if r.clicked() {
+                    self.settings.method = method;
+                }
+            }
+            ui.add_space(10.0);
+            let r = ui.add_sized(
+                [full, CONTROL_HEIGHT_PT],
+                egui::Button::new(
+                    RichText::new(if self.settings.floor {
+                        "Floor under the artifact: on"
+                    } else {
+                        "Floor under the artifact: off"
+                    })
+                    .size(17.0),
+                )
+                .selected(self.settings.floor),
+            );
+            self.remember("floor", r.rect);
+            if r.clicked() {
+                self.settings.floor = !self.settings.floor;
+            }
+            ui.add_space(6.0);
+            ui.label(RichText::new("Your own files: how much stands in front of the glass (%)").size(16.0));
+            // Room for the value box beside the slider.
+            ui.spacing_mut().slider_width = (full - 80.0).max(100.0);
+            ui.spacing_mut().interact_size.y = CONTROL_HEIGHT_PT;
+            let mut percent = self.settings.protrude_fraction * 100.0;
+            let r = ui.add(egui::Slider::new(&mut percent, 0.0..=100.0).step_by(5.0));
+            self.remember("protrude", r.rect);
+            self.settings.protrude_fraction = (percent / 100.0).clamp(0.0, 1.0);
+            let r = ui.add_sized(
+                [full, CONTROL_HEIGHT_PT],
+                egui::Button::new(
+                    RichText::new(if self.settings.true_size {
+                        "Size: as in the file (true size)"
+                    } else {
+                        "Size: fitted to the screen"
+                    })
+                    .size(17.0),
+                )
+                .selected(self.settings.true_size),
+            );
+            self.remember("true-size", r.rect);
+            if r.clicked() {
+                self.settings.true_size = !self.settings.true_size;
+            }
+            ui.add_space(10.0);
+            let r = ui.add_sized(
+                [full, CONTROL_HEIGHT_PT],
+                egui::Button::new(RichText::new("Done").size(17.0)),
+            );
+            self.remember("done", r.rect);
+            if r.clicked() {
+                actions.push(SettingsAction::Close);
+            }
+        });
+        if self.settings != before {
+            actions.insert(0, SettingsAction::Changed(self.settings));
+        }
+        actions
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use egui::{Pos2, Vec2};
+
+    fn frame(ctx: &egui::Context, s: &mut SettingsUi, events: Vec<egui::Event>) -> Vec<SettingsAction> {
+        let input = egui::RawInput {
+            screen_rect: Some(Rect::from_min_size(Pos2::ZERO, Vec2::new(390.0, 844.0))),
+            events,
+            ..Default::default()
+        };
+        let mut actions = Vec::new();
+        let mut out = ctx.run_ui(input, |ui| actions = s.show(ui));
+        out.textures_delta.clear();
+        actions
+    }
+
+    fn tap(ctx: &egui::Context, s: &mut SettingsUi, name: &str) -> Vec<SettingsAction> {
+        let pos = s.widget_rect(name).unwrap_or_else(|| panic!("no {name}")).center();
+        let button = |pressed| egui::Event::PointerButton {
+            pos,
+            button: egui::PointerButton::Primary,
+            pressed,
+            modifiers: Default::default(),
+        };
+        let mut a = frame(ctx, s, vec![egui::Event::PointerMoved(pos), button(true)]);
+        a.extend(frame(ctx, s, vec![button(false), egui::Event::PointerGone]));
+        a.extend(frame(ctx, s, vec![]));
+        a
+    }
+
+    #[test]
+    fn taps_choose_the_glasses_floor_and_size_and_each_change_is_reported() {
+        let ctx = egui::Context::default();
+        let start = Settings {
+            method: Method::DuboisRedCyan,
+            floor: true,
+            protrude_fraction: 0.4,
+            true_size: false,
+        };
+        let mut s = SettingsUi::new(start);
+        frame(&ctx, &mut s, vec![]);
+        frame(&ctx, &mut s, vec![]);
+        for name in ["red-cyan", "none", "floor", "true-size", "done"] {
+            assert!(
+                s.widget_rect(name).unwrap().height() >= CONTROL_HEIGHT_PT - 0.5,
+                "{name}"
+            );
+        }
+        let changed = |m: Method, floor: bool, true_size: bool| {
+            SettingsAction::Changed(Settings {
+                method: m,
+                floor,
+                protrude_fraction: 0.4,
+                true_size,
+            })
+        };
+        assert_eq!(
+            tap(&ctx, &mut s, "amber-blue"),
+            vec![changed(Method::DuboisAmberBlue, true, false)]
+        );
+        assert_eq!(
+            tap(&ctx, &mut s, "floor"),
+            vec![changed(Method::DuboisAmberBlue, false, false)]
+        );
+        assert_eq!(
+            tap(&ctx, &mut s, "true-size"),
+            vec![changed(Method::DuboisAmberBlue, false, true)]
+        );
+        assert_eq!(tap(&ctx, &mut s, "none"), vec![changed(Method::Mono, false, true)]);
+        assert_eq!(tap(&ctx, &mut s, "done"), vec![SettingsAction::Close]);
+    }
+}
