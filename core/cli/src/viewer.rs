@@ -202,11 +202,49 @@ impl App {
                 "a" => {
                     self.engine.open_menu();
                 }
+                // Share, as the phones' share sheet: the view as an anaglyph and as a stereo pair.
+                "s" => self.save_snapshots(),
                 _ => {}
             },
             _ => {}
         }
         self.report_calibration_warning();
+    }
+
+    /// Writes the current view as `phantogram-anaglyph-N.png` and `phantogram-pair-N.png` (left
+    /// eye on the left) in the working folder, never over an existing file.
+    fn save_snapshots(&mut self) {
+        let n = (1..10_000)
+            .find(|n| {
+                !std::path::Path::new(&format!("phantogram-anaglyph-{n}.png")).exists()
+                    && !std::path::Path::new(&format!("phantogram-pair-{n}.png")).exists()
+            })
+            .unwrap_or(0);
+        for (kind, name) in [
+            (
+                phantogram::engine::Snapshot::Composed,
+                format!("phantogram-anaglyph-{n}.png"),
+            ),
+            (
+                phantogram::engine::Snapshot::SideBySide,
+                format!("phantogram-pair-{n}.png"),
+            ),
+        ] {
+            let written = self
+                .engine
+                .snapshot_png(kind)
+                .map_err(|e| e.to_string())
+                .and_then(|png| {
+                    let mut file = phantogram::files::AtomicFile::create(std::path::Path::new(&name))
+                        .map_err(|e| e.to_string())?;
+                    std::io::Write::write_all(file.file(), &png).map_err(|e| e.to_string())?;
+                    file.commit().map_err(|e| e.to_string())
+                });
+            match written {
+                Ok(()) => eprintln!("saved {name}"),
+                Err(e) => eprintln!("{name}: {e}"),
+            }
+        }
     }
 
     /// Says once why the calibration could not be saved or applied, when that changes.
@@ -340,7 +378,7 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         EventLoop::new().context("no display to open a window on (set DISPLAY, or use `phantogram render`)")?;
     event_loop.set_control_flow(ControlFlow::Poll);
     eprintln!(
-        "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, c calibration screens, a artifacts menu (or click once), Esc quit"
+        "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, c calibration screens, a artifacts menu (or click once), s save the view (anaglyph and stereo pair), Esc quit"
     );
     let ViewerArgs {
         mut engine,

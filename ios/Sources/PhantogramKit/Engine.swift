@@ -92,9 +92,9 @@ public final class Engine {
     /// Hands a document the user opened to the core (copied there; loaded in the background, the
     /// core's banner shows progress or why it failed).
     public func importArtifact(name: String, data: Data) throws {
-        try data.withUnsafeBytes { (raw: UnsafeRawBufferPointer) in
+        _ = try data.withUnsafeBytes { (raw: UnsafeRawBufferPointer) in
             let bytes = raw.bindMemory(to: UInt8.self)
-            try check(pg_import_artifact(handle, name, bytes.baseAddress, bytes.count))
+            return try check(pg_import_artifact(handle, name, bytes.baseAddress, bytes.count))
         }
     }
 
