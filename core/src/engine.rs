@@ -280,6 +280,8 @@ enum Page {
     Calibration(crate::calibration_ui::CalibrationUi),
     /// The card of the annotation with this index in [`ModelInfo::annotations`].
     Annotation(usize),
+    /// What the gestures do.
+    Help,
     Welcome(crate::calibration_ui::welcome::WelcomeUi),
     Settings(crate::calibration_ui::settings::SettingsUi),
 }
@@ -641,6 +643,28 @@ impl Engine {
             std::mem::swap(&mut input.left, &mut input.right);
         }
         input
+    }
+
+    /// How the eyes are found, in words for the menu: the front camera's state.
+    pub fn eyes_status(&self) -> String {
+        let stats = self.stats();
+        let text = if cfg!(not(feature = "face")) || !self.face_tracking_on() {
+            "Front camera off: the view follows the phone's tilt."
+        } else if stats.face_tracking_stopped {
+            "Face tracking stopped: the view follows the phone's tilt."
+        } else if stats.eyes_from_camera {
+            "The front camera is following your eyes."
+        } else {
+            "Front camera on, looking for your eyes (meanwhile the view follows the tilt)."
+        };
+        text.to_owned()
+    }
+
+    fn face_tracking_on(&self) -> bool {
+        #[cfg(feature = "face")]
+        return self.face.is_some();
+        #[cfg(not(feature = "face"))]
+        false
     }
 
     /// Whether the first-run screens are showing.
@@ -1143,6 +1167,7 @@ impl Engine {
         let mut settings_actions = Vec::new();
         let filters = filter_colours(self.method);
         let mut card_closed = false;
+        let eyes_status = self.eyes_status();
         let annotations = &self.model_info.annotations;
         let mut banner_action = None;
         let mut banner_pt = None;
@@ -1151,7 +1176,15 @@ impl Engine {
         let mut output = screens.ctx.run_ui(raw, |root| {
             match page {
                 Some(Page::Calibration(ui)) => calibration_actions = ui.show(root, &screen, ppp),
-                Some(Page::Menu(menu)) => menu_actions = menu.show(root, items, current.as_deref()),
+                Some(Page::Menu(menu)) => menu_actions = menu.show(root, items, current.as_deref(), &eyes_status),
+                Some(Page::Help) => {
+                    card_closed = crate::calibration_ui::menu::show_annotation(
+                        root.ctx(),
+                        "How to use it",
+                        crate::calibration_ui::menu::GESTURE_HELP,
+                    )
+                    .0
+                }
                 Some(Page::Welcome(welcome)) => welcome_actions = welcome.show(root, filters),
                 Some(Page::Settings(settings)) => settings_actions = settings.show(root),
                 Some(Page::Annotation(i)) => match annotations.get(*i) {
@@ -1320,6 +1353,7 @@ impl Engine {
                 self.set_page(None);
                 self.open_calibration();
             }
+            A::Help => self.set_page(Some(Page::Help)),
             A::Settings => {
                 let settings = crate::calibration_ui::settings::Settings {
                     method: self.method,

@@ -360,6 +360,27 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
         t += 16;
         e.draw(Some(t * 1_000_000)).unwrap();
     }
+    // "How to use it": the gestures' card over the picture.
+    let help = e.menu_control_px("help").expect("the menu's help button");
+    tap_at(&mut e, help, &mut t);
+    assert!(!e.menu_open(), "the help card replaced the menu");
+    let help_card = e.last_frame().unwrap().2.to_vec();
+    assert!(differing_pixels(&with_floor, &help_card) > 5000, "no help card drawn");
+    if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
+        image::save_buffer(
+            std::path::Path::new(&dir).join("help-card.png"),
+            &help_card,
+            w,
+            h,
+            image::ExtendedColorType::Rgba8,
+        )
+        .unwrap();
+    }
+    assert!(e.open_menu());
+    for _ in 0..2 {
+        t += 16;
+        e.draw(Some(t * 1_000_000)).unwrap();
+    }
     let settings = e.menu_control_px("settings").expect("the menu's settings button");
     tap_at(&mut e, settings, &mut t);
     let screen = e.last_frame().unwrap().2.to_vec();

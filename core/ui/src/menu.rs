@@ -39,6 +39,8 @@ pub enum MenuAction {
     Calibrate,
     /// Open the settings screen instead.
     Settings,
+    /// Show what the gestures do.
+    Help,
     Close,
 }
 
@@ -55,7 +57,7 @@ impl MenuUi {
     }
 
     /// The rectangle (points) of a control drawn last frame: `item:<id>`, `remove:<id>`,
-    /// `open`, `settings`, `calibrate`, `close`.
+    /// `open`, `help`, `settings`, `calibrate`, `close`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.iter().find(|(n, _)| n == name).map(|(_, r)| *r)
     }
@@ -65,13 +67,21 @@ impl MenuUi {
         self.widget_rects.push((name, rect));
     }
 
-    /// Draws the menu into the root `ui` of one egui frame; `current` is the id on screen.
-    pub fn show(&mut self, ui: &mut egui::Ui, items: &[MenuItem], current: Option<&str>) -> Vec<MenuAction> {
+    /// Draws the menu into the root `ui` of one egui frame; `current` is the id on screen and
+    /// `status` a line on how the eyes are found (the front camera's state).
+    pub fn show(
+        &mut self,
+        ui: &mut egui::Ui,
+        items: &[MenuItem],
+        current: Option<&str>,
+        status: &str,
+    ) -> Vec<MenuAction> {
         let mut actions = Vec::new();
         egui::Panel::bottom("menu buttons").show(ui, |ui| {
             ui.add_space(6.0);
             let buttons = [
                 ("open", "Open a file of your own…"),
+                ("help", "How to use it"),
                 ("settings", "Settings (glasses, size, floor)"),
                 ("calibrate", "Calibration"),
                 ("close", "Done"),
@@ -87,6 +97,7 @@ impl MenuUi {
                         "open" => MenuAction::OpenFile,
                         "calibrate" => MenuAction::Calibrate,
                         "settings" => MenuAction::Settings,
+                        "help" => MenuAction::Help,
                         _ => MenuAction::Close,
                     });
                 }
@@ -95,6 +106,7 @@ impl MenuUi {
         });
         egui::CentralPanel::default().show(ui, |ui| {
             ui.heading(RichText::new("Artifacts").size(24.0));
+            ui.label(RichText::new(status).color(Color32::from_rgb(150, 200, 255)));
             ui.label("Tap one to look at it. Files you open are kept here.");
             ui.add_space(8.0);
             egui::ScrollArea::vertical().show(ui, |ui| {
@@ -192,6 +204,14 @@ pub fn show_annotation(ctx: &egui::Context, title: &str, lead: &str) -> (bool, R
     (closed, area.response.rect)
 }
 
+/// What the gestures do, for the help card.
+pub const GESTURE_HELP: &str = "Tilt the phone to look around the artifact.\n\
+    Tap once: this menu (on an amber dot: what it marks).\n\
+    Tap twice: the way you hold the phone now counts as straight on.\n\
+    Hold one finger still: the light stays where it is in the room.\n\
+    Tap with two fingers: coloured glasses on or off (a flat picture).\n\
+    Tap with three fingers: calibration.";
+
 /// What the banner shows.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Banner {
@@ -284,7 +304,9 @@ mod tests {
             ..Default::default()
         };
         let mut actions = Vec::new();
-        let mut out = ctx.run_ui(input, |ui| actions = menu.show(ui, &items(), Some("builtin:amphora")));
+        let mut out = ctx.run_ui(input, |ui| {
+            actions = menu.show(ui, &items(), Some("builtin:amphora"), "Camera off")
+        });
         out.textures_delta.clear();
         actions
     }
@@ -338,6 +360,7 @@ mod tests {
         assert_eq!(tap(&ctx, &mut menu, "open"), vec![MenuAction::OpenFile]);
         assert_eq!(tap(&ctx, &mut menu, "calibrate"), vec![MenuAction::Calibrate]);
         assert_eq!(tap(&ctx, &mut menu, "settings"), vec![MenuAction::Settings]);
+        assert_eq!(tap(&ctx, &mut menu, "help"), vec![MenuAction::Help]);
         assert_eq!(tap(&ctx, &mut menu, "close"), vec![MenuAction::Close]);
     }
 
