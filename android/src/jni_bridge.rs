@@ -244,6 +244,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
             camera_position_m: None,
             fit: Default::default(),
             floor: true,
+            adapt_straight_on: true,
             calibration_path: optional_string(env, &calibration_path)?.map(Into::into),
             artifact: optional_string(env, &artifact)?
                 .map(|id| id.parse())

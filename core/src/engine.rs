@@ -93,6 +93,10 @@ pub struct EngineConfig {
     pub fit: crate::model::DioramaFit,
     /// Draw the diorama's floor under the artifact.
     pub floor: bool,
+    /// Let the straight-on pose follow slowly the pose the viewer settles into (after one was
+    /// taken, while no face is tracked; `phantogram_sensing::straight_on`). On by default, as
+    /// on the phones.
+    pub adapt_straight_on: bool,
     /// Where the viewer's calibration is kept (a file in the app's private storage); `None`: the
     /// defaults, and nothing saved. **Important:** with a path whose calibration does not say
     /// the first run is done, the engine opens on the first-run screens (how to hold the phone,
@@ -115,6 +119,7 @@ impl Default for EngineConfig {
             camera_position_m: None,
             fit: crate::model::DioramaFit::default(),
             floor: true,
+            adapt_straight_on: true,
             calibration_path: None,
         }
     }
@@ -365,6 +370,9 @@ impl Engine {
         }
         let session_config = SessionConfig {
             screen,
+            straight_on: config
+                .adapt_straight_on
+                .then(crate::straight_on::StraightOnParams::default),
             ..SessionConfig::default()
         };
         let session = Session::new(session_config)?;

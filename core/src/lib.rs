@@ -20,7 +20,7 @@
 //!   [`containment`], [`anaglyph`]. Its crate docs hold the frames-and-units contract every crate
 //!   uses.
 //! * `phantogram_sensing`: [`sensors`], [`lowpass`], [`attitude`], [`fusion`], [`eyetrack`],
-//!   [`calibration`], [`camera`], [`session`], [`synthetic`], [`clock`].
+//!   [`straight_on`], [`calibration`], [`camera`], [`session`], [`synthetic`], [`clock`].
 //! * `phantogram_assets` (feature `models`): `model`, `artifact`, `builtin`, `library`, `ibl`,
 //!   `parallel`, `progress`, `budget`.
 //! * `phantogram_render` (feature `render`): `render` (the crate itself) and `surface`.
@@ -61,7 +61,7 @@ pub use phantogram_files as files;
 pub use phantogram_geometry::{anaglyph, containment, eyes, light, projection, screen, viewpoint};
 pub use phantogram_sensing::storage::face_models_dir;
 pub use phantogram_sensing::{
-    attitude, calibration, camera, clock, eyetrack, fusion, lowpass, sensors, session, synthetic,
+    attitude, calibration, camera, clock, eyetrack, fusion, lowpass, sensors, session, straight_on, synthetic,
 };
 
 #[cfg(feature = "models")]

@@ -343,6 +343,7 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             camera_position_m: None,
             fit: Default::default(),
             floor: c.floor != 0,
+            adapt_straight_on: true,
             calibration_path: calibration.map(PathBuf::from),
             artifact,
             library_dir: library.map(PathBuf::from),

@@ -33,6 +33,7 @@ pub mod lowpass;
 pub mod sensors;
 pub mod session;
 pub mod storage;
+pub mod straight_on;
 pub mod synthetic;
 
 pub use session::{FrameView, Session, SessionConfig, SessionError};

@@ -66,6 +66,10 @@ pub struct SessionConfig {
     /// Where the world-fixed light appears when anchored, device frame (towards the light).
     pub light_toward_device: Vec3,
     pub inbox_capacity: usize,
+    /// Once a pose was taken as straight on, let it follow slowly the pose the viewer settles
+    /// into while no face is tracked (`crate::straight_on`; `None`: it stays where it was set,
+    /// as the desktop replays keep it).
+    pub straight_on: Option<crate::straight_on::StraightOnParams>,
 }
 
 impl Default for SessionConfig {
@@ -77,6 +81,7 @@ impl Default for SessionConfig {
             estimator: EstimatorChoice::default(),
             light_toward_device: WorldLight::DEFAULT_TOWARD_LIGHT_DEVICE,
             inbox_capacity: SensorInbox::DEFAULT_CAPACITY,
+            straight_on: None,
         }
     }
 }
@@ -125,6 +130,7 @@ pub struct Session {
     newest_t_ns: Option<i64>,
     eye_tracker: EyeTracker,
     eye_source: EyeSource,
+    straight_on: Option<crate::straight_on::StraightOnAdapter>,
 }
 
 impl std::fmt::Debug for Session {
@@ -161,6 +167,7 @@ impl Session {
             newest_t_ns: None,
             eye_tracker: EyeTracker::new(EyeTrackParams::default(), config.eyes.viewing_distance_m),
             eye_source: EyeSource::Tilt,
+            straight_on: config.straight_on.map(crate::straight_on::StraightOnAdapter::new),
         })
     }
 
@@ -232,6 +239,9 @@ impl Session {
         self.update();
         let up = self.estimator.up_device().ok_or(SessionError::NoGravityYet)?;
         if self.viewpoint.calibrate_flat_angle(up) {
+            if let Some(a) = &mut self.straight_on {
+                a.reset();
+            }
             Ok(())
         } else {
             Err(SessionError::NoGravityYet)
@@ -240,6 +250,9 @@ impl Session {
 
     pub fn reset_flat_angle(&mut self) {
         self.viewpoint.reset_flat_angle();
+        if let Some(a) = &mut self.straight_on {
+            a.reset();
+        }
     }
 
     /// The "up" (device frame) of the pose that counts as straight on, to save with the
@@ -251,12 +264,33 @@ impl Session {
     /// Restores a saved flat angle ([`Self::flat_up_device`]); `None` resets it. Returns `false`
     /// and changes nothing if `up` is degenerate.
     pub fn set_flat_up_device(&mut self, up: Option<Vec3>) -> bool {
+        if let Some(a) = &mut self.straight_on {
+            a.reset();
+        }
         match up {
             Some(up) => self.viewpoint.calibrate_flat_angle(up),
             None => {
                 self.viewpoint.reset_flat_angle();
                 true
             }
+        }
+    }
+
+    /// One step of the straight-on pose's slow re-adaptation (`SessionConfig::straight_on`),
+    /// at the newest sensor time, from the held "up" (not a prediction).
+    fn adapt_straight_on(&mut self) {
+        let (Some(adapter), Some(straight), Some(held), Some(t)) = (
+            self.straight_on.as_mut(),
+            self.viewpoint.flat_up_device(),
+            self.estimator.up_device(),
+            self.newest_t_ns,
+        ) else {
+            return;
+        };
+        let face = self.eye_source == EyeSource::Camera;
+        let adapted = adapter.step(t, straight, held, face);
+        if adapted != straight {
+            self.viewpoint.calibrate_flat_angle(adapted);
         }
     }
 
@@ -338,6 +372,7 @@ impl Session {
         // below: draw as if none were given.
         let display_t_ns = display_t_ns.filter(|&t| crate::sensors::time_in_range(t));
         self.update();
+        self.adapt_straight_on();
         let predicted = display_t_ns.and_then(|t| self.estimator.predict_device_to_world(t));
         let up = match predicted {
             Some(q) => Some(q.inverse() * Vec3::Z),
@@ -460,6 +495,41 @@ mod tests {
         assert_eq!(fused.stats().ignored_non_finite, 4);
         assert!(fused.up_device().is_some_and(|u| u.distance(Vec3::Z) < 1e-3));
         assert!(low_pass.up_device().is_some_and(|u| u.distance(Vec3::Z) < 1e-3));
+    }
+
+    /// With `straight_on` configured, a pose taken as straight on follows, over a minute and a
+    /// half, the pose the viewer settles into; without it, it stays where it was taken.
+    #[test]
+    fn the_straight_on_pose_follows_a_settled_pose_only_when_configured() {
+        let held = |deg: f32| {
+            let a = deg.to_radians();
+            Vec3::new(0.0, a.sin(), a.cos())
+        };
+        for adapt in [true, false] {
+            let mut s = Session::new(SessionConfig {
+                straight_on: adapt.then(crate::straight_on::StraightOnParams::default),
+                ..SessionConfig::default()
+            })
+            .unwrap();
+            s.push(SensorEvent::accelerometer(0, held(35.0) * 9.81)).unwrap();
+            s.calibrate_flat_angle().unwrap();
+            // 90 s settled at 50°, 100 Hz, a frame every 20 ms.
+            for k in 1..=9000i64 {
+                s.push(SensorEvent::accelerometer(k * 10_000_000, held(50.0) * 9.81))
+                    .unwrap();
+                if k % 2 == 0 {
+                    s.frame().unwrap();
+                }
+            }
+            let straight = s.flat_up_device().unwrap();
+            let to_new = straight.angle_between(held(50.0)).to_degrees();
+            let to_old = straight.angle_between(held(35.0)).to_degrees();
+            if adapt {
+                assert!(to_new < 1.5, "{to_new}° from the settled pose after 90 s");
+            } else {
+                assert!(to_old < 1e-3, "moved {to_old}° without being asked to");
+            }
+        }
     }
 
     #[test]
