@@ -1,17 +1,18 @@
 //! Changing the artifact on screen while the engine runs: the [`crate::library`] on a worker
 //! thread, with progress and cancel, and the result handed to the render thread.
 //!
-//! * One load at a time: a new request cancels the one under way (its result, if it still
-//!   comes, is dropped by its generation number).
+//! * One load at a time, on one long-lived thread: a new request cancels the one under way (its
+//!   result, if it still comes, is dropped by its generation number).
 //! * The artifact on screen stays until the new one is ready: the worker loads, fits and floors
 //!   the model (CPU work) into a [`Prepared`]; the render thread only uploads it.
 //! * A failure (a damaged file, an unknown id, over the budget) becomes
 //!   [`LoadStatus::Failed`] with a message for the screen; a cancelled load becomes
 //!   [`LoadStatus::Idle`] again, not an error.
 //!
-//! **Threading**: a [`Loader`] lives on the render thread (inside the engine's mutex); each
-//! load runs on a thread of its own named `artifact-loader`, sharing only the request, an
-//! `Arc<Progress>` and a channel. **Panics**: a panic inside a load (a bug) is caught on its
+//! **Threading**: a [`Loader`] lives on the render thread (inside the engine's mutex); the loads
+//! run on its thread `artifact-loader` (started with the first), sharing only the request, an
+//! `Arc<Progress>` and channels; a file given as a reader is read first on a short-lived
+//! `artifact-reader` thread. **Panics**: a panic inside a load (a bug) is caught on its
 //! thread and reported as that load's failure.
 
 use std::sync::Arc;
@@ -109,10 +110,10 @@ pub enum Request {
 /// The content of an opened file.
 pub enum FileSource {
     Bytes(Vec<u8>),
-    /// Read on the loader's thread, at most the budget's memory: an Android `content://`
+    /// Read on a thread of its own, at most the budget's memory: an Android `content://`
     /// document's descriptor, read without passing through the Java heap. **Important:** a
-    /// source that blocks forever (a stalled pipe) holds its loader thread until the process
-    /// ends; a newer request still runs on a thread of its own.
+    /// source that blocks forever (a stalled pipe) holds that reader thread until the process
+    /// ends; the loads that follow are not held up.
     Reader(Box<dyn std::io::Read + Send>),
 }
 
@@ -157,6 +158,61 @@ impl FileSource {
 
 type Outcome = (u64, Result<Prepared, String>);
 
+/// A load for the loader thread.
+struct Work {
+    generation: u64,
+    request: Request,
+    placing: Placing,
+    progress: Arc<Progress>,
+}
+
+/// The loader thread: one load at a time, the newest request first (older ones waiting were
+/// superseded), each result tagged with its request's generation. One long-lived thread keeps
+/// each switch's allocations in one place (a thread per load left the allocator's per-thread
+/// arenas holding freed models: resident memory crept up over many switches). Ends when the
+/// loader is dropped.
+fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, results: Sender<Outcome>) {
+    while let Ok(mut work) = jobs.recv() {
+        while let Ok(newer) = jobs.try_recv() {
+            work = newer;
+        }
+        if work.progress.is_cancelled() {
+            continue;
+        }
+        let Work {
+            generation,
+            request,
+            placing,
+            progress,
+        } = work;
+        let run = || -> Result<Prepared, LoadError> {
+            let loaded: LoadedArtifact = match request {
+                Request::Select(id) => library.load(&id, budget, &progress)?,
+                Request::Import { name, source } => {
+                    let bytes = source.into_bytes(&name, budget.memory_bytes)?;
+                    library.import(&name, &bytes, budget, &progress)?
+                }
+            };
+            if progress.is_cancelled() {
+                return Err(LoadError::Cancelled);
+            }
+            let prepared = prepare(loaded.model, Some(loaded.entry), loaded.placed, &placing)?;
+            progress.advance_to(0.95);
+            Ok(prepared)
+        };
+        let outcome = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+            Ok(Ok(p)) => Ok(p),
+            Ok(Err(e)) if e.is_cancelled() => continue,
+            Ok(Err(e)) => Err(e.to_string()),
+            Err(_) => Err("the loader failed unexpectedly (a bug); the artifact stays as it was".into()),
+        };
+        // The engine may be gone: then nobody wants the result.
+        if results.send((generation, outcome)).is_err() {
+            return;
+        }
+    }
+}
+
 struct Job {
     generation: u64,
     title: String,
@@ -172,6 +228,8 @@ pub struct Loader {
     failed: Option<(String, String)>,
     tx: Sender<Outcome>,
     rx: Receiver<Outcome>,
+    /// The loader thread's queue, once started.
+    worker: Option<Sender<Work>>,
 }
 
 impl std::fmt::Debug for Loader {
@@ -194,6 +252,7 @@ impl Loader {
             failed: None,
             tx,
             rx,
+            worker: None,
         }
     }
 
@@ -226,37 +285,14 @@ impl Loader {
             Request::Import { name, .. } => display_name(name),
         };
         let progress = Arc::new(Progress::new());
-        let (library, budget, tx) = (self.library.clone(), self.budget, self.tx.clone());
-        let worker_progress = Arc::clone(&progress);
-        let spawned = std::thread::Builder::new()
-            .name("artifact-loader".into())
-            .spawn(move || {
-                let run = || -> Result<Prepared, LoadError> {
-                    let loaded: LoadedArtifact = match request {
-                        Request::Select(id) => library.load(&id, budget, &worker_progress)?,
-                        Request::Import { name, source } => {
-                            let bytes = source.into_bytes(&name, budget.memory_bytes)?;
-                            library.import(&name, &bytes, budget, &worker_progress)?
-                        }
-                    };
-                    if worker_progress.is_cancelled() {
-                        return Err(LoadError::Cancelled);
-                    }
-                    let prepared = prepare(loaded.model, Some(loaded.entry), loaded.placed, &placing)?;
-                    worker_progress.advance_to(0.95);
-                    Ok(prepared)
-                };
-                let outcome = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
-                    Ok(Ok(p)) => Ok(p),
-                    Ok(Err(e)) if e.is_cancelled() => return,
-                    Ok(Err(e)) => Err(e.to_string()),
-                    Err(_) => Err("the loader failed unexpectedly (a bug); the artifact stays as it was".into()),
-                };
-                // The engine may be gone: then nobody wants the result.
-                let _ = tx.send((generation, outcome));
-            });
-        match spawned {
-            Ok(_) => {
+        let work = Work {
+            generation,
+            request,
+            placing,
+            progress: Arc::clone(&progress),
+        };
+        match self.queue(work) {
+            Ok(()) => {
                 self.job = Some(Job {
                     generation,
                     title,
@@ -265,6 +301,55 @@ impl Loader {
             }
             Err(e) => self.failed = Some((title, format!("could not start loading: {e}"))),
         }
+    }
+
+    /// Hands `work` to the loader thread (started with the first load). A file to be read from
+    /// a reader is read on a short-lived thread of its own first, so that a stalled source holds
+    /// only that thread, never the loads that follow.
+    fn queue(&mut self, work: Work) -> std::io::Result<()> {
+        if self.worker.is_none() {
+            let (tx, rx) = channel::<Work>();
+            let (library, budget, results) = (self.library.clone(), self.budget, self.tx.clone());
+            std::thread::Builder::new()
+                .name("artifact-loader".into())
+                .spawn(move || load_loop(rx, library, budget, results))?;
+            self.worker = Some(tx);
+        }
+        let Some(worker) = self.worker.clone() else {
+            return Ok(());
+        };
+        match work.request {
+            Request::Import {
+                name,
+                source: FileSource::Reader(reader),
+            } => {
+                let (max_bytes, results) = (self.budget.memory_bytes, self.tx.clone());
+                let (generation, placing, progress) = (work.generation, work.placing, work.progress);
+                std::thread::Builder::new()
+                    .name("artifact-reader".into())
+                    .spawn(move || match FileSource::Reader(reader).into_bytes(&name, max_bytes) {
+                        Ok(bytes) => {
+                            let request = Request::Import {
+                                name,
+                                source: FileSource::Bytes(bytes),
+                            };
+                            let _ = worker.send(Work {
+                                generation,
+                                request,
+                                placing,
+                                progress,
+                            });
+                        }
+                        Err(e) => {
+                            let _ = results.send((generation, Err(e.to_string())));
+                        }
+                    })?;
+            }
+            request => {
+                let _ = worker.send(Work { request, ..work });
+            }
+        }
+        Ok(())
     }
 
     /// Gives up the load under way, if any; the artifact on screen stays.

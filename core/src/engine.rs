@@ -724,28 +724,21 @@ impl Engine {
         self.screens().items = items;
     }
 
-    /// The centre of a control of the calibration screens in the last frame drawn, in physical
-    /// pixels (names as [`crate::calibration_ui::CalibrationUi::widget_rect`]): for tests and
-    /// automation.
+    /// The centre of a control of the screen showing, in the last frame drawn, in physical
+    /// pixels: for tests and automation. Names are the open page's (`widget_rect` of
+    /// [`crate::calibration_ui::CalibrationUi`], [`crate::calibration_ui::menu::MenuUi`],
+    /// [`crate::calibration_ui::settings::SettingsUi`] or
+    /// [`crate::calibration_ui::welcome::WelcomeUi`]); `banner` is the status banner's button
+    /// (Cancel or OK) whatever page shows.
     #[cfg(feature = "ui")]
-    pub fn calibration_control_px(&self, name: &str) -> Option<[f32; 2]> {
-        let Some(Page::Calibration(ui)) = self.screens.as_ref()?.page.as_ref() else {
-            return None;
-        };
-        let centre = ui.widget_rect(name)?.center();
-        let ppp = self.pixels_per_point();
-        Some([centre.x * ppp, centre.y * ppp])
-    }
-
-    /// As [`Self::calibration_control_px`] for the menu (names as
-    /// [`crate::calibration_ui::menu::MenuUi::widget_rect`]) and, with `banner`, the status
-    /// banner's button (Cancel or OK).
-    #[cfg(feature = "ui")]
-    pub fn menu_control_px(&self, name: &str) -> Option<[f32; 2]> {
+    pub fn control_px(&self, name: &str) -> Option<[f32; 2]> {
         let screens = self.screens.as_ref()?;
         let rect = match (&screens.page, name) {
             (_, "banner") => screens.banner_button_pt?,
-            (Some(Page::Menu(menu)), _) => menu.widget_rect(name)?,
+            (Some(Page::Calibration(ui)), _) => ui.widget_rect(name)?,
+            (Some(Page::Menu(ui)), _) => ui.widget_rect(name)?,
+            (Some(Page::Settings(ui)), _) => ui.widget_rect(name)?,
+            (Some(Page::Welcome(ui)), _) => ui.widget_rect(name)?,
             _ => return None,
         };
         let ppp = self.pixels_per_point();
@@ -1282,18 +1275,6 @@ impl Engine {
         }
     }
 
-    /// As [`Self::calibration_control_px`] for the settings screen (names as
-    /// [`crate::calibration_ui::settings::SettingsUi::widget_rect`]).
-    #[cfg(feature = "ui")]
-    pub fn settings_control_px(&self, name: &str) -> Option<[f32; 2]> {
-        let Some(Page::Settings(s)) = self.screens.as_ref()?.page.as_ref() else {
-            return None;
-        };
-        let centre = s.widget_rect(name)?.center();
-        let ppp = self.pixels_per_point();
-        Some([centre.x * ppp, centre.y * ppp])
-    }
-
     #[cfg(feature = "ui")]
     fn apply_welcome_action(&mut self, action: crate::calibration_ui::welcome::WelcomeAction) {
         use crate::calibration_ui::welcome::WelcomeAction as A;
@@ -1317,18 +1298,6 @@ impl Engine {
                 self.open_calibration();
             }
         }
-    }
-
-    /// As [`Self::calibration_control_px`] for the first-run screens (names as
-    /// [`crate::calibration_ui::welcome::WelcomeUi::widget_rect`]).
-    #[cfg(feature = "ui")]
-    pub fn welcome_control_px(&self, name: &str) -> Option<[f32; 2]> {
-        let Some(Page::Welcome(w)) = self.screens.as_ref()?.page.as_ref() else {
-            return None;
-        };
-        let centre = w.widget_rect(name)?.center();
-        let ppp = self.pixels_per_point();
-        Some([centre.x * ppp, centre.y * ppp])
     }
 
     #[cfg(feature = "ui")]

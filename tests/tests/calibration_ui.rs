@@ -244,9 +244,7 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
             .expect("saving");
     }
 
-    let flat = engine
-        .calibration_control_px("flat")
-        .expect("the menu's straight-on button");
+    let flat = engine.control_px("flat").expect("the menu's straight-on button");
     // A touch the system takes back (Cancel) is no click.
     engine.touch(TouchPhase::Down, 0, flat[0], flat[1], 1_100 * ms);
     engine.draw(Some(1_120 * ms)).unwrap();
@@ -272,7 +270,7 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
     let text = std::fs::read_to_string(&path).expect("the calibration was saved");
     assert!(text.contains("flat_up_device"), "{text}");
 
-    let close = engine.calibration_control_px("close").expect("the menu's close button");
+    let close = engine.control_px("close").expect("the menu's close button");
     tap_fingers(&mut engine, &[close]);
     engine.draw(Some(2_000 * ms)).unwrap();
     assert!(!engine.calibration_open());
@@ -326,13 +324,13 @@ fn the_screens_keep_the_phones_layout_on_a_smaller_target() {
     engine.resume_offscreen(panel.width_px, panel.height_px).unwrap();
     engine.draw(Some(10 * ms)).unwrap();
     engine.draw(Some(20 * ms)).unwrap();
-    let full = engine.calibration_control_px("close").expect("the close button");
+    let full = engine.control_px("close").expect("the close button");
     // A window of 3/8 of the panel's width, as the viewer's 405 px for a 1080 px phone.
     let (w, h) = (panel.width_px * 3 / 8, panel.height_px * 3 / 8);
     engine.resize(w, h).unwrap();
     engine.draw(Some(30 * ms)).unwrap();
     engine.draw(Some(40 * ms)).unwrap();
-    let small = engine.calibration_control_px("close").expect("the close button");
+    let small = engine.control_px("close").expect("the close button");
     for i in 0..2 {
         assert!(
             (small[i] - full[i] * 3.0 / 8.0).abs() < 2.0,
@@ -404,7 +402,7 @@ fn the_first_run_screens_check_the_glasses_and_take_the_pose() {
     golden::check("welcome-intro", w, h, engine.last_frame().unwrap().2, 3, 0.003);
     let tap = |engine: &mut Engine, name: &str, t: &mut i64| {
         let p = engine
-            .welcome_control_px(name)
+            .control_px(name)
             .unwrap_or_else(|| panic!("no {name} on the first-run screen"));
         engine.touch(TouchPhase::Down, 0, p[0], p[1], *t * ms);
         frames(engine, 1, t);

@@ -20,6 +20,8 @@
 
 pub mod menu;
 pub mod settings;
+#[cfg(test)]
+mod test_taps;
 pub mod welcome;
 
 use egui::{Align2, Color32, Pos2, Rect, Stroke, Vec2 as EVec2};

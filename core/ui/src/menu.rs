@@ -181,27 +181,38 @@ impl MenuUi {
     }
 }
 
-/// Draws an annotation's card (its title and text) at the bottom of the screen; returns `true`
-/// when the viewer closed it, and the card's rectangle (points).
-pub fn show_annotation(ctx: &egui::Context, title: &str, lead: &str) -> (bool, Rect) {
-    let mut closed = false;
+/// A card across the bottom of the screen, over everything (the banner, an annotation, the
+/// help): `body` fills it; returns the card's rectangle (points).
+fn bottom_card(ctx: &egui::Context, id: &str, body: impl FnOnce(&mut egui::Ui)) -> Rect {
     let width = (ctx.content_rect().width() - 24.0).max(100.0);
-    let area = egui::Area::new(egui::Id::unique("annotation card"))
+    egui::Area::new(egui::Id::unique(id))
         .anchor(Align2::CENTER_BOTTOM, [0.0, -12.0])
         .order(egui::Order::Foreground)
+        // Shown at once: a fading card would be unreadable for its first frames.
         .fade_in(false)
         .show(ctx, |ui| {
             egui::Frame::popup(ui.style()).show(ui, |ui| {
                 ui.set_width(width - 16.0);
-                ui.label(RichText::new(title).size(20.0).color(Color32::from_rgb(255, 190, 90)));
-                if !lead.is_empty() {
-                    ui.label(RichText::new(lead).size(16.0));
-                }
-                let r = ui.add_sized([ui.available_width(), CONTROL_HEIGHT_PT], egui::Button::new("Close"));
-                closed = r.clicked();
+                body(ui);
             });
-        });
-    (closed, area.response.rect)
+        })
+        .response
+        .rect
+}
+
+/// Draws an annotation's card (its title and text) at the bottom of the screen; returns `true`
+/// when the viewer closed it, and the card's rectangle (points).
+pub fn show_annotation(ctx: &egui::Context, title: &str, lead: &str) -> (bool, Rect) {
+    let mut closed = false;
+    let rect = bottom_card(ctx, "annotation card", |ui| {
+        ui.label(RichText::new(title).size(20.0).color(Color32::from_rgb(255, 190, 90)));
+        if !lead.is_empty() {
+            ui.label(RichText::new(lead).size(16.0));
+        }
+        let r = ui.add_sized([ui.available_width(), CONTROL_HEIGHT_PT], egui::Button::new("Close"));
+        closed = r.clicked();
+    });
+    (closed, rect)
 }
 
 /// What the gestures do, for the help card.
@@ -234,43 +245,32 @@ pub enum BannerAction {
 pub fn show_banner(ctx: &egui::Context, banner: &Banner) -> (Option<BannerAction>, Rect, Rect) {
     let mut action = None;
     let mut button = Rect::NOTHING;
-    let width = (ctx.content_rect().width() - 24.0).max(100.0);
-    let area = egui::Area::new(egui::Id::unique("status banner"))
-        .anchor(Align2::CENTER_BOTTOM, [0.0, -12.0])
-        .order(egui::Order::Foreground)
-        // Shown at once: a fading banner would be unreadable for its first frames.
-        .fade_in(false)
-        .show(ctx, |ui| {
-            egui::Frame::popup(ui.style()).show(ui, |ui| {
-                ui.set_width(width - 16.0);
-                match banner {
-                    Banner::Loading { title, fraction } => {
-                        ui.label(RichText::new(format!("Opening {title}…")).size(17.0));
-                        ui.add(egui::ProgressBar::new(fraction.clamp(0.0, 1.0)).show_percentage());
-                        let r = ui.add_sized([ui.available_width(), CONTROL_HEIGHT_PT], egui::Button::new("Cancel"));
-                        button = r.rect;
-                        if r.clicked() {
-                            action = Some(BannerAction::Cancel);
-                        }
-                    }
-                    Banner::Failed { title, message } => {
-                        ui.label(
-                            RichText::new(format!("Could not open {title}"))
-                                .size(17.0)
-                                .color(Color32::from_rgb(255, 140, 120)),
-                        );
-                        ui.label(message);
-                        ui.label("The artifact you were looking at stays on screen.");
-                        let r = ui.add_sized([ui.available_width(), CONTROL_HEIGHT_PT], egui::Button::new("OK"));
-                        button = r.rect;
-                        if r.clicked() {
-                            action = Some(BannerAction::Dismiss);
-                        }
-                    }
-                }
-            });
-        });
-    (action, area.response.rect, button)
+    let area = bottom_card(ctx, "status banner", |ui| match banner {
+        Banner::Loading { title, fraction } => {
+            ui.label(RichText::new(format!("Opening {title}…")).size(17.0));
+            ui.add(egui::ProgressBar::new(fraction.clamp(0.0, 1.0)).show_percentage());
+            let r = ui.add_sized([ui.available_width(), CONTROL_HEIGHT_PT], egui::Button::new("Cancel"));
+            button = r.rect;
+            if r.clicked() {
+                action = Some(BannerAction::Cancel);
+            }
+        }
+        Banner::Failed { title, message } => {
+            ui.label(
+                RichText::new(format!("Could not open {title}"))
+                    .size(17.0)
+                    .color(Color32::from_rgb(255, 140, 120)),
+            );
+            ui.label(message);
+            ui.label("The artifact you were looking at stays on screen.");
+            let r = ui.add_sized([ui.available_width(), CONTROL_HEIGHT_PT], egui::Button::new("OK"));
+            button = r.rect;
+            if r.clicked() {
+                action = Some(BannerAction::Dismiss);
+            }
+        }
+    });
+    (action, area, button)
 }
 
 #[cfg(test)]
@@ -298,31 +298,18 @@ mod tests {
     }
 
     fn frame(ctx: &egui::Context, menu: &mut MenuUi, events: Vec<egui::Event>) -> Vec<MenuAction> {
-        let input = egui::RawInput {
-            screen_rect: Some(Rect::from_min_size(Pos2::ZERO, Vec2::new(390.0, 844.0))),
-            events,
-            ..Default::default()
-        };
         let mut actions = Vec::new();
-        let mut out = ctx.run_ui(input, |ui| {
+        crate::test_taps::frame(ctx, events, |ui| {
             actions = menu.show(ui, &items(), Some("builtin:amphora"), "Camera off")
         });
-        out.textures_delta.clear();
         actions
     }
 
     fn tap(ctx: &egui::Context, menu: &mut MenuUi, name: &str) -> Vec<MenuAction> {
         let pos = menu.widget_rect(name).unwrap_or_else(|| panic!("no {name}")).center();
-        let button = |pressed| egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: Default::default(),
-        };
-        let mut a = frame(ctx, menu, vec![egui::Event::PointerMoved(pos), button(true)]);
-        a.extend(frame(ctx, menu, vec![button(false), egui::Event::PointerGone]));
-        a.extend(frame(ctx, menu, vec![]));
-        a
+        let mut actions = Vec::new();
+        crate::test_taps::tap(pos, |events| actions.extend(frame(ctx, menu, events)));
+        actions
     }
 
     #[test]

@@ -144,32 +144,18 @@ impl SettingsUi {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use egui::{Pos2, Vec2};
 
     fn frame(ctx: &egui::Context, s: &mut SettingsUi, events: Vec<egui::Event>) -> Vec<SettingsAction> {
-        let input = egui::RawInput {
-            screen_rect: Some(Rect::from_min_size(Pos2::ZERO, Vec2::new(390.0, 844.0))),
-            events,
-            ..Default::default()
-        };
         let mut actions = Vec::new();
-        let mut out = ctx.run_ui(input, |ui| actions = s.show(ui));
-        out.textures_delta.clear();
+        crate::test_taps::frame(ctx, events, |ui| actions = s.show(ui));
         actions
     }
 
     fn tap(ctx: &egui::Context, s: &mut SettingsUi, name: &str) -> Vec<SettingsAction> {
         let pos = s.widget_rect(name).unwrap_or_else(|| panic!("no {name}")).center();
-        let button = |pressed| egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: Default::default(),
-        };
-        let mut a = frame(ctx, s, vec![egui::Event::PointerMoved(pos), button(true)]);
-        a.extend(frame(ctx, s, vec![button(false), egui::Event::PointerGone]));
-        a.extend(frame(ctx, s, vec![]));
-        a
+        let mut actions = Vec::new();
+        crate::test_taps::tap(pos, |events| actions.extend(frame(ctx, s, events)));
+        actions
     }
 
     #[test]

@@ -259,15 +259,9 @@ mod tests {
     use super::*;
 
     fn frame(ctx: &egui::Context, ui_state: &mut WelcomeUi, events: Vec<egui::Event>) -> Vec<WelcomeAction> {
-        let input = egui::RawInput {
-            screen_rect: Some(Rect::from_min_size(Pos2::ZERO, Vec2::new(390.0, 844.0))),
-            events,
-            ..Default::default()
-        };
         let mut actions = Vec::new();
         let filters = Some(([255, 0, 0], [0, 255, 255]));
-        let mut out = ctx.run_ui(input, |ui| actions = ui_state.show(ui, filters));
-        out.textures_delta.clear();
+        crate::test_taps::frame(ctx, events, |ui| actions = ui_state.show(ui, filters));
         actions
     }
 
@@ -276,16 +270,9 @@ mod tests {
             .widget_rect(name)
             .unwrap_or_else(|| panic!("no {name}"))
             .center();
-        let button = |pressed| egui::Event::PointerButton {
-            pos,
-            button: egui::PointerButton::Primary,
-            pressed,
-            modifiers: Default::default(),
-        };
-        let mut a = frame(ctx, ui_state, vec![egui::Event::PointerMoved(pos), button(true)]);
-        a.extend(frame(ctx, ui_state, vec![button(false), egui::Event::PointerGone]));
-        a.extend(frame(ctx, ui_state, vec![]));
-        a
+        let mut actions = Vec::new();
+        crate::test_taps::tap(pos, |events| actions.extend(frame(ctx, ui_state, events)));
+        actions
     }
 
     #[test]
