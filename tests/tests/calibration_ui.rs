@@ -452,3 +452,48 @@ fn the_first_run_screens_check_the_glasses_and_take_the_pose() {
     drop(engine);
     assert!(!Engine::new(config(&path)).unwrap().welcome_open());
 }
+
+/// The eye-reflection page darkens the glass: the screen is a mirror only where it emits no
+/// light, so nothing of the picture may show behind the targets.
+#[test]
+fn the_eye_reflection_page_darkens_the_glass() {
+    use phantogram::engine::{Engine, EngineConfig};
+    use phantogram::gesture::TouchPhase;
+
+    let mut engine = match Engine::new(EngineConfig {
+        method: phantogram::anaglyph::Method::Mono,
+        ..EngineConfig::default()
+    }) {
+        Ok(e) => e,
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no engine ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    };
+    let (w, h) = (270, 600);
+    engine.resume_offscreen(w, h).unwrap();
+    assert!(engine.open_calibration());
+    let ms = 1_000_000;
+    let mut t = 10;
+    let draw = |engine: &mut Engine, t: &mut i64| {
+        engine.draw(Some(*t * ms)).unwrap();
+        *t += 16;
+    };
+    draw(&mut engine, &mut t);
+    draw(&mut engine, &mut t);
+    let eye = engine.control_px("eye").expect("the eye-distance button");
+    engine.touch(TouchPhase::Down, 0, eye[0], eye[1], t * ms);
+    draw(&mut engine, &mut t);
+    engine.touch(TouchPhase::Up, 0, eye[0], eye[1], t * ms);
+    for _ in 0..3 {
+        draw(&mut engine, &mut t);
+    }
+    assert!(engine.control_px("accept").is_some(), "on the eye-reflection page");
+    // The upper third (above the page's controls): dark but for the two targets' thin strokes.
+    let (_, _, pixels) = engine.last_frame().unwrap();
+    let upper = &pixels[..(w * h / 3 * 4) as usize];
+    let lit = upper.chunks(4).filter(|p| p[..3].iter().any(|&c| c > 24)).count();
+    let fraction = lit as f64 / (upper.len() / 4) as f64;
+    assert!(fraction < 0.05, "{:.1} % of the upper screen lit", fraction * 100.0);
+}

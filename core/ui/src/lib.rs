@@ -231,6 +231,8 @@ impl CalibrationUi {
                 });
             }
             Page::EyeReflection => {
+                // A dark glass is a mirror: nothing of the picture may light it.
+                painter.rect_filled(ctx.content_rect(), 0.0, Color32::BLACK);
                 let targets = reflection_targets_px(screen, self.target_separation_mm, self.target_offset_mm);
                 for t in targets {
                     let p = to_points(t);
