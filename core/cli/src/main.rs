@@ -11,6 +11,7 @@
 use std::io::{BufWriter, Write};
 use std::path::PathBuf;
 
+mod check_artifacts;
 mod face_eval;
 mod output;
 mod render_frames;
@@ -130,6 +131,9 @@ enum Command {
     },
     /// Summarise a log: duration, events and rate per sensor.
     Info { log: PathBuf },
+    /// Load every artifact in a folder (.glb/.gltf files, Voyager folders) as a phone will, as
+    /// `cargo xtask android|ios --artifacts FOLDER` does before bundling them.
+    CheckArtifacts { folder: PathBuf },
     /// Score estimators against recorded ground truth.
     Eval {
         #[command(subcommand)]
@@ -250,6 +254,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Info { log } => info_command(&log),
+        Command::CheckArtifacts { folder } => check_artifacts::check_artifacts_command(&folder),
         Command::View {
             scene,
             log,

@@ -577,3 +577,41 @@ fn render_side_by_side_puts_each_eye_in_its_half() {
         "side by side is no anaglyph"
     );
 }
+
+/// `check-artifacts`: a curator's folder loaded as a phone will; every entry that would not
+/// show is named, and the run fails.
+#[test]
+fn check_artifacts_names_every_entry_that_would_not_show() {
+    let dir = Scratch::new("cli-check-artifacts");
+    let good = dir.join("good");
+    std::fs::create_dir_all(good.join("scan")).unwrap();
+    std::fs::write(
+        good.join("votive.glb"),
+        phantogram_testkit::tetrahedron_glb(0.1, r#""extras":{"title":"Votive"}"#),
+    )
+    .unwrap();
+    std::fs::write(good.join("scan/x.glb"), phantogram_testkit::tetrahedron_glb(0.2, "")).unwrap();
+    let run = bin().arg("check-artifacts").arg(&good).output().unwrap();
+    let stdout = String::from_utf8_lossy(&run.stdout);
+    assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
+    assert!(
+        stdout.contains("ok votive.glb: Votive (4 triangles") && stdout.contains("ok scan:"),
+        "{stdout}"
+    );
+
+    let bad = dir.join("bad");
+    std::fs::create_dir_all(&bad).unwrap();
+    std::fs::write(bad.join("broken.glb"), b"glTF\x02\0\0\0 not a model").unwrap();
+    std::fs::write(bad.join("notes.txt"), "a curator's notes").unwrap();
+    std::fs::write(bad.join("fine.glb"), phantogram_testkit::tetrahedron_glb(0.1, "")).unwrap();
+    let run = bin().arg("check-artifacts").arg(&bad).output().unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(!run.status.success());
+    assert!(
+        stderr.contains("2 entries would not show")
+            && stderr.contains("broken.glb: ")
+            && stderr.contains("notes.txt: not a .glb"),
+        "{stderr}"
+    );
+    assert!(String::from_utf8_lossy(&run.stdout).contains("ok fine.glb"));
+}
