@@ -554,13 +554,16 @@ impl Engine {
         false
     }
 
+    /// The full screen open over the picture, if any.
+    #[cfg(feature = "ui")]
+    fn page(&self) -> Option<&Page> {
+        self.screens.as_ref().and_then(|s| s.page.as_ref())
+    }
+
     /// Whether the calibration screens are showing (touches then drive them, not gestures).
     pub fn calibration_open(&self) -> bool {
         #[cfg(feature = "ui")]
-        return matches!(
-            self.screens.as_ref().and_then(|s| s.page.as_ref()),
-            Some(Page::Calibration(_))
-        );
+        return matches!(self.page(), Some(Page::Calibration(_)));
         #[cfg(not(feature = "ui"))]
         false
     }
@@ -625,7 +628,7 @@ impl Engine {
     /// The annotation whose card is showing, if one is.
     pub fn open_annotation_index(&self) -> Option<usize> {
         #[cfg(feature = "ui")]
-        if let Some(Page::Annotation(i)) = self.screens.as_ref().and_then(|s| s.page.as_ref()) {
+        if let Some(Page::Annotation(i)) = self.page() {
             return Some(*i);
         }
         None
@@ -634,7 +637,7 @@ impl Engine {
     /// Whether the menu is showing (touches then drive it, not gestures).
     pub fn menu_open(&self) -> bool {
         #[cfg(feature = "ui")]
-        return matches!(self.screens.as_ref().and_then(|s| s.page.as_ref()), Some(Page::Menu(_)));
+        return matches!(self.page(), Some(Page::Menu(_)));
         #[cfg(not(feature = "ui"))]
         false
     }
@@ -678,10 +681,7 @@ impl Engine {
     /// Whether the first-run screens are showing.
     pub fn welcome_open(&self) -> bool {
         #[cfg(feature = "ui")]
-        return matches!(
-            self.screens.as_ref().and_then(|s| s.page.as_ref()),
-            Some(Page::Welcome(_))
-        );
+        return matches!(self.page(), Some(Page::Welcome(_)));
         #[cfg(not(feature = "ui"))]
         false
     }

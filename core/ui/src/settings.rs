@@ -61,6 +61,18 @@ impl SettingsUi {
         self.widget_rects.push((name, rect));
     }
 
+    /// A button that switches `value`, its label saying the state.
+    fn switch(&mut self, ui: &mut egui::Ui, name: &'static str, width: f32, value: &mut bool, on: &str, off: &str) {
+        let r = ui.add_sized(
+            [width, CONTROL_HEIGHT_PT],
+            egui::Button::new(RichText::new(if *value { on } else { off }).size(17.0)).selected(*value),
+        );
+        self.remember(name, r.rect);
+        if r.clicked() {
+            *value = !*value;
+        }
+    }
+
     pub fn show(&mut self, ui: &mut egui::Ui) -> Vec<SettingsAction> {
         let before = self.settings;
         let mut actions = Vec::new();
@@ -83,22 +95,16 @@ impl SettingsUi {
                 }
             }
             ui.add_space(10.0);
-            let r = ui.add_sized(
-                [full, CONTROL_HEIGHT_PT],
-                egui::Button::new(
-                    RichText::new(if self.settings.floor {
-                        "Floor under the artifact: on"
-                    } else {
-                        "Floor under the artifact: off"
-                    })
-                    .size(17.0),
-                )
-                .selected(self.settings.floor),
+            let mut floor = self.settings.floor;
+            self.switch(
+                ui,
+                "floor",
+                full,
+                &mut floor,
+                "Floor under the artifact: on",
+                "Floor under the artifact: off",
             );
-            self.remember("floor", r.rect);
-            if r.clicked() {
-                self.settings.floor = !self.settings.floor;
-            }
+            self.settings.floor = floor;
             ui.add_space(6.0);
             ui.label(RichText::new("Your own files: how much stands in front of the glass (%)").size(16.0));
             // Room for the value box beside the slider.
@@ -108,22 +114,16 @@ impl SettingsUi {
             let r = ui.add(egui::Slider::new(&mut percent, 0.0..=100.0).step_by(5.0));
             self.remember("protrude", r.rect);
             self.settings.protrude_fraction = (percent / 100.0).clamp(0.0, 1.0);
-            let r = ui.add_sized(
-                [full, CONTROL_HEIGHT_PT],
-                egui::Button::new(
-                    RichText::new(if self.settings.true_size {
-                        "Size: as in the file (true size)"
-                    } else {
-                        "Size: fitted to the screen"
-                    })
-                    .size(17.0),
-                )
-                .selected(self.settings.true_size),
+            let mut true_size = self.settings.true_size;
+            self.switch(
+                ui,
+                "true-size",
+                full,
+                &mut true_size,
+                "Size: as in the file (true size)",
+                "Size: fitted to the screen",
             );
-            self.remember("true-size", r.rect);
-            if r.clicked() {
-                self.settings.true_size = !self.settings.true_size;
-            }
+            self.settings.true_size = true_size;
             ui.add_space(10.0);
             let r = ui.add_sized(
                 [full, CONTROL_HEIGHT_PT],
