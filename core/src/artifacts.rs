@@ -426,10 +426,10 @@ impl Loader {
 /// A file name as a title on screen: control characters dropped, at most 80 characters.
 fn display_name(name: &str) -> String {
     let clean: String = name.chars().filter(|c| !c.is_control()).collect();
-    match clean.char_indices().nth(80) {
-        Some((end, _)) => format!("{}…", &clean[..end]),
-        None if clean.trim().is_empty() => "a file".to_owned(),
-        None => clean,
+    if clean.chars().count() <= 80 && clean.trim().is_empty() {
+        "a file".to_owned()
+    } else {
+        phantogram_files::text::truncate_chars(&clean, 80)
     }
 }
 

@@ -6,6 +6,8 @@
 //! * An error message quotes what it could not read, but only an excerpt ([`excerpt`]): a
 //!   one-megabyte "tag" must not become a one-megabyte message, and control characters are
 //!   escaped so that a terminal shows them as text.
+//! * Text shown on screen (a title, an annotation) is cut to a length ([`truncate_chars`]),
+//!   not quoted.
 
 /// The UTF-8 byte-order mark, U+FEFF.
 pub const BOM: char = '\u{feff}';
@@ -30,6 +32,14 @@ pub fn excerpt(text: &str) -> String {
     }
 }
 
+/// `text` cut after `max_chars` characters, with `…` where it was cut.
+pub fn truncate_chars(text: &str, max_chars: usize) -> String {
+    match text.char_indices().nth(max_chars) {
+        Some((end, _)) => format!("{}…", &text[..end]),
+        None => text.to_owned(),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -43,5 +53,7 @@ mod tests {
         assert_eq!(excerpt("acc\u{1b}[2J"), "\"acc\\u{1b}[2J\"");
         assert_eq!(strip_bom("\u{feff}phantogram"), "phantogram");
         assert_eq!(strip_bom("phantogram"), "phantogram");
+        assert_eq!(truncate_chars("émail", 3), "éma…");
+        assert_eq!(truncate_chars("émail", 5), "émail");
     }
 }

@@ -36,10 +36,7 @@ fn text(v: Option<&Value>) -> Option<String> {
     if s.is_empty() {
         return None;
     }
-    Some(match s.char_indices().nth(200) {
-        Some((end, _)) => format!("{}…", &s[..end]),
-        None => s.to_owned(),
-    })
+    Some(phantogram_files::text::truncate_chars(s, 200))
 }
 
 fn first_text(v: &Value, keys: &[&str]) -> Option<String> {
@@ -113,13 +110,20 @@ fn gltf_json(path: &Path) -> Option<Value> {
 /// what a museum writes; the glTF's `asset` is often the exporter's).
 pub fn of_model_file(path: &Path) -> Metadata {
     let from_gltf = gltf_json(path).map(|j| of_gltf_json(&j)).unwrap_or_default();
-    let scene = path.parent().map(|p| p.join("scene.svx.json"));
-    let from_scene = scene
-        .and_then(|s| phantogram_files::read_regular_file(&s, MAX_JSON_BYTES).ok())
-        .and_then(|b| serde_json::from_slice::<Value>(&b).ok())
-        .map(|j| of_voyager_scene(&j))
+    let from_scene = path
+        .parent()
+        .map(|p| of_scene_file(&p.join("scene.svx.json")))
         .unwrap_or_default();
     from_scene.or(from_gltf)
+}
+
+/// The metadata of a Voyager scene file; none when it cannot be read.
+pub fn of_scene_file(path: &Path) -> Metadata {
+    phantogram_files::read_regular_file(path, MAX_JSON_BYTES)
+        .ok()
+        .and_then(|b| serde_json::from_slice::<Value>(&b).ok())
+        .map(|j| of_voyager_scene(&j))
+        .unwrap_or_default()
 }
 
 /// A readable title from a file or folder name: extension dropped, `_` and `-` as spaces, the

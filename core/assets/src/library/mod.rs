@@ -457,19 +457,14 @@ impl Drop for Staging {
 
 /// The metadata of a model file or a Voyager folder.
 fn describe(model_path: &Path) -> Metadata {
-    if model_path.is_dir() {
-        let scene = model_path.join("scene.svx.json");
-        let from_scene = phantogram_files::read_regular_file(&scene, MAX_RECORD_BYTES << 8)
-            .ok()
-            .and_then(|b| serde_json::from_slice(&b).ok())
-            .map(|j| metadata::of_voyager_scene(&j))
-            .unwrap_or_default();
-        let from_scan = crate::model::voyager_scan(model_path)
-            .map(|p| metadata::of_model_file(&p))
-            .unwrap_or_default();
-        from_scene.or(from_scan)
-    } else {
-        metadata::of_model_file(model_path)
+    if !model_path.is_dir() {
+        return metadata::of_model_file(model_path);
+    }
+    // The scan the folder offers lies beside its scene: the scene's metadata comes with the
+    // scan's (read once).
+    match crate::model::voyager_scan(model_path) {
+        Ok(scan) => metadata::of_model_file(&scan),
+        Err(_) => metadata::of_scene_file(&model_path.join("scene.svx.json")),
     }
 }
 

@@ -784,11 +784,7 @@ pub fn voyager_annotations(scene: &Path, model_path: &Path) -> Vec<Annotation> {
         return Vec::new();
     };
     let cut = |v: Option<&serde_json::Value>, max: usize| -> String {
-        let s = v.and_then(|v| v.as_str()).unwrap_or("").trim();
-        match s.char_indices().nth(max) {
-            Some((end, _)) => format!("{}…", &s[..end]),
-            None => s.to_owned(),
-        }
+        phantogram_files::text::truncate_chars(v.and_then(|v| v.as_str()).unwrap_or("").trim(), max)
     };
     let vec3 = |v: Option<&serde_json::Value>| -> Option<Vec3> {
         let a = v?.as_array()?;
