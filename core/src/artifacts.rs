@@ -260,10 +260,6 @@ impl Loader {
         &self.library
     }
 
-    pub fn budget(&self) -> ResourceBudget {
-        self.budget
-    }
-
     /// Loads synchronously, on the calling thread (the engine's first artifact).
     pub fn load_now(&self, id: &ArtifactId, placing: &Placing) -> Result<Prepared, LoadError> {
         let loaded = self.library.load(id, self.budget, &Progress::new())?;

@@ -267,7 +267,7 @@ pub struct Engine {
 }
 
 /// Something only the platform can do, asked for by the core's screens: the shell takes these
-/// with [`Engine::take_shell_requests`] after each frame and answers through the engine's
+/// with [`Engine::take_shell_request`] after each frame and answers through the engine's
 /// calls (for a file: [`Engine::import_artifact`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShellRequest {
@@ -582,20 +582,11 @@ impl Engine {
 
     /// Target pixels per screen pixel: 1 on a phone; less in the desktop viewer's window.
     fn target_scale(&self) -> f32 {
-        let screen = self.session.config().screen;
-        let width = match &self.target {
-            Target::Offscreen { width, .. } => *width,
-            Target::Window(host) => match host.state() {
-                crate::surface::SurfaceState::Active { width, .. } => width,
-                _ => 0,
-            },
-            Target::Detached => 0,
-        };
-        if width > 0 {
-            width as f32 / screen.width_px() as f32
-        } else {
-            1.0
-        }
+        let screen_width_px = self.session.config().screen.width_px() as f32;
+        self.target_size()
+            .map(|(w, _)| w)
+            .filter(|&w| w > 0)
+            .map_or(1.0, |w| w as f32 / screen_width_px)
     }
 
     /// The annotation whose marker is nearest `px` (physical pixels), within 6 mm on the glass
@@ -642,11 +633,6 @@ impl Engine {
         false
     }
 
-    /// What the core's screens asked of the shell since the last call (see [`ShellRequest`]).
-    pub fn take_shell_requests(&mut self) -> Vec<ShellRequest> {
-        std::mem::take(&mut self.requests)
-    }
-
     /// Each eye's image to the filter that is really in front of it: swapped when the glasses
     /// check found the glasses on the other way round.
     fn oriented<'a>(&self, mut input: FrameInput<'a>) -> FrameInput<'a> {
@@ -659,7 +645,7 @@ impl Engine {
     /// How the eyes are found, in words for the menu: the front camera's state.
     pub fn eyes_status(&self) -> String {
         let stats = self.stats();
-        let text = if cfg!(not(feature = "face")) || !self.face_tracking_on() {
+        let text = if !self.face_tracking_on() {
             "Front camera off: the view follows the phone's tilt."
         } else if stats.face_tracking_stopped {
             "Face tracking stopped: the view follows the phone's tilt."
@@ -686,7 +672,8 @@ impl Engine {
         false
     }
 
-    /// The oldest request not yet taken (for bridges that hand over one at a time).
+    /// The oldest request of the core's screens not yet taken (see [`ShellRequest`]); call until
+    /// `None` after each frame.
     pub fn take_shell_request(&mut self) -> Option<ShellRequest> {
         (!self.requests.is_empty()).then(|| self.requests.remove(0))
     }
@@ -762,7 +749,6 @@ impl Engine {
 
     /// The drawing target's size in physical pixels; `None` while detached or while the window's
     /// surface is not active.
-    #[cfg(feature = "ui")]
     fn target_size(&self) -> Option<(u32, u32)> {
         match &self.target {
             Target::Detached => None,
@@ -1168,7 +1154,11 @@ impl Engine {
         let mut settings_actions = Vec::new();
         let filters = filter_colours(self.method);
         let mut card_closed = false;
-        let eyes_status = self.eyes_status();
+        // Only the menu says how the eyes are found.
+        let eyes_status = match &screens.page {
+            Some(Page::Menu(_)) => self.eyes_status(),
+            _ => String::new(),
+        };
         let annotations = &self.model_info.annotations;
         let mut banner_action = None;
         let mut banner_pt = None;
@@ -1390,14 +1380,10 @@ impl Engine {
     /// detached), without the screens drawn over it: width, height and sRGB RGBA pixels.
     pub fn snapshot(&mut self, kind: Snapshot) -> Result<(u32, u32, Vec<u8>), EngineError> {
         let screen = self.session.config().screen;
-        let (w, h) = match &self.target {
-            Target::Window(host) => match host.state() {
-                crate::surface::SurfaceState::Active { width, height } if width > 0 && height > 0 => (width, height),
-                _ => (screen.width_px(), screen.height_px()),
-            },
-            Target::Offscreen { width, height } if *width > 0 && *height > 0 => (*width, *height),
-            _ => (screen.width_px(), screen.height_px()),
-        };
+        let (w, h) = self
+            .target_size()
+            .filter(|&(w, h)| w > 0 && h > 0)
+            .unwrap_or((screen.width_px(), screen.height_px()));
         let view = self.session.frame_at(self.last_display_t_ns)?;
         let input = self.oriented(frame_input(&view, Vec3::Z * -self.last_push_m));
         Ok(match kind {

@@ -74,16 +74,20 @@ impl<'a> Span<'a> {
         Self { progress, from, to }
     }
 
-    /// Reports `done` of this step (0 to 1) and fails if the load was cancelled.
-    pub fn step(&self, done: f32) -> Result<(), Cancelled> {
-        self.progress
-            .step(self.from + (self.to - self.from) * done.clamp(0.0, 1.0))
+    /// The whole's fraction when `done` of this step (0 to 1) is done.
+    pub fn at(&self, done: f32) -> f32 {
+        self.from + (self.to - self.from) * done.clamp(0.0, 1.0)
     }
 
-    /// The part `[a, b]` of this step (each 0 to 1), as a span of the whole.
-    pub fn part(&self, a: f32, b: f32) -> Span<'a> {
-        let at = |x: f32| self.from + (self.to - self.from) * x.clamp(0.0, 1.0);
-        Span::new(self.progress, at(a), at(b))
+    /// Reports `done` of this step (0 to 1) and fails if the load was cancelled.
+    pub fn step(&self, done: f32) -> Result<(), Cancelled> {
+        self.progress.step(self.at(done))
+    }
+
+    /// Reports `done` of this step without looking at the cancel flag (from a task that cannot
+    /// stop half-way).
+    pub fn advance(&self, done: f32) {
+        self.progress.advance_to(self.at(done));
     }
 }
 
@@ -121,7 +125,10 @@ mod tests {
         let s = Span::new(&p, 0.2, 0.6);
         s.step(0.5).unwrap();
         assert!((p.fraction() - 0.4).abs() < 1e-6);
-        s.part(0.5, 1.0).step(1.0).unwrap();
+        s.advance(1.0);
         assert!((p.fraction() - 0.6).abs() < 1e-6);
+        p.cancel();
+        s.advance(0.9);
+        assert!((p.fraction() - 0.6).abs() < 1e-6, "never back, cancelled or not");
     }
 }

@@ -342,7 +342,7 @@ impl ApplicationHandler for App {
                     self.fail(event_loop, e);
                 }
                 // The desktop's answer to the menu's "Open a file": a file dropped on the window.
-                for request in self.engine.take_shell_requests() {
+                while let Some(request) = self.engine.take_shell_request() {
                     match request {
                         phantogram::engine::ShellRequest::OpenFile => {
                             eprintln!("drop a .glb, .gltf or .zip file on the window to open it")

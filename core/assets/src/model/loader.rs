@@ -1103,9 +1103,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
             .map_err(|e| (what(), e.to_string()))
             .map(|decoded| {
                 let done = decoded_count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                images_share
-                    .progress
-                    .advance_to(images_share.from + (images_share.to - images_share.from) * done as f32 / image_count);
+                images_share.advance(done as f32 / image_count);
                 // Larger than the device's textures: scaled down (a triangle filter averages
                 // the texels each new one covers), and the user told.
                 let (fw, fh) = *fitted;
