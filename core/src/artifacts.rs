@@ -5,6 +5,10 @@
 //!   result, if it still comes, is dropped by its generation number).
 //! * The artifact on screen stays until the new one is ready: the worker loads, fits and floors
 //!   the model (CPU work) into a [`Prepared`]; the render thread only uploads it.
+//! * An artifact with a lighter scan (a Voyager folder's "Thumb" beside its best scan) is shown
+//!   in it first, marked [`ModelInfo::preview`], while its best scan loads: a museum download's
+//!   full scan takes seconds to decode on a phone. If the best scan then fails, the preview stays
+//!   on screen with the failure's message.
 //! * A failure (a damaged file, an unknown id, over the budget) becomes
 //!   [`LoadStatus::Failed`] with a message for the screen; a cancelled load becomes
 //!   [`LoadStatus::Idle`] again, not an error.
@@ -41,6 +45,8 @@ pub struct ModelInfo {
     /// The publisher's points of interest, in the device frame (fitted with the model); each is
     /// drawn as a marker ([`Model::add_annotation_pins`]) and read by tapping it.
     pub annotations: Vec<crate::model::Annotation>,
+    /// A lighter scan shown while the artifact's best scan loads (see the module docs).
+    pub preview: bool,
 }
 
 /// A model ready to upload: fitted into the diorama, floored, its bounds known.
@@ -79,6 +85,7 @@ pub fn prepare(
         warnings: model.warnings.clone(),
         artifact: entry,
         annotations: model.annotations.clone(),
+        preview: false,
     };
     if placing.floor {
         model.add_floor(&placing.screen, Model::FLOOR_REACH);
@@ -156,7 +163,13 @@ impl FileSource {
     }
 }
 
-type Outcome = (u64, Result<Prepared, String>);
+/// A load's result, by its request's generation. A preview ([`Library::load_preview`]) comes
+/// before the final result of the same request, never instead of it.
+struct Outcome {
+    generation: u64,
+    preview: bool,
+    result: Result<Prepared, String>,
+}
 
 /// A load for the loader thread.
 struct Work {
@@ -185,6 +198,31 @@ fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, res
             placing,
             progress,
         } = work;
+        // A lighter scan first, when the artifact has one: the visitor sees the artifact within
+        // a fraction of the full load and watches it sharpen. Its own progress, so the bar
+        // tracks the full load; a cancel is seen when the preview is done (a fraction of a
+        // second), and a preview that fails just is not shown.
+        if let Request::Select(id) = &request {
+            let preview = || {
+                let loaded = library.load_preview(id, budget, &Progress::new())?.ok()?;
+                let mut prepared = prepare(loaded.model, Some(loaded.entry), loaded.placed, &placing).ok()?;
+                prepared.info.preview = true;
+                Some(prepared)
+            };
+            if let Ok(Some(prepared)) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(preview)) {
+                if progress.is_cancelled() {
+                    continue;
+                }
+                let outcome = Outcome {
+                    generation,
+                    preview: true,
+                    result: Ok(prepared),
+                };
+                if results.send(outcome).is_err() {
+                    return;
+                }
+            }
+        }
         let run = || -> Result<Prepared, LoadError> {
             let loaded: LoadedArtifact = match request {
                 Request::Select(id) => library.load(&id, budget, &progress)?,
@@ -200,14 +238,19 @@ fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, res
             progress.advance_to(0.95);
             Ok(prepared)
         };
-        let outcome = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        let result = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
             Ok(Ok(p)) => Ok(p),
             Ok(Err(e)) if e.is_cancelled() => continue,
             Ok(Err(e)) => Err(e.to_string()),
             Err(_) => Err("the loader failed unexpectedly (a bug); the artifact stays as it was".into()),
         };
+        let outcome = Outcome {
+            generation,
+            preview: false,
+            result,
+        };
         // The engine may be gone: then nobody wants the result.
-        if results.send((generation, outcome)).is_err() {
+        if results.send(outcome).is_err() {
             return;
         }
     }
@@ -337,7 +380,11 @@ impl Loader {
                             });
                         }
                         Err(e) => {
-                            let _ = results.send((generation, Err(e.to_string())));
+                            let _ = results.send(Outcome {
+                                generation,
+                                preview: false,
+                                result: Err(e.to_string()),
+                            });
                         }
                     })?;
             }
@@ -360,18 +407,20 @@ impl Loader {
         self.failed = None;
     }
 
-    /// The newest finished load of the current request, if one finished: `Ok` to upload, or
-    /// `Err` (already kept for [`Self::status`]).
+    /// The newest finished load of the current request, if one finished: `Some` to upload (a
+    /// preview, after which the load goes on, or its final result), `None` if nothing new or
+    /// it failed (the failure is kept for [`Self::status`]).
     pub fn poll(&mut self) -> Option<Prepared> {
-        self.take(None)
+        self.take(None, true)
     }
 
-    /// As [`Self::poll`], waiting up to `timeout` for the load under way.
+    /// Waits up to `timeout` for the final result of the load under way (a preview that comes
+    /// meanwhile is dropped): as [`Self::poll`] otherwise.
     pub fn wait(&mut self, timeout: Duration) -> Option<Prepared> {
-        self.take(Some(timeout))
+        self.take(Some(timeout), false)
     }
 
-    fn take(&mut self, timeout: Option<Duration>) -> Option<Prepared> {
+    fn take(&mut self, timeout: Option<Duration>, previews: bool) -> Option<Prepared> {
         let deadline = timeout.map(|t| std::time::Instant::now() + t);
         loop {
             let received = match deadline {
@@ -381,13 +430,19 @@ impl Loader {
                     .ok(),
                 _ => self.rx.try_recv().ok(),
             };
-            let (generation, outcome) = received?;
-            let Some(job) = self.job.as_ref().filter(|j| j.generation == generation) else {
+            let outcome = received?;
+            let Some(job) = self.job.as_ref().filter(|j| j.generation == outcome.generation) else {
                 continue; // a superseded or cancelled load's result
             };
+            if outcome.preview {
+                match outcome.result {
+                    Ok(p) if previews => return Some(p),
+                    _ => continue,
+                }
+            }
             let title = job.title.clone();
             self.job = None;
-            return match outcome {
+            return match outcome.result {
                 Ok(p) => Some(p),
                 Err(message) => {
                     self.failed = Some((title, message));

@@ -138,6 +138,61 @@ fn an_opened_file_is_imported_listed_shown_and_a_damaged_one_keeps_the_previous(
 }
 
 #[test]
+fn a_voyager_folder_is_shown_in_its_thumb_first_then_in_its_best_scan() {
+    let _serial = serial();
+    let dir = Scratch::new("engine-preview");
+    let turtle = dir.join("bundled/turtle");
+    std::fs::create_dir_all(&turtle).unwrap();
+    let scene = br#"{"models":[{"derivatives":[
+        {"usage":"Web3D","quality":"High","assets":[{"uri":"t-high.glb"}]},
+        {"usage":"Web3D","quality":"Thumb","assets":[{"uri":"t-thumb.glb"}]}]}]}"#;
+    std::fs::write(turtle.join("scene.svx.json"), scene).unwrap();
+    std::fs::write(turtle.join("t-high.glb"), tetrahedron_glb(0.2, "")).unwrap();
+    std::fs::write(turtle.join("t-thumb.glb"), tetrahedron_glb(0.2, "")).unwrap();
+    let Some(mut e) = start(EngineConfig {
+        bundled_dir: Some(dir.join("bundled")),
+        ..EngineConfig::default()
+    }) else {
+        return;
+    };
+    e.resume_offscreen(W, H).unwrap();
+    let amphora = frame(&mut e);
+    let id: ArtifactId = "bundled:turtle".parse().unwrap();
+    e.select_artifact(id.clone());
+    // Frames as a shell draws them: the first that shows the turtle shows its thumb, with the
+    // load still under way; later ones its best scan, and the load is over.
+    let mut names = Vec::new();
+    let deadline = std::time::Instant::now() + WAIT;
+    while std::time::Instant::now() < deadline {
+        let pixels = frame(&mut e);
+        let info = e.model_info();
+        if info.artifact.as_ref().map(|a| &a.id) == Some(&id) {
+            if names.last() != Some(&info.name) {
+                assert!(differing_pixels(&amphora, &pixels) > 1000, "the turtle is drawn");
+                let loading = matches!(e.loading_status(), LoadStatus::Loading { .. });
+                names.push(info.name.clone());
+                assert_eq!(info.preview, loading, "{:?} while {:?}", info.name, e.loading_status());
+            }
+            if !info.preview {
+                break;
+            }
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    assert_eq!(names, ["t-thumb", "t-high"]);
+    assert_eq!(e.loading_status(), LoadStatus::Idle);
+    // The tools wait for the best scan only.
+    e.select_artifact(ArtifactId::built_in("medal"));
+    assert!(e.wait_for_artifact(WAIT));
+    e.select_artifact(id);
+    assert!(e.wait_for_artifact(WAIT));
+    assert_eq!(
+        (e.model_info().name.as_str(), e.model_info().preview),
+        ("t-high", false)
+    );
+}
+
+#[test]
 fn a_hundred_switches_leave_resident_memory_flat() {
     let _serial = serial();
     let dir = Scratch::new("engine-switches");

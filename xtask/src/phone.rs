@@ -248,12 +248,7 @@ pub fn ios(artifacts: Option<&Path>) -> Result<()> {
     let build = root.join("ios/build");
     let _ = std::fs::remove_dir_all(&build);
     let headers = build.join("headers");
-    std::fs::create_dir_all(&headers)?;
-    std::fs::copy(root.join("ios/include/phantogram.h"), headers.join("phantogram.h"))?;
-    std::fs::write(
-        headers.join("module.modulemap"),
-        "module PhantogramCore {\n    header \"phantogram.h\"\n    export *\n}\n",
-    )?;
+    write_xcframework_headers(&root.join("ios/include/phantogram.h"), &headers)?;
     let simulator = build.join("libphantogram_ios-simulator.a");
     run(Command::new("lipo")
         .arg("-create")
@@ -278,6 +273,22 @@ pub fn ios(artifacts: Option<&Path>) -> Result<()> {
         "built {}; open the app with `xcodegen generate` in ios/App (or add the package to an Xcode app target)",
         build.join("PhantogramCore.xcframework").display()
     );
+    Ok(())
+}
+
+/// The XCFramework's `Headers` folder: the header and its module map in a folder named for the
+/// module (`Headers/PhantogramCore/`). Xcode copies every XCFramework's headers into one include
+/// folder, so a `module.modulemap` at the top would collide with another framework's ("multiple
+/// commands produce …/module.modulemap"); inside its own folder it cannot, and Clang still finds
+/// it by searching one level down.
+fn write_xcframework_headers(header: &Path, headers: &Path) -> Result<()> {
+    let module = headers.join("PhantogramCore");
+    std::fs::create_dir_all(&module).with_context(|| format!("creating {}", module.display()))?;
+    std::fs::copy(header, module.join("phantogram.h")).with_context(|| format!("copying {}", header.display()))?;
+    std::fs::write(
+        module.join("module.modulemap"),
+        "module PhantogramCore {\n    header \"phantogram.h\"\n    export *\n}\n",
+    )?;
     Ok(())
 }
 
@@ -432,7 +443,27 @@ fn header_functions(header: &str) -> std::collections::BTreeSet<String> {
 
 #[cfg(test)]
 mod tests {
-    use super::header_functions;
+    use super::{header_functions, write_xcframework_headers};
+
+    #[test]
+    fn the_module_map_sits_in_a_folder_named_for_the_module() {
+        let dir = std::env::temp_dir().join(format!("xtask-headers-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let header = dir.join("phantogram.h");
+        std::fs::create_dir_all(&dir).unwrap();
+        std::fs::write(&header, "void pg_x(void);\n").unwrap();
+        write_xcframework_headers(&header, &dir.join("Headers")).unwrap();
+        let mut top: Vec<String> = std::fs::read_dir(dir.join("Headers"))
+            .unwrap()
+            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+            .collect();
+        top.sort();
+        assert_eq!(top, ["PhantogramCore"], "nothing at the top of Headers/");
+        let map = std::fs::read_to_string(dir.join("Headers/PhantogramCore/module.modulemap")).unwrap();
+        assert!(map.contains("module PhantogramCore") && map.contains("header \"phantogram.h\""));
+        assert!(dir.join("Headers/PhantogramCore/phantogram.h").is_file());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn header_functions_are_the_called_pg_names() {

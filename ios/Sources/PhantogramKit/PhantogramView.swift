@@ -77,6 +77,13 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
         }
         motion.start()
         let link = CADisplayLink(target: self, selector: #selector(step(_:)))
+        // ProMotion screens: ask for their full rate (a phantogram follows the head; every frame
+        // sooner is less lag). iOS grants more than 60 Hz only with the app's Info.plist key
+        // `CADisableMinimumFrameDurationOnPhone` (set in App/project.yml).
+        if #available(iOS 15.0, *) {
+            let fastest = Float(UIScreen.main.maximumFramesPerSecond)
+            link.preferredFrameRateRange = CAFrameRateRange(minimum: 30, maximum: fastest, preferred: fastest)
+        }
         link.add(to: .main, forMode: .common)
         self.link = link
     }

@@ -339,6 +339,29 @@ impl Library {
         Ok(loaded)
     }
 
+    /// A lighter scan of the artifact to show while [`Self::load`] runs (a Voyager folder's
+    /// lowest-quality scan beside the best one, [`crate::model::voyager_preview`]), loaded within
+    /// `budget`; `None` when the artifact has no such scan.
+    pub fn load_preview(
+        &self,
+        id: &ArtifactId,
+        budget: ResourceBudget,
+        progress: &Progress,
+    ) -> Option<Result<LoadedArtifact, LibraryError>> {
+        let entry = self.entry(id).ok()?;
+        let folder = entry.model_path.as_deref().filter(|p| p.is_dir())?;
+        let preview = crate::model::voyager_preview(folder)?;
+        Some(
+            crate::model::load_model_with(&preview, budget, progress)
+                .map(|model| LoadedArtifact {
+                    model,
+                    entry,
+                    placed: false,
+                })
+                .map_err(LibraryError::from),
+        )
+    }
+
     /// Imports a file the user opened: `source_name` is its display name (for the title and
     /// messages), `bytes` its content. The model is loaded within `budget` before the import is
     /// kept, and returned loaded. Opening a file already imported returns that artifact.

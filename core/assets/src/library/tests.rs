@@ -228,3 +228,35 @@ fn a_damaged_record_still_lists_the_artifact() {
     assert_eq!(list[3].title, metadata::title_from_name(&a.entry.id.key));
     assert!(lib.load(&a.entry.id, budget(), &Progress::new()).is_ok());
 }
+
+#[test]
+fn a_voyager_folder_offers_its_lightest_scan_as_a_preview() {
+    let dir = Scratch::new("library-preview");
+    let bundled = dir.join("bundled");
+    let turtle = bundled.join("turtle");
+    std::fs::create_dir_all(&turtle).unwrap();
+    let scene = br#"{"models":[{"derivatives":[
+        {"usage":"Web3D","quality":"Thumb","assets":[{"uri":"t-thumb.glb"}]},
+        {"usage":"Web3D","quality":"High","assets":[{"uri":"t-high.glb"}]},
+        {"usage":"Web3D","quality":"Low","assets":[{"uri":"t-low.glb"}]}]}]}"#;
+    std::fs::write(turtle.join("scene.svx.json"), scene).unwrap();
+    std::fs::write(turtle.join("t-high.glb"), tetrahedron_glb(0.07, "")).unwrap();
+    std::fs::write(turtle.join("t-thumb.glb"), tetrahedron_glb(0.05, "")).unwrap();
+    let lib = Library::new(None, Some(bundled.clone()));
+    let id: ArtifactId = "bundled:turtle".parse().unwrap();
+    // The best present (High) is the artifact; the lightest present (Thumb; Low is absent) its
+    // preview.
+    let full = lib.load(&id, budget(), &Progress::new()).unwrap();
+    assert_eq!(full.model.name, "t-high");
+    let preview = lib.load_preview(&id, budget(), &Progress::new()).unwrap().unwrap();
+    assert_eq!(preview.model.name, "t-thumb");
+    assert_eq!(preview.entry.id, id);
+    // One scan present: nothing lighter to show first.
+    std::fs::remove_file(turtle.join("t-thumb.glb")).unwrap();
+    assert!(lib.load_preview(&id, budget(), &Progress::new()).is_none());
+    // Built-in artifacts are generated at once: no preview.
+    assert!(
+        lib.load_preview(&"builtin:medal".parse().unwrap(), budget(), &Progress::new())
+            .is_none()
+    );
+}

@@ -851,6 +851,24 @@ const VOYAGER_SCENE: &str = "scene.svx.json";
 /// its best-quality "Web3D" derivative present beside it (High, then Medium, Low, Thumb: the
 /// downloads usually hold some of them).
 pub fn voyager_scan(scene_or_folder: &Path) -> Result<PathBuf, ModelError> {
+    let mut scans = voyager_scans(scene_or_folder)?;
+    Ok(scans.swap_remove(0))
+}
+
+/// A lighter scan of the same artifact to show while [`voyager_scan`]'s loads: the
+/// lowest-quality "Web3D" derivative present (Voyager's own viewer shows its "Thumb" first and
+/// refines it the same way), `None` when the scene offers only one scan here or cannot be read.
+pub fn voyager_preview(scene_or_folder: &Path) -> Option<PathBuf> {
+    let scans = voyager_scans(scene_or_folder).ok()?;
+    scans
+        .last()
+        .filter(|lightest| Some(*lightest) != scans.first())
+        .cloned()
+}
+
+/// The "Web3D" scans a Voyager scene lists and that are present beside it, best first (never
+/// empty).
+fn voyager_scans(scene_or_folder: &Path) -> Result<Vec<PathBuf>, ModelError> {
     let scene_path = if scene_or_folder.is_dir() {
         scene_or_folder.join(VOYAGER_SCENE)
     } else {
@@ -894,17 +912,19 @@ pub fn voyager_scan(scene_or_folder: &Path) -> Result<PathBuf, ModelError> {
     if offered.is_empty() {
         return Err(not_a_model("the Voyager scene lists no glTF scan".into()));
     }
-    offered
+    let present: Vec<PathBuf> = offered
         .iter()
         .map(|(_, uri)| folder.join(uri))
-        .find(|p| p.is_file())
-        .ok_or_else(|| {
-            let names: Vec<&str> = offered.iter().map(|(_, u)| *u).collect();
-            not_a_model(format!(
-                "none of the scans the Voyager scene lists is here ({})",
-                names.join(", ")
-            ))
-        })
+        .filter(|p| p.is_file())
+        .collect();
+    if present.is_empty() {
+        let names: Vec<&str> = offered.iter().map(|(_, u)| *u).collect();
+        return Err(not_a_model(format!(
+            "none of the scans the Voyager scene lists is here ({})",
+            names.join(", ")
+        )));
+    }
+    Ok(present)
 }
 
 /// Loads a model as its publisher meant it to be seen: [`load_gltf`], then the orientation of a

@@ -568,7 +568,8 @@ fn push_ball(mesh: &mut Mesh, centre: Vec3, radius: f32, segments: u32, rings: u
 
 pub use loader::{
     MAX_COORDINATE, ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with, load_gltf_within, load_model,
-    load_model_with, load_model_within, resolve_inside, voyager_annotations, voyager_rotation, voyager_scan,
+    load_model_with, load_model_within, resolve_inside, voyager_annotations, voyager_preview, voyager_rotation,
+    voyager_scan,
 };
 
 mod loader;
