@@ -782,6 +782,20 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCurrentArtifact<'l
     })
 }
 
+/// The app has no camera permission yet and may ask: the core shows its camera page first and
+/// asks through `nativeTakeShellRequest` (2) when the user wants the camera.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraPermissionNeeded<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) {
+    run(&mut env, |_| {
+        engine(handle)?.lock().camera_permission_needed();
+        Ok(())
+    })
+}
+
 /// Opens the menu (the artifact gallery, opening a file, calibration), as a single tap does.
 #[unsafe(no_mangle)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeOpenMenu<'local>(
@@ -796,7 +810,8 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeOpenMenu<'local>(
 }
 
 /// The oldest request of the core's screens not yet taken: 0 none, 1 open a file (start
-/// `ACTION_OPEN_DOCUMENT`, then `nativeImportArtifactFd`). Call after each frame.
+/// `ACTION_OPEN_DOCUMENT`, then `nativeImportArtifactFd`), 2 ask for the camera permission
+/// (the core has shown why). Call after each frame.
 #[unsafe(no_mangle)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeTakeShellRequest<'local>(
     mut env: EnvUnowned<'local>,
@@ -804,10 +819,10 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeTakeShellRequest<'
     handle: jlong,
 ) -> jint {
     run(&mut env, |_| {
-        Ok(match engine(handle)?.lock().take_shell_request() {
-            None => 0,
-            Some(phantogram::engine::ShellRequest::OpenFile) => 1,
-        })
+        Ok(engine(handle)?
+            .lock()
+            .take_shell_request()
+            .map_or(0, phantogram::engine::ShellRequest::code))
     })
 }
 
@@ -858,7 +873,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSnapshotPng<'local
 
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 25] = [
+pub const NATIVE_METHODS: [&str; 26] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
@@ -878,6 +893,7 @@ pub const NATIVE_METHODS: [&str; 25] = [
     "nativeCalibrationWarning",
     "nativeImportArtifact",
     "nativeImportArtifactFd",
+    "nativeCameraPermissionNeeded",
     "nativeSelectArtifact",
     "nativeCurrentArtifact",
     "nativeOpenMenu",

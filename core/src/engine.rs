@@ -264,6 +264,9 @@ pub struct Engine {
     screens: Option<Box<Screens>>,
     /// What the core asks of the shell (a file picker), until taken.
     requests: Vec<ShellRequest>,
+    /// The camera page waits for the screens in front of it to close.
+    #[cfg(feature = "ui")]
+    camera_page_pending: bool,
 }
 
 /// Something only the platform can do, asked for by the core's screens: the shell takes these
@@ -273,6 +276,19 @@ pub struct Engine {
 pub enum ShellRequest {
     /// Show the system's document picker for a `.glb`, `.gltf` or `.zip`.
     OpenFile,
+    /// Show the system's camera permission request (the user has read why, on the core's
+    /// camera page, and wants it): see [`Engine::camera_permission_needed`].
+    CameraPermission,
+}
+
+impl ShellRequest {
+    /// The request's number across the bridges (C and JNI): 0 is "none", so never used here.
+    pub fn code(self) -> i32 {
+        match self {
+            Self::OpenFile => 1,
+            Self::CameraPermission => 2,
+        }
+    }
 }
 
 /// Paints over a composed frame: the GPU, the frame's view, its format and size.
@@ -478,6 +494,8 @@ impl Engine {
             #[cfg(feature = "ui")]
             screens: None,
             requests: Vec::new(),
+            #[cfg(feature = "ui")]
+            camera_page_pending: false,
         };
         engine.apply_calibration();
         #[cfg(feature = "ui")]
@@ -670,6 +688,31 @@ impl Engine {
         return matches!(self.page(), Some(Page::Welcome(_)));
         #[cfg(not(feature = "ui"))]
         false
+    }
+
+    /// The shell has no camera permission yet and may ask for it. Instead of the system's
+    /// request out of the blue, the core shows its camera page (what the camera is for, that no
+    /// picture is kept) as soon as no other screen is open — after the first-run screens, if
+    /// they show — and only when the user taps "Use the camera" asks the shell
+    /// ([`ShellRequest::CameraPermission`]). "Not now" leaves tilt only, until the next start.
+    /// Without the `ui` feature the request is made at once.
+    pub fn camera_permission_needed(&mut self) {
+        #[cfg(feature = "ui")]
+        {
+            self.camera_page_pending = true;
+            self.open_pending_camera_page();
+        }
+        #[cfg(not(feature = "ui"))]
+        self.requests.push(ShellRequest::CameraPermission);
+    }
+
+    /// Opens the camera page if it waits and nothing else is open.
+    #[cfg(feature = "ui")]
+    fn open_pending_camera_page(&mut self) {
+        if self.camera_page_pending && self.page().is_none() {
+            self.camera_page_pending = false;
+            self.set_page(Some(Page::Welcome(crate::calibration_ui::welcome::WelcomeUi::camera())));
+        }
     }
 
     /// The oldest request of the core's screens not yet taken (see [`ShellRequest`]); call until
@@ -1065,6 +1108,7 @@ impl Engine {
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
         {
+            self.open_pending_camera_page();
             let page_open = self.screens.as_ref().is_some_and(|s| s.page.is_some());
             let status = self.loader.status();
             if page_open || status != LoadStatus::Idle {
@@ -1287,6 +1331,11 @@ impl Engine {
                 self.set_page(None);
                 self.open_calibration();
             }
+            A::AllowCamera => {
+                self.requests.push(ShellRequest::CameraPermission);
+                self.set_page(None);
+            }
+            A::CameraNotNow => self.set_page(None),
         }
     }
 

@@ -326,9 +326,18 @@ size_t pg_current_artifact(const struct PgEngine *engine, char *buffer, size_t c
 // `engine` is a live handle.
 enum PgStatus pg_open_menu(const struct PgEngine *engine);
 
+// The app has no camera permission yet and may ask (`AVAuthorizationStatus.notDetermined`):
+// the core shows its camera page first, and asks through `pg_take_shell_request` (2) when the
+// user wants the camera.
+//
+// # Safety
+// `engine` is a live handle.
+enum PgStatus pg_camera_permission_needed(const struct PgEngine *engine);
+
 // Takes the oldest thing the core's screens asked of the app since the last call: `*request`
-// receives 0 (nothing), or 1 (show the document picker for a `.glb`, `.gltf` or `.zip`, then
-// `pg_import_artifact`). Call after each `pg_draw`.
+// receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf` or `.zip`, then
+// `pg_import_artifact`) or 2 (ask for the camera permission: the core's camera page has said
+// why; start the camera when granted). Call after each `pg_draw`.
 //
 // # Safety
 // `engine` is a live handle; `request` is valid for a write.

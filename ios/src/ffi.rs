@@ -858,9 +858,25 @@ pub unsafe extern "C" fn pg_open_menu(engine: *const PgEngine) -> PgStatus {
     })
 }
 
+/// The app has no camera permission yet and may ask (`AVAuthorizationStatus.notDetermined`):
+/// the core shows its camera page first, and asks through `pg_take_shell_request` (2) when the
+/// user wants the camera.
+///
+/// # Safety
+/// `engine` is a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_camera_permission_needed(engine: *const PgEngine) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        unsafe { engine_ref(engine) }?.shared.lock().camera_permission_needed();
+        Ok(())
+    })
+}
+
 /// Takes the oldest thing the core's screens asked of the app since the last call: `*request`
-/// receives 0 (nothing), or 1 (show the document picker for a `.glb`, `.gltf` or `.zip`, then
-/// `pg_import_artifact`). Call after each `pg_draw`.
+/// receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf` or `.zip`, then
+/// `pg_import_artifact`) or 2 (ask for the camera permission: the core's camera page has said
+/// why; start the camera when granted). Call after each `pg_draw`.
 ///
 /// # Safety
 /// `engine` is a live handle; `request` is valid for a write.
@@ -869,10 +885,11 @@ pub unsafe extern "C" fn pg_take_shell_request(engine: *const PgEngine, request:
     guard(|| {
         // SAFETY: forwarded caller promise.
         let engine = unsafe { engine_ref(engine) }?;
-        let first = match engine.shared.lock().take_shell_request() {
-            None => 0,
-            Some(phantogram::engine::ShellRequest::OpenFile) => 1,
-        };
+        let first = engine
+            .shared
+            .lock()
+            .take_shell_request()
+            .map_or(0, phantogram::engine::ShellRequest::code);
         // SAFETY: the caller promises a writable `request` (null is reported).
         let out =
             unsafe { request.as_mut() }.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`request` is null"))?;

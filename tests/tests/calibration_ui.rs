@@ -353,7 +353,8 @@ mod golden;
 
 /// The first run, driven by taps as a new user would: the screens open by themselves, the
 /// glasses check swaps the eyes when the glasses are on the other way round, Start takes the
-/// pose held as straight on, and they do not open again.
+/// pose held as straight on, the camera is explained before it is asked for, and the screens do
+/// not open again.
 #[test]
 fn the_first_run_screens_check_the_glasses_and_take_the_pose() {
     use phantogram::engine::{Engine, EngineConfig, Snapshot};
@@ -447,6 +448,31 @@ fn the_first_run_screens_check_the_glasses_and_take_the_pose() {
         same += usize::from(s[..half] == n[half..] && s[half..] == n[..half]);
     }
     assert!(same > h as usize * 99 / 100, "only {same} of {h} rows swapped");
+
+    // No camera permission yet: the core's camera page says why before the system asks, and
+    // waits for the screen in front of it to close.
+    engine.open_menu();
+    engine.camera_permission_needed();
+    frames(&mut engine, 2, &mut t);
+    assert!(engine.control_px("allow-camera").is_none(), "the menu stays in front");
+    tap(&mut engine, "close", &mut t);
+    assert!(
+        engine.control_px("allow-camera").is_some(),
+        "then the camera page shows"
+    );
+    golden::check("welcome-camera", w, h, engine.last_frame().unwrap().2, 3, 0.003);
+    assert_eq!(engine.take_shell_request(), None, "nothing asked of the system yet");
+    tap(&mut engine, "not-now", &mut t);
+    assert_eq!(engine.take_shell_request(), None, "\"Not now\" asks nothing");
+    assert!(!engine.welcome_open());
+    engine.camera_permission_needed();
+    frames(&mut engine, 1, &mut t);
+    tap(&mut engine, "allow-camera", &mut t);
+    assert_eq!(
+        engine.take_shell_request(),
+        Some(phantogram::engine::ShellRequest::CameraPermission)
+    );
+    assert!(!engine.welcome_open(), "back to the picture while the system asks");
 
     // Not shown again.
     drop(engine);

@@ -210,6 +210,9 @@ public final class ReplayThroughJni {
                 throw new AssertionError("after selecting the tablet: " + NativeBridge.nativeCurrentArtifact(a));
             }
             NativeBridge.nativeOpenMenu(a);
+            // The core explains the camera before anything is asked of the system.
+            NativeBridge.nativeCameraPermissionNeeded(a);
+            NativeBridge.nativeDrawFrame(a, -1);
             if (NativeBridge.nativeTakeShellRequest(a) != NativeBridge.REQUEST_NONE) {
                 throw new AssertionError("a shell request before anything was asked");
             }

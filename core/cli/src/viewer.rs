@@ -347,6 +347,8 @@ impl ApplicationHandler for App {
                         phantogram::engine::ShellRequest::OpenFile => {
                             eprintln!("drop a .glb, .gltf or .zip file on the window to open it")
                         }
+                        // The desktop asks no permission (the viewer never reports one missing).
+                        phantogram::engine::ShellRequest::CameraPermission => {}
                     }
                 }
             }

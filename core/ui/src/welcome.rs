@@ -8,6 +8,10 @@
 //! engine swaps the eyes' images. "Both" or "neither" means no glasses, or glasses of other
 //! colours than the chosen method's.
 //!
+//! The camera page says what the front camera is for before the system asks for it (a request
+//! out of the blue is the one most people refuse): "Use the camera" makes the engine ask the
+//! shell to show the system's permission request; "Not now" keeps tilt only.
+//!
 //! **Threading**: the render thread. **Panics**: none.
 
 use egui::{Align2, Color32, FontId, Pos2, Rect, RichText, Stroke, Vec2};
@@ -21,6 +25,8 @@ pub enum WelcomePage {
     Glasses,
     /// The check's outcome, in words, until "Continue".
     GlassesResult(GlassesFinding),
+    /// What the front camera is for, before the system's permission request.
+    Camera,
 }
 
 /// What the glasses check found.
@@ -41,6 +47,10 @@ pub enum WelcomeAction {
     GlassesSwapped(bool),
     /// Note the first run as done and open the calibration screens.
     Calibrate,
+    /// The user wants the camera: show the system's permission request.
+    AllowCamera,
+    /// The user declined the camera for now: close the page.
+    CameraNotNow,
 }
 
 /// The two filters' colours, left eye's first (sRGB), for the rings.
@@ -67,9 +77,17 @@ impl WelcomeUi {
         Self::default()
     }
 
+    /// The camera page on its own (when the shell reports the permission missing).
+    pub fn camera() -> Self {
+        Self {
+            page: WelcomePage::Camera,
+            widget_rects: Vec::new(),
+        }
+    }
+
     /// The rectangle (points) of a control drawn last frame: `start`, `glasses`, `calibrate`,
-    /// `left-ring`, `right-ring`, `unclear`, `continue`; and the rings themselves, `ring-left`
-    /// and `ring-right`.
+    /// `left-ring`, `right-ring`, `unclear`, `continue`, `allow-camera`, `not-now`; and the
+    /// rings themselves, `ring-left` and `ring-right`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
     }
@@ -184,6 +202,37 @@ impl WelcomeUi {
                     }
                 });
             }
+            WelcomePage::Camera => {
+                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                    ui.heading(RichText::new("Follow your eyes with the camera?").size(22.0));
+                    ui.add_space(6.0);
+                    let (rect, _) =
+                        ui.allocate_exact_size(Vec2::new(ui.available_width(), 150.0), egui::Sense::hover());
+                    camera_picture(ui.painter(), rect);
+                    ui.add_space(6.0);
+                    ui.label(
+                        RichText::new(
+                            "The front camera can find your eyes, so the artifact keeps its place in 3D when \
+                             you move your head, not only when you tilt the phone.",
+                        )
+                        .size(16.0),
+                    );
+                    ui.label(
+                        RichText::new(
+                            "The pictures are looked at on the phone and forgotten at once: nothing is stored or \
+                             sent anywhere. Without the camera, tilting the phone still works.",
+                        )
+                        .size(16.0),
+                    );
+                    ui.add_space(8.0);
+                    if self.button(ui, "allow-camera", "Use the camera") {
+                        actions.push(WelcomeAction::AllowCamera);
+                    }
+                    if self.button(ui, "not-now", "Not now") {
+                        actions.push(WelcomeAction::CameraNotNow);
+                    }
+                });
+            }
         }
         actions
     }
@@ -254,6 +303,42 @@ fn pose_picture(painter: &egui::Painter, rect: Rect) {
     );
 }
 
+/// A phone seen from the front, its front camera looking at a face.
+fn camera_picture(painter: &egui::Painter, rect: Rect) {
+    let ink = Color32::from_gray(210);
+    let accent = Color32::from_rgb(255, 190, 90);
+    let s = (rect.width() / 300.0).min(rect.height() / 150.0);
+    let at = |x: f32, y: f32| {
+        Pos2::new(
+            rect.left() + (rect.width() - 300.0 * s) * 0.5 + x * s,
+            rect.top() + y * s,
+        )
+    };
+    // The phone, upright, with its camera dot at the top.
+    let phone = Rect::from_min_max(at(40.0, 10.0), at(110.0, 140.0));
+    painter.rect_stroke(phone, 8.0 * s, Stroke::new(2.0, ink), egui::StrokeKind::Inside);
+    let lens = at(75.0, 20.0);
+    painter.circle_filled(lens, 4.0 * s, accent);
+    // The face, right: head, two eyes.
+    let head = at(230.0, 70.0);
+    painter.circle_stroke(head, 45.0 * s, Stroke::new(2.0, ink));
+    for dx in [-16.0, 16.0] {
+        painter.circle_filled(head + Vec2::new(dx, -8.0) * s, 5.0 * s, ink);
+    }
+    // The camera's view, a dashed cone from the lens around the face, the eyes ringed.
+    for target in [head + Vec2::new(-20.0, -52.0) * s, head + Vec2::new(-20.0, 52.0) * s] {
+        let dashes = 12;
+        for k in (0..dashes).step_by(2) {
+            let a = lens + (target - lens) * (k as f32 / dashes as f32);
+            let b = lens + (target - lens) * ((k + 1) as f32 / dashes as f32);
+            painter.line_segment([a, b], Stroke::new(1.5, accent));
+        }
+    }
+    for dx in [-16.0, 16.0] {
+        painter.circle_stroke(head + Vec2::new(dx, -8.0) * s, 9.0 * s, Stroke::new(1.5, accent));
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -307,6 +392,18 @@ mod tests {
         assert_eq!(tap(&ctx, &mut w, "start"), vec![WelcomeAction::Start]);
         assert_eq!(tap(&ctx, &mut w, "calibrate"), vec![WelcomeAction::Calibrate]);
         for name in ["start", "glasses", "calibrate"] {
+            assert!(w.widget_rect(name).unwrap().height() >= CONTROL_HEIGHT_PT - 0.5);
+        }
+    }
+
+    #[test]
+    fn the_camera_page_asks_before_the_system_does() {
+        let ctx = egui::Context::default();
+        let mut w = WelcomeUi::camera();
+        frame(&ctx, &mut w, vec![]);
+        assert_eq!(tap(&ctx, &mut w, "allow-camera"), vec![WelcomeAction::AllowCamera]);
+        assert_eq!(tap(&ctx, &mut w, "not-now"), vec![WelcomeAction::CameraNotNow]);
+        for name in ["allow-camera", "not-now"] {
             assert!(w.widget_rect(name).unwrap().height() >= CONTROL_HEIGHT_PT - 0.5);
         }
     }

@@ -12,20 +12,28 @@ final class CameraSource: NSObject, AVCaptureVideoDataOutputSampleBufferDelegate
 
     private init(engine: Engine) { self.engine = engine }
 
-    /// Asks for permission when needed; returns the running source, or nil (tilt only).
+    /// Starts at once when allowed. When the user has not been asked yet, the core's camera page
+    /// explains first (`pg_camera_permission_needed`) and the system's request waits for
+    /// `requestAccess()`, called when the core asks for it. Returns the source, or nil when the
+    /// camera was refused (tilt only).
     static func startIfAllowed(engine: Engine) -> CameraSource? {
         let source = CameraSource(engine: engine)
         switch AVCaptureDevice.authorizationStatus(for: .video) {
         case .authorized:
             source.queue.async { source.configureAndStart() }
         case .notDetermined:
-            AVCaptureDevice.requestAccess(for: .video) { granted in
-                if granted { source.queue.async { source.configureAndStart() } }
-            }
+            _ = pg_camera_permission_needed(engine.handle)
         default:
             return nil
         }
         return source
+    }
+
+    /// The system's permission request (the core's camera page has said why); starts when granted.
+    func requestAccess() {
+        AVCaptureDevice.requestAccess(for: .video) { granted in
+            if granted { self.queue.async { self.configureAndStart() } }
+        }
     }
 
     private func configureAndStart() {

@@ -98,9 +98,22 @@ public final class Engine {
         }
     }
 
-    /// What the core's screens ask of the app: `true` when it wants the document picker.
-    func wantsDocumentPicker() -> Bool {
+    /// What the core's screens ask of the app (`pg_take_shell_request`).
+    enum ShellRequest {
+        /// The document picker for a .glb, .gltf or .zip.
+        case openFile
+        /// The system's camera permission request (the core's camera page said why).
+        case cameraPermission
+    }
+
+    /// The oldest request of the core's screens, or nil; call after each frame.
+    func takeShellRequest() -> ShellRequest? {
         var request: Int32 = 0
-        return pg_take_shell_request(handle, &request) == PG_STATUS_OK && request == 1
+        guard pg_take_shell_request(handle, &request) == PG_STATUS_OK else { return nil }
+        switch request {
+        case 1: return .openFile
+        case 2: return .cameraPermission
+        default: return nil
+        }
     }
 }

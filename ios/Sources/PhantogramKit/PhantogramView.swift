@@ -105,7 +105,11 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
         do { try check(pg_draw(engine.handle, link.targetTimestamp, &presented)) } catch {
             NSLog("phantogram: %@", String(describing: error))
         }
-        if engine.wantsDocumentPicker() { presentDocumentPicker() }
+        switch engine.takeShellRequest() {
+        case .openFile?: presentDocumentPicker()
+        case .cameraPermission?: camera?.requestAccess()
+        case nil: break
+        }
     }
 
     /// The core's menu asked for a file: the system's document browser for glTF and zip files.

@@ -233,6 +233,10 @@ int main(int argc, char **argv) {
         return 1;
     }
     check(pg_open_menu(engine), PG_STATUS_OK, "open the menu", NULL);
+    /* The core explains the camera before anything is asked of the system. */
+    check(pg_camera_permission_needed(engine), PG_STATUS_OK, "camera permission needed", NULL);
+    check(pg_camera_permission_needed(NULL), PG_STATUS_NULL_POINTER, "camera permission on null", "engine");
+    check(pg_draw(engine, -1.0, NULL), PG_STATUS_OK, "draw with the camera page waiting", NULL);
     int request = -1;
     check(pg_take_shell_request(engine, &request), PG_STATUS_OK, "shell request", NULL);
     check(pg_take_shell_request(engine, NULL), PG_STATUS_NULL_POINTER, "shell request to null", "request");

@@ -111,6 +111,13 @@ public final class NativeBridge {
     public static final int REQUEST_NONE = 0;
     /** Show ACTION_OPEN_DOCUMENT for a .glb, .gltf or .zip, then nativeImportArtifactFd. */
     public static final int REQUEST_OPEN_FILE = 1;
+    /** Ask for the CAMERA permission (the core's camera page has said why); start the camera
+     *  when granted. */
+    public static final int REQUEST_CAMERA_PERMISSION = 2;
+
+    /** The app has no camera permission yet and may ask: the core explains first, then asks
+     *  with REQUEST_CAMERA_PERMISSION if the user wants the camera. */
+    public static native void nativeCameraPermissionNeeded(long handle);
 
     /** Imports a file the user opened (display name, bytes); loaded in the background, the
      *  core's banner shows progress or the reason it failed. */

@@ -38,7 +38,9 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
     private val render = RenderLoop(
         onError = { t -> Log.e(TAG, "phantogram", t) },
         // The core's menu asked for a file: the system's document picker, on the UI thread.
-        onOpenFile = { runOnUiThread { openDocument.launch(MODEL_TYPES) } }
+        onOpenFile = { runOnUiThread { openDocument.launch(MODEL_TYPES) } },
+        // The core's camera page said why and the user wants the camera: the system's request.
+        onCameraPermission = { runOnUiThread { askCamera.launch(Manifest.permission.CAMERA) } }
     )
     private lateinit var sensors: SensorForwarder
     private var camera: CameraForwarder? = null
@@ -69,7 +71,9 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         if (checkSelfPermission(Manifest.permission.CAMERA) == PackageManager.PERMISSION_GRANTED) {
             startCamera()
         } else {
-            askCamera.launch(Manifest.permission.CAMERA)
+            // Not asked out of the blue: the core's camera page says what the camera is for and
+            // asks back (onCameraPermission) only if the user wants it.
+            render.cameraPermissionNeeded()
         }
     }
 

@@ -19,7 +19,9 @@ import java.util.concurrent.TimeUnit
 class RenderLoop(
     private val onError: (Throwable) -> Unit,
     /** The core's menu asked for a file (called on the render thread). */
-    private val onOpenFile: () -> Unit
+    private val onOpenFile: () -> Unit,
+    /** The core's camera page: the user wants the camera (called on the render thread). */
+    private val onCameraPermission: () -> Unit
 ) : Choreographer.FrameCallback {
     private val thread = HandlerThread("phantogram-render").apply { start() }
     private val handler = Handler(thread.looper)
@@ -40,6 +42,11 @@ class RenderLoop(
         engine = NativeBridge.nativeCreate(null, facesDir, panel.widthPx, panel.heightPx,
             panel.xdpi, panel.ydpi, panel.rotation, anaglyph, calibrationPath, libraryDir, bundledDir, artifact)
         NativeBridge.nativeCalibrationWarning(engine)?.let { Log.w("Phantogram", it) }
+    }
+
+    /** No camera permission yet: the core explains the camera before the system asks. */
+    fun cameraPermissionNeeded() = post {
+        if (engine != 0L) NativeBridge.nativeCameraPermissionNeeded(engine)
     }
 
     /** A document the user opened: the engine takes the descriptor over (and closes it). */
@@ -109,8 +116,11 @@ class RenderLoop(
         try {
             if (engine != 0L) {
                 NativeBridge.nativeDrawFrame(engine, displayNs)
-                // What the core's screens ask of the platform (the document picker).
-                if (NativeBridge.nativeTakeShellRequest(engine) == NativeBridge.REQUEST_OPEN_FILE) onOpenFile()
+                // What the core's screens ask of the platform.
+                when (NativeBridge.nativeTakeShellRequest(engine)) {
+                    NativeBridge.REQUEST_OPEN_FILE -> onOpenFile()
+                    NativeBridge.REQUEST_CAMERA_PERMISSION -> onCameraPermission()
+                }
             }
         } catch (t: RuntimeException) {
             onError(t)
