@@ -16,10 +16,6 @@ android {
         targetSdk = 35
         versionCode = 1
         versionName = "0.1.0"
-        ndk {
-            // What `cargo xtask android` builds into src/main/jniLibs.
-            abiFilters += listOf("arm64-v8a", "armeabi-v7a", "x86_64")
-        }
     }
 
     buildTypes {
@@ -37,19 +33,17 @@ android {
     kotlinOptions {
         jvmTarget = "17"
     }
-    // The face models are copied here by `cargo xtask android` (from `cargo xtask models`) and
-    // must stay uncompressed in the APK only for speed; they are extracted once at start.
+    // The museum's own scans, copied into src/main/assets/artifacts by
+    // `cargo xtask android --artifacts DIR`: stored as they are (glb and jpg are compressed
+    // already), extracted to app storage when the app is installed or updated.
     androidResources {
-        noCompress += "onnx"
+        noCompress += listOf("glb", "zip")
     }
 }
 
 dependencies {
-    val camerax = "1.4.1"
-    implementation("androidx.camera:camera-core:$camerax")
-    implementation("androidx.camera:camera-camera2:$camerax")
-    implementation("androidx.camera:camera-lifecycle:$camerax")
+    // The viewer: native core, JNI bridge, sensor/camera/render forwarding, face models.
+    implementation(project(":phantogram"))
     implementation("androidx.core:core-ktx:1.15.0")
     implementation("androidx.activity:activity-ktx:1.9.3")
-    implementation("androidx.lifecycle:lifecycle-runtime-ktx:2.8.7")
 }

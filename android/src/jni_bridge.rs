@@ -1,5 +1,5 @@
 //! The JNI bridge: the native methods of `org.phantogram.NativeBridge`
-//! (`android/app/src/main/java/org/phantogram/NativeBridge.java`, the one declaration of them,
+//! (`android/phantogram/src/main/java/org/phantogram/NativeBridge.java`, the one declaration of them,
 //! compiled unchanged by the desktop JVM test).
 //!
 //! * **Handles**: `nativeCreate` returns a `long` owning a [`SharedEngine`]; every other method

@@ -122,7 +122,7 @@ fn jni_bridge_replays_a_log_on_the_desktop_jvm() {
     let status = Command::new(tool(&home, "javac"))
         .arg("-d")
         .arg(&dir)
-        .arg(workspace().join("android/app/src/main/java/org/phantogram/NativeBridge.java"))
+        .arg(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
         .arg(workspace().join("android/tests/java/ReplayThroughJni.java"))
         .status()
         .expect("running javac");
@@ -178,8 +178,9 @@ fn jni_bridge_replays_a_log_on_the_desktop_jvm() {
 /// `NativeBridge.java`'s native declarations, the library's exports and the bridge's list agree.
 #[test]
 fn java_declarations_match_the_exported_methods() {
-    let java = std::fs::read_to_string(workspace().join("android/app/src/main/java/org/phantogram/NativeBridge.java"))
-        .expect("NativeBridge.java");
+    let java =
+        std::fs::read_to_string(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
+            .expect("NativeBridge.java");
     let mut declared: Vec<String> = java
         .split("public static native ")
         .skip(1)

@@ -1,5 +1,6 @@
-//! The Kotlin shell compiles: `android/app/src/main/kotlin` with Debian's `kotlinc` against the
-//! real `NativeBridge.java` and the host stubs of the Android/AndroidX API in `android/stubs`
+//! The Kotlin shell compiles: the viewer library's and the app's Kotlin
+//! (`android/phantogram/src/main/kotlin`, `android/app/src/main/kotlin`) with Debian's `kotlinc`
+//! against the real `NativeBridge.java` and the host stubs of the Android/AndroidX API in `android/stubs`
 //! (what they do and do not prove: `android/stubs/README.md`). Skipped with a notice without
 //! `kotlinc` and `javac`, unless `PHANTOGRAM_REQUIRE_KOTLIN` is set (`.ci/run` sets it).
 
@@ -32,7 +33,7 @@ fn kotlin_shell_compiles_against_the_bridge_and_the_api_stubs() {
     let classes = dir.join("classes");
     let mut java = Vec::new();
     files(&android.join("stubs"), "java", &mut java);
-    java.push(android.join("app/src/main/java/org/phantogram/NativeBridge.java"));
+    java.push(android.join("phantogram/src/main/java/org/phantogram/NativeBridge.java"));
     // Java 8 class files: what the old kotlinc reads, whichever JDK provides javac.
     let out = Command::new("javac")
         .args(["--release", "8", "-d"])
@@ -42,6 +43,7 @@ fn kotlin_shell_compiles_against_the_bridge_and_the_api_stubs() {
         .expect("running javac");
     assert!(out.status.success(), "javac: {}", String::from_utf8_lossy(&out.stderr));
     let mut kotlin = Vec::new();
+    files(&android.join("phantogram/src/main/kotlin"), "kt", &mut kotlin);
     files(&android.join("app/src/main/kotlin"), "kt", &mut kotlin);
     assert!(kotlin.len() >= 5, "the shell's Kotlin sources");
     let out = Command::new("kotlinc")

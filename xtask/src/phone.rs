@@ -133,6 +133,15 @@ fn copy_tree(from: &Path, to: &Path) -> Result<()> {
     Ok(())
 }
 
+/// An NDK's version (`Pkg.Revision` in its `source.properties`), as Gradle's `ndkVersion` names it.
+fn ndk_revision(ndk: &Path) -> Option<String> {
+    let text = std::fs::read_to_string(ndk.join("source.properties")).ok()?;
+    text.lines().find_map(|l| {
+        let (key, value) = l.split_once('=')?;
+        (key.trim() == "Pkg.Revision").then(|| value.trim().to_owned())
+    })
+}
+
 pub fn android(artifacts: Option<&Path>) -> Result<()> {
     let root = workspace_root();
     // First, so that a curator learns whether the scans will open before any SDK is needed.
@@ -140,13 +149,6 @@ pub fn android(artifacts: Option<&Path>) -> Result<()> {
     let sdk = env_dir(&["ANDROID_HOME", "ANDROID_SDK_ROOT"]);
     let ndk = android_ndk(sdk.as_deref());
     let targets = installed_targets();
-    let gradle = if root.join("android/gradlew").is_file() {
-        Some(root.join("android/gradlew").display().to_string())
-    } else if succeeds("gradle", &["--version"]) {
-        Some("gradle".to_owned())
-    } else {
-        None
-    };
     let mut missing = Vec::new();
     if sdk.is_none() {
         missing.push(
@@ -172,13 +174,6 @@ pub fn android(artifacts: Option<&Path>) -> Result<()> {
     if !absent.is_empty() {
         missing.push(format!("the Rust targets: `rustup target add {}`", absent.join(" ")));
     }
-    if gradle.is_none() {
-        missing.push(
-            "Gradle 8.9 or newer on the PATH (https://gradle.org/install/; once present, `gradle wrapper` \
-             in android/ pins it for everyone)"
-                .to_owned(),
-        );
-    }
     if !succeeds("java", &["-version"]) {
         missing.push("a JDK 17 (`apt-get install openjdk-17-jdk-headless`)".to_owned());
     }
@@ -188,28 +183,24 @@ pub fn android(artifacts: Option<&Path>) -> Result<()> {
             missing.join("\n  - ")
         );
     }
-    let jni_libs = root.join("android/app/src/main/jniLibs");
-    let mut args = vec!["ndk".to_owned()];
-    for (abi, _) in ANDROID_ABIS {
-        args.extend(["-t".to_owned(), abi.to_owned()]);
+    // The face models go into the viewer library's assets; Gradle builds the Rust core for every
+    // ABI itself (`:phantogram:cargoNdk`, as Android Studio's Run does) and then the APK. The
+    // committed wrapper fetches the pinned Gradle on its first run (android/gradlew).
+    copy_face_models(&root.join("android/phantogram/src/main/assets/models"))?;
+    let mut gradle = Command::new("sh");
+    gradle
+        .arg(root.join("android/gradlew"))
+        .arg(":app:assembleRelease")
+        .current_dir(root.join("android"));
+    // The cargo running this, wherever it is installed, and the NDK found (Gradle pins one
+    // version, the one `sdkmanager` installs below, unless told another).
+    if let Ok(cargo) = std::env::var("CARGO") {
+        gradle.arg(format!("-Pphantogram.cargo={cargo}"));
     }
-    args.extend([
-        "--platform".to_owned(),
-        "26".to_owned(),
-        "-o".to_owned(),
-        jni_libs.display().to_string(),
-        "build".to_owned(),
-        "--release".to_owned(),
-        "-p".to_owned(),
-        "phantogram-android".to_owned(),
-    ]);
-    let args: Vec<&str> = args.iter().map(String::as_str).collect();
-    cargo(&args)?;
-    copy_face_models(&root.join("android/app/src/main/assets/models"))?;
-    let gradle = gradle.unwrap_or_default();
-    run(Command::new(&gradle)
-        .args(["assembleRelease"])
-        .current_dir(root.join("android")))?;
+    if let Some(revision) = ndk.as_deref().and_then(ndk_revision) {
+        gradle.arg(format!("-Pphantogram.ndkVersion={revision}"));
+    }
+    run(&mut gradle)?;
     let apk = root.join("android/app/build/outputs/apk/release/app-release.apk");
     println!(
         "built {}\ninstall on a phone (USB debugging on): adb install -r {}",
