@@ -811,7 +811,8 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeOpenMenu<'local>(
 
 /// The oldest request of the core's screens not yet taken: 0 none, 1 open a file (start
 /// `ACTION_OPEN_DOCUMENT`, then `nativeImportArtifactFd`), 2 ask for the camera permission
-/// (the core has shown why). Call after each frame.
+/// (the core has shown why), 3 or 4 share the view (`nativeSnapshotPng` kind 0 or 1 through
+/// the share sheet). Call after each frame.
 #[unsafe(no_mangle)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeTakeShellRequest<'local>(
     mut env: EnvUnowned<'local>,

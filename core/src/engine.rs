@@ -279,6 +279,9 @@ pub enum ShellRequest {
     /// Show the system's camera permission request (the user has read why, on the core's
     /// camera page, and wants it): see [`Engine::camera_permission_needed`].
     CameraPermission,
+    /// Share the view through the system's share sheet: take [`Engine::snapshot_png`] of this
+    /// kind and hand the PNG over.
+    Share(Snapshot),
 }
 
 impl ShellRequest {
@@ -287,6 +290,8 @@ impl ShellRequest {
         match self {
             Self::OpenFile => 1,
             Self::CameraPermission => 2,
+            Self::Share(Snapshot::Composed) => 3,
+            Self::Share(Snapshot::SideBySide) => 4,
         }
     }
 }
@@ -1363,6 +1368,15 @@ impl Engine {
             }
             A::OpenFile => {
                 self.requests.push(ShellRequest::OpenFile);
+                self.set_page(None);
+            }
+            A::Share { side_by_side } => {
+                let kind = if side_by_side {
+                    Snapshot::SideBySide
+                } else {
+                    Snapshot::Composed
+                };
+                self.requests.push(ShellRequest::Share(kind));
                 self.set_page(None);
             }
             A::Calibrate => {

@@ -336,8 +336,10 @@ enum PgStatus pg_camera_permission_needed(const struct PgEngine *engine);
 
 // Takes the oldest thing the core's screens asked of the app since the last call: `*request`
 // receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf` or `.zip`, then
-// `pg_import_artifact`) or 2 (ask for the camera permission: the core's camera page has said
-// why; start the camera when granted). Call after each `pg_draw`.
+// `pg_import_artifact`), 2 (ask for the camera permission: the core's camera page has said
+// why; start the camera when granted), 3 or 4 (share the view: `pg_snapshot_png` of kind 0,
+// the anaglyph, or 1, the side-by-side pair, through the system's share sheet). Call after
+// each `pg_draw`.
 //
 // # Safety
 // `engine` is a live handle; `request` is valid for a write.

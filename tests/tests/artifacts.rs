@@ -315,6 +315,31 @@ fn the_menu_and_the_banner_are_driven_by_taps() {
         !e.menu_open(),
         "the banner's tap was not also a single tap on the picture"
     );
+
+    // Share as a stereo pair: the menu closes and the shell is asked for its share sheet; the
+    // picture it then takes is the pair without the menu.
+    e.open_menu();
+    e.draw(Some(t * ms)).unwrap();
+    e.draw(Some((t + 16) * ms)).unwrap();
+    t += 100;
+    let share = e.control_px("share-pair").expect("the share button");
+    tap_at(&mut e, share, &mut t);
+    assert!(!e.menu_open());
+    assert_eq!(
+        e.take_shell_request(),
+        Some(phantogram::engine::ShellRequest::Share(
+            phantogram::engine::Snapshot::SideBySide
+        ))
+    );
+    let (pw, ph, pair) = e.snapshot(phantogram::engine::Snapshot::SideBySide).unwrap();
+    assert_eq!((pw, ph), (2 * w, h));
+    let (_, _, picture) = e.snapshot(phantogram::engine::Snapshot::Composed).unwrap();
+    assert_eq!(
+        differing_pixels(&picture, e.last_frame().unwrap().2),
+        0,
+        "the view, no menu"
+    );
+    assert!(pair.len() == (4 * pw * ph) as usize);
     if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
         for (name, px) in [("menu-gallery", &menu), ("banner-failure", &banner)] {
             image::save_buffer(

@@ -35,6 +35,11 @@ pub enum MenuAction {
     Remove(String),
     /// Ask the platform for a file (Android's document picker, iOS's document browser).
     OpenFile,
+    /// Share the view through the platform's share sheet: as the red/cyan picture, or as a
+    /// side-by-side stereo pair (`side_by_side`).
+    Share {
+        side_by_side: bool,
+    },
     /// Open the calibration screens instead.
     Calibrate,
     /// Open the settings screen instead.
@@ -57,7 +62,7 @@ impl MenuUi {
     }
 
     /// The rectangle (points) of a control drawn last frame: `item:<id>`, `remove:<id>`,
-    /// `open`, `help`, `settings`, `calibrate`, `close`.
+    /// `open`, `share`, `share-pair`, `help`, `settings`, `calibrate`, `close`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.iter().find(|(n, _)| n == name).map(|(_, r)| *r)
     }
@@ -79,6 +84,23 @@ impl MenuUi {
         let mut actions = Vec::new();
         egui::Panel::bottom("menu buttons").show(ui, |ui| {
             ui.add_space(6.0);
+            // The view as it is now (the menu is not in the picture), two ways, side by side.
+            ui.horizontal(|ui| {
+                let half = (ui.available_width() - ui.spacing().item_spacing.x) / 2.0;
+                for (name, label, side_by_side) in [
+                    ("share", "Share the picture", false),
+                    ("share-pair", "Share as a stereo pair", true),
+                ] {
+                    let r = ui.add_sized(
+                        [half, CONTROL_HEIGHT_PT],
+                        egui::Button::new(RichText::new(label).size(16.0)),
+                    );
+                    self.remember(name.to_owned(), r.rect);
+                    if r.clicked() {
+                        actions.push(MenuAction::Share { side_by_side });
+                    }
+                }
+            });
             let buttons = [
                 ("open", "Open a file of your own…"),
                 ("help", "How to use it"),
@@ -323,6 +345,8 @@ mod tests {
             "item:imported:jar-1",
             "remove:imported:jar-1",
             "open",
+            "share",
+            "share-pair",
             "close",
         ] {
             let r = menu.widget_rect(name).unwrap_or_else(|| panic!("{name} not drawn"));
@@ -345,6 +369,14 @@ mod tests {
             vec![MenuAction::Remove("imported:jar-1".into())]
         );
         assert_eq!(tap(&ctx, &mut menu, "open"), vec![MenuAction::OpenFile]);
+        assert_eq!(
+            tap(&ctx, &mut menu, "share"),
+            vec![MenuAction::Share { side_by_side: false }]
+        );
+        assert_eq!(
+            tap(&ctx, &mut menu, "share-pair"),
+            vec![MenuAction::Share { side_by_side: true }]
+        );
         assert_eq!(tap(&ctx, &mut menu, "calibrate"), vec![MenuAction::Calibrate]);
         assert_eq!(tap(&ctx, &mut menu, "settings"), vec![MenuAction::Settings]);
         assert_eq!(tap(&ctx, &mut menu, "help"), vec![MenuAction::Help]);

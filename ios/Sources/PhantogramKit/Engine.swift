@@ -104,6 +104,8 @@ public final class Engine {
         case openFile
         /// The system's camera permission request (the core's camera page said why).
         case cameraPermission
+        /// The share sheet with a snapshot of the view: the anaglyph, or the stereo pair.
+        case share(pair: Bool)
     }
 
     /// The oldest request of the core's screens, or nil; call after each frame.
@@ -113,7 +115,23 @@ public final class Engine {
         switch request {
         case 1: return .openFile
         case 2: return .cameraPermission
+        case 3: return .share(pair: false)
+        case 4: return .share(pair: true)
         default: return nil
         }
+    }
+
+    /// The view as PNG bytes, without the core's screens over it: the anaglyph, or the
+    /// side-by-side stereo pair (`pg_snapshot_png`, asked for its size first).
+    func snapshotPng(pair: Bool) throws -> Data {
+        let kind: Int32 = pair ? 1 : 0
+        var len = 0
+        try check(pg_snapshot_png(handle, kind, nil, 0, &len))
+        var data = Data(count: len)
+        try data.withUnsafeMutableBytes { (bytes: UnsafeMutableRawBufferPointer) in
+            let base = bytes.bindMemory(to: UInt8.self).baseAddress
+            _ = try check(pg_snapshot_png(handle, kind, base, len, &len))
+        }
+        return data
     }
 }

@@ -108,7 +108,25 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
         switch engine.takeShellRequest() {
         case .openFile?: presentDocumentPicker()
         case .cameraPermission?: camera?.requestAccess()
+        case .share(let pair)?: presentShareSheet(pair: pair)
         case nil: break
+        }
+    }
+
+    /// The core's menu: the view through the system's share sheet, as a named PNG file.
+    private func presentShareSheet(pair: Bool) {
+        do {
+            let png = try engine.snapshotPng(pair: pair)
+            let name = pair ? "phantogram-stereo-pair.png" : "phantogram-anaglyph.png"
+            let url = FileManager.default.temporaryDirectory.appendingPathComponent(name)
+            try png.write(to: url, options: .atomic)
+            let sheet = UIActivityViewController(activityItems: [url], applicationActivities: nil)
+            // iPad: the sheet is a popover and needs an anchor.
+            sheet.popoverPresentationController?.sourceView = self
+            sheet.popoverPresentationController?.sourceRect = CGRect(x: bounds.midX, y: bounds.midY, width: 1, height: 1)
+            window?.rootViewController?.present(sheet, animated: true)
+        } catch {
+            NSLog("phantogram: cannot share: %@", String(describing: error))
         }
     }
 

@@ -4,6 +4,7 @@ package androidx.activity; public class ComponentActivity extends android.conten
   public void onConfigurationChanged(android.content.res.Configuration c) {} public boolean onTouchEvent(android.view.MotionEvent e) { return false; }
   public android.view.Window getWindow() { return null; } public android.view.WindowManager getWindowManager() { return null; }
   public void setContentView(android.view.View v) {}
+  public java.io.File getCacheDir() { return null; } public void startActivity(android.content.Intent intent) {}
   public <T> T getSystemService(Class<T> c) { return null; } public android.content.res.AssetManager getAssets() { return null; }
   public java.io.File getFilesDir() { return null; } public android.content.ContentResolver getContentResolver() { return null; }
   public android.content.SharedPreferences getSharedPreferences(String name, int mode) { return null; } public android.content.Intent getIntent() { return null; }

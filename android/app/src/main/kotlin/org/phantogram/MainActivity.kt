@@ -23,6 +23,7 @@ import android.view.WindowManager
 import android.widget.Toast
 import androidx.activity.ComponentActivity
 import androidx.activity.result.contract.ActivityResultContracts
+import androidx.core.content.FileProvider
 import java.io.File
 
 /**
@@ -40,7 +41,8 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         // The core's menu asked for a file: the system's document picker, on the UI thread.
         onOpenFile = { runOnUiThread { openDocument.launch(MODEL_TYPES) } },
         // The core's camera page said why and the user wants the camera: the system's request.
-        onCameraPermission = { runOnUiThread { askCamera.launch(Manifest.permission.CAMERA) } }
+        onCameraPermission = { runOnUiThread { askCamera.launch(Manifest.permission.CAMERA) } },
+        onShare = { png, pair -> runOnUiThread { share(png, pair) } }
     )
     private lateinit var sensors: SensorForwarder
     private var camera: CameraForwarder? = null
@@ -74,6 +76,26 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
             // Not asked out of the blue: the core's camera page says what the camera is for and
             // asks back (onCameraPermission) only if the user wants it.
             render.cameraPermissionNeeded()
+        }
+    }
+
+    /** A snapshot of the view to the system's share sheet: written to the app's cache and
+     *  handed over through its FileProvider (read permission for the chosen app only). */
+    private fun share(png: ByteArray, pair: Boolean) {
+        try {
+            val dir = File(cacheDir, "shared")
+            dir.mkdirs()
+            val file = File(dir, if (pair) "phantogram-stereo-pair.png" else "phantogram-anaglyph.png")
+            file.writeBytes(png)
+            val uri = FileProvider.getUriForFile(this, "$packageName.share", file)
+            val send = Intent(Intent.ACTION_SEND)
+                .setType("image/png")
+                .putExtra(Intent.EXTRA_STREAM, uri)
+                .addFlags(Intent.FLAG_GRANT_READ_URI_PERMISSION)
+            startActivity(Intent.createChooser(send, getString(R.string.share_title)))
+        } catch (e: Exception) {
+            Log.e(TAG, "share", e)
+            Toast.makeText(this, R.string.cannot_share, Toast.LENGTH_LONG).show()
         }
     }
 

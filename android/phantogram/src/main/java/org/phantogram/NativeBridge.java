@@ -114,6 +114,10 @@ public final class NativeBridge {
     /** Ask for the CAMERA permission (the core's camera page has said why); start the camera
      *  when granted. */
     public static final int REQUEST_CAMERA_PERMISSION = 2;
+    /** Share the view as the anaglyph picture: nativeSnapshotPng(handle, 0) to the share sheet. */
+    public static final int REQUEST_SHARE_PICTURE = 3;
+    /** Share the view as a side-by-side stereo pair: nativeSnapshotPng(handle, 1). */
+    public static final int REQUEST_SHARE_PAIR = 4;
 
     /** The app has no camera permission yet and may ask: the core explains first, then asks
      *  with REQUEST_CAMERA_PERMISSION if the user wants the camera. */

@@ -21,7 +21,9 @@ class RenderLoop(
     /** The core's menu asked for a file (called on the render thread). */
     private val onOpenFile: () -> Unit,
     /** The core's camera page: the user wants the camera (called on the render thread). */
-    private val onCameraPermission: () -> Unit
+    private val onCameraPermission: () -> Unit,
+    /** The core's menu: share this PNG of the view, a stereo pair if `pair` (render thread). */
+    private val onShare: (png: ByteArray, pair: Boolean) -> Unit
 ) : Choreographer.FrameCallback {
     private val thread = HandlerThread("phantogram-render").apply { start() }
     private val handler = Handler(thread.looper)
@@ -120,6 +122,9 @@ class RenderLoop(
                 when (NativeBridge.nativeTakeShellRequest(engine)) {
                     NativeBridge.REQUEST_OPEN_FILE -> onOpenFile()
                     NativeBridge.REQUEST_CAMERA_PERMISSION -> onCameraPermission()
+                    // Taken here, on the thread that owns the engine, without the menu drawn over it.
+                    NativeBridge.REQUEST_SHARE_PICTURE -> onShare(NativeBridge.nativeSnapshotPng(engine, 0), false)
+                    NativeBridge.REQUEST_SHARE_PAIR -> onShare(NativeBridge.nativeSnapshotPng(engine, 1), true)
                 }
             }
         } catch (t: RuntimeException) {
