@@ -267,6 +267,9 @@ pub struct Engine {
     /// The camera page waits for the screens in front of it to close.
     #[cfg(feature = "ui")]
     camera_page_pending: bool,
+    /// The gallery's pictures, made while the menu is open.
+    #[cfg(feature = "ui")]
+    thumbnails: crate::thumbnails::Thumbnails,
 }
 
 /// Something only the platform can do, asked for by the core's screens: the shell takes these
@@ -327,6 +330,8 @@ struct Screens {
     /// The status banner's rectangle in the last frame (points), while one shows: a touch that
     /// starts there is the banner's, any other the gestures'.
     banner_pt: Option<egui::Rect>,
+    /// The gallery's pictures as egui textures, by artifact id.
+    thumbnail_textures: std::collections::HashMap<String, egui::TextureHandle>,
     /// The banner's button (Cancel or OK) in the last frame, points.
     banner_button_pt: Option<egui::Rect>,
 }
@@ -418,6 +423,12 @@ impl Engine {
             ..crate::budget::ResourceBudget::PHONE
         };
         let library = crate::library::Library::new(config.library_dir.clone(), config.bundled_dir.clone());
+        #[cfg(feature = "ui")]
+        let thumbnails = crate::thumbnails::Thumbnails::new(
+            library.clone(),
+            budget,
+            config.library_dir.as_ref().map(|d| d.join("thumbnails")),
+        );
         let mut loader = crate::artifacts::Loader::new(library, budget);
         let placing = crate::artifacts::Placing { screen, fit, floor };
         let prepared = match (&config.model_path, &config.artifact) {
@@ -501,6 +512,8 @@ impl Engine {
             requests: Vec::new(),
             #[cfg(feature = "ui")]
             camera_page_pending: false,
+            #[cfg(feature = "ui")]
+            thumbnails,
         };
         engine.apply_calibration();
         #[cfg(feature = "ui")]
@@ -738,6 +751,7 @@ impl Engine {
                 pointer: None,
                 banner_pt: None,
                 banner_button_pt: None,
+                thumbnail_textures: std::collections::HashMap::new(),
             })
         })
     }
@@ -745,18 +759,70 @@ impl Engine {
     /// Reads the gallery's items from the library again.
     #[cfg(feature = "ui")]
     fn refresh_menu_items(&mut self) {
-        let items = self
-            .artifacts()
+        let artifacts = self.artifacts();
+        self.thumbnails.request(&artifacts);
+        let screens = self.screens();
+        let items = artifacts
             .into_iter()
-            .map(|a| crate::calibration_ui::menu::MenuItem {
-                removable: a.id.origin == crate::library::Origin::Imported,
-                id: a.id.to_string(),
-                title: a.title,
-                credit: a.credit,
-                licence: a.licence,
+            .map(|a| {
+                let id = a.id.to_string();
+                crate::calibration_ui::menu::MenuItem {
+                    removable: a.id.origin == crate::library::Origin::Imported,
+                    thumbnail: screens.thumbnail_textures.get(&id).map(egui::TextureHandle::id),
+                    id,
+                    title: a.title,
+                    credit: a.credit,
+                    licence: a.licence,
+                }
             })
             .collect();
-        self.screens().items = items;
+        screens.items = items;
+    }
+
+    /// Waits up to `timeout` until the open menu's pictures are all made (or found impossible),
+    /// drawing them meanwhile; for tests and tools (the shells just keep drawing frames).
+    /// Returns whether none is left to make.
+    #[cfg(feature = "ui")]
+    pub fn wait_for_thumbnails(&mut self, timeout: std::time::Duration) -> bool {
+        let deadline = std::time::Instant::now() + timeout;
+        loop {
+            self.take_thumbnails();
+            if self.thumbnails.pending() == 0 {
+                return true;
+            }
+            if std::time::Instant::now() >= deadline {
+                return false;
+            }
+            std::thread::sleep(std::time::Duration::from_millis(5));
+        }
+    }
+
+    /// Takes the gallery's finished pictures (drawing at most one a frame) into egui textures.
+    #[cfg(feature = "ui")]
+    fn take_thumbnails(&mut self) {
+        let renderer = &mut self.renderer;
+        let new = self.thumbnails.poll(|posed| crate::thumbnails::render(renderer, posed));
+        if new.is_empty() {
+            return;
+        }
+        let size = crate::thumbnails::THUMBNAIL_PX as usize;
+        for id in new {
+            let Some(image) = self
+                .thumbnails
+                .get(&id)
+                .map(|t| egui::ColorImage::from_rgba_unmultiplied([size, size], &t.rgba))
+            else {
+                continue;
+            };
+            let screens = self.screens();
+            let texture = screens
+                .ctx
+                .load_texture(format!("thumbnail {id}"), image, egui::TextureOptions::LINEAR);
+            for item in screens.items.iter_mut().filter(|i| i.id == id) {
+                item.thumbnail = Some(texture.id());
+            }
+            screens.thumbnail_textures.insert(id, texture);
+        }
     }
 
     /// The centre of a control of the screen showing, in the last frame drawn, in physical
@@ -1114,6 +1180,9 @@ impl Engine {
         #[cfg(feature = "ui")]
         {
             self.open_pending_camera_page();
+            if self.menu_open() {
+                self.take_thumbnails();
+            }
             let page_open = self.screens.as_ref().is_some_and(|s| s.page.is_some());
             let status = self.loader.status();
             if page_open || status != LoadStatus::Idle {
@@ -1284,6 +1353,10 @@ impl Engine {
 
     #[cfg(feature = "ui")]
     fn set_page(&mut self, page: Option<Page>) {
+        if !matches!(page, Some(Page::Menu(_))) {
+            // Pictures not started yet are not needed now; asked for again at the next menu.
+            self.thumbnails.cancel_pending();
+        }
         self.screens().page = page;
     }
 

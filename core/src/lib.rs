@@ -9,8 +9,8 @@
 //! ## Layers
 //!
 //! This crate is the top of the library's layers and the one the shells and users depend on: it
-//! holds [`engine`] (the one embedding API), [`artifacts`] (switching artifacts while it runs)
-//! and [`gesture`], and re-exports the lower crates'
+//! holds [`engine`] (the one embedding API), [`artifacts`] (switching artifacts while it runs),
+//! [`thumbnails`] (the gallery's pictures) and [`gesture`], and re-exports the lower crates'
 //! modules under their old paths (`phantogram::screen`, `phantogram::fusion`, …). Dependencies
 //! point down only (see `ARCHITECTURE.md`):
 //!
@@ -80,6 +80,8 @@ pub mod artifacts;
 #[cfg(feature = "render")]
 pub mod engine;
 pub mod gesture;
+#[cfg(feature = "render")]
+pub mod thumbnails;
 
 pub use glam;
 /// The wgpu the renderer is built on, for shells that hand it window handles.

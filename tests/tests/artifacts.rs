@@ -282,6 +282,10 @@ fn the_menu_and_the_banner_are_driven_by_taps() {
     assert!(!e.menu_open(), "not before a second tap could have come");
     e.draw(Some((t + 800) * ms)).unwrap();
     assert!(e.menu_open());
+    // Each artifact's picture, drawn by the renderer and kept in the library's folder.
+    assert!(e.wait_for_thumbnails(WAIT), "the gallery's pictures are made");
+    let cached = std::fs::read_dir(dir.join("thumbnails")).map_or(0, |d| d.count());
+    assert_eq!(cached, 4, "one picture per artifact, cached");
     e.draw(Some((t + 816) * ms)).unwrap();
     e.draw(Some((t + 832) * ms)).unwrap();
     t += 1000;

@@ -146,6 +146,31 @@ fn default_artifact_matches_its_golden_images() {
     check_golden("amphora-floor-dubois", &pixels, 3, 0.002);
 }
 
+/// A gallery thumbnail of another model is drawn beside the one set, which stays as it was:
+/// the frame after it is the frame before it, to the bit.
+#[test]
+fn another_model_drawn_beside_leaves_the_frame_as_it_was() {
+    let Some(gpu) = gpu() else { return };
+    let view = oblique_view();
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
+    let mut renderer = Renderer::new(gpu, &default_model()).unwrap();
+    let before = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
+    let mut mesh = Mesh::default();
+    mesh.push_cube(Vec3::ZERO, 0.02, [0.2, 0.8, 0.3, 1.0]);
+    let posed = phantogram::thumbnails::pose(Model::from_painted_mesh("cube", mesh)).unwrap();
+    let thumb = phantogram::thumbnails::render(&mut renderer, &posed).expect("a thumbnail");
+    let side = phantogram::thumbnails::THUMBNAIL_PX as usize;
+    assert_eq!(thumb.len(), side * side * 4);
+    // The green cube fills the middle of its picture.
+    let centre = &thumb[(side / 2 * side + side / 2) * 4..][..4];
+    assert!(
+        centre[1] > centre[0] + 20 && centre[1] > centre[2] + 20,
+        "green: {centre:?}"
+    );
+    let after = renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
+    assert!(before == after, "the frame changed after drawing another model");
+}
+
 #[test]
 fn shared_models_match_their_golden_images() {
     let Some(models) = phantogram_integration::data_subdir("models") else {

@@ -591,6 +591,9 @@ pub struct Renderer {
     /// The environment's irradiance, as the shader takes it.
     environment_sh: [[f32; 4]; 9],
     targets: Option<Targets>,
+    /// The targets of [`Renderer::render_other_model`] (thumbnails), kept apart so that the
+    /// frames' full-size targets are not dropped and made again for each.
+    side_targets: Option<Targets>,
     pub lighting: Lighting,
 }
 
@@ -836,6 +839,7 @@ impl Renderer {
             shadow_view,
             environment_sh,
             targets: None,
+            side_targets: None,
             lighting: Lighting::default(),
             gpu,
         }
@@ -868,6 +872,13 @@ impl Renderer {
 
     /// Replaces the model drawn (keeps pipelines and targets).
     pub fn set_model(&mut self, model: &Model) -> Result<(), RenderError> {
+        self.model = self.upload_with_pipelines(model)?;
+        Ok(())
+    }
+
+    /// Uploads `model` and builds the scene pipelines its materials need. On failure no
+    /// pipeline that failed to build is kept, and the model set stays drawable.
+    fn upload_with_pipelines(&mut self, model: &Model) -> Result<GpuModel, RenderError> {
         if model.triangle_count() == 0 {
             return Err(RenderError::EmptyModel);
         }
@@ -880,15 +891,34 @@ impl Renderer {
         if let Err(e) = checked(&device, "the model's pipelines", || {
             self.scene.prepare(&device, &gpu_model)
         }) {
-            // Keep no pipeline that failed to build; the previous model stays drawable.
             self.scene.variants.retain(|v, _| before.contains(v));
             if !had_shadow_masked {
                 self.scene.shadow_masked = None;
             }
             return Err(e);
         }
-        self.model = gpu_model;
-        Ok(())
+        Ok(gpu_model)
+    }
+
+    /// Renders `model` — not the one set — once from `input`'s mono eye at `width × height` (a
+    /// gallery thumbnail): uploads it, draws it in targets of its own and drops it again. The
+    /// model set and the frames' targets stay as they are; the scene pipelines it needed are
+    /// kept for later models.
+    pub fn render_other_model(
+        &mut self,
+        model: &Model,
+        input: &FrameInput,
+        width: u32,
+        height: u32,
+    ) -> Result<Vec<u8>, RenderError> {
+        let gpu_model = self.upload_with_pipelines(model)?;
+        let set_model = std::mem::replace(&mut self.model, gpu_model);
+        let side = self.side_targets.take();
+        let frame_targets = std::mem::replace(&mut self.targets, side);
+        let pixels = self.render_views(&[input.mono], input, Method::Mono, width, height);
+        self.side_targets = std::mem::replace(&mut self.targets, frame_targets);
+        self.model = set_model;
+        pixels
     }
 
     fn targets(&mut self, width: u32, height: u32) -> Result<&Targets, RenderError> {

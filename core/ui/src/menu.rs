@@ -24,6 +24,9 @@ pub struct MenuItem {
     pub licence: Option<String>,
     /// Imported by the user: may be removed.
     pub removable: bool,
+    /// Its picture, drawn by the renderer (an egui texture the host registered); `None` until
+    /// made, or when it cannot be.
+    pub thumbnail: Option<egui::TextureId>,
 }
 
 /// What the host must do after a frame of the menu.
@@ -61,8 +64,9 @@ impl MenuUi {
         Self::default()
     }
 
-    /// The rectangle (points) of a control drawn last frame: `item:<id>`, `remove:<id>`,
-    /// `open`, `share`, `share-pair`, `help`, `settings`, `calibrate`, `close`.
+    /// The rectangle (points) of a control drawn last frame: `item:<id>`, `thumb:<id>` (its
+    /// picture), `remove:<id>`, `open`, `share`, `share-pair`, `help`, `settings`, `calibrate`,
+    /// `close`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.iter().find(|(n, _)| n == name).map(|(_, r)| *r)
     }
@@ -144,6 +148,20 @@ impl MenuUi {
         let confirming = self.confirm_remove.as_deref() == Some(item.id.as_str());
         ui.horizontal(|ui| {
             let remove_w = if item.removable { 96.0 } else { 0.0 };
+            // The picture, left of the title; a tap on it chooses the artifact too.
+            let side = CONTROL_HEIGHT_PT * 1.4;
+            let (rect, picture) = ui.allocate_exact_size(egui::Vec2::splat(side), egui::Sense::click());
+            ui.painter()
+                .rect_filled(rect, 6.0, ui.visuals().widgets.inactive.weak_bg_fill);
+            if let Some(texture) = item.thumbnail {
+                let uv = Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+                ui.painter().image(texture, rect.shrink(2.0), uv, Color32::WHITE);
+            }
+            self.remember(format!("thumb:{}", item.id), rect);
+            if picture.clicked() {
+                self.confirm_remove = None;
+                actions.push(MenuAction::Select(item.id.clone()));
+            }
             let mut text = egui::text::LayoutJob::default();
             let title_colour = if on_screen {
                 Color32::from_rgb(255, 210, 120)
@@ -308,6 +326,7 @@ mod tests {
                 credit: Some("Generated".into()),
                 licence: None,
                 removable: false,
+                thumbnail: None,
             },
             MenuItem {
                 id: "imported:jar-1".into(),
@@ -315,6 +334,7 @@ mod tests {
                 credit: None,
                 licence: Some("CC0".into()),
                 removable: true,
+                thumbnail: None,
             },
         ]
     }
@@ -362,6 +382,11 @@ mod tests {
         assert_eq!(
             tap(&ctx, &mut menu, "item:imported:jar-1"),
             vec![MenuAction::Select("imported:jar-1".into())]
+        );
+        assert_eq!(
+            tap(&ctx, &mut menu, "thumb:builtin:amphora"),
+            vec![MenuAction::Select("builtin:amphora".into())],
+            "the picture chooses too"
         );
         assert_eq!(tap(&ctx, &mut menu, "remove:imported:jar-1"), vec![], "asks first");
         assert_eq!(
