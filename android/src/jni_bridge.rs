@@ -782,6 +782,18 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCurrentArtifact<'l
     })
 }
 
+/// The system's font scale (`Configuration.fontScale`): the core's screens scale their text
+/// and controls by it (0.85 to 2, clamped). Call at start and on configuration changes.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSetTextScale<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    scale: jni::sys::jfloat,
+) {
+    run(&mut env, |_| Ok(engine(handle)?.lock().set_text_scale(scale)?))
+}
+
 /// The app has no camera permission yet and may ask: the core shows its camera page first and
 /// asks through `nativeTakeShellRequest` (2) when the user wants the camera.
 #[unsafe(no_mangle)]
@@ -874,7 +886,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSnapshotPng<'local
 
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 26] = [
+pub const NATIVE_METHODS: [&str; 27] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
@@ -895,6 +907,7 @@ pub const NATIVE_METHODS: [&str; 26] = [
     "nativeImportArtifact",
     "nativeImportArtifactFd",
     "nativeCameraPermissionNeeded",
+    "nativeSetTextScale",
     "nativeSelectArtifact",
     "nativeCurrentArtifact",
     "nativeOpenMenu",

@@ -152,6 +152,10 @@ pub enum EngineError {
     Share(String),
 }
 
+/// The text scales the screens follow ([`Engine::set_text_scale`]): Android's smallest font
+/// size to twice the default.
+pub const TEXT_SCALE_RANGE: std::ops::RangeInclusive<f32> = 0.85..=2.0;
+
 /// What [`Engine::snapshot`] makes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Snapshot {
@@ -258,6 +262,8 @@ pub struct Engine {
     calibration_warning: Option<String>,
     /// The panel as the platform reports it; a calibrated density goes over it.
     platform_panel: PanelSpec,
+    /// The system's text size setting, applied to the screens ([`Engine::set_text_scale`]).
+    text_scale: f32,
     /// The screens drawn over the picture (menu, calibration, status banner); made when first
     /// needed and kept, so egui's fonts are uploaded once.
     #[cfg(feature = "ui")]
@@ -507,6 +513,7 @@ impl Engine {
             calibration_path: config.calibration_path,
             calibration_warning,
             platform_panel: config.panel,
+            text_scale: 1.0,
             #[cfg(feature = "ui")]
             screens: None,
             requests: Vec::new(),
@@ -853,7 +860,7 @@ impl Engine {
     #[cfg(feature = "ui")]
     fn pixels_per_point(&self) -> f32 {
         let screen = self.session.config().screen;
-        let density = (screen.panel().xdpi / 160.0).clamp(1.0, 4.0);
+        let density = (screen.panel().xdpi / 160.0).clamp(1.0, 4.0) * self.text_scale;
         let target_width_px = self.target_size().map(|(w, _)| w);
         match target_width_px.filter(|&w| w > 0) {
             Some(w) => density * (w as f32 / screen.width_px() as f32).clamp(0.1, 10.0),
@@ -985,6 +992,21 @@ impl Engine {
     #[cfg(feature = "face")]
     pub fn face_worker(&self) -> Option<Arc<crate::face::FaceWorker>> {
         self.face.clone()
+    }
+
+    /// The system's text size setting (Android's `Configuration.fontScale`, iOS's Dynamic Type
+    /// as a ratio to the default size): the core's screens scale their text and controls
+    /// together by it, within [`TEXT_SCALE_RANGE`] (beyond it the phone's screen holds too
+    /// little; the galleries scroll). A scale that is not a finite positive number is an
+    /// [`EngineError::InvalidArgument`].
+    pub fn set_text_scale(&mut self, scale: f32) -> Result<(), EngineError> {
+        if !(scale.is_finite() && scale > 0.0) {
+            return Err(EngineError::InvalidArgument(format!(
+                "text scale must be a positive number, got {scale}"
+            )));
+        }
+        self.text_scale = scale.clamp(*TEXT_SCALE_RANGE.start(), *TEXT_SCALE_RANGE.end());
+        Ok(())
     }
 
     pub fn method(&self) -> Method {

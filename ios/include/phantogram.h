@@ -326,6 +326,14 @@ size_t pg_current_artifact(const struct PgEngine *engine, char *buffer, size_t c
 // `engine` is a live handle.
 enum PgStatus pg_open_menu(const struct PgEngine *engine);
 
+// The system's text size as a ratio to the default (iOS: Dynamic Type,
+// `UIFontMetrics.default.scaledValue(for: 17) / 17`): the core's screens scale their text and
+// controls by it (0.85 to 2, clamped). Call at start and when the setting changes.
+//
+// # Safety
+// `engine` is a live handle.
+enum PgStatus pg_set_text_scale(const struct PgEngine *engine, float scale);
+
 // The app has no camera permission yet and may ask (`AVAuthorizationStatus.notDetermined`):
 // the core shows its camera page first, and asks through `pg_take_shell_request` (2) when the
 // user wants the camera.

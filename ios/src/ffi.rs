@@ -858,6 +858,21 @@ pub unsafe extern "C" fn pg_open_menu(engine: *const PgEngine) -> PgStatus {
     })
 }
 
+/// The system's text size as a ratio to the default (iOS: Dynamic Type,
+/// `UIFontMetrics.default.scaledValue(for: 17) / 17`): the core's screens scale their text and
+/// controls by it (0.85 to 2, clamped). Call at start and when the setting changes.
+///
+/// # Safety
+/// `engine` is a live handle.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_set_text_scale(engine: *const PgEngine, scale: f32) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        unsafe { engine_ref(engine) }?.shared.lock().set_text_scale(scale)?;
+        Ok(())
+    })
+}
+
 /// The app has no camera permission yet and may ask (`AVAuthorizationStatus.notDetermined`):
 /// the core shows its camera page first, and asks through `pg_take_shell_request` (2) when the
 /// user wants the camera.

@@ -481,3 +481,40 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
     let again = Engine::new(config()).unwrap();
     assert_eq!(again.method(), Method::DuboisAmberBlue, "kept for the next start");
 }
+
+/// The system's text size reaches the screens: the menu's controls grow with it, within
+/// [`phantogram::engine::TEXT_SCALE_RANGE`]; nonsense is refused.
+#[test]
+fn the_menu_follows_the_system_text_size() {
+    let _serial = serial();
+    let dir = Scratch::new("engine-text-scale");
+    let Some(mut e) = engine(&dir) else { return };
+    let (w, h) = (360, 800);
+    e.resume_offscreen(w, h).unwrap();
+    e.open_menu();
+    let spacing = |e: &mut Engine| {
+        e.draw(None).unwrap();
+        e.draw(None).unwrap();
+        let (open, help) = (e.control_px("open").unwrap(), e.control_px("help").unwrap());
+        help[1] - open[1]
+    };
+    let normal = spacing(&mut e);
+    e.set_text_scale(1.5).unwrap();
+    let large = spacing(&mut e);
+    assert!((large / normal - 1.5).abs() < 0.05, "{normal} → {large}");
+    if let Ok(out) = std::env::var("PHANTOGRAM_SAVE_UI") {
+        let (fw, fh, px) = e.last_frame().unwrap();
+        image::save_buffer(
+            std::path::Path::new(&out).join("menu-text-1.5.png"),
+            px,
+            fw,
+            fh,
+            image::ExtendedColorType::Rgba8,
+        )
+        .unwrap();
+    }
+    e.set_text_scale(9.0).unwrap();
+    let most = spacing(&mut e);
+    assert!((most / normal - 2.0).abs() < 0.05, "clamped to 2×: {normal} → {most}");
+    assert!(e.set_text_scale(f32::NAN).is_err() && e.set_text_scale(0.0).is_err());
+}

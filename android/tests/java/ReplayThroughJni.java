@@ -210,6 +210,8 @@ public final class ReplayThroughJni {
                 throw new AssertionError("after selecting the tablet: " + NativeBridge.nativeCurrentArtifact(a));
             }
             NativeBridge.nativeOpenMenu(a);
+            NativeBridge.nativeSetTextScale(a, 1.3f);
+            expect(IllegalArgumentException.class, "text scale", () -> NativeBridge.nativeSetTextScale(a, Float.NaN));
             // The core explains the camera before anything is asked of the system.
             NativeBridge.nativeCameraPermissionNeeded(a);
             NativeBridge.nativeDrawFrame(a, -1);

@@ -95,9 +95,11 @@ impl MenuUi {
                     ("share", "Share the picture", false),
                     ("share-pair", "Share as a stereo pair", true),
                 ] {
+                    // Wrapped: at a large system text size the label takes two lines rather
+                    // than widening the row past the screen.
                     let r = ui.add_sized(
                         [half, CONTROL_HEIGHT_PT],
-                        egui::Button::new(RichText::new(label).size(16.0)),
+                        egui::Button::new(RichText::new(label).size(16.0)).wrap(),
                     );
                     self.remember(name.to_owned(), r.rect);
                     if r.clicked() {
@@ -115,7 +117,7 @@ impl MenuUi {
             for (name, label) in buttons {
                 let r = ui.add_sized(
                     [ui.available_width(), CONTROL_HEIGHT_PT],
-                    egui::Button::new(RichText::new(label).size(17.0)),
+                    egui::Button::new(RichText::new(label).size(17.0)).wrap(),
                 );
                 self.remember(name.to_owned(), r.rect);
                 if r.clicked() {

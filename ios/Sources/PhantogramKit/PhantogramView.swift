@@ -29,6 +29,17 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
                                             object: nil, queue: .main) { [weak self] _ in self?.background() })
         observers.append(center.addObserver(forName: UIApplication.willEnterForegroundNotification,
                                             object: nil, queue: .main) { [weak self] _ in self?.foreground() })
+        // Dynamic Type: the core's screens follow the user's text size.
+        observers.append(center.addObserver(forName: UIContentSizeCategory.didChangeNotification,
+                                            object: nil, queue: .main) { [weak self] _ in self?.applyTextScale() })
+        applyTextScale()
+    }
+
+    /// The user's text size as a ratio to the default body size, for the core's screens.
+    private func applyTextScale() {
+        let body: CGFloat = 17
+        let scale = UIFontMetrics(forTextStyle: .body).scaledValue(for: body) / body
+        _ = pg_set_text_scale(engine.handle, Float(scale))
     }
 
     @available(*, unavailable)

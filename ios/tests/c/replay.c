@@ -233,6 +233,8 @@ int main(int argc, char **argv) {
         return 1;
     }
     check(pg_open_menu(engine), PG_STATUS_OK, "open the menu", NULL);
+    check(pg_set_text_scale(engine, 1.3f), PG_STATUS_OK, "text scale", NULL);
+    check(pg_set_text_scale(engine, 0.0f), PG_STATUS_INVALID_ARGUMENT, "text scale 0", "text scale");
     /* The core explains the camera before anything is asked of the system. */
     check(pg_camera_permission_needed(engine), PG_STATUS_OK, "camera permission needed", NULL);
     check(pg_camera_permission_needed(NULL), PG_STATUS_NULL_POINTER, "camera permission on null", "engine");

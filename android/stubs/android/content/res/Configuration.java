@@ -1,2 +1,2 @@
 // Host stub of the Android/AndroidX API surface the shell uses; see android/stubs/README.md.
-package android.content.res; public final class Configuration { public int orientation; }
+package android.content.res; public final class Configuration { public int orientation; public float fontScale; }

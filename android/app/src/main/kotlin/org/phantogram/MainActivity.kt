@@ -68,6 +68,7 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         refreshBundledAssets(prefs)
         render.create(extractFaceModels(), panel(), "dubois", File(filesDir, "calibration.txt").path,
             File(filesDir, "artifacts").path, File(filesDir, BUNDLED).path, prefs.getString(PREF_ARTIFACT, null))
+        render.setTextScale(resources.configuration.fontScale)
         intent?.let { openedWith(it) }
         sensors = SensorForwarder(getSystemService(SensorManager::class.java)) { render.engine }
         if (checkSelfPermission(Manifest.permission.CAMERA) == PackageManager.PERMISSION_GRANTED) {
@@ -129,6 +130,7 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
     override fun onConfigurationChanged(newConfig: Configuration) {
         super.onConfigurationChanged(newConfig)
         render.setDisplay(panel())
+        render.setTextScale(newConfig.fontScale)
     }
 
     // Surface: created → (changed)+ → destroyed. Sizes are physical pixels, so the image is

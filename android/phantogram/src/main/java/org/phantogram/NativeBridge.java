@@ -119,6 +119,10 @@ public final class NativeBridge {
     /** Share the view as a side-by-side stereo pair: nativeSnapshotPng(handle, 1). */
     public static final int REQUEST_SHARE_PAIR = 4;
 
+    /** The system's font scale (Configuration.fontScale): the core's screens scale their text
+     *  and controls by it (0.85 to 2). IllegalArgumentException for a non-positive scale. */
+    public static native void nativeSetTextScale(long handle, float scale);
+
     /** The app has no camera permission yet and may ask: the core explains first, then asks
      *  with REQUEST_CAMERA_PERMISSION if the user wants the camera. */
     public static native void nativeCameraPermissionNeeded(long handle);

@@ -46,6 +46,11 @@ class RenderLoop(
         NativeBridge.nativeCalibrationWarning(engine)?.let { Log.w("Phantogram", it) }
     }
 
+    /** The system's font scale (Configuration.fontScale), for the core's screens. */
+    fun setTextScale(scale: Float) = post {
+        if (engine != 0L) NativeBridge.nativeSetTextScale(engine, scale)
+    }
+
     /** No camera permission yet: the core explains the camera before the system asks. */
     fun cameraPermissionNeeded() = post {
         if (engine != 0L) NativeBridge.nativeCameraPermissionNeeded(engine)
