@@ -113,12 +113,17 @@ impl WelcomeUi {
         let black = egui::Frame::central_panel(ui.style()).fill(Color32::BLACK);
         match self.page {
             WelcomePage::Intro => {
-                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                scrolling_page(ui, black, |ui| {
                     ui.heading(RichText::new("A window onto the artifact").size(24.0));
                     ui.add_space(6.0);
                     let (rect, _) =
                         ui.allocate_exact_size(Vec2::new(ui.available_width(), 170.0), egui::Sense::hover());
                     pose_picture(ui.painter(), rect);
+                    ui.label(
+                        RichText::new("The phone tilted back, like a picture on a table.")
+                            .size(13.0)
+                            .color(Color32::from_gray(170)),
+                    );
                     ui.add_space(6.0);
                     let glasses = match filters {
                         Some(_) => "Put on the coloured glasses. ",
@@ -152,7 +157,7 @@ impl WelcomeUi {
                 });
             }
             WelcomePage::Glasses => {
-                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                scrolling_page(ui, black, |ui| {
                     ui.heading(RichText::new("Which way are the glasses on?").size(22.0));
                     ui.label(
                         RichText::new("Close your LEFT eye. Which ring do you see with your right eye?").size(17.0),
@@ -183,7 +188,7 @@ impl WelcomeUi {
                 });
             }
             WelcomePage::GlassesResult(finding) => {
-                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                scrolling_page(ui, black, |ui| {
                     let text = match finding {
                         GlassesFinding::RightWayRound => "Your glasses are the right way round.",
                         GlassesFinding::Swapped => {
@@ -203,7 +208,7 @@ impl WelcomeUi {
                 });
             }
             WelcomePage::Camera => {
-                egui::CentralPanel::default().frame(black).show(ui, |ui| {
+                scrolling_page(ui, black, |ui| {
                     ui.heading(RichText::new("Follow your eyes with the camera?").size(22.0));
                     ui.add_space(6.0);
                     let (rect, _) =
@@ -236,6 +241,14 @@ impl WelcomeUi {
         }
         actions
     }
+}
+
+/// A first-run page on black that scrolls when it is taller than the screen (a large system
+/// text size): its buttons stay reachable.
+fn scrolling_page(ui: &mut egui::Ui, frame: egui::Frame, body: impl FnOnce(&mut egui::Ui)) {
+    egui::CentralPanel::default().frame(frame).show(ui, |ui| {
+        egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, body);
+    });
 }
 
 /// The holding pose, side on: the eye, the sight line of about 30 cm, and the phone tilted back
@@ -293,13 +306,6 @@ fn pose_picture(painter: &egui::Painter, rect: Rect) {
         "about 30 cm",
         FontId::proportional(14.0),
         ink,
-    );
-    painter.text(
-        foot + Vec2::new(70.0, 14.0) * s,
-        Align2::CENTER_TOP,
-        "phone tilted back, like a picture on a table",
-        FontId::proportional(12.0),
-        Color32::from_gray(170),
     );
 }
 
