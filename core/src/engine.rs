@@ -264,6 +264,8 @@ pub struct Engine {
     platform_panel: PanelSpec,
     /// The system's text size setting, applied to the screens ([`Engine::set_text_scale`]).
     text_scale: f32,
+    /// The finger turning the artifact and where it was ("reduce motion"), physical pixels.
+    drag_px: Option<(i32, [f32; 2])>,
     /// The screens drawn over the picture (menu, calibration, status banner); made when first
     /// needed and kept, so egui's fonts are uploaded once.
     #[cfg(feature = "ui")]
@@ -514,6 +516,7 @@ impl Engine {
             calibration_warning,
             platform_panel: config.panel,
             text_scale: 1.0,
+            drag_px: None,
             #[cfg(feature = "ui")]
             screens: None,
             requests: Vec::new(),
@@ -536,6 +539,7 @@ impl Engine {
         if let Err(refused) = self.session.apply_calibration(&self.calibration, self.platform_panel) {
             self.calibration_warning = Some(format!("calibration not fully applied: {refused}"));
         }
+        self.session.set_turn_by_touch(self.calibration.turn_by_touch);
         self.gestures = Gestures::new(self.session.config().screen.panel().xdpi);
         // The camera's metric scale: the viewer's own IPD, once calibrated.
         #[cfg(feature = "face")]
@@ -1110,9 +1114,38 @@ impl Engine {
                 }
             }
         }
+        self.drag_to_turn(phase, pointer_id, [x_px, y_px]);
         let g = self.gestures.touch(phase, pointer_id, x_px, y_px, t_ns)?;
         self.apply_gesture(g);
         Some(g)
+    }
+
+    /// "Reduce motion": the first finger down drags the artifact around
+    /// ([`crate::turn_by_touch`]); a drag across about a phone's width (60 mm) turns it 90°.
+    fn drag_to_turn(&mut self, phase: TouchPhase, pointer_id: i32, px: [f32; 2]) {
+        const RAD_PER_MM: f32 = std::f32::consts::FRAC_PI_2 / 60.0;
+        if !self.session.turning_by_touch() {
+            self.drag_px = None;
+            return;
+        }
+        match (phase, self.drag_px) {
+            (TouchPhase::Down, None) => self.drag_px = Some((pointer_id, px)),
+            (TouchPhase::Move, Some((id, last))) if id == pointer_id => {
+                // Millimetres on the glass: the displayed image's size over the target's pixels
+                // (the panel's on a phone; smaller in a desktop window or an offscreen test).
+                let screen = self.session.config().screen;
+                let (w_px, h_px) = self
+                    .target_size()
+                    .filter(|&(w, h)| w > 0 && h > 0)
+                    .unwrap_or((screen.width_px(), screen.height_px()));
+                let right_rad = (px[0] - last[0]) * screen.width_m() * 1e3 / w_px as f32 * RAD_PER_MM;
+                let down_rad = (px[1] - last[1]) * screen.height_m() * 1e3 / h_px as f32 * RAD_PER_MM;
+                self.session.turn_by_touch(right_rad, down_rad);
+                self.drag_px = Some((id, px));
+            }
+            (TouchPhase::Up | TouchPhase::Cancel, Some((id, _))) if id == pointer_id => self.drag_px = None,
+            _ => {}
+        }
     }
 
     fn apply_gesture(&mut self, g: Gesture) {
@@ -1400,6 +1433,8 @@ impl Engine {
                 self.calibration.floor = Some(s.floor);
                 self.calibration.protrude_fraction = Some(s.protrude_fraction);
                 self.calibration.true_size = s.true_size;
+                self.calibration.turn_by_touch = s.turn_by_touch;
+                self.session.set_turn_by_touch(s.turn_by_touch);
                 self.save_calibration();
                 if placing_changed && let Some(id) = self.model_info.artifact.as_ref().map(|a| a.id.clone()) {
                     self.select_artifact(id);
@@ -1485,6 +1520,7 @@ impl Engine {
                     floor: self.floor,
                     protrude_fraction: self.fit.protrude_fraction,
                     true_size: self.fit.true_size,
+                    turn_by_touch: self.session.turning_by_touch(),
                 };
                 self.set_page(Some(Page::Settings(crate::calibration_ui::settings::SettingsUi::new(
                     settings,

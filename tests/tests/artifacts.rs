@@ -518,3 +518,82 @@ fn the_menu_follows_the_system_text_size() {
     assert!((most / normal - 2.0).abs() < 0.05, "clamped to 2×: {normal} → {most}");
     assert!(e.set_text_scale(f32::NAN).is_err() && e.set_text_scale(0.0).is_err());
 }
+
+/// "Reduce motion", chosen in the settings: tilting the phone no longer moves the picture, a
+/// finger's drag turns the artifact, and the choice is kept for the next start.
+#[test]
+fn with_reduce_motion_a_finger_turns_the_artifact_and_tilting_does_nothing() {
+    let _serial = serial();
+    use phantogram::sensors::SensorEvent;
+    let dir = Scratch::new("engine-reduce-motion");
+    let calibration = dir.join("calibration.txt");
+    std::fs::write(&calibration, "phantogram-calibration 1\nintroduced 1\n").unwrap();
+    let config = || EngineConfig {
+        calibration_path: Some(calibration.clone()),
+        ..EngineConfig::default()
+    };
+    let Some(mut e) = start(config()) else { return };
+    let (w, h) = (360, 800);
+    e.resume_offscreen(w, h).unwrap();
+    let tilted = |deg: f32| {
+        let a = deg.to_radians();
+        phantogram::glam::Vec3::new(0.0, a.sin(), a.cos()) * 9.81
+    };
+    let mut t = 100;
+    let ms = 1_000_000;
+    let push = |e: &Engine, deg: f32, t: i64| {
+        for k in 0..30 {
+            e.inbox()
+                .push(SensorEvent::accelerometer((t + k) * ms, tilted(deg)))
+                .unwrap();
+        }
+    };
+    push(&e, 30.0, t);
+    t += 100;
+    assert!(e.open_menu());
+    e.draw(Some(t * ms)).unwrap();
+    e.draw(Some((t + 16) * ms)).unwrap();
+    t += 100;
+    let settings = e.control_px("settings").expect("settings");
+    tap_at(&mut e, settings, &mut t);
+    let turn = e.control_px("turn-by-touch").expect("the reduce-motion switch");
+    tap_at(&mut e, turn, &mut t);
+    let done = e.control_px("done").expect("done");
+    tap_at(&mut e, done, &mut t);
+    assert!(e.session().turning_by_touch());
+    e.draw(Some(t * ms)).unwrap();
+    let still = frame(&mut e);
+    // The phone tilts by 40°: the picture stays.
+    push(&e, 70.0, t);
+    t += 100;
+    e.draw(Some(t * ms)).unwrap();
+    let after_tilt = frame(&mut e);
+    assert_eq!(differing_pixels(&still, &after_tilt), 0, "tilting moved the picture");
+    // A finger drags 20 mm to the right: the artifact turns.
+    use phantogram::gesture::TouchPhase;
+    let px_per_mm = 420.0 / 25.4 * (w as f32 / 1080.0);
+    let (x0, y0) = (w as f32 * 0.3, h as f32 * 0.5);
+    e.touch(TouchPhase::Down, 0, x0, y0, t * ms);
+    for k in 1..=10 {
+        e.touch(
+            TouchPhase::Move,
+            0,
+            x0 + k as f32 * 2.0 * px_per_mm,
+            y0,
+            (t + k * 16) * ms,
+        );
+    }
+    e.touch(TouchPhase::Up, 0, x0 + 20.0 * px_per_mm, y0, (t + 200) * ms);
+    t += 1000;
+    e.draw(Some(t * ms)).unwrap();
+    let turned = frame(&mut e);
+    assert!(differing_pixels(&still, &turned) > 1000, "the drag did not turn it");
+    // 20 mm at 90° per 60 mm: a third of a right angle to the right, none down.
+    let (right, down) = e.session().touch_turn_rad().unwrap();
+    assert!((right - 20.0 / 60.0 * std::f32::consts::FRAC_PI_2).abs() < 0.02 && down.abs() < 1e-3);
+    let saved = std::fs::read_to_string(&calibration).unwrap();
+    assert!(saved.contains("turn_by_touch 1"), "{saved}");
+    drop(e);
+    let again = Engine::new(config()).unwrap();
+    assert!(again.session().turning_by_touch(), "kept for the next start");
+}

@@ -143,6 +143,9 @@ pub struct Calibration {
     pub floor: Option<bool>,
     pub protrude_fraction: Option<f32>,
     pub true_size: bool,
+    /// "Reduce motion": the artifact is turned by touch, not by tilting the phone
+    /// (`crate::turn_by_touch`).
+    pub turn_by_touch: bool,
 }
 
 /// First line of a calibration file.
@@ -184,6 +187,9 @@ impl Calibration {
         }
         if self.true_size {
             s += "true_size 1\n";
+        }
+        if self.turn_by_touch {
+            s += "turn_by_touch 1\n";
         }
         s
     }
@@ -276,6 +282,10 @@ impl Calibration {
                 "true_size" => {
                     want(1)?;
                     c.true_size = values[0] != 0.0;
+                }
+                "turn_by_touch" => {
+                    want(1)?;
+                    c.turn_by_touch = values[0] != 0.0;
                 }
                 // Keys from newer versions are skipped, so a downgrade keeps what it understands.
                 _ => {}
@@ -407,6 +417,7 @@ mod tests {
             floor: Some(false),
             protrude_fraction: Some(0.25),
             true_size: true,
+            turn_by_touch: true,
         };
         c.save(&path).unwrap();
         assert_eq!(Calibration::load(&path), (c, None));

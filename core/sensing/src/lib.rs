@@ -35,5 +35,6 @@ pub mod session;
 pub mod storage;
 pub mod straight_on;
 pub mod synthetic;
+pub mod turn_by_touch;
 
 pub use session::{FrameView, Session, SessionConfig, SessionError};

@@ -131,6 +131,8 @@ pub struct Session {
     eye_tracker: EyeTracker,
     eye_source: EyeSource,
     straight_on: Option<crate::straight_on::StraightOnAdapter>,
+    /// "Reduce motion": the view turned by touch, not by tilt or the camera.
+    turn_by_touch: Option<crate::turn_by_touch::TurnByTouch>,
 }
 
 impl std::fmt::Debug for Session {
@@ -168,6 +170,7 @@ impl Session {
             eye_tracker: EyeTracker::new(EyeTrackParams::default(), config.eyes.viewing_distance_m),
             eye_source: EyeSource::Tilt,
             straight_on: config.straight_on.map(crate::straight_on::StraightOnAdapter::new),
+            turn_by_touch: None,
         })
     }
 
@@ -232,6 +235,34 @@ impl Session {
 
     pub fn up_device(&self) -> Option<Vec3> {
         self.estimator.up_device()
+    }
+
+    /// "Reduce motion" on or off ([`crate::turn_by_touch`]): on, the eyes stay straight on and
+    /// only [`Self::turn_by_touch`] turns the view; the light keeps its place of this moment.
+    pub fn set_turn_by_touch(&mut self, on: bool) {
+        if on == self.turn_by_touch.is_some() {
+            return;
+        }
+        self.update();
+        let distance_m = self.eye_tracker.distance_m();
+        self.turn_by_touch = on.then(|| crate::turn_by_touch::TurnByTouch::new(self.device_to_world(), distance_m));
+    }
+
+    pub fn turning_by_touch(&self) -> bool {
+        self.turn_by_touch.is_some()
+    }
+
+    /// How far a finger has turned the artifact (right, down; radians), while it does.
+    pub fn touch_turn_rad(&self) -> Option<(f32, f32)> {
+        self.turn_by_touch.as_ref().map(|t| t.angles_rad())
+    }
+
+    /// Turns the artifact by a drag (radians right and down); nothing while the view follows
+    /// the tilt.
+    pub fn turn_by_touch(&mut self, right_rad: f32, down_rad: f32) {
+        if let Some(t) = &mut self.turn_by_touch {
+            t.turn(right_rad, down_rad);
+        }
     }
 
     /// Makes the current holding pose count as straight on.
@@ -316,6 +347,10 @@ impl Session {
         eyes.validate()?;
         self.config.eyes = eyes;
         self.eye_tracker.set_default_distance_m(eyes.viewing_distance_m);
+        // A calibrated distance applies to the view turned by touch too.
+        if let Some(t) = &mut self.turn_by_touch {
+            t.set_distance_m(eyes.viewing_distance_m);
+        }
         Ok(())
     }
 
@@ -378,23 +413,35 @@ impl Session {
             Some(q) => Some(q.inverse() * Vec3::Z),
             None => self.estimator.up_device(),
         };
-        let device_to_world = predicted.or_else(|| self.device_to_world());
-        let cfg = &self.config;
-        let tilt = |distance_m: f32| {
-            let pair = cfg
-                .eyes
-                .stereo_pair(&cfg.screen, self.viewpoint.cyclopean_eye_m(up, distance_m));
-            [pair.left_m, pair.right_m]
+        let device_to_world = match &self.turn_by_touch {
+            Some(turned) => turned.device_to_world(),
+            None => predicted.or_else(|| self.device_to_world()),
         };
-        // Always through the tracker, so that a first camera result blends in from the tilt
-        // model's eyes; without one its output is exactly the tilt model's.
-        let t_ns = display_t_ns.or(self.newest_t_ns).unwrap_or(0);
-        let tracked = self.eye_tracker.eyes_at(t_ns, device_to_world, tilt);
-        self.eye_source = tracked.source;
+        let cfg = &self.config;
+        let (left_m, right_m) = if let Some(turned) = &self.turn_by_touch {
+            // Turned by touch: neither the tilt nor the camera moves the eyes.
+            self.eye_source = EyeSource::Tilt;
+            let eye = turned.eye_m(cfg.screen.right_device(), cfg.screen.up_device());
+            let pair = cfg.eyes.stereo_pair(&cfg.screen, eye);
+            (pair.left_m, pair.right_m)
+        } else {
+            let tilt = |distance_m: f32| {
+                let pair = cfg
+                    .eyes
+                    .stereo_pair(&cfg.screen, self.viewpoint.cyclopean_eye_m(up, distance_m));
+                [pair.left_m, pair.right_m]
+            };
+            // Always through the tracker, so that a first camera result blends in from the tilt
+            // model's eyes; without one its output is exactly the tilt model's.
+            let t_ns = display_t_ns.or(self.newest_t_ns).unwrap_or(0);
+            let tracked = self.eye_tracker.eyes_at(t_ns, device_to_world, tilt);
+            self.eye_source = tracked.source;
+            (tracked.left_m, tracked.right_m)
+        };
         let eyes = StereoEyes {
-            cyclopean_m: tracked.cyclopean_m(),
-            left_m: tracked.left_m,
-            right_m: tracked.right_m,
+            cyclopean_m: (left_m + right_m) * 0.5,
+            left_m,
+            right_m,
         };
         let project = |eye| OffAxisProjection::new(&cfg.screen, eye, cfg.depth);
         Ok(FrameView {
@@ -445,6 +492,50 @@ mod tests {
         assert!(last.eyes.left_m.distance(seen[0]) < 1e-4 && last.eyes.right_m.distance(seen[1]) < 1e-4);
         // The stereo pair follows the tracked eyes, and the projection is built from them.
         assert!(last.left.eye_m.distance(seen[0]) < 1e-4, "{:?}", last.left.eye_m);
+    }
+
+    #[test]
+    fn turned_by_touch_neither_the_tilt_nor_the_camera_moves_the_view() {
+        let mut s = Session::new(SessionConfig::default()).unwrap();
+        let tilted = |deg: f32| {
+            let a = deg.to_radians();
+            Vec3::new(0.0, a.sin(), a.cos()) * 9.81
+        };
+        s.push(SensorEvent::accelerometer(0, tilted(30.0))).unwrap();
+        let following = s.frame_at(Some(0)).unwrap();
+        s.set_turn_by_touch(true);
+        assert!(s.turning_by_touch());
+        let still = s.frame_at(Some(0)).unwrap();
+        assert!(
+            still.eyes.cyclopean_m.normalize().distance(Vec3::Z) < 1e-5,
+            "straight on"
+        );
+        assert!(
+            following.eyes.cyclopean_m.normalize().distance(Vec3::Z) > 0.3,
+            "the tilt had moved it"
+        );
+        // The phone tilts, a face is seen: the picture stays.
+        for k in 1..100 {
+            s.push(SensorEvent::accelerometer(k * 10_000_000, tilted(60.0)))
+                .unwrap();
+        }
+        s.observe_face(FaceObservation {
+            capture_t_ns: 990_000_000,
+            eyes_m: Some([Vec3::new(0.07, 0.0, 0.4), Vec3::new(0.13, 0.0, 0.4)]),
+            confidence: 0.9,
+        });
+        let later = s.frame_at(Some(1_000_000_000)).unwrap();
+        assert_eq!(later.eyes, still.eyes);
+        assert_eq!(later.toward_light_device, still.toward_light_device, "the light stays");
+        assert_eq!(s.eye_source(), EyeSource::Tilt);
+        // A drag turns it; off again, the tilt takes over.
+        s.turn_by_touch(0.4, 0.0);
+        let turned = s.frame_at(Some(1_000_000_000)).unwrap();
+        assert!(turned.eyes.cyclopean_m.x < -0.05, "{:?}", turned.eyes.cyclopean_m);
+        s.set_turn_by_touch(false);
+        s.turn_by_touch(0.4, 0.0);
+        let tilt_again = s.frame_at(Some(1_000_000_000)).unwrap();
+        assert!(tilt_again.eyes.cyclopean_m.x.abs() < 1e-4 && tilt_again.eyes.cyclopean_m.y > 0.1);
     }
 
     /// Time stamps from a damaged log or a faulty shell, at the ends of `i64`: each interval the

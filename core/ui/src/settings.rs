@@ -1,6 +1,8 @@
 //! The settings screen, opened from the menu: which glasses (red/cyan, green/magenta,
-//! amber/blue, or none for a plain picture), the diorama's floor, how much of a loaded model
-//! stands in front of the glass, and whether loaded models keep their true size.
+//! amber/blue, or none for a plain picture), whether tilting the phone or a finger turns the
+//! artifact ("reduce motion"), the diorama's floor, how much of a loaded model stands in front
+//! of the glass, and whether loaded models keep their true size. It scrolls when a large system
+//! text size makes it taller than the screen.
 //!
 //! The host gives the current settings when it opens the screen and applies (and saves) each
 //! [`SettingsAction::Changed`]. **Threading**: the render thread. **Panics**: none.
@@ -18,6 +20,8 @@ pub struct Settings {
     /// Fraction of a loaded model's height in front of the glass, 0 to 1.
     pub protrude_fraction: f32,
     pub true_size: bool,
+    /// "Reduce motion": a finger turns the artifact; tilting the phone does nothing.
+    pub turn_by_touch: bool,
 }
 
 /// What the host must do after a frame of the settings screen.
@@ -51,7 +55,8 @@ impl SettingsUi {
     }
 
     /// The rectangle (points) of a control drawn last frame: the glasses by key (`red-cyan`,
-    /// `green-magenta`, `amber-blue`, `none`), `floor`, `protrude`, `true-size`, `done`.
+    /// `green-magenta`, `amber-blue`, `none`), `turn-by-touch`, `floor`, `protrude`,
+    /// `true-size`, `done`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
     }
@@ -77,62 +82,75 @@ impl SettingsUi {
         let before = self.settings;
         let mut actions = Vec::new();
         egui::CentralPanel::default().show(ui, |ui| {
-            // One width for every control (a slider's own layout may widen the rest).
-            let full = ui.available_width();
-            ui.heading(RichText::new("Settings").size(24.0));
-            ui.add_space(6.0);
-            ui.label(RichText::new("Glasses").size(18.0));
-            for (key, label, method) in GLASSES {
-                let chosen = self.settings.method == method
-                    || (key == "red-cyan" && !GLASSES.iter().any(|g| g.2 == self.settings.method));
+            egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
+                // One width for every control (a slider's own layout may widen the rest).
+                let full = ui.available_width();
+                ui.heading(RichText::new("Settings").size(24.0));
+                ui.add_space(6.0);
+                ui.label(RichText::new("Glasses").size(18.0));
+                for (key, label, method) in GLASSES {
+                    let chosen = self.settings.method == method
+                        || (key == "red-cyan" && !GLASSES.iter().any(|g| g.2 == self.settings.method));
+                    let r = ui.add_sized(
+                        [full, CONTROL_HEIGHT_PT],
+                        egui::Button::new(RichText::new(label).size(17.0)).selected(chosen),
+                    );
+                    self.remember(key, r.rect);
+                    if r.clicked() {
+                        self.settings.method = method;
+                    }
+                }
+                ui.add_space(10.0);
+                let mut turn = self.settings.turn_by_touch;
+                self.switch(
+                    ui,
+                    "turn-by-touch",
+                    full,
+                    &mut turn,
+                    "Turn it with a finger (tilting does nothing)",
+                    "Look around it by tilting the phone",
+                );
+                self.settings.turn_by_touch = turn;
+                ui.add_space(6.0);
+                let mut floor = self.settings.floor;
+                self.switch(
+                    ui,
+                    "floor",
+                    full,
+                    &mut floor,
+                    "Floor under the artifact: on",
+                    "Floor under the artifact: off",
+                );
+                self.settings.floor = floor;
+                ui.add_space(6.0);
+                ui.label(RichText::new("Your own files: how much stands in front of the glass (%)").size(16.0));
+                // Room for the value box beside the slider.
+                ui.spacing_mut().slider_width = (full - 80.0).max(100.0);
+                ui.spacing_mut().interact_size.y = CONTROL_HEIGHT_PT;
+                let mut percent = self.settings.protrude_fraction * 100.0;
+                let r = ui.add(egui::Slider::new(&mut percent, 0.0..=100.0).step_by(5.0));
+                self.remember("protrude", r.rect);
+                self.settings.protrude_fraction = (percent / 100.0).clamp(0.0, 1.0);
+                let mut true_size = self.settings.true_size;
+                self.switch(
+                    ui,
+                    "true-size",
+                    full,
+                    &mut true_size,
+                    "Size: as in the file (true size)",
+                    "Size: fitted to the screen",
+                );
+                self.settings.true_size = true_size;
+                ui.add_space(10.0);
                 let r = ui.add_sized(
                     [full, CONTROL_HEIGHT_PT],
-                    egui::Button::new(RichText::new(label).size(17.0)).selected(chosen),
+                    egui::Button::new(RichText::new("Done").size(17.0)),
                 );
-                self.remember(key, r.rect);
+                self.remember("done", r.rect);
                 if r.clicked() {
-                    self.settings.method = method;
+                    actions.push(SettingsAction::Close);
                 }
-            }
-            ui.add_space(10.0);
-            let mut floor = self.settings.floor;
-            self.switch(
-                ui,
-                "floor",
-                full,
-                &mut floor,
-                "Floor under the artifact: on",
-                "Floor under the artifact: off",
-            );
-            self.settings.floor = floor;
-            ui.add_space(6.0);
-            ui.label(RichText::new("Your own files: how much stands in front of the glass (%)").size(16.0));
-            // Room for the value box beside the slider.
-            ui.spacing_mut().slider_width = (full - 80.0).max(100.0);
-            ui.spacing_mut().interact_size.y = CONTROL_HEIGHT_PT;
-            let mut percent = self.settings.protrude_fraction * 100.0;
-            let r = ui.add(egui::Slider::new(&mut percent, 0.0..=100.0).step_by(5.0));
-            self.remember("protrude", r.rect);
-            self.settings.protrude_fraction = (percent / 100.0).clamp(0.0, 1.0);
-            let mut true_size = self.settings.true_size;
-            self.switch(
-                ui,
-                "true-size",
-                full,
-                &mut true_size,
-                "Size: as in the file (true size)",
-                "Size: fitted to the screen",
-            );
-            self.settings.true_size = true_size;
-            ui.add_space(10.0);
-            let r = ui.add_sized(
-                [full, CONTROL_HEIGHT_PT],
-                egui::Button::new(RichText::new("Done").size(17.0)),
-            );
-            self.remember("done", r.rect);
-            if r.clicked() {
-                actions.push(SettingsAction::Close);
-            }
+            });
         });
         if self.settings != before {
             actions.insert(0, SettingsAction::Changed(self.settings));
@@ -166,11 +184,12 @@ mod tests {
             floor: true,
             protrude_fraction: 0.4,
             true_size: false,
+            turn_by_touch: false,
         };
         let mut s = SettingsUi::new(start);
         frame(&ctx, &mut s, vec![]);
         frame(&ctx, &mut s, vec![]);
-        for name in ["red-cyan", "none", "floor", "true-size", "done"] {
+        for name in ["red-cyan", "none", "turn-by-touch", "floor", "true-size", "done"] {
             assert!(
                 s.widget_rect(name).unwrap().height() >= CONTROL_HEIGHT_PT - 0.5,
                 "{name}"
@@ -182,6 +201,7 @@ mod tests {
                 floor,
                 protrude_fraction: 0.4,
                 true_size,
+                turn_by_touch: false,
             })
         };
         assert_eq!(
@@ -197,6 +217,14 @@ mod tests {
             vec![changed(Method::DuboisAmberBlue, false, true)]
         );
         assert_eq!(tap(&ctx, &mut s, "none"), vec![changed(Method::Mono, false, true)]);
+        assert_eq!(
+            tap(&ctx, &mut s, "turn-by-touch"),
+            vec![SettingsAction::Changed(Settings {
+                turn_by_touch: true,
+                ..s.settings
+            })]
+        );
+        assert!(s.settings.turn_by_touch);
         assert_eq!(tap(&ctx, &mut s, "done"), vec![SettingsAction::Close]);
     }
 }
