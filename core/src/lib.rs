@@ -59,7 +59,7 @@
 
 pub use phantogram_files as files;
 pub use phantogram_geometry::{anaglyph, containment, eyes, light, projection, screen, viewpoint};
-pub use phantogram_sensing::storage::face_models_dir;
+pub use phantogram_sensing::storage::{face_models_dir, library_dir};
 pub use phantogram_sensing::{
     attitude, calibration, camera, clock, eyetrack, fusion, lowpass, sensors, session, straight_on, synthetic,
 };

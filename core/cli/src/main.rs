@@ -95,6 +95,13 @@ enum Command {
         /// viewing distance by the blind spot, screen size by a bank card, flat angle, light.
         #[arg(long)]
         calibration: bool,
+        /// Open the artifacts menu at start (also key `a`, or a click).
+        #[arg(long, conflicts_with = "calibration")]
+        menu: bool,
+        /// With --frames: once they are presented, print "ready" and keep the window showing
+        /// the last frame this many seconds before closing (for a screenshot of the window).
+        #[arg(long, requires = "frames", value_name = "SECONDS")]
+        linger_s: Option<f32>,
     },
     /// Render a sensor log as phantogram frames (PNG), headless.
     Render {
@@ -262,6 +269,8 @@ fn run(cli: Cli) -> Result<()> {
             frames,
             lifecycle_test,
             calibration,
+            menu,
+            linger_s,
         } => {
             let log = match log {
                 Some(path) => Some(sensorlog::read_all(&path, open_events(&path)?)?),
@@ -275,6 +284,8 @@ fn run(cli: Cli) -> Result<()> {
                 frames,
                 lifecycle_test,
                 calibration,
+                menu,
+                linger_s,
             })
         }
         Command::Render {

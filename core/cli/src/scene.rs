@@ -78,6 +78,8 @@ impl SceneArgs {
             },
             floor: !self.no_floor,
             calibration_path,
+            // Files dropped on the viewer's window are kept, as a phone keeps those it opens.
+            library_dir: phantogram::library_dir(),
             ..EngineConfig::default()
         };
         let engine = Engine::new(config)?;

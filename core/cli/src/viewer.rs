@@ -35,6 +35,10 @@ pub struct ViewerArgs {
     pub lifecycle_test: bool,
     /// Open the calibration screens at start.
     pub calibration: bool,
+    /// Open the artifacts menu at start.
+    pub menu: bool,
+    /// After `frames`: print "ready", keep the last frame on screen this long, then close.
+    pub linger_s: Option<f32>,
 }
 
 /// A phone tilted by the mouse: pitch about the screen's horizontal, roll about its vertical.
@@ -72,6 +76,9 @@ struct App {
     inbox: Arc<SensorInbox>,
     log: Option<Vec<SensorEvent>>,
     frames: Option<u64>,
+    linger_s: Option<f32>,
+    /// When the lingering after the last frame ends.
+    linger_until: Option<Instant>,
     lifecycle_test: bool,
     /// How many of [`App::lifecycle_step`]'s steps were taken.
     lifecycle_steps_done: u8,
@@ -130,13 +137,27 @@ impl App {
     }
 
     fn frame(&mut self, event_loop: &ActiveEventLoop) -> Result<()> {
+        if let Some(until) = self.linger_until {
+            // The last frame stays on screen, untouched, for a screenshot.
+            if Instant::now() >= until {
+                event_loop.exit();
+            }
+            std::thread::sleep(std::time::Duration::from_millis(20));
+            return Ok(());
+        }
         let t_ns = self.feed_sensors();
         self.engine.draw(Some(t_ns))?;
         if self.lifecycle_test {
             self.lifecycle_step(t_ns)?;
         }
         if self.frames.is_some_and(|n| self.engine.stats().frames_drawn >= n) {
-            event_loop.exit();
+            match self.linger_s {
+                Some(s) => {
+                    eprintln!("ready: {} frames presented", self.engine.stats().frames_drawn);
+                    self.linger_until = Some(Instant::now() + std::time::Duration::from_secs_f32(s.clamp(0.0, 3600.0)));
+                }
+                None => event_loop.exit(),
+            }
         }
         Ok(())
     }
@@ -390,9 +411,16 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         frames,
         lifecycle_test,
         calibration,
+        menu,
+        linger_s,
     } = args;
     if calibration {
         engine.open_calibration();
+    }
+    if menu {
+        engine.open_menu();
+        // Its pictures before the first frame, so the first one shows the menu complete.
+        engine.wait_for_thumbnails(std::time::Duration::from_secs(30));
     }
     // Printed when the engine was made.
     let engine_warning = engine.calibration_warning().map(str::to_owned);
@@ -401,6 +429,8 @@ pub fn run(args: ViewerArgs) -> Result<()> {
         engine,
         log,
         frames,
+        linger_s,
+        linger_until: None,
         lifecycle_test,
         lifecycle_steps_done: 0,
         window: None,

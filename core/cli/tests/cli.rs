@@ -289,6 +289,73 @@ fn viewer_runs_its_surface_lifecycle_in_a_window() {
     assert!(after("reconfigured ") >= 4, "{line}");
 }
 
+#[path = "../../../tests/tests/support/golden.rs"]
+mod golden;
+
+/// The menu as the desktop viewer's window shows it, screenshotted from a virtual X server
+/// (ImageMagick's `import`) once the viewer has presented its frames, against its golden image:
+/// the window path (surface, presentation) shows what the offscreen goldens show. Needs
+/// `xvfb-run` and `import`; skipped with a notice without them, except under CI.
+#[test]
+fn the_menu_in_a_window_matches_its_golden_screenshot() {
+    let have = |tool: &str| {
+        Command::new("sh")
+            .args(["-c", &format!("command -v {tool}")])
+            .output()
+            .is_ok_and(|o| o.status.success())
+    };
+    if !have("xvfb-run") || !have("import") {
+        assert!(std::env::var_os("CI").is_none(), "CI must provide xvfb-run and import");
+        eprintln!("xvfb-run or import (ImageMagick) not found: skipping the window screenshot");
+        return;
+    }
+    let dir = Scratch::new("cli-window-shot");
+    let runtime = dir.join("runtime");
+    std::fs::create_dir_all(&runtime).unwrap();
+    let shot = dir.join("shot.png");
+    // The viewer prints "ready" after its frames and keeps the last on screen; the screenshot
+    // is taken then, and the viewer stopped.
+    let script = r#"
+        "$0" view --menu --frames 5 --linger-s 120 2> "$1/viewer.log" &
+        pid=$!
+        until grep -q ready "$1/viewer.log" || ! kill -0 $pid 2>/dev/null; do sleep 0.2; done
+        import -window root "$1/shot.png"
+        kill $pid 2>/dev/null
+        wait $pid
+        exit 0
+    "#;
+    let out = Command::new("timeout")
+        .args([
+            "300",
+            "xvfb-run",
+            "-a",
+            "-s",
+            "-screen 0 800x1280x24",
+            "sh",
+            "-c",
+            script,
+        ])
+        .arg(env!("CARGO_BIN_EXE_phantogram"))
+        .arg(&*dir)
+        .env("XDG_RUNTIME_DIR", &runtime)
+        .env("XDG_CONFIG_HOME", dir.join("config"))
+        .env("XDG_DATA_HOME", dir.join("data"))
+        .env_remove("PHANTOGRAM_CALIBRATION")
+        .env_remove("PHANTOGRAM_LIBRARY")
+        .output()
+        .unwrap();
+    let log = std::fs::read_to_string(dir.join("viewer.log")).unwrap_or_default();
+    assert!(
+        out.status.success() && log.contains("ready") && shot.is_file(),
+        "{}\n{log}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    // The window (405 × 900, no window manager: at the origin) out of the screen.
+    let screen = image::open(&shot).unwrap().to_rgba8();
+    let window = image::imageops::crop_imm(&screen, 0, 0, 405, 900).to_image();
+    golden::check("xvfb-menu", 405, 900, window.as_raw(), 3, 0.003);
+}
+
 /// `eval face --json`: one object per image with the documented keys; a missing model folder is a
 /// clear error naming `cargo xtask models`. Needs `PHANTOGRAM_MODELS` and `PHANTOGRAM_DATA` for
 /// the positive part.

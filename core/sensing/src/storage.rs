@@ -1,4 +1,5 @@
-//! Where the desktop tools keep per-user files: the calibration, the face models. The phone shells pass their app-private folders instead and never use this.
+//! Where the desktop tools keep per-user files: the calibration, the face models, the artifact
+//! library. The phone shells pass their app-private folders instead and never use this.
 
 use std::path::PathBuf;
 
@@ -19,4 +20,11 @@ pub fn user_path(override_var: &str, xdg_var: &str, home_dir: &str, name: &str) 
 /// `~/.cache/phantogram/models`. `None` only without any of those variables.
 pub fn face_models_dir() -> Option<PathBuf> {
     user_path("PHANTOGRAM_MODELS", "XDG_CACHE_HOME", ".cache", "models")
+}
+
+/// Where the desktop viewer keeps the artifacts opened in it (and their thumbnails):
+/// `$PHANTOGRAM_LIBRARY` if set, else `$XDG_DATA_HOME/phantogram/library`, else
+/// `~/.local/share/phantogram/library`. `None` only without any of those variables.
+pub fn library_dir() -> Option<PathBuf> {
+    user_path("PHANTOGRAM_LIBRARY", "XDG_DATA_HOME", ".local/share", "library")
 }

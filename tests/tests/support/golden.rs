@@ -6,10 +6,14 @@
 
 use std::path::PathBuf;
 
+/// `tests/golden/NAME.png` of the workspace, from whichever of its crates includes this file.
 pub fn path(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("golden")
-        .join(format!("{name}.png"))
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    let root = manifest
+        .ancestors()
+        .find(|p| p.join("tests/golden").is_dir())
+        .unwrap_or(&manifest);
+    root.join("tests/golden").join(format!("{name}.png"))
 }
 
 /// Compares `pixels` (`width × height` RGBA8) with `tests/golden/NAME.png`: fails if more than
