@@ -185,6 +185,7 @@ struct Work {
 /// arenas holding freed models: resident memory crept up over many switches). Ends when the
 /// loader is dropped.
 fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, results: Sender<Outcome>) {
+    crate::background::lower_current_thread_priority();
     while let Ok(mut work) = jobs.recv() {
         while let Ok(newer) = jobs.try_recv() {
             work = newer;

@@ -78,6 +78,8 @@ pub use phantogram_vision as face;
 #[cfg(feature = "render")]
 pub mod artifacts;
 #[cfg(feature = "render")]
+mod background;
+#[cfg(feature = "render")]
 pub mod engine;
 pub mod gesture;
 #[cfg(feature = "render")]

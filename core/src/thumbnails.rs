@@ -216,6 +216,7 @@ impl Thumbnails {
             std::thread::Builder::new()
                 .name("artifact-thumbnails".into())
                 .spawn(move || {
+                    crate::background::lower_current_thread_priority();
                     while let Ok(job) = inbox.recv() {
                         if job.generation != generation.load(Ordering::Relaxed) {
                             continue;

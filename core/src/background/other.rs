@@ -1,0 +1,3 @@
+//! Other platforms: left at the default priority.
+
+pub fn lower_current_thread_priority() {}
