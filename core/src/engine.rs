@@ -266,6 +266,10 @@ pub struct Engine {
     text_scale: f32,
     /// The finger turning the artifact and where it was ("reduce motion"), physical pixels.
     drag_px: Option<(i32, [f32; 2])>,
+    /// The Diorama, while it is the artifact on screen ([`crate::diorama`]).
+    diorama: Option<Box<crate::diorama::DioramaScene>>,
+    /// The finger holding a Diorama body: its pointer and the body's depth along the sight line.
+    diorama_grab: Option<(i32, f32)>,
     /// The screens drawn over the picture (menu, calibration, status banner); made when first
     /// needed and kept, so egui's fonts are uploaded once.
     #[cfg(feature = "ui")]
@@ -444,6 +448,10 @@ impl Engine {
                 let model = crate::model::load_model_within(path, budget)?;
                 crate::artifacts::prepare(model, None, false, &placing)?
             }
+            // The Diorama is made once the engine exists (below); the default artifact first.
+            (None, Some(id)) if id.to_string() == crate::diorama::DIORAMA_ID => loader
+                .load_now(&crate::library::ArtifactId::default_artifact(), &placing)
+                .map_err(load_error)?,
             (None, Some(id)) => match loader.load_now(id, &placing) {
                 Ok(p) => p,
                 // What the shell saved may have been removed or damaged since: the default
@@ -517,6 +525,8 @@ impl Engine {
             platform_panel: config.panel,
             text_scale: 1.0,
             drag_px: None,
+            diorama: None,
+            diorama_grab: None,
             #[cfg(feature = "ui")]
             screens: None,
             requests: Vec::new(),
@@ -526,6 +536,14 @@ impl Engine {
             thumbnails,
         };
         engine.apply_calibration();
+        if config.model_path.is_none()
+            && config
+                .artifact
+                .as_ref()
+                .is_some_and(|id| id.to_string() == crate::diorama::DIORAMA_ID)
+        {
+            engine.show_diorama();
+        }
         #[cfg(feature = "ui")]
         if engine.calibration_path.is_some() && !engine.calibration.introduced {
             engine.screens().page = Some(Page::Welcome(crate::calibration_ui::welcome::WelcomeUi::new()));
@@ -892,15 +910,63 @@ impl Engine {
 
     /// Every artifact the library offers (built in, bundled, imported), for the gallery.
     pub fn artifacts(&self) -> Vec<crate::library::ArtifactEntry> {
-        self.loader.library().list()
+        let mut list = self.loader.library().list();
+        // The Diorama is a scene, not a file: listed after the built-in artifacts.
+        let after_built_ins = list
+            .iter()
+            .position(|e| e.id.origin != crate::library::Origin::BuiltIn)
+            .unwrap_or(list.len());
+        list.insert(after_built_ins, diorama_entry());
+        list
     }
 
     /// Starts showing an artifact of the library: loaded in the background (see
     /// [`crate::artifacts`]); the artifact on screen stays until it is ready. Progress and
     /// failure: [`Self::loading_status`].
     pub fn select_artifact(&mut self, id: crate::library::ArtifactId) {
+        if id.to_string() == crate::diorama::DIORAMA_ID {
+            self.loader.cancel();
+            self.show_diorama();
+            return;
+        }
         let placing = self.placing();
         self.loader.start(crate::artifacts::Request::Select(id), placing);
+    }
+
+    /// Shows the Diorama in place of the artifact (made at once: no file to load).
+    fn show_diorama(&mut self) {
+        let screen = self.session.config().screen;
+        let scene = match crate::diorama::DioramaScene::new(&screen) {
+            Ok(scene) => scene,
+            Err(e) => {
+                self.loader.fail("Diorama".into(), e.to_string());
+                return;
+            }
+        };
+        if let Err(e) = self.renderer.set_model(scene.model()) {
+            self.loader.fail("Diorama".into(), e.to_string());
+            return;
+        }
+        let model = scene.model();
+        self.bounds = model.bounds().unwrap_or(self.bounds);
+        self.model_info = ModelInfo {
+            name: model.name.clone(),
+            triangles: model.triangle_count(),
+            materials: model.materials.len(),
+            images: 0,
+            warnings: Vec::new(),
+            artifact: Some(diorama_entry()),
+            annotations: Vec::new(),
+            preview: false,
+        };
+        self.smoother = ContainmentSmoother::default();
+        self.diorama = Some(Box::new(scene));
+        self.diorama_grab = None;
+    }
+
+    /// The Diorama on screen, if it is.
+    pub fn diorama(&self) -> Option<&crate::diorama::DioramaScene> {
+        self.diorama.as_deref()
     }
 
     /// Imports a file the user opened (its display name and bytes: a `.glb`, `.gltf` or `.zip`)
@@ -966,6 +1032,8 @@ impl Engine {
     fn install(&mut self, prepared: crate::artifacts::Prepared) -> bool {
         match self.renderer.set_model(&prepared.model) {
             Ok(()) => {
+                self.diorama = None;
+                self.diorama_grab = None;
                 self.bounds = prepared.bounds;
                 self.model_info = prepared.info;
                 self.smoother = ContainmentSmoother::default();
@@ -1115,9 +1183,47 @@ impl Engine {
             }
         }
         self.drag_to_turn(phase, pointer_id, [x_px, y_px]);
+        self.touch_diorama(phase, pointer_id, [x_px, y_px]);
         let g = self.gestures.touch(phase, pointer_id, x_px, y_px, t_ns)?;
         self.apply_gesture(g);
         Some(g)
+    }
+
+    /// The Diorama's finger: a body under the first finger down (on the line from the eye
+    /// through the touched point of the glass) is held and follows the finger at its depth;
+    /// lifting the finger lets it go with its speed (a flick).
+    fn touch_diorama(&mut self, phase: TouchPhase, pointer_id: i32, px: [f32; 2]) {
+        if self.diorama.is_none() {
+            return;
+        }
+        let screen = self.session.config().screen;
+        let scale = self.target_scale();
+        let (Some(mono), Some(scene)) = (self.last_mono, self.diorama.as_deref_mut()) else {
+            return;
+        };
+        let glass = screen.glass_point_of_pixel(glam::Vec2::new(px[0], px[1]) / scale);
+        let eye = mono.eye_m;
+        let Some(direction) = (glass - eye).try_normalize() else {
+            return;
+        };
+        match (phase, self.diorama_grab) {
+            (TouchPhase::Down, None) => {
+                let world = scene.world();
+                if let Some(i) = world.pick(eye, direction) {
+                    let depth = (world.stepped_poses()[i].translation_m - eye).dot(direction);
+                    scene.world_mut().grab(i, eye + direction * depth);
+                    self.diorama_grab = Some((pointer_id, depth));
+                }
+            }
+            (TouchPhase::Move, Some((id, depth))) if id == pointer_id => {
+                scene.world_mut().drag_to(eye + direction * depth);
+            }
+            (TouchPhase::Up | TouchPhase::Cancel, Some((id, _))) if id == pointer_id => {
+                scene.world_mut().release();
+                self.diorama_grab = None;
+            }
+            _ => {}
+        }
     }
 
     /// "Reduce motion": the first finger down drags the artifact around
@@ -1153,9 +1259,13 @@ impl Engine {
         // Without gravity yet the calibrations cannot be done; the gesture is then a no-op, as a
         // user would expect from tapping a phone that has not measured anything.
         match g {
-            Gesture::StraightOn => {
-                let _ = self.calibrate_flat_angle();
-            }
+            // In the Diorama a double tap puts everything back in the tray.
+            Gesture::StraightOn => match self.diorama.as_deref_mut() {
+                Some(scene) => scene.reset(),
+                None => {
+                    let _ = self.calibrate_flat_angle();
+                }
+            },
             Gesture::Calibrate => {
                 self.open_calibration();
             }
@@ -1225,9 +1335,19 @@ impl Engine {
         if display_t_ns.is_some() {
             self.last_display_t_ns = display_t_ns;
         }
-        let push = self
-            .smoother
-            .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s);
+        let push = match self.diorama.as_deref_mut() {
+            // The Diorama keeps its bodies inside the eyes' pyramids itself (its own
+            // containment, per body): the scene is not pushed back as a whole.
+            Some(scene) => {
+                let t_ns = display_t_ns.or(view.sensor_t_ns).unwrap_or(0);
+                scene.update(&view, self.session.newest_specific_force(), t_ns);
+                self.renderer.update_vertices(scene.model())?;
+                0.0
+            }
+            None => self
+                .smoother
+                .follow(&self.bounds, &view.stereo_eyes_m(), &self.session.config().screen, dt_s),
+        };
         self.last_push_m = push;
         self.last_mono = Some(view.mono);
         let input = self.oriented(frame_input(&view, Vec3::Z * -push));
@@ -1750,6 +1870,17 @@ fn filter_colours(method: Method) -> Option<([u8; 3], [u8; 3])> {
         Method::DuboisRedCyan | Method::HalfColor | Method::Optimized | Method::Gray | Method::Color => {
             Some(([255, 0, 0], [0, 255, 255]))
         }
+    }
+}
+
+/// The Diorama's entry in the artifact library.
+fn diorama_entry() -> crate::library::ArtifactEntry {
+    crate::library::ArtifactEntry {
+        id: crate::library::ArtifactId::built_in("diorama"),
+        title: "Diorama: tilt to roll marbles".into(),
+        credit: Some(crate::builtin::CREDIT.into()),
+        licence: Some(crate::builtin::LICENCE.into()),
+        model_path: None,
     }
 }
 

@@ -23,6 +23,8 @@
 //!   [`straight_on`], [`calibration`], [`camera`], [`session`], [`synthetic`], [`clock`].
 //! * `phantogram_assets` (feature `models`): `model`, `artifact`, `builtin`, `library`, `ibl`,
 //!   `parallel`, `progress`, `budget`.
+//! * `phantogram_physics` (feature `render`): `physics` (the Diorama's world; [`diorama`] shows
+//!   it through the engine).
 //! * `phantogram_render` (feature `render`): `render` (the crate itself) and `surface`.
 //! * `phantogram_vision` (feature `face`): `face` (the crate itself).
 //! * `phantogram_ui` (feature `ui`): `calibration_ui` (the crate itself).
@@ -67,6 +69,8 @@ pub use phantogram_sensing::{
 #[cfg(feature = "models")]
 pub use phantogram_assets::{artifact, budget, builtin, ibl, library, model, parallel, progress};
 #[cfg(feature = "render")]
+pub use phantogram_physics as physics;
+#[cfg(feature = "render")]
 pub use phantogram_render as render;
 #[cfg(feature = "render")]
 pub use phantogram_render::surface;
@@ -79,6 +83,8 @@ pub use phantogram_vision as face;
 pub mod artifacts;
 #[cfg(feature = "render")]
 mod background;
+#[cfg(feature = "render")]
+pub mod diorama;
 #[cfg(feature = "render")]
 pub mod engine;
 pub mod gesture;

@@ -39,10 +39,10 @@ use crate::screen::{DisplayRotation, PanelSpec, Screen};
 pub const THUMBNAIL_PX: u32 = 192;
 
 /// How far above the glass the thumbnail's view looks down at the artifact.
-const VIEW_ELEVATION_RAD: f32 = 40.0 * std::f32::consts::PI / 180.0;
+pub const VIEW_ELEVATION_RAD: f32 = 40.0 * std::f32::consts::PI / 180.0;
 /// The posed artifact's larger half-extent across the view, metres, and the eye's distance.
-const HALF_EXTENT_M: f32 = 0.045;
-const EYE_DISTANCE_M: f32 = 0.4;
+pub const HALF_EXTENT_M: f32 = 0.045;
+pub const EYE_DISTANCE_M: f32 = 0.4;
 /// Room around the artifact's silhouette.
 const MARGIN: f32 = 1.06;
 

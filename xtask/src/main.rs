@@ -6,6 +6,8 @@
 //! * `bench render` — cold load-to-first-frame of the Draco turtle, the turtle chosen in a running
 //!   engine's gallery (tap to first frame), stereo/mono frame-time ratio at 1080×2400, peak
 //!   memory (`PHANTOGRAM_DATA` for the turtle).
+//! * `bench diorama` — ms per physics step of the Diorama with 50 bodies, moving and at rest
+//!   (`benchmarks/diorama.md`).
 //! * `bench face` — ms per 640×480 camera frame in detection and tracking modes (needs the
 //!   models from `models` and `PHANTOGRAM_DATA` for a face photograph).
 //! * `bench orientation` — score the orientation estimators on the recordings in
@@ -50,6 +52,7 @@ fn main() -> Result<()> {
         ["bench", "orientation"] => bench_orientation(),
         ["bench", "render"] => cargo(&["bench", "-p", "phantogram", "--bench", "render"]),
         ["bench", "face"] => cargo(&["bench", "-p", "phantogram", "--bench", "face"]),
+        ["bench", "diorama"] => cargo(&["bench", "-p", "phantogram-physics", "--bench", "step"]),
         ["models"] => models(false),
         ["models", "--force"] => models(true),
         ["android"] => phone::android(None),
@@ -76,7 +79,7 @@ fn main() -> Result<()> {
         }
         [] | ["help"] | ["--help"] => {
             println!(
-                "usage: cargo xtask <assets | bench core | bench render | bench face | bench orientation | models [--force] | android | ios | header | fuzz [TARGET…] [--seconds N] [--record] | ci>"
+                "usage: cargo xtask <assets | bench core | bench render | bench face | bench diorama | bench orientation | models [--force] | android | ios | header | fuzz [TARGET…] [--seconds N] [--record] | ci>"
             );
             Ok(())
         }

@@ -16,7 +16,8 @@ pub struct SceneArgs {
     /// A glTF 2.0 model (.gltf or .glb), or a Smithsonian Voyager folder or its scene.svx.json
     /// (its best scan present); the default artifact when omitted.
     model: Option<PathBuf>,
-    /// One of the built-in artifacts instead: amphora (the default), medal or tablet.
+    /// One of the built-in artifacts instead: amphora (the default), medal or tablet; or the
+    /// Diorama (marbles, dice, coins and vessels in a tray, under the log's gravity).
     #[arg(long, value_name = "NAME", conflicts_with = "model")]
     artifact: Option<String>,
     /// Fraction of a loaded model's height that stands in front of the glass.
@@ -51,7 +52,8 @@ impl SceneArgs {
         }
         let artifact = match &self.artifact {
             Some(name) => {
-                let known: Vec<&str> = phantogram::builtin::BUILT_INS.iter().map(|b| b.key).collect();
+                let mut known: Vec<&str> = phantogram::builtin::BUILT_INS.iter().map(|b| b.key).collect();
+                known.push("diorama");
                 if !known.contains(&name.as_str()) {
                     bail!(
                         "--artifact {name:?} is not a built-in artifact (choose from {})",

@@ -300,6 +300,8 @@ impl Offscreen {
 
 struct GpuPrimitive {
     vertices: wgpu::Buffer,
+    /// Vertices in `vertices` (for [`Renderer::update_vertices`]).
+    vertex_count: usize,
     indices: wgpu::Buffer,
     index_count: u32,
     material: usize,
@@ -873,6 +875,33 @@ impl Renderer {
     /// Replaces the model drawn (keeps pipelines and targets).
     pub fn set_model(&mut self, model: &Model) -> Result<(), RenderError> {
         self.model = self.upload_with_pipelines(model)?;
+        Ok(())
+    }
+
+    /// Moves the model drawn to `model`'s vertex positions without uploading it anew, when
+    /// `model` has the same primitives with the same vertex counts as the one set (bodies that
+    /// moved: the Diorama rewrites a few hundred kilobytes a frame instead of rebuilding buffers,
+    /// materials and bind groups); otherwise it is set as [`Self::set_model`] does. Indices,
+    /// materials and textures are taken to be unchanged.
+    pub fn update_vertices(&mut self, model: &Model) -> Result<(), RenderError> {
+        let drawn: Vec<&phantogram_assets::model::Primitive> =
+            model.primitives.iter().filter(|p| !p.mesh.indices.is_empty()).collect();
+        let same_shape = drawn.len() == self.model.primitives.len()
+            && drawn
+                .iter()
+                .zip(&self.model.primitives)
+                .all(|(p, g)| p.mesh.vertices.len() == g.vertex_count);
+        if !same_shape {
+            return self.set_model(model);
+        }
+        for (p, g) in drawn.iter().zip(&self.model.primitives) {
+            self.gpu
+                .queue
+                .write_buffer(&g.vertices, 0, bytemuck::cast_slice(&p.mesh.vertices));
+        }
+        let fallback = phantogram_geometry::containment::Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05));
+        self.model.bounds = model.bounds().unwrap_or(fallback);
+        self.model.standing = model.bounds_of(|p| !p.is_floor).unwrap_or(self.model.bounds);
         Ok(())
     }
 

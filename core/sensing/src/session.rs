@@ -133,6 +133,8 @@ pub struct Session {
     straight_on: Option<crate::straight_on::StraightOnAdapter>,
     /// "Reduce motion": the view turned by touch, not by tilt or the camera.
     turn_by_touch: Option<crate::turn_by_touch::TurnByTouch>,
+    /// The newest accelerometer reading taken (time, specific force in the device frame).
+    newest_accel: Option<(i64, Vec3)>,
 }
 
 impl std::fmt::Debug for Session {
@@ -171,6 +173,7 @@ impl Session {
             eye_source: EyeSource::Tilt,
             straight_on: config.straight_on.map(crate::straight_on::StraightOnAdapter::new),
             turn_by_touch: None,
+            newest_accel: None,
         })
     }
 
@@ -198,6 +201,12 @@ impl Session {
         self.inbox.drain_into(&mut self.batch);
         for e in &self.batch {
             self.estimator.push(e);
+            if e.kind == crate::sensors::SensorKind::Accelerometer {
+                let v = Vec3::new(e.value[0], e.value[1], e.value[2]);
+                if v.is_finite() && self.newest_accel.is_none_or(|(t, _)| e.t_ns >= t) {
+                    self.newest_accel = Some((e.t_ns, v));
+                }
+            }
         }
         if let Some(last) = self.batch.last() {
             self.newest_t_ns = Some(self.newest_t_ns.map_or(last.t_ns, |t| t.max(last.t_ns)));
@@ -231,6 +240,12 @@ impl Session {
         self.estimator
             .device_to_world()
             .or_else(|| device_to_world_from_up(self.estimator.up_device()?))
+    }
+
+    /// The newest accelerometer reading taken in (its time and specific force, device frame,
+    /// m/s²): what the hand's own acceleration is read from (the Diorama's bodies feel it).
+    pub fn newest_specific_force(&self) -> Option<(i64, Vec3)> {
+        self.newest_accel
     }
 
     pub fn up_device(&self) -> Option<Vec3> {
