@@ -69,8 +69,9 @@ fn main() {
         resting.push(start.elapsed().as_secs_f64() * 1e3 / 30.0);
     }
     println!(
-        "diorama, {BODIES} bodies, 120 Hz: {:.3} ms per step while they move (gravity turning, eyes moving), {:.4} ms at rest",
+        "diorama, {BODIES} bodies, 120 Hz: {:.3} ms per step while they move (gravity turning, eyes moving), {:.4} ms at rest ({} of {BODIES} asleep)",
         median(moving),
-        median(resting)
+        median(resting),
+        d.sleeping_bodies()
     );
 }

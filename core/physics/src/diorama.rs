@@ -5,7 +5,8 @@
 //!   screen's edges, from the floor to the glass and a little beyond (thick fixed boxes, so that
 //!   no body passes through them between two steps); a lid at [`DioramaParams::lid_fraction`] of
 //!   the way to the eyes. In front of the glass the eyes' pyramids ([`crate::frustum`]) are the
-//!   walls: eight kinematic half-spaces moved to the current eyes before every step.
+//!   walls: eight slabs standing on the glass, one per side and eye, reshaped to the current
+//!   eyes before every step.
 //! * **Time**: the world advances in fixed steps of `1 / step_hz` seconds of the sensor clock
 //!   ([`Diorama::advance_to`]), whatever the frame rate; a frame's poses are interpolated
 //!   between the last two steps ([`Diorama::poses`]). After a pause (a suspended app, a gap in a
@@ -26,11 +27,15 @@ use rapier3d::prelude::*;
 
 use crate::bodies::{BodyShape, BodySpec};
 use crate::convert::{from_rapier, pose, quat_from_rapier, to_rapier};
-use crate::frustum::{EyePlane, stereo_pyramids};
+use crate::frustum::{EyePlane, screen_edges, side_prism, stereo_pyramids};
 
 /// How far a body may reach out of an eye's pyramid before it is moved back (0.2 mm: about three
 /// pixels of a 420 dpi screen).
 pub const CONTAINMENT_TOLERANCE_M: f32 = 0.0002;
+
+/// How thick the pyramids' side slabs are, and how far they reach past the screen's corners.
+const SIDE_THICKNESS_M: f32 = 0.05;
+const SIDE_OVERLAP_M: f32 = 0.02;
 
 /// The diorama's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,8 +89,9 @@ pub struct Diorama {
     screen: Screen,
     specs: Vec<BodySpec>,
     handles: Vec<RigidBodyHandle>,
-    /// The eight kinematic half-spaces of the eyes' pyramids, and the lid's.
-    pyramid: [RigidBodyHandle; 8],
+    /// The colliders of the eight sides of the eyes' pyramids (on one fixed body), and the lid's
+    /// kinematic half-space.
+    pyramid: [ColliderHandle; 8],
     lid: RigidBodyHandle,
     eyes_m: Option<[Vec3; 2]>,
     /// The eyes the planes were last moved to.
@@ -120,12 +126,17 @@ fn collider_for(shape: &BodyShape) -> Option<ColliderBuilder> {
         BodyShape::Cuboid { half_extents_m: h } if ok(h.x) && ok(h.y) && ok(h.z) => {
             ColliderBuilder::cuboid(h.x, h.y, h.z)
         }
-        // rapier's cylinders stand along y; ours along z.
+        // rapier's cylinders stand along y; ours along z. Rounded edges (a third of the
+        // thickness): a sharp-edged thin cylinder wedged in the tray's corner was seen to sink
+        // millimetres into the wall and the floor.
         BodyShape::Cylinder {
             radius_m,
             half_height_m,
-        } if ok(*radius_m) && ok(*half_height_m) => ColliderBuilder::cylinder(*half_height_m, *radius_m)
-            .rotation(to_rapier(Vec3::X * std::f32::consts::FRAC_PI_2)),
+        } if ok(*radius_m) && ok(*half_height_m) => {
+            let border = (half_height_m * 0.66).min(*radius_m * 0.5);
+            ColliderBuilder::round_cylinder(half_height_m - border, radius_m - border, border)
+                .rotation(to_rapier(Vec3::X * std::f32::consts::FRAC_PI_2))
+        }
         BodyShape::Convex { points_m } if points_m.iter().all(|p| p.is_finite()) => {
             let points: Vec<_> = points_m.iter().map(|p| to_rapier(*p)).collect();
             ColliderBuilder::convex_hull(&points)?
@@ -179,17 +190,23 @@ impl Diorama {
             let (handle, _) = world.insert(body, collider);
             handles.push(handle);
         }
-        let plane = |world: &mut PhysicsWorld| {
-            // Each half-space's solid lies below its local xy plane, its free side along +z.
+        // The pyramids' sides: reshaped as the eyes move (a tiny placeholder until then).
+        let sides_body = world.insert_body(RigidBodyBuilder::fixed());
+        let pyramid = std::array::from_fn(|_| {
+            let placeholder = ColliderBuilder::ball(1e-4)
+                .translation(to_rapier(Vec3::new(0.0, 0.0, 10.0)))
+                .friction(0.2);
             world
-                .insert(
-                    RigidBodyBuilder::kinematic_position_based(),
-                    ColliderBuilder::new(SharedShape::halfspace(to_rapier(Vec3::Z))).friction(0.2),
-                )
-                .0
-        };
-        let pyramid = std::array::from_fn(|_| plane(&mut world));
-        let lid = plane(&mut world);
+                .colliders
+                .insert_with_parent(placeholder, sides_body, &mut world.bodies)
+        });
+        // The lid's solid lies above its local xy plane turned over: free side along its +z.
+        let lid = world
+            .insert(
+                RigidBodyBuilder::kinematic_position_based(),
+                ColliderBuilder::new(SharedShape::halfspace(to_rapier(Vec3::Z))).friction(0.2),
+            )
+            .0;
         let mut diorama = Self {
             world,
             params,
@@ -258,22 +275,35 @@ impl Diorama {
         }
     }
 
-    /// Moves the pyramids' and the lid's half-spaces to `eyes_m` (at once when `teleport`, else
-    /// as the next step's kinematic target, so that they push what they meet).
+    /// Reshapes the pyramids' sides for `eyes_m` and moves the lid (at once when `teleport`,
+    /// else as the next step's kinematic target).
     fn place_planes(&mut self, eyes_m: [Vec3; 2], teleport: bool) {
         let Some(planes) = stereo_pyramids(&self.screen, eyes_m) else {
             return; // an eye behind the glass: the pyramids stay where they were
         };
+        let edges = screen_edges(&self.screen);
+        for (k, (plane, &collider)) in planes.iter().zip(&self.pyramid).enumerate() {
+            let (a, b) = edges[k % 4];
+            let eye = eyes_m[k / 4];
+            let Some(points) = side_prism(plane, a, b, eye, SIDE_THICKNESS_M, SIDE_OVERLAP_M) else {
+                continue;
+            };
+            let points: Vec<_> = points.iter().map(|p| to_rapier(*p)).collect();
+            if let (Some(shape), Some(c)) = (
+                SharedShape::convex_hull(&points),
+                self.world.colliders.get_mut(collider),
+            ) {
+                c.set_shape(shape);
+                c.set_translation_wrt_parent(to_rapier(Vec3::ZERO));
+            }
+        }
         let lid = self.lid_plane(eyes_m);
-        let targets = planes.iter().zip(self.pyramid).chain(std::iter::once((&lid, self.lid)));
-        for (plane, handle) in targets {
-            let target = pose(plane.point_m(), Quat::from_rotation_arc(Vec3::Z, plane.normal));
-            if let Some(body) = self.world.bodies.get_mut(handle) {
-                if teleport {
-                    body.set_position(target, false);
-                } else {
-                    body.set_next_kinematic_position(target);
-                }
+        let target = pose(lid.point_m(), Quat::from_rotation_arc(Vec3::Z, lid.normal));
+        if let Some(body) = self.world.bodies.get_mut(self.lid) {
+            if teleport {
+                body.set_position(target, false);
+            } else {
+                body.set_next_kinematic_position(target);
             }
         }
         self.eyes_m = Some(eyes_m);
@@ -353,52 +383,116 @@ impl Diorama {
         self.previous = std::mem::replace(&mut self.current, now);
     }
 
-    /// The pyramids as a hard limit: after the solver, a body that still reaches more than
-    /// [`CONTAINMENT_TOLERANCE_M`] out of an eye's pyramid or the lid (pressed into a corner
-    /// of three planes, the solver's soft contacts were seen to leave a die 2–3 mm out of both
-    /// eyes' pyramids) is moved back onto it, and its velocity out of it is removed. The planes
-    /// are taken in turn until none is crossed (projections onto convex sets: they converge to a
-    /// position inside all of them, which exists while the eyes are in front of the glass —
-    /// behind it there is always room).
+    /// The tray and the pyramids as hard limits: after the solver, a body reaching more than
+    /// [`CONTAINMENT_TOLERANCE_M`] through the tray's floor or a wall is moved back in, and one
+    /// whose part in front of the glass
+    /// reaches more than [`CONTAINMENT_TOLERANCE_M`] out of an eye's pyramid or the lid
+    /// (pressed into a corner of three planes, the solver's soft contacts were seen to leave a
+    /// die 2–3 mm out of both eyes' pyramids) is moved the shorter way back: onto the pyramids
+    /// (the planes taken in turn until none is crossed: projections onto convex sets converge
+    /// inside all of them) or just behind the glass, where the window may frame it. Its
+    /// velocity out of the planes is removed.
     fn enforce_pyramids(&mut self) {
         let Some(eyes) = self.placed_eyes_m else { return };
         let Some(pyramids) = stereo_pyramids(&self.screen, eyes) else {
             return;
         };
         let lid = self.lid_plane(eyes);
+        let planes: Vec<EyePlane> = pyramids.into_iter().chain(std::iter::once(lid)).collect();
+        let tray = self.tray_planes();
         for (&h, spec) in self.handles.iter().zip(&self.specs) {
             let Some(body) = self.world.bodies.get_mut(h) else {
                 continue;
             };
-            let rotation = quat_from_rapier(*body.rotation()).inverse();
-            let mut centre = from_rapier(body.translation());
-            let mut velocity = from_rapier(body.linvel());
-            let mut moved = false;
+            let to_body = quat_from_rapier(*body.rotation()).inverse();
+            let front = |c: Vec3| c.z + spec.shape.support_m(to_body * Vec3::Z);
+            let out_of = |c: Vec3, p: &EyePlane| spec.shape.support_m(to_body * -p.normal) - p.distance_m(c);
+            // The tray's floor and walls first (at right angles: one pass each), so that no body
+            // is left even partly through them (a coin wedged in a corner under a pile was).
+            let into_tray = |c: Vec3| {
+                tray.iter().fold(c, |c, p| {
+                    let out = out_of(c, p);
+                    if out > CONTAINMENT_TOLERANCE_M {
+                        c + p.normal * out
+                    } else {
+                        c
+                    }
+                })
+            };
+            let original = from_rapier(body.translation());
+            let start = into_tray(original);
+            let in_view = front(start) <= 0.0 || planes.iter().all(|p| out_of(start, p) <= CONTAINMENT_TOLERANCE_M);
+            if in_view {
+                if start != original {
+                    body.set_translation(to_rapier(start), true);
+                    let mut velocity = from_rapier(body.linvel());
+                    for p in &tray {
+                        let into = velocity.dot(p.normal);
+                        if into < 0.0 && out_of(original, p) > CONTAINMENT_TOLERANCE_M {
+                            velocity -= p.normal * into;
+                        }
+                    }
+                    body.set_linvel(to_rapier(velocity), true);
+                }
+                continue;
+            }
+            let mut inside = start;
+            let mut crossed_normals: Vec<Vec3> = Vec::new();
             // In a narrow wedge each turn gains a fixed fraction: enough turns for millimetres.
             for _ in 0..32 {
-                let mut any = false;
-                for plane in pyramids.iter().chain(std::iter::once(&lid)) {
-                    let reach = spec.shape.support_m(rotation * -plane.normal);
-                    let inside = plane.distance_m(centre) - reach;
-                    if inside < -CONTAINMENT_TOLERANCE_M {
-                        centre += plane.normal * -inside;
-                        let into = velocity.dot(plane.normal);
-                        if into < 0.0 {
-                            velocity -= plane.normal * into;
+                let mut crossed = false;
+                for p in &planes {
+                    let out = out_of(inside, p);
+                    if out > CONTAINMENT_TOLERANCE_M {
+                        inside += p.normal * out;
+                        crossed = true;
+                        if !crossed_normals.contains(&p.normal) {
+                            crossed_normals.push(p.normal);
                         }
-                        any = true;
-                        moved = true;
                     }
                 }
-                if !any {
+                if !crossed {
                     break;
                 }
             }
-            if moved {
-                body.set_translation(to_rapier(centre), true);
-                body.set_linvel(to_rapier(velocity), true);
+            let behind = start - Vec3::Z * front(start);
+            // In a sliver of a pyramid (an eye low over the glass) the turns may not get inside
+            // at all: then behind the glass it goes.
+            let got_inside = planes.iter().all(|p| out_of(inside, p) <= CONTAINMENT_TOLERANCE_M);
+            let (mut target, normals) = if !got_inside || start.distance(behind) < start.distance(inside) {
+                (behind, vec![-Vec3::Z])
+            } else {
+                (inside, crossed_normals)
+            };
+            // Back into the tray if that left it; still out of view then, behind the glass.
+            target = into_tray(target);
+            if front(target) > 0.0 && planes.iter().any(|p| out_of(target, p) > CONTAINMENT_TOLERANCE_M) {
+                target = into_tray(target - Vec3::Z * front(target));
             }
+            let mut velocity = from_rapier(body.linvel());
+            for n in normals {
+                let into = velocity.dot(n);
+                if into < 0.0 {
+                    velocity -= n * into;
+                }
+            }
+            body.set_translation(to_rapier(target), true);
+            body.set_linvel(to_rapier(velocity), true);
         }
+    }
+
+    /// The tray's floor and four walls as planes, normals inwards.
+    fn tray_planes(&self) -> [EyePlane; 5] {
+        let (hw, hh) = (self.screen.width_m() / 2.0, self.screen.height_m() / 2.0);
+        let (r, u) = (self.screen.right_device(), self.screen.up_device());
+        let plane = |normal: Vec3, offset_m: f32| EyePlane { normal, offset_m };
+        [
+            plane(Vec3::Z, -self.params.depth_m),
+            plane(r, -hw),
+            plane(-r, -hw),
+            plane(u, -hh),
+            plane(-u, -hh),
+        ]
     }
 
     /// The lid over the tray, a fraction of the nearer eye's distance in front of the glass.
@@ -451,6 +545,14 @@ impl Diorama {
     /// Steps taken since the first [`Self::advance_to`] (simulated or skipped after a pause).
     pub fn steps(&self) -> u64 {
         self.steps
+    }
+
+    /// How many bodies the engine has put to sleep (at rest, not simulated until disturbed).
+    pub fn sleeping_bodies(&self) -> usize {
+        self.handles
+            .iter()
+            .filter(|&&h| self.world.bodies.get(h).is_some_and(|b| b.is_sleeping()))
+            .count()
     }
 
     pub fn skipped_steps(&self) -> u64 {

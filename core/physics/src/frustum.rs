@@ -6,8 +6,11 @@
 //! the objects inside it; here each side of the pyramid is a plane through the eye and one screen
 //! edge, one [`EyePlane`] per side and eye, eight in all.
 //!
-//! Behind the glass the same planes widen beyond the screen's edges, where the tray's walls
-//! already stand: they constrain only the space in front of it.
+//! The planes matter only in front of the glass: behind it, what the window's frame hides is
+//! simply behind a window (and for an eye low over the glass a plane cuts deep into the tray
+//! there, so it must not act). The physics therefore gets each side as a finite slab standing on
+//! the glass ([`side_prism`]): the pyramid's side face from the screen's edge to the eye,
+//! thickened outwards without ever reaching below the glass.
 
 use glam::Vec3;
 use phantogram_geometry::screen::Screen;
@@ -70,6 +73,43 @@ pub fn stereo_pyramids(screen: &Screen, eyes_m: [Vec3; 2]) -> Option<[EyePlane; 
     Some([l[0], l[1], l[2], l[3], r[0], r[1], r[2], r[3]])
 }
 
+/// The collider of one pyramid side: the face from the screen's edge `a`–`b` (on the glass) to
+/// the eye, thickened by `thickness_m` away from the pyramid but never below the glass, as six
+/// points whose convex hull is the slab. The edge is lengthened by `overlap_m` at both ends so
+/// that neighbouring sides leave no gap at the corners. `None` for a degenerate face.
+pub fn side_prism(
+    plane: &EyePlane,
+    a: Vec3,
+    b: Vec3,
+    eye_m: Vec3,
+    thickness_m: f32,
+    overlap_m: f32,
+) -> Option<[Vec3; 6]> {
+    let along = (b - a).try_normalize()?;
+    let (a, b) = (a - along * overlap_m, b + along * overlap_m);
+    // Outwards, but level or upwards: a slab that dipped below the glass would cut into the tray.
+    let out = -plane.normal;
+    let out = Vec3::new(out.x, out.y, out.z.max(0.0)).try_normalize()?;
+    if out.dot(plane.normal) >= 0.0 {
+        return None;
+    }
+    let d = out * thickness_m;
+    Some([a, b, eye_m, a + d, b + d, eye_m + d])
+}
+
+/// The four edges of the screen on the glass, in [`eye_pyramid`]'s order (lower, right, upper,
+/// left), each as its two ends.
+pub fn screen_edges(screen: &Screen) -> [(Vec3, Vec3); 4] {
+    let c = screen.corners();
+    let upper_right = c.lower_right + (c.upper_left - c.lower_left);
+    [
+        (c.lower_left, c.lower_right),
+        (c.lower_right, upper_right),
+        (upper_right, c.upper_left),
+        (c.upper_left, c.lower_left),
+    ]
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -108,5 +148,26 @@ mod tests {
         }
         assert!(eye_pyramid(&screen, Vec3::new(0.0, 0.0, -0.1)).is_none());
         assert!(eye_pyramid(&screen, Vec3::NAN).is_none());
+    }
+
+    #[test]
+    fn side_slabs_stand_on_the_glass_outside_the_pyramid() {
+        let screen = Screen::default();
+        // An eye low over the glass, far to the right: its planes cut into the tray behind the
+        // glass, the slabs must not.
+        for eye in [Vec3::new(0.0, -0.05, 0.3), Vec3::new(0.3, 0.0, 0.05)] {
+            let planes = eye_pyramid(&screen, eye).unwrap();
+            for (plane, (a, b)) in planes.iter().zip(screen_edges(&screen)) {
+                let points = side_prism(plane, a, b, eye, 0.05, 0.02).unwrap();
+                for p in points {
+                    assert!(p.z >= -1e-6, "below the glass: {p}");
+                    assert!(plane.distance_m(p) <= 1e-5, "inside the pyramid: {p}");
+                }
+                // The face itself lies on the plane.
+                for p in &points[..3] {
+                    assert!(plane.distance_m(*p).abs() < 1e-5);
+                }
+            }
+        }
     }
 }
