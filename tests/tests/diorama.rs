@@ -349,3 +349,84 @@ fn the_diorama_at_rest_and_mid_slide_matches_its_golden_frames() {
     golden::check("diorama-rest", w, h, &rest, 3, 0.003);
     golden::check("diorama-sliding", w, h, &sliding, 3, 0.003);
 }
+
+/// The finger in the Diorama through the engine, as a shell sends touches: a drag on a body
+/// carries it across the tray; a double tap puts everything back.
+#[test]
+fn a_finger_drags_a_body_and_a_double_tap_resets_the_diorama() {
+    use phantogram::engine::{Engine, EngineConfig};
+    use phantogram::gesture::TouchPhase;
+    let mut engine = match Engine::new(EngineConfig {
+        artifact: Some("builtin:diorama".parse().unwrap()),
+        ..EngineConfig::default()
+    }) {
+        Ok(e) => e,
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no engine ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    };
+    let (w, h) = (180u32, 400u32);
+    engine.resume_offscreen(w, h).unwrap();
+    let ms = 1_000_000;
+    // Lying flat: the bodies settle where they start.
+    for k in 0..20 {
+        engine
+            .inbox()
+            .push(SensorEvent::accelerometer(k * 50 * ms, Vec3::Z * 9.81))
+            .unwrap();
+        engine.draw(Some(k * 50 * ms)).unwrap();
+    }
+    let world = engine.diorama().unwrap().world();
+    let before = world.stepped_poses().to_vec();
+    // The body nearest the screen's centre, and where it is drawn.
+    let screen = Screen::default();
+    let (i, at) = before
+        .iter()
+        .enumerate()
+        .min_by(|a, b| {
+            a.1.translation_m
+                .truncate()
+                .length()
+                .total_cmp(&b.1.translation_m.truncate().length())
+        })
+        .map(|(i, p)| (i, p.translation_m))
+        .unwrap();
+    let eye = Vec3::Z * 0.3;
+    let on_glass = |p: Vec3| eye + (p - eye) * (eye.z / (eye.z - p.z));
+    let px = screen.pixel_of_glass_point(on_glass(at)) * (w as f32 / screen.width_px() as f32);
+    let mut t = 1000;
+    engine.touch(TouchPhase::Down, 0, px.x, px.y, t * ms);
+    // 15 mm to the right on the glass, over half a second, drawing meanwhile.
+    let right_px = 15.0 / 25.4 * screen.panel().xdpi * (w as f32 / screen.width_px() as f32);
+    for k in 1..=30 {
+        t += 16;
+        engine.touch(TouchPhase::Move, 0, px.x + right_px * k as f32 / 30.0, px.y, t * ms);
+        engine.draw(Some(t * ms)).unwrap();
+    }
+    engine.touch(TouchPhase::Up, 0, px.x + right_px, px.y, (t + 16) * ms);
+    for _ in 0..10 {
+        t += 50;
+        engine.draw(Some(t * ms)).unwrap();
+    }
+    let moved = engine.diorama().unwrap().world().stepped_poses()[i].translation_m;
+    assert!(
+        moved.x - at.x > 0.008,
+        "dragged {:.1} mm to the right",
+        (moved.x - at.x) * 1e3
+    );
+    // A double tap away from the bodies: back to the start.
+    let corner = (5.0, 5.0);
+    for k in 0..2 {
+        let t0 = t + 100 + k * 150;
+        engine.touch(TouchPhase::Down, 0, corner.0, corner.1, t0 * ms);
+        engine.touch(TouchPhase::Up, 0, corner.0, corner.1, (t0 + 60) * ms);
+    }
+    let reset = engine.diorama().unwrap().world();
+    assert_eq!(
+        reset.stepped_poses()[i].translation_m,
+        reset.specs()[i].start_m,
+        "the double tap put it back"
+    );
+}

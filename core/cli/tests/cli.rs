@@ -682,3 +682,55 @@ fn check_artifacts_names_every_entry_that_would_not_show() {
     );
     assert!(String::from_utf8_lossy(&run.stdout).contains("ok fine.glb"));
 }
+
+/// `render --artifact diorama`: a recorded log replayed into the Diorama's frames; the bodies
+/// move between the first and the last, and the same log gives the same frames.
+#[test]
+fn render_replays_a_log_into_the_diorama() {
+    let dir = Scratch::new("cli-diorama");
+    let render = |out: &std::path::Path| {
+        let run = bin()
+            .args([
+                "render",
+                "--artifact",
+                "diorama",
+                "--every",
+                "3000",
+                "--size",
+                "180x400",
+                "--log",
+            ])
+            .arg(default_log())
+            .arg("--out")
+            .arg(out)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+        assert!(run.status.success() || stderr.contains("no GPU adapter"), "{stderr}");
+        stderr
+    };
+    let stderr = render(&dir.join("a"));
+    if stderr.contains("no GPU adapter") && std::env::var_os("CI").is_none() {
+        eprintln!("no GPU adapter: skipping the Diorama render test");
+        return;
+    }
+    render(&dir.join("b"));
+    let frames: Vec<_> = std::fs::read_dir(dir.join("a"))
+        .unwrap()
+        .flatten()
+        .map(|e| e.path())
+        .collect();
+    assert!(frames.len() >= 3, "{stderr}");
+    let read = |p: &std::path::Path| image::open(p).unwrap().to_rgba8().into_raw();
+    let first = read(&dir.join("a/frame_00000.png"));
+    let last = read(&dir.join(format!("a/frame_{:05}.png", frames.len() - 1)));
+    let differ = first.chunks(4).zip(last.chunks(4)).filter(|(a, b)| a != b).count();
+    assert!(differ > 2000, "the bodies did not move ({differ} pixels)");
+    for f in &frames {
+        let name = f.file_name().unwrap();
+        assert!(
+            read(f) == read(&dir.join("b").join(name)),
+            "{name:?} differs between two runs"
+        );
+    }
+}
