@@ -293,6 +293,15 @@ fn make(library: &Library, budget: ResourceBudget, cache_dir: Option<&Path>, ent
     if let Some(rgba) = cache.as_deref().and_then(read_png) {
         return Made::Cached(Thumbnail { id, rgba });
     }
+    if id == crate::diorama::DIORAMA_ID {
+        // Made, not loaded: its tray with the bodies where they start.
+        let screen = Screen::new(PanelSpec::TYPICAL_PHONE, DisplayRotation::Deg0);
+        let scene = screen.ok().and_then(|s| crate::diorama::DioramaScene::new(&s).ok());
+        return match scene.and_then(|s| pose(s.model().clone())) {
+            Some(posed) => Made::Posed { id, cache, posed },
+            None => Made::Failed(id),
+        };
+    }
     let progress = Progress::new();
     let loaded = match library.load_preview(&entry.id, budget, &progress) {
         Some(Ok(loaded)) => Ok(loaded),
