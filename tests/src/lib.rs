@@ -31,6 +31,20 @@ pub fn data_subdir(name: &str) -> Option<PathBuf> {
 
 pub use phantogram_testkit::Scratch;
 
+/// An engine on `config`; `None` (the test skips, saying so) where no GPU adapter is found,
+/// except under CI (`CI` set), where that fails the test: `.ci/run` installs lavapipe. Any
+/// other failure to make it fails the test everywhere.
+pub fn engine_or_skip(config: phantogram::engine::EngineConfig) -> Option<phantogram::engine::Engine> {
+    match phantogram::engine::Engine::new(config) {
+        Ok(e) => Some(e),
+        Err(e) if std::env::var_os("CI").is_none() && e.to_string().contains("adapter") => {
+            eprintln!("no GPU adapter ({e}): skipping");
+            None
+        }
+        Err(e) => panic!("no engine (CI needs a GPU adapter: lavapipe): {e}"),
+    }
+}
+
 /// A scratch folder unique to this process and `name`, emptied first, removed when the returned
 /// guard drops unless the test is failing (see [`Scratch`]).
 pub fn scratch(name: &str) -> Scratch {

@@ -21,16 +21,9 @@ fn serial() -> std::sync::MutexGuard<'static, ()> {
     SERIAL.lock().unwrap_or_else(|p| p.into_inner())
 }
 
-/// An engine on `config`; `None` (the test skips) where no GPU adapter is found, except in CI.
+/// An engine on `config` (see [`phantogram_integration::engine_or_skip`]).
 fn start(config: EngineConfig) -> Option<Engine> {
-    match Engine::new(config) {
-        Ok(e) => Some(e),
-        Err(e) if std::env::var_os("CI").is_none() && e.to_string().contains("adapter") => {
-            eprintln!("no GPU adapter ({e}): skipping");
-            None
-        }
-        Err(e) => panic!("{e}"),
-    }
+    phantogram_integration::engine_or_skip(config)
 }
 
 fn engine(library: &Scratch) -> Option<Engine> {

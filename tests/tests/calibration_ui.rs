@@ -180,13 +180,8 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
         calibration_path: Some(path.clone()),
         ..EngineConfig::default()
     };
-    let mut engine = match Engine::new(config()) {
-        Ok(e) => e,
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no engine ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config()) else {
+        return;
     };
     assert_eq!(
         engine.calibration_warning(),
@@ -298,7 +293,7 @@ fn phones_open_the_screens_with_three_fingers_and_keep_what_they_set() {
 /// the phone's layout scaled down, and touches there still hit the controls.
 #[test]
 fn the_screens_keep_the_phones_layout_on_a_smaller_target() {
-    use phantogram::engine::{Engine, EngineConfig};
+    use phantogram::engine::EngineConfig;
     use phantogram::gesture::TouchPhase;
 
     let panel = PanelSpec {
@@ -307,17 +302,12 @@ fn the_screens_keep_the_phones_layout_on_a_smaller_target() {
         xdpi: 210.0,
         ydpi: 210.0,
     };
-    let mut engine = match Engine::new(EngineConfig {
+    let Some(mut engine) = phantogram_integration::engine_or_skip(EngineConfig {
         panel,
         method: phantogram::anaglyph::Method::Mono,
         ..EngineConfig::default()
-    }) {
-        Ok(e) => e,
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no engine ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    }) else {
+        return;
     };
     let ms = 1_000_000;
     assert!(engine.open_calibration());
@@ -368,13 +358,8 @@ fn the_first_run_screens_check_the_glasses_and_take_the_pose() {
         calibration_path: Some(path.to_path_buf()),
         ..EngineConfig::default()
     };
-    let mut engine = match Engine::new(config(&path)) {
-        Ok(e) => e,
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no engine ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config(&path)) else {
+        return;
     };
     assert!(engine.welcome_open(), "a first run opens on the welcome screens");
     // Held 40° from flat.
@@ -486,16 +471,11 @@ fn the_eye_reflection_page_darkens_the_glass() {
     use phantogram::engine::{Engine, EngineConfig};
     use phantogram::gesture::TouchPhase;
 
-    let mut engine = match Engine::new(EngineConfig {
+    let Some(mut engine) = phantogram_integration::engine_or_skip(EngineConfig {
         method: phantogram::anaglyph::Method::Mono,
         ..EngineConfig::default()
-    }) {
-        Ok(e) => e,
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no engine ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    }) else {
+        return;
     };
     let (w, h) = (270, 600);
     engine.resume_offscreen(w, h).unwrap();

@@ -307,13 +307,8 @@ fn the_diorama_at_rest_and_mid_slide_matches_its_golden_frames() {
         artifact: Some("builtin:diorama".parse().unwrap()),
         ..EngineConfig::default()
     };
-    let mut engine = match Engine::new(config) {
-        Ok(e) => e,
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no engine ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config) else {
+        return;
     };
     assert!(engine.diorama().is_some(), "the Diorama is on screen");
     let (w, h) = (180, 400);
@@ -354,18 +349,13 @@ fn the_diorama_at_rest_and_mid_slide_matches_its_golden_frames() {
 /// carries it across the tray; a double tap puts everything back.
 #[test]
 fn a_finger_drags_a_body_and_a_double_tap_resets_the_diorama() {
-    use phantogram::engine::{Engine, EngineConfig};
+    use phantogram::engine::EngineConfig;
     use phantogram::gesture::TouchPhase;
-    let mut engine = match Engine::new(EngineConfig {
+    let Some(mut engine) = phantogram_integration::engine_or_skip(EngineConfig {
         artifact: Some("builtin:diorama".parse().unwrap()),
         ..EngineConfig::default()
-    }) {
-        Ok(e) => e,
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no engine ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    }) else {
+        return;
     };
     let (w, h) = (180u32, 400u32);
     engine.resume_offscreen(w, h).unwrap();

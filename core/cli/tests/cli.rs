@@ -592,23 +592,27 @@ fn render_replaces_an_earlier_runs_frames_and_nothing_else() {
 /// `render --side-by-side`: frames twice as wide, the left eye's image on the left. Checked
 /// against the plain colour anaglyph of the same frame, which carries the left eye in its red
 /// channel and the right eye in green and blue.
+/// `render ARGS --every EVERY_MS --size 180x400 --log <default log> --out OUT`; its stderr. A
+/// missing GPU adapter is for the caller to skip on (it says so); any other failure fails.
+fn render_default_log(args: &[&str], every_ms: &str, out: &std::path::Path) -> String {
+    let run = bin()
+        .arg("render")
+        .args(args)
+        .args(["--every", every_ms, "--size", "180x400", "--log"])
+        .arg(default_log())
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
+    assert!(run.status.success() || stderr.contains("no GPU adapter"), "{stderr}");
+    stderr
+}
+
 #[test]
 fn render_side_by_side_puts_each_eye_in_its_half() {
     let dir = Scratch::new("cli-side-by-side");
-    let render = |args: &[&str], out: &std::path::Path| {
-        let run = bin()
-            .arg("render")
-            .args(args)
-            .args(["--every", "6000", "--size", "180x400", "--log"])
-            .arg(default_log())
-            .arg("--out")
-            .arg(out)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
-        assert!(run.status.success() || stderr.contains("no GPU adapter"), "{stderr}");
-        stderr
-    };
+    let render = |args: &[&str], out: &std::path::Path| render_default_log(args, "6000", out);
     let stderr = render(&["--side-by-side"], &dir.join("pair"));
     if stderr.contains("no GPU adapter") && std::env::var_os("CI").is_none() {
         eprintln!("no GPU adapter: skipping the render test");
@@ -688,27 +692,7 @@ fn check_artifacts_names_every_entry_that_would_not_show() {
 #[test]
 fn render_replays_a_log_into_the_diorama() {
     let dir = Scratch::new("cli-diorama");
-    let render = |out: &std::path::Path| {
-        let run = bin()
-            .args([
-                "render",
-                "--artifact",
-                "diorama",
-                "--every",
-                "3000",
-                "--size",
-                "180x400",
-                "--log",
-            ])
-            .arg(default_log())
-            .arg("--out")
-            .arg(out)
-            .output()
-            .unwrap();
-        let stderr = String::from_utf8_lossy(&run.stderr).into_owned();
-        assert!(run.status.success() || stderr.contains("no GPU adapter"), "{stderr}");
-        stderr
-    };
+    let render = |out: &std::path::Path| render_default_log(&["--artifact", "diorama"], "3000", out);
     let stderr = render(&dir.join("a"));
     if stderr.contains("no GPU adapter") && std::env::var_os("CI").is_none() {
         eprintln!("no GPU adapter: skipping the Diorama render test");
