@@ -23,6 +23,7 @@ pub mod settings;
 #[cfg(test)]
 mod test_taps;
 pub mod welcome;
+mod widget_rects;
 
 use egui::{Align2, Color32, Pos2, Rect, Stroke, Vec2 as EVec2};
 use glam::{Vec2, Vec3};
@@ -74,7 +75,7 @@ pub struct CalibrationUi {
     /// Card check: drawn size relative to what the reported density makes 85.60 mm.
     pub card_scale: f32,
     /// Where the main controls were drawn last frame (points), for tests and automation.
-    widget_rects: Vec<(&'static str, Rect)>,
+    widget_rects: crate::widget_rects::WidgetRects,
     pending_change: Option<Calibration>,
 }
 
@@ -88,7 +89,7 @@ impl Default for CalibrationUi {
             closed_eye: ClosedEye::Left,
             dot_separation_mm: 60.0,
             card_scale: 1.0,
-            widget_rects: Vec::new(),
+            widget_rects: crate::widget_rects::WidgetRects::new(),
             pending_change: None,
         }
     }
@@ -144,12 +145,7 @@ impl CalibrationUi {
     /// The rectangle (points) of a control drawn last frame: "eye", "blind", "card", "flat",
     /// "light", "close", "accept", "back", "slider".
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
-        self.widget_rects.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
-    }
-
-    fn remember(&mut self, name: &'static str, rect: Rect) {
-        self.widget_rects.retain(|(n, _)| *n != name);
-        self.widget_rects.push((name, rect));
+        self.widget_rects.get(name)
     }
 
     /// The page's instructions and controls, in a panel along the bottom of the screen.
@@ -167,8 +163,8 @@ impl CalibrationUi {
         ui.horizontal(|ui| {
             let a = ui.add_sized([120.0, 40.0], egui::Button::new("Accept"));
             let b = ui.add_sized([120.0, 40.0], egui::Button::new("Back"));
-            self.remember("accept", a.rect);
-            self.remember("back", b.rect);
+            self.widget_rects.remember("accept", a.rect);
+            self.widget_rects.remember("back", b.rect);
             if a.clicked() {
                 accept(self);
                 self.pending_change = Some(self.calibration);
@@ -206,7 +202,7 @@ impl CalibrationUi {
                     ];
                     for (name, label) in buttons {
                         let r = ui.add_sized([ui.available_width(), 48.0], egui::Button::new(label));
-                        self.remember(name, r.rect);
+                        self.widget_rects.remember(name, r.rect);
                         if r.clicked() {
                             match name {
                                 "eye" => self.page = Page::EyeReflection,
@@ -258,7 +254,7 @@ impl CalibrationUi {
                             .text("separation (mm)")
                             .fixed_decimals(1),
                     );
-                    this.remember("slider", r.rect);
+                    this.widget_rects.remember("slider", r.rect);
                     ui.add(egui::Slider::new(&mut this.target_offset_mm.x, -30.0..=30.0).text("left/right (mm)"));
                     ui.add(egui::Slider::new(&mut this.target_offset_mm.y, -60.0..=60.0).text("up/down (mm)"));
                     this.accept_back(ui, |this| {
@@ -296,7 +292,7 @@ impl CalibrationUi {
                     }
                     let r = ui
                         .add(egui::Slider::new(&mut this.dot_separation_mm, 10.0..=max_mm.max(11.0)).text("dot (mm)"));
-                    this.remember("slider", r.rect);
+                    this.widget_rects.remember("slider", r.rect);
                     if let Some(d) = calibration::blind_spot_distance_m(this.dot_separation_mm * 1e-3) {
                         ui.label(format!("distance ≈ {:.0} cm", d * 1e2));
                     }
@@ -321,7 +317,7 @@ impl CalibrationUi {
                 self.controls(ui, "Screen size", |this, ui| {
                     ui.label("Lay a bank card on the screen and make the outline match its edges.");
                     let r = ui.add(egui::Slider::new(&mut this.card_scale, 0.7..=1.3).text("size"));
-                    this.remember("slider", r.rect);
+                    this.widget_rects.remember("slider", r.rect);
                     this.accept_back(ui, |this| {
                         let px = card_size_px(screen, this.card_scale);
                         // Display pixels along the display's axes → the panel's x/y.

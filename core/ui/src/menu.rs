@@ -56,7 +56,7 @@ pub enum MenuAction {
 #[derive(Clone, Debug, Default)]
 pub struct MenuUi {
     confirm_remove: Option<String>,
-    widget_rects: Vec<(String, Rect)>,
+    widget_rects: crate::widget_rects::WidgetRects,
 }
 
 impl MenuUi {
@@ -68,12 +68,7 @@ impl MenuUi {
     /// picture), `remove:<id>`, `open`, `share`, `share-pair`, `help`, `settings`, `calibrate`,
     /// `close`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
-        self.widget_rects.iter().find(|(n, _)| n == name).map(|(_, r)| *r)
-    }
-
-    fn remember(&mut self, name: String, rect: Rect) {
-        self.widget_rects.retain(|(n, _)| *n != name);
-        self.widget_rects.push((name, rect));
+        self.widget_rects.get(name)
     }
 
     /// Draws the menu into the root `ui` of one egui frame; `current` is the id on screen and
@@ -101,7 +96,7 @@ impl MenuUi {
                         [half, CONTROL_HEIGHT_PT],
                         egui::Button::new(RichText::new(label).size(16.0)).wrap(),
                     );
-                    self.remember(name.to_owned(), r.rect);
+                    self.widget_rects.remember(name, r.rect);
                     if r.clicked() {
                         actions.push(MenuAction::Share { side_by_side });
                     }
@@ -119,7 +114,7 @@ impl MenuUi {
                     [ui.available_width(), CONTROL_HEIGHT_PT],
                     egui::Button::new(RichText::new(label).size(17.0)).wrap(),
                 );
-                self.remember(name.to_owned(), r.rect);
+                self.widget_rects.remember(name, r.rect);
                 if r.clicked() {
                     actions.push(match name {
                         "open" => MenuAction::OpenFile,
@@ -159,7 +154,7 @@ impl MenuUi {
                 let uv = Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
                 ui.painter().image(texture, rect.shrink(2.0), uv, Color32::WHITE);
             }
-            self.remember(format!("thumb:{}", item.id), rect);
+            self.widget_rects.remember(format!("thumb:{}", item.id), rect);
             if picture.clicked() {
                 self.confirm_remove = None;
                 actions.push(MenuAction::Select(item.id.clone()));
@@ -192,7 +187,7 @@ impl MenuUi {
                 [width, CONTROL_HEIGHT_PT * 1.4],
                 egui::Button::new(text).selected(on_screen).wrap(),
             );
-            self.remember(format!("item:{}", item.id), r.rect);
+            self.widget_rects.remember(format!("item:{}", item.id), r.rect);
             if r.clicked() {
                 self.confirm_remove = None;
                 actions.push(MenuAction::Select(item.id.clone()));
@@ -208,7 +203,7 @@ impl MenuUi {
                     [remove_w - 8.0, CONTROL_HEIGHT_PT * 1.4],
                     egui::Button::new(label).fill(fill),
                 );
-                self.remember(format!("remove:{}", item.id), r.rect);
+                self.widget_rects.remember(format!("remove:{}", item.id), r.rect);
                 if r.clicked() {
                     if confirming {
                         self.confirm_remove = None;

@@ -43,14 +43,14 @@ pub const GLASSES: [(&str, &str, Method); 4] = [
 #[derive(Clone, Debug)]
 pub struct SettingsUi {
     pub settings: Settings,
-    widget_rects: Vec<(&'static str, Rect)>,
+    widget_rects: crate::widget_rects::WidgetRects,
 }
 
 impl SettingsUi {
     pub fn new(settings: Settings) -> Self {
         Self {
             settings,
-            widget_rects: Vec::new(),
+            widget_rects: crate::widget_rects::WidgetRects::new(),
         }
     }
 
@@ -58,12 +58,7 @@ impl SettingsUi {
     /// `green-magenta`, `amber-blue`, `none`), `turn-by-touch`, `floor`, `protrude`,
     /// `true-size`, `done`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
-        self.widget_rects.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
-    }
-
-    fn remember(&mut self, name: &'static str, rect: Rect) {
-        self.widget_rects.retain(|(n, _)| *n != name);
-        self.widget_rects.push((name, rect));
+        self.widget_rects.get(name)
     }
 
     /// A button that switches `value`, its label saying the state.
@@ -72,7 +67,7 @@ impl SettingsUi {
             [width, CONTROL_HEIGHT_PT],
             egui::Button::new(RichText::new(if *value { on } else { off }).size(17.0)).selected(*value),
         );
-        self.remember(name, r.rect);
+        self.widget_rects.remember(name, r.rect);
         if r.clicked() {
             *value = !*value;
         }
@@ -95,7 +90,7 @@ impl SettingsUi {
                         [full, CONTROL_HEIGHT_PT],
                         egui::Button::new(RichText::new(label).size(17.0)).selected(chosen),
                     );
-                    self.remember(key, r.rect);
+                    self.widget_rects.remember(key, r.rect);
                     if r.clicked() {
                         self.settings.method = method;
                     }
@@ -129,7 +124,7 @@ impl SettingsUi {
                 ui.spacing_mut().interact_size.y = CONTROL_HEIGHT_PT;
                 let mut percent = self.settings.protrude_fraction * 100.0;
                 let r = ui.add(egui::Slider::new(&mut percent, 0.0..=100.0).step_by(5.0));
-                self.remember("protrude", r.rect);
+                self.widget_rects.remember("protrude", r.rect);
                 self.settings.protrude_fraction = (percent / 100.0).clamp(0.0, 1.0);
                 let mut true_size = self.settings.true_size;
                 self.switch(
@@ -146,7 +141,7 @@ impl SettingsUi {
                     [full, CONTROL_HEIGHT_PT],
                     egui::Button::new(RichText::new("Done").size(17.0)),
                 );
-                self.remember("done", r.rect);
+                self.widget_rects.remember("done", r.rect);
                 if r.clicked() {
                     actions.push(SettingsAction::Close);
                 }

@@ -60,14 +60,14 @@ pub type FilterColours = ([u8; 3], [u8; 3]);
 #[derive(Clone, Debug)]
 pub struct WelcomeUi {
     pub page: WelcomePage,
-    widget_rects: Vec<(&'static str, Rect)>,
+    widget_rects: crate::widget_rects::WidgetRects,
 }
 
 impl Default for WelcomeUi {
     fn default() -> Self {
         Self {
             page: WelcomePage::Intro,
-            widget_rects: Vec::new(),
+            widget_rects: crate::widget_rects::WidgetRects::new(),
         }
     }
 }
@@ -81,7 +81,7 @@ impl WelcomeUi {
     pub fn camera() -> Self {
         Self {
             page: WelcomePage::Camera,
-            widget_rects: Vec::new(),
+            widget_rects: crate::widget_rects::WidgetRects::new(),
         }
     }
 
@@ -89,12 +89,7 @@ impl WelcomeUi {
     /// `left-ring`, `right-ring`, `unclear`, `continue`, `allow-camera`, `not-now`; and the
     /// rings themselves, `ring-left` and `ring-right`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
-        self.widget_rects.iter().find(|(n, _)| *n == name).map(|(_, r)| *r)
-    }
-
-    fn remember(&mut self, name: &'static str, rect: Rect) {
-        self.widget_rects.retain(|(n, _)| *n != name);
-        self.widget_rects.push((name, rect));
+        self.widget_rects.get(name)
     }
 
     fn button(&mut self, ui: &mut egui::Ui, name: &'static str, label: &str) -> bool {
@@ -102,7 +97,7 @@ impl WelcomeUi {
             [ui.available_width(), CONTROL_HEIGHT_PT],
             egui::Button::new(RichText::new(label).size(17.0)),
         );
-        self.remember(name, r.rect);
+        self.widget_rects.remember(name, r.rect);
         r.clicked()
     }
 
@@ -171,7 +166,8 @@ impl WelcomeUi {
                         let centre = Pos2::new(rect.left() + rect.width() * x, rect.center().y);
                         ui.painter()
                             .circle_stroke(centre, r, Stroke::new(r * 0.28, rgb(colour)));
-                        self.remember(name, Rect::from_center_size(centre, Vec2::splat(2.0 * r)));
+                        self.widget_rects
+                            .remember(name, Rect::from_center_size(centre, Vec2::splat(2.0 * r)));
                     }
                     ui.add_space(6.0);
                     if self.button(ui, "left-ring", "The ring on the left") {
