@@ -1709,17 +1709,7 @@ impl Engine {
     /// [`Self::snapshot`] as a PNG file's bytes, for the platform's share sheet.
     pub fn snapshot_png(&mut self, kind: Snapshot) -> Result<Vec<u8>, EngineError> {
         let (w, h, pixels) = self.snapshot(kind)?;
-        let mut png = Vec::new();
-        image::write_buffer_with_format(
-            &mut std::io::Cursor::new(&mut png),
-            &pixels,
-            w,
-            h,
-            image::ExtendedColorType::Rgba8,
-            image::ImageFormat::Png,
-        )
-        .map_err(|e| EngineError::Share(e.to_string()))?;
-        Ok(png)
+        encode_png(w, h, &pixels).map_err(|e| EngineError::Share(e.to_string()))
     }
 
     /// The last offscreen frame: width, height and 8-bit sRGB RGBA pixels, rows top to bottom.
@@ -1871,6 +1861,21 @@ fn filter_colours(method: Method) -> Option<([u8; 3], [u8; 3])> {
             Some(([255, 0, 0], [0, 255, 255]))
         }
     }
+}
+
+/// `width × height` sRGB RGBA pixels (rows top to bottom, as the engine's frames) as a PNG
+/// file's bytes: what the share sheet, the gallery's cache and `phantogram render` write.
+pub fn encode_png(width: u32, height: u32, rgba: &[u8]) -> Result<Vec<u8>, image::ImageError> {
+    let mut png = Vec::new();
+    image::write_buffer_with_format(
+        &mut std::io::Cursor::new(&mut png),
+        rgba,
+        width,
+        height,
+        image::ExtendedColorType::Rgba8,
+        image::ImageFormat::Png,
+    )?;
+    Ok(png)
 }
 
 /// The Diorama's entry in the artifact library.

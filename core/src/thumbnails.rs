@@ -360,15 +360,7 @@ fn write_png(path: &Path, rgba: &[u8]) -> Result<(), Box<dyn std::error::Error>>
     if let Some(dir) = path.parent() {
         std::fs::create_dir_all(dir)?;
     }
-    let mut png = Vec::new();
-    image::write_buffer_with_format(
-        &mut std::io::Cursor::new(&mut png),
-        rgba,
-        THUMBNAIL_PX,
-        THUMBNAIL_PX,
-        image::ExtendedColorType::Rgba8,
-        image::ImageFormat::Png,
-    )?;
+    let png = crate::engine::encode_png(THUMBNAIL_PX, THUMBNAIL_PX, rgba)?;
     let mut file = phantogram_files::AtomicFile::create(path)?;
     std::io::Write::write_all(file.file(), &png)?;
     file.commit()?;

@@ -164,16 +164,7 @@ impl Replayed for Frames<'_> {
             self.engine.last_frame()?
         };
         let path = self.out_dir.join(frame_name(self.index));
-        let mut png = Vec::new();
-        image::write_buffer_with_format(
-            &mut std::io::Cursor::new(&mut png),
-            pixels,
-            width,
-            height,
-            image::ExtendedColorType::Rgba8,
-            image::ImageFormat::Png,
-        )
-        .context("encoding a frame as PNG")?;
+        let png = phantogram::engine::encode_png(width, height, pixels).context("encoding a frame as PNG")?;
         // Written and flushed to the disk now: a full disk is an error here, and the swap in
         // `Staging::commit` only renames.
         std::fs::File::create(&path)
