@@ -49,6 +49,22 @@ pub struct ModelInfo {
     pub preview: bool,
 }
 
+impl ModelInfo {
+    /// What `model` is, as the library's `entry` (not a preview).
+    pub fn of(model: &Model, entry: Option<ArtifactEntry>) -> Self {
+        Self {
+            name: model.name.clone(),
+            triangles: model.triangle_count(),
+            materials: model.materials.len(),
+            images: model.images.len(),
+            warnings: model.warnings.clone(),
+            artifact: entry,
+            annotations: model.annotations.clone(),
+            preview: false,
+        }
+    }
+}
+
 /// A model ready to upload: fitted into the diorama, floored, its bounds known.
 #[derive(Debug)]
 pub struct Prepared {
@@ -77,16 +93,7 @@ pub fn prepare(
         model.fit_to_diorama(&placing.screen, &placing.fit);
     }
     let bounds = model.bounds().ok_or(crate::render::RenderError::EmptyModel)?;
-    let info = ModelInfo {
-        name: model.name.clone(),
-        triangles: model.triangle_count(),
-        materials: model.materials.len(),
-        images: model.images.len(),
-        warnings: model.warnings.clone(),
-        artifact: entry,
-        annotations: model.annotations.clone(),
-        preview: false,
-    };
+    let info = ModelInfo::of(&model, entry);
     if placing.floor {
         model.add_floor(&placing.screen, Model::FLOOR_REACH);
     }

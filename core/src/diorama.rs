@@ -12,7 +12,7 @@
 use glam::{Mat4, Quat, Vec3};
 
 use crate::model::{Material, Mesh, Model, Primitive, Vertex};
-use crate::physics::apparent_gravity::{ApparentGravity, ShakeParams, gravity_device};
+use crate::physics::apparent_gravity::{ApparentGravity, ShakeParams};
 use crate::physics::bodies::{BodyKind, BodyShape, BodySpec, default_scene, vessel_points};
 use crate::physics::diorama::{Diorama, DioramaError, DioramaParams};
 use crate::screen::Screen;
@@ -72,11 +72,6 @@ impl DioramaScene {
         self.world.set_eyes(view.stereo_eyes_m());
         self.world.advance_to(t_ns);
         self.pose_bodies();
-    }
-
-    /// The room's gravity alone, for callers without an accelerometer reading.
-    pub fn room_gravity(device_to_world: Quat) -> Vec3 {
-        gravity_device(device_to_world)
     }
 
     /// Rewrites the bodies' primitive (the model's first) from the interpolated poses.

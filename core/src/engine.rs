@@ -949,16 +949,7 @@ impl Engine {
         }
         let model = scene.model();
         self.bounds = model.bounds().unwrap_or(self.bounds);
-        self.model_info = ModelInfo {
-            name: model.name.clone(),
-            triangles: model.triangle_count(),
-            materials: model.materials.len(),
-            images: 0,
-            warnings: Vec::new(),
-            artifact: Some(diorama_entry()),
-            annotations: Vec::new(),
-            preview: false,
-        };
+        self.model_info = ModelInfo::of(model, Some(diorama_entry()));
         self.smoother = ContainmentSmoother::default();
         self.diorama = Some(Box::new(scene));
         self.diorama_grab = None;

@@ -16,6 +16,7 @@ mod golden;
 use phantogram::FrameView;
 use phantogram::diorama::DioramaScene;
 use phantogram::glam::{Quat, Vec3};
+use phantogram::physics::apparent_gravity::gravity_device;
 use phantogram::physics::bodies::default_scene;
 use phantogram::physics::diorama::{CONTAINMENT_TOLERANCE_M, Diorama, DioramaParams};
 use phantogram::screen::Screen;
@@ -258,7 +259,7 @@ fn tilted_to_one_side_in_the_room_the_bodies_end_up_on_that_side_from_any_pose()
                 let lower_side = -x_down.signum();
                 let mut world = Diorama::new(&screen, default_scene(&screen, -params.depth_m, 30), params).unwrap();
                 world.set_eyes(eyes);
-                world.set_gravity(DioramaScene::room_gravity(q));
+                world.set_gravity(gravity_device(q));
                 for k in 0..=480 {
                     world.advance_to(k * 8_333_334);
                 }

@@ -94,8 +94,10 @@ pub struct Diorama {
     pyramid: [ColliderHandle; 8],
     lid: RigidBodyHandle,
     eyes_m: Option<[Vec3; 2]>,
-    /// The eyes the planes were last moved to.
-    placed_eyes_m: Option<[Vec3; 2]>,
+    /// The eyes the pyramids were last shaped for, and their planes (left eye's four first).
+    placed: Option<([Vec3; 2], [EyePlane; 8])>,
+    /// The tray's floor and walls as planes, normals inwards.
+    tray: [EyePlane; 5],
     gravity: Vec3,
     /// Sensor time of step 0, and the steps taken since.
     t0_ns: Option<i64>,
@@ -117,6 +119,20 @@ impl std::fmt::Debug for Diorama {
             .field("gravity", &self.gravity)
             .finish_non_exhaustive()
     }
+}
+
+/// The tray's floor and four walls under `screen` as planes, normals inwards.
+fn tray_planes(screen: &Screen, depth_m: f32) -> [EyePlane; 5] {
+    let (hw, hh) = (screen.width_m() / 2.0, screen.height_m() / 2.0);
+    let (r, u) = (screen.right_device(), screen.up_device());
+    let plane = |normal: Vec3, offset_m: f32| EyePlane { normal, offset_m };
+    [
+        plane(Vec3::Z, -depth_m),
+        plane(r, -hw),
+        plane(-r, -hw),
+        plane(u, -hh),
+        plane(-u, -hh),
+    ]
 }
 
 fn collider_for(shape: &BodyShape) -> Option<ColliderBuilder> {
@@ -216,7 +232,8 @@ impl Diorama {
             pyramid,
             lid,
             eyes_m: None,
-            placed_eyes_m: None,
+            placed: None,
+            tray: tray_planes(screen, params.depth_m),
             gravity: Vec3::new(0.0, 0.0, -crate::apparent_gravity::G_M_S2),
             t0_ns: None,
             steps: 0,
@@ -307,7 +324,7 @@ impl Diorama {
             }
         }
         self.eyes_m = Some(eyes_m);
-        self.placed_eyes_m = Some(eyes_m);
+        self.placed = Some((eyes_m, planes));
     }
 
     /// The gravity the bodies feel, device frame (see [`crate::apparent_gravity`]); sleeping
@@ -363,7 +380,7 @@ impl Diorama {
 
     fn step(&mut self) {
         if let Some(eyes) = self.eyes_m
-            && self.placed_eyes_m != Some(eyes)
+            && self.placed.is_none_or(|(placed, _)| placed != eyes)
         {
             self.place_planes(eyes, false);
         }
@@ -393,13 +410,10 @@ impl Diorama {
     /// inside all of them) or just behind the glass, where the window may frame it. Its
     /// velocity out of the planes is removed.
     fn enforce_pyramids(&mut self) {
-        let Some(eyes) = self.placed_eyes_m else { return };
-        let Some(pyramids) = stereo_pyramids(&self.screen, eyes) else {
-            return;
-        };
+        let Some((eyes, pyramids)) = self.placed else { return };
         let lid = self.lid_plane(eyes);
         let planes: Vec<EyePlane> = pyramids.into_iter().chain(std::iter::once(lid)).collect();
-        let tray = self.tray_planes();
+        let tray = self.tray;
         for (&h, spec) in self.handles.iter().zip(&self.specs) {
             let Some(body) = self.world.bodies.get_mut(h) else {
                 continue;
@@ -481,20 +495,6 @@ impl Diorama {
         }
     }
 
-    /// The tray's floor and four walls as planes, normals inwards.
-    fn tray_planes(&self) -> [EyePlane; 5] {
-        let (hw, hh) = (self.screen.width_m() / 2.0, self.screen.height_m() / 2.0);
-        let (r, u) = (self.screen.right_device(), self.screen.up_device());
-        let plane = |normal: Vec3, offset_m: f32| EyePlane { normal, offset_m };
-        [
-            plane(Vec3::Z, -self.params.depth_m),
-            plane(r, -hw),
-            plane(-r, -hw),
-            plane(u, -hh),
-            plane(-u, -hh),
-        ]
-    }
-
     /// The lid over the tray, a fraction of the nearer eye's distance in front of the glass.
     fn lid_plane(&self, eyes_m: [Vec3; 2]) -> EyePlane {
         let lid_z = self.params.lid_fraction.clamp(0.05, 0.95) * eyes_m[0].z.min(eyes_m[1].z);
@@ -559,10 +559,10 @@ impl Diorama {
         self.skipped_steps
     }
 
-    /// The eight planes the pyramids stand on now (left eye's four first), if the eyes are in
-    /// front of the glass.
+    /// The eight planes the pyramids stand on now (left eye's four first): those the last
+    /// step held the bodies by. `None` before the eyes were first in front of the glass.
     pub fn pyramid_planes(&self) -> Option<[EyePlane; 8]> {
-        stereo_pyramids(&self.screen, self.eyes_m?)
+        self.placed.map(|(_, planes)| planes)
     }
 
     pub fn params(&self) -> &DioramaParams {
