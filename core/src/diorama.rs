@@ -77,10 +77,19 @@ impl DioramaScene {
     /// Rewrites the bodies' primitive (the model's first) from the interpolated poses.
     fn pose_bodies(&mut self) {
         let poses = self.world.poses();
-        let mut merged = Mesh::default();
+        let merged = &mut self.model.primitives[0].mesh;
+        // The same bodies in the same order every frame: the indices are made once, the
+        // vertices rewritten in their buffer.
+        if merged.indices.is_empty() {
+            let mut base = 0u32;
+            for mesh in &self.body_meshes {
+                merged.indices.extend(mesh.indices.iter().map(|i| i + base));
+                base += mesh.vertices.len() as u32;
+            }
+        }
+        merged.vertices.clear();
         for (mesh, pose) in self.body_meshes.iter().zip(&poses) {
             let m = Mat4::from_rotation_translation(pose.rotation, pose.translation_m);
-            let base = merged.vertices.len() as u32;
             let normal_m = glam::Mat3::from_quat(pose.rotation);
             merged.vertices.extend(mesh.vertices.iter().map(|v| {
                 Vertex {
@@ -92,9 +101,7 @@ impl DioramaScene {
                     ..*v
                 }
             }));
-            merged.indices.extend(mesh.indices.iter().map(|i| i + base));
         }
-        self.model.primitives[0].mesh = merged;
     }
 
     /// The model to draw now.
