@@ -1,0 +1,184 @@
+//! The specular part of the image-based light: the environment convolved with the GGX lobe for a
+//! ladder of roughnesses, and the split-sum table (see the [parent module](super)).
+
+use glam::Vec3;
+
+use super::Environment;
+
+/// Number of roughness levels in the prefiltered environment (roughness `k / (LEVELS − 1)`).
+pub const PREFILTER_LEVELS: usize = 6;
+
+/// The `i`-th point of the Hammersley set of `n`.
+fn hammersley(i: u32, n: u32) -> (f32, f32) {
+    (i as f32 / n as f32, (i.reverse_bits() as f64 / 4_294_967_296.0) as f32)
+}
+
+/// A GGX half vector about `n` for the sample `(u1, u2)` and `alpha = roughness²`.
+fn ggx_half_vector(u1: f32, u2: f32, alpha: f32, n: Vec3) -> Vec3 {
+    let phi = std::f32::consts::TAU * u1;
+    let cos_theta = ((1.0 - u2) / (1.0 + (alpha * alpha - 1.0) * u2)).max(0.0).sqrt();
+    let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+    let up = if n.z.abs() < 0.999 { Vec3::Z } else { Vec3::X };
+    let t = up.cross(n).normalize();
+    let b = n.cross(t);
+    (t * (sin_theta * phi.cos()) + b * (sin_theta * phi.sin()) + n * cos_theta).normalize()
+}
+
+/// The environment convolved with the GGX lobe: level `k` (roughness `k / (LEVELS − 1)`) at
+/// `base_width / 2^k` × `base_width / 2^(k+1)`, so the levels form the first [`PREFILTER_LEVELS`]
+/// levels of a texture mip chain. Level 0 is the environment itself, resampled to
+/// `base_width × base_width / 2`.
+///
+/// `base_width` is rounded up to a power of two of at least `2^PREFILTER_LEVELS` so that every
+/// level has whole texels.
+pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environment> {
+    let base_width = base_width.max(1 << PREFILTER_LEVELS).next_power_of_two();
+    // Sample from a source a little coarser than each level, so few samples suffice.
+    let mut source = env.clone();
+    while source.width >= 2 * base_width && source.width > 8 {
+        source = source.downsampled();
+    }
+    if source.width != base_width || source.height != base_width / 2 {
+        let mut level0 = Environment {
+            width: base_width,
+            height: base_width / 2,
+            texels: Vec::new(),
+        };
+        level0.texels = (0..level0.height)
+            .flat_map(|y| (0..level0.width).map(move |x| (x, y)))
+            .map(|(x, y)| source.sample(level0.direction(x, y)))
+            .collect();
+        source = level0;
+    }
+    let mut levels = vec![source.clone()];
+    let samples = 96u32;
+    for k in 1..PREFILTER_LEVELS {
+        let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
+        let alpha = roughness * roughness;
+        let (w, h) = (base_width >> k, base_width >> (k + 1));
+        while source.width > 2 * w && source.width > 8 {
+            source = source.downsampled();
+        }
+        let grid = Environment {
+            width: w,
+            height: h,
+            texels: Vec::new(),
+        };
+        let convolve = |x: usize, y: usize| {
+            let n = grid.direction(x, y);
+            let mut acc = [0.0f32; 3];
+            let mut weight = 0.0f32;
+            for i in 0..samples {
+                let (u1, u2) = hammersley(i, samples);
+                let hv = ggx_half_vector(u1, u2, alpha, n);
+                let l = (hv * 2.0 * n.dot(hv) - n).normalize();
+                let n_dot_l = n.dot(l);
+                if n_dot_l > 0.0 {
+                    let c = source.sample(l);
+                    for ch in 0..3 {
+                        acc[ch] += c[ch] * n_dot_l;
+                    }
+                    weight += n_dot_l;
+                }
+            }
+            acc.map(|a| a / weight.max(1e-6))
+        };
+        // Rows on every core: this runs when a renderer starts or the environment changes, on
+        // the phone's CPU, and each texel is independent (same result as in series).
+        let rows: Vec<usize> = (0..h).collect();
+        let level = Environment {
+            width: w,
+            height: h,
+            texels: crate::parallel::map(&rows, |&y| (0..w).map(|x| convolve(x, y)).collect::<Vec<_>>()).concat(),
+        };
+        levels.push(level);
+    }
+    levels
+}
+
+/// The split-sum BRDF table: `size × size` entries of `(scale, bias)` with n·v along x (0 → 1)
+/// and roughness along y (0 → 1), so that the specular image-based light is
+/// `prefiltered(r, roughness) · (F0 · scale + bias)`.
+pub fn brdf_lut(size: usize) -> Vec<[f32; 2]> {
+    let samples = 256u32;
+    let mut out = Vec::with_capacity(size * size);
+    for j in 0..size {
+        let roughness = (j as f32 + 0.5) / size as f32;
+        let alpha = roughness * roughness;
+        // Schlick–GGX geometry with k = α/2 for image-based light (Karis 2013).
+        let k = alpha / 2.0;
+        let g1 = |c: f32| c / (c * (1.0 - k) + k);
+        for i in 0..size {
+            let n_dot_v = ((i as f32 + 0.5) / size as f32).max(1e-3);
+            let v = Vec3::new((1.0 - n_dot_v * n_dot_v).sqrt(), 0.0, n_dot_v);
+            let (mut a, mut b) = (0.0f32, 0.0f32);
+            for s in 0..samples {
+                let (u1, u2) = hammersley(s, samples);
+                let h = ggx_half_vector(u1, u2, alpha, Vec3::Z);
+                let l = h * 2.0 * v.dot(h) - v;
+                let (n_dot_l, n_dot_h, v_dot_h) = (l.z, h.z.max(0.0), v.dot(h).max(0.0));
+                if n_dot_l > 0.0 {
+                    let g_vis = g1(n_dot_l) * g1(n_dot_v) * v_dot_h / (n_dot_h * n_dot_v).max(1e-6);
+                    let fc = (1.0 - v_dot_h).powi(5);
+                    a += (1.0 - fc) * g_vis;
+                    b += fc * g_vis;
+                }
+            }
+            out.push([a / samples as f32, b / samples as f32]);
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ibl::tests::uniform;
+
+    #[test]
+    fn split_sum_table_matches_known_values() {
+        let lut = brdf_lut(32);
+        let at = |nv: f32, r: f32| lut[((r * 32.0) as usize).min(31) * 32 + ((nv * 32.0) as usize).min(31)];
+        // Smooth surface seen head-on: all of F0, no bias.
+        let smooth = at(0.99, 0.0);
+        assert!((smooth[0] - 1.0).abs() < 0.05 && smooth[1] < 0.02, "{smooth:?}");
+        // Rough and grazing: the reflectance drops well below 1.
+        let rough = at(0.5, 0.99);
+        assert!(rough[0] + rough[1] < 0.8 && rough[0] > 0.2, "{rough:?}");
+        // Every entry is a reflectance in [0, 1].
+        assert!(lut.iter().all(|[a, b]| *a >= 0.0 && *b >= 0.0 && a + b <= 1.05));
+    }
+
+    #[test]
+    fn prefiltering_keeps_constant_light_and_blurs_a_sun() {
+        let levels = prefiltered_levels(&uniform(0.7), 64);
+        assert_eq!(levels.len(), PREFILTER_LEVELS);
+        // A mip chain: each level halves both sizes (a 64-wide request is already the minimum).
+        for (k, l) in levels.iter().enumerate() {
+            assert_eq!((l.width, l.height), (64 >> k, 32 >> k));
+        }
+        // A small environment is resampled up to the requested base.
+        let small = Environment {
+            width: 16,
+            height: 8,
+            texels: vec![[0.7; 3]; 128],
+        };
+        assert_eq!(prefiltered_levels(&small, 100)[0].width, 128);
+        for l in &levels {
+            assert!(
+                l.texels.iter().all(|t| (t[0] - 0.7).abs() < 0.01),
+                "{}x{}",
+                l.width,
+                l.height
+            );
+        }
+        // A small bright patch: the rough levels spread it (lower peak, light further away).
+        let mut sun = uniform(0.0);
+        sun.texels[10 * sun.width + 40] = [1000.0; 3];
+        let levels = prefiltered_levels(&sun, 64);
+        let peak = |e: &Environment| e.texels.iter().map(|t| t[0]).fold(0.0, f32::max);
+        assert!(peak(&levels[5]) < peak(&levels[1]));
+        let lit = |e: &Environment| e.texels.iter().filter(|t| t[0] > 1e-3).count() as f32 / e.texels.len() as f32;
+        assert!(lit(&levels[5]) > lit(&levels[1]));
+    }
+}
