@@ -8,6 +8,8 @@
 //!   memory (`PHANTOGRAM_DATA` for the turtle).
 //! * `bench diorama` — ms per physics step of the Diorama with 50 bodies, moving and at rest
 //!   (`benchmarks/diorama.md`).
+//! * `bench ibl` — ms to update the image-based light (SH9, specular levels) from 1024-, 2048-
+//!   and 4096-wide maps on the CPU (`benchmarks/ibl.md`).
 //! * `bench face` — ms per 640×480 camera frame in detection and tracking modes (needs the
 //!   models from `models` and `PHANTOGRAM_DATA` for a face photograph).
 //! * `bench orientation` — score the orientation estimators on the recordings in
@@ -53,6 +55,7 @@ fn main() -> Result<()> {
         ["bench", "render"] => cargo(&["bench", "-p", "phantogram", "--bench", "render"]),
         ["bench", "face"] => cargo(&["bench", "-p", "phantogram", "--bench", "face"]),
         ["bench", "diorama"] => cargo(&["bench", "-p", "phantogram-physics", "--bench", "step"]),
+        ["bench", "ibl"] => cargo(&["bench", "-p", "phantogram-assets", "--bench", "ibl"]),
         ["models"] => models(false),
         ["models", "--force"] => models(true),
         ["android"] => phone::android(None),

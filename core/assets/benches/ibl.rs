@@ -1,0 +1,105 @@
+//! `cargo bench -p phantogram-assets --bench ibl` (or `cargo xtask bench ibl`): time to update the
+//! image-based light from a changed environment map on this machine's CPU, release build — the
+//! nine irradiance SH coefficients ([`IrradianceSh::from_environment`], on every core) beside a
+//! plain texel-by-texel loop on one thread, and the specular levels ([`prefiltered_levels`] at the
+//! renderer's 256-texel base) — for 1024-, 2048- and 4096-wide maps, as in the tabletop paper's
+//! table. Each figure is the median of several runs; the machine is shared and noisy, so compare
+//! figures of one run only. Prints a Markdown table.
+
+use std::time::Instant;
+
+use glam::Vec3;
+use phantogram_assets::ibl::{Environment, IrradianceSh, prefiltered_levels};
+
+/// The renderer's prefiltered base width (`phantogram_render`'s `PREFILTERED_BASE_WIDTH`).
+const PREFILTERED_BASE_WIDTH: usize = 256;
+
+/// A map with structure (a sky gradient, a sun, per-texel noise), so that nothing is constant.
+fn environment(width: usize) -> Environment {
+    let height = width / 2;
+    let mut env = Environment {
+        width,
+        height,
+        texels: Vec::with_capacity(width * height),
+    };
+    let sun = Vec3::new(0.3, -0.5, 0.8).normalize();
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    for y in 0..height {
+        for x in 0..width {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            let noise = (state >> 40) as f32 / (1u64 << 24) as f32;
+            let d = env.direction(x, y);
+            let s = if d.dot(sun) > 0.9995 { 5000.0 } else { 0.0 };
+            let sky = 0.2 + 0.8 * d.z.max(0.0) + 0.1 * noise;
+            env.texels.push([sky + s, sky * 1.1 + s, sky * 1.3 + s]);
+        }
+    }
+    env
+}
+
+/// The projection as the basis is written, texel by texel on one thread (the starting point).
+fn naive_sh(env: &Environment) -> [[f64; 3]; 9] {
+    let mut c = [[0.0f64; 3]; 9];
+    let d_phi = std::f64::consts::TAU / env.width as f64;
+    let d_theta = std::f64::consts::PI / env.height as f64;
+    for y in 0..env.height {
+        let solid_angle = ((y as f64 + 0.5) * d_theta).sin() * d_theta * d_phi;
+        for x in 0..env.width {
+            let d = env.direction(x, y);
+            let (dx, dy, dz) = (d.x, d.y, d.z);
+            let b = [
+                0.282_095,
+                0.488_603 * dy,
+                0.488_603 * dz,
+                0.488_603 * dx,
+                1.092_548 * dx * dy,
+                1.092_548 * dy * dz,
+                0.315_392 * (3.0 * dz * dz - 1.0),
+                1.092_548 * dx * dz,
+                0.546_274 * (dx * dx - dy * dy),
+            ];
+            let l = env.texels[y * env.width + x];
+            for (k, bk) in b.iter().enumerate() {
+                for ch in 0..3 {
+                    c[k][ch] += f64::from(l[ch]) * f64::from(*bk) * solid_angle;
+                }
+            }
+        }
+    }
+    c
+}
+
+/// Median milliseconds of `runs` calls of `f`, after one warm-up call.
+fn median_ms<R>(runs: usize, mut f: impl FnMut() -> R) -> f64 {
+    std::hint::black_box(f());
+    let mut t: Vec<f64> = (0..runs)
+        .map(|_| {
+            let start = Instant::now();
+            std::hint::black_box(f());
+            start.elapsed().as_secs_f64() * 1e3
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[runs / 2]
+}
+
+fn main() {
+    let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+    println!("CPU: {cores} cores; median of several runs, ms\n");
+    println!("| map | SH9 (ours, {cores} cores) | SH9 texel by texel (1 core) | ratio | specular levels (256 base) |");
+    println!("|---|---|---|---|---|");
+    for width in [1024, 2048, 4096] {
+        let env = environment(width);
+        let runs = (4096 / width) * 10 + 5;
+        let fast = median_ms(runs * 4, || IrradianceSh::from_environment(&env));
+        let naive = median_ms(runs.min(9), || naive_sh(&env));
+        let prefilter = median_ms(5, || prefiltered_levels(&env, PREFILTERED_BASE_WIDTH));
+        println!(
+            "| {width}×{} | {fast:.3} | {naive:.2} | {:.1}× | {prefilter:.1} |",
+            width / 2,
+            naive / fast
+        );
+    }
+}
