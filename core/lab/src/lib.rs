@@ -3,7 +3,8 @@
 //! The desktop's side of the sensors: recorded logs and the formats they come in ([`sensorlog`],
 //! with importers for the public datasets in [`sensorlog::import`]), deterministic replay of a log
 //! through a `Session` ([`replay`]), and orientation scoring against motion-capture truth
-//! ([`orientation_eval`]). Used by the `phantogram` CLI, the benchmarks and the tests; the phone
+//! ([`orientation_eval`]), and a synthetic camera looking into an HDR environment for the live
+//! room light ([`synthetic_camera`]). Used by the `phantogram` CLI, the benchmarks and the tests; the phone
 //! libraries do not link it.
 //!
 //! ## Panics and errors
@@ -15,3 +16,4 @@
 pub mod orientation_eval;
 pub mod replay;
 pub mod sensorlog;
+pub mod synthetic_camera;

@@ -296,10 +296,10 @@ pub struct PlatformRotationVector {
 
 impl OrientationEstimator for PlatformRotationVector {
     fn push(&mut self, event: &SensorEvent) {
-        if event.kind == SensorKind::RotationVector {
-            if let Some(q) = event.quat() {
-                self.latest = Some(q);
-            }
+        if event.kind == SensorKind::RotationVector
+            && let Some(q) = event.quat()
+        {
+            self.latest = Some(q);
         }
     }
 

@@ -452,10 +452,10 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
 /// Integer nanoseconds, or a float (some exports write `1.76e18`).
 fn parse_ns(field: &str) -> Result<i64, String> {
     let f = field.trim().trim_matches('"');
-    if let Ok(t) = f.parse::<i64>() {
-        if phantogram_sensing::sensors::time_in_range(t) {
-            return Ok(t);
-        }
+    if let Ok(t) = f.parse::<i64>()
+        && phantogram_sensing::sensors::time_in_range(t)
+    {
+        return Ok(t);
     }
     let t = parse_f64(f)?;
     if t.is_finite() && t.abs() <= phantogram_sensing::sensors::MAX_ABS_T_NS as f64 {

@@ -1,0 +1,214 @@
+//! The live room light reconstructs a room's diffuse light from camera frames: a synthetic phone
+//! camera (`phantogram_lab::synthetic_camera`, auto-exposed, clipped, 8-bit sRGB) sweeps each
+//! HDR environment in `$PHANTOGRAM_DATA/env` as a visitor turning on the spot would, the frames
+//! go into `RoomCapture` with the device's orientation, and the nine SH coefficients of the map
+//! give the environment's irradiance (relative RMS over 2000 normals spread evenly over the
+//! sphere): within 5 % once the sweep has seen the whole sphere, with an exposure bracket whose
+//! exposures the platform reports; at 80 % seen the figures are printed and guarded (the goal
+//! of 5 % there is not reached on every room: see the TODO). Auto-exposure alone, exposures
+//! estimated, is printed for comparison (up to the unknown overall scale).
+//!
+//! Needs the external data (`PHANTOGRAM_DATA`); without it the test prints a notice and returns.
+
+use phantogram::glam::{Mat3, Quat, Vec3};
+use phantogram::ibl::{Environment, IrradianceSh};
+use phantogram_integration::data_subdir;
+use phantogram_lab::synthetic_camera::{Metering, SyntheticCamera};
+
+/// The short frame of the room light's bracket: the highlights just below clipping, down to
+/// 1/10 000 of the average exposure (a phone's shortest exposure at its lowest gain against an
+/// indoor auto-exposure, 1/20 000 s at ISO 50 against 1/30 s at ISO 400, is about 1/5000 of it).
+const BRACKET: Metering = Metering::Highlights { min_ratio: 1e-4 };
+use phantogram_roomlight::{CaptureFrame, CaptureParams, RoomCapture};
+
+/// Normals spread evenly over the sphere (a Fibonacci lattice).
+fn normals(n: usize) -> Vec<Vec3> {
+    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
+    (0..n)
+        .map(|i| {
+            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
+            let r = (1.0 - z * z).sqrt();
+            let a = golden * i as f32;
+            Vec3::new(r * a.cos(), r * a.sin(), z)
+        })
+        .collect()
+}
+
+/// Relative RMS difference of two irradiances over the normals, after scaling `got` by `scale`.
+fn relative_rms(got: &IrradianceSh, want: &IrradianceSh, scale: f32, normals: &[Vec3]) -> f32 {
+    let (mut err, mut norm) = (0.0f64, 0.0f64);
+    for n in normals {
+        let (g, w) = (got.irradiance(*n), want.irradiance(*n));
+        for c in 0..3 {
+            err += f64::from(g[c] * scale - w[c]).powi(2);
+            norm += f64::from(w[c]).powi(2);
+        }
+    }
+    (err / norm).sqrt() as f32
+}
+
+/// The scale that best fits `got` to `want` (least squares over the normals).
+fn best_scale(got: &IrradianceSh, want: &IrradianceSh, normals: &[Vec3]) -> f32 {
+    let (mut gw, mut gg) = (0.0f64, 0.0f64);
+    for n in normals {
+        let (g, w) = (got.irradiance(*n), want.irradiance(*n));
+        for c in 0..3 {
+            gw += f64::from(g[c] * w[c]);
+            gg += f64::from(g[c] * g[c]);
+        }
+    }
+    (gw / gg.max(1e-30)) as f32
+}
+
+/// The device held with its screen's normal (the front camera's axis) along `dir`, the phone's
+/// top towards the zenith where it can be.
+fn holding(dir: Vec3) -> Quat {
+    let z = dir.normalize();
+    let x = Vec3::Z.cross(z).try_normalize().unwrap_or(Vec3::X);
+    let y = z.cross(x);
+    Quat::from_mat3(&Mat3::from_cols(x, y, z))
+}
+
+/// A visitor turning on the spot, the phone at one tilt per turn, then the next, in 15° steps of
+/// azimuth: first nearly flat in the hand as a phantogram is held (the front camera sees the
+/// ceiling), then raised towards upright (the walls behind the visitor), then lowered past it
+/// (the floor, seen last and least).
+fn sweep() -> Vec<Quat> {
+    let mut poses = Vec::new();
+    for elevation_deg in [85.0f32, 60.0, 35.0, 10.0, -15.0, -40.0, -65.0, -85.0] {
+        for step in 0..24 {
+            let az = (step as f32 * 15.0).to_radians();
+            let el = elevation_deg.to_radians();
+            poses.push(holding(Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())));
+        }
+    }
+    poses
+}
+
+/// Rooms where the capture is known to fall short of 5 % even when it has seen everything, with
+/// the error it must stay under meanwhile.
+/// TODO(issue 20): royal esplanade's sun is within the bracket's reach by its peak, yet its
+/// irradiance comes out 17 % off; not yet understood (a sun smaller than a camera pixel?).
+const KNOWN_SHORT: &[(&str, f32)] = &[("royal_esplanade_1k.hdr", 0.20)];
+
+#[test]
+fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
+    let Some(dir) = data_subdir("env") else {
+        eprintln!("PHANTOGRAM_DATA not set: skipping the room-light reconstruction test");
+        return;
+    };
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("env folder")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "hdr" || e == "exr"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no environments in {}", dir.display());
+    let camera = SyntheticCamera::phone_front();
+    let normals = normals(2000);
+    let (mut worst_full, mut worst_80) = ((0.0f32, String::new()), (0.0f32, String::new()));
+    for path in &files {
+        let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
+        let env = Environment::load(path).expect("environment");
+        let want = IrradianceSh::from_environment(&env);
+        // A sun brighter than the short exposure can hold (peak over mean luminance beyond
+        // 0.9 / (middle grey × the bracket's floor)) is clipped in every frame, as on a phone.
+        let luminance = |c: &[f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+        let mean = env.texels.iter().map(luminance).sum::<f32>() / env.texels.len() as f32;
+        let peak = env.texels.iter().flat_map(|c| c.iter().copied()).fold(0.0f32, f32::max);
+        let Metering::Highlights { min_ratio } = BRACKET else {
+            unreachable!()
+        };
+        let beyond_reach = peak / mean > 0.9 / (camera.middle_grey * min_ratio);
+        let mut line = Vec::new();
+        for bracketed in [true, false] {
+            let mut capture = RoomCapture::new(CaptureParams::default());
+            let mut at_80 = None;
+            for (k, pose) in sweep().into_iter().enumerate() {
+                // Bracketed: every other frame the short one, exposures reported (the platform
+                // sets them). Not: auto-exposure only, exposures estimated from the overlap.
+                let metering = if bracketed && k % 2 == 1 {
+                    BRACKET
+                } else {
+                    Metering::Average
+                };
+                let (frame, exposure) = camera.capture(&env, pose, metering, k as i64 * 33_000_000);
+                capture
+                    .add(&CaptureFrame {
+                        image: frame.as_frame(),
+                        world_from_camera: camera.world_from_camera(pose),
+                        exposure: bracketed.then_some(exposure),
+                    })
+                    .expect("frame");
+                if at_80.is_none() && capture.coverage() >= 0.8 {
+                    at_80 = Some((k + 1, IrradianceSh::from_environment(&capture.environment())));
+                }
+            }
+            let (frames_80, sh_80) = at_80.expect("the sweep sees 80 % of the sphere");
+            let full = IrradianceSh::from_environment(&capture.environment());
+            let error = |got: &IrradianceSh| {
+                let scale = if bracketed {
+                    1.0
+                } else {
+                    best_scale(got, &want, &normals)
+                };
+                relative_rms(got, &want, scale, &normals)
+            };
+            let (e80, efull) = (error(&sh_80), error(&full));
+            line.push(format!(
+                "{}: {:.1} % at 80 % seen ({frames_80} frames), {:.1} % at {:.0} % seen",
+                if bracketed {
+                    "bracketed"
+                } else {
+                    "auto-exposed (up to scale)"
+                },
+                e80 * 100.0,
+                efull * 100.0,
+                capture.coverage() * 100.0
+            ));
+            if bracketed {
+                if e80 > worst_80.0 {
+                    worst_80 = (e80, name.clone());
+                }
+                let known = KNOWN_SHORT.iter().find(|(n, _)| *n == name);
+                if let Some((_, bound)) = known {
+                    assert!(efull <= *bound, "{name}: {:.1} % off at full coverage", efull * 100.0);
+                }
+                if efull > worst_full.0 && !beyond_reach && known.is_none() {
+                    worst_full = (efull, name.clone());
+                }
+            }
+        }
+        let reach = if beyond_reach {
+            format!(" [peak {:.0}× the mean: beyond the bracket]", peak / mean)
+        } else {
+            String::new()
+        };
+        println!("{name}{reach}: {}", line.join("; "));
+    }
+    println!(
+        "worst (bracketed): {:.1} % at full coverage ({}; rooms within the bracket's reach, but the known short ones), {:.1} % at 80 % ({})",
+        worst_full.0 * 100.0,
+        worst_full.1,
+        worst_80.0 * 100.0,
+        worst_80.1
+    );
+    // The capture itself (linearising, exposure, blending, highlights): within 5 % once the
+    // sweep has seen everything, in every room whose light the bracket can hold.
+    assert!(
+        worst_full.0 <= 0.05,
+        "{:.1} % off in {}",
+        worst_full.0 * 100.0,
+        worst_full.1
+    );
+    // TODO(issue 20): the goal is 5 % at 80 % seen; filling the unseen fifth (pull-push from the
+    // nearest seen light) reaches it on five of the nine environments, not on rooms whose unseen
+    // floor differs from the lowest walls seen (apartment ~21 %, royal esplanade ~18 %). Until
+    // a better prior exists, this guards against regressions only.
+    assert!(
+        worst_80.0 <= 0.25,
+        "{:.1} % off at 80 % seen in {}",
+        worst_80.0 * 100.0,
+        worst_80.1
+    );
+}
