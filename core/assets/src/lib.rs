@@ -30,3 +30,4 @@ pub mod library;
 pub mod model;
 pub mod parallel;
 pub mod progress;
+pub mod ward;
