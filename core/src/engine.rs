@@ -152,6 +152,14 @@ pub enum EngineError {
     Share(String),
 }
 
+/// The key an artifact's material changes are kept under: its library id, or `file:NAME` for a
+/// model opened from the command line.
+fn appearance_key(info: &ModelInfo) -> String {
+    info.artifact
+        .as_ref()
+        .map_or_else(|| format!("file:{}", info.name), |a| a.id.to_string())
+}
+
 /// The text scales the screens follow ([`Engine::set_text_scale`]): Android's smallest font
 /// size to twice the default.
 pub const TEXT_SCALE_RANGE: std::ops::RangeInclusive<f32> = 0.85..=2.0;
@@ -282,6 +290,8 @@ pub struct Engine {
     /// The gallery's pictures, made while the menu is open.
     #[cfg(feature = "ui")]
     thumbnails: crate::thumbnails::Thumbnails,
+    /// The material screen's changes per artifact (`<library>/appearances.json`).
+    appearances: crate::appearances::AppearanceStore,
 }
 
 /// Something only the platform can do, asked for by the core's screens: the shell takes these
@@ -476,7 +486,11 @@ impl Engine {
             Some(path) => Some(crate::ibl::Environment::load(path)?),
             None => None,
         };
-        let renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
+        let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
+        let (appearances, appearance_warning) =
+            crate::appearances::AppearanceStore::open(config.library_dir.as_ref().map(|d| d.join("appearances.json")));
+        renderer.appearance = appearances.get(&appearance_key(&model_info));
+        let calibration_warning = calibration_warning.or(appearance_warning);
         #[cfg(feature = "face")]
         let face = match &config.face_models_dir {
             Some(dir) => {
@@ -534,6 +548,7 @@ impl Engine {
             camera_page_pending: false,
             #[cfg(feature = "ui")]
             thumbnails,
+            appearances,
         };
         engine.apply_calibration();
         if config.model_path.is_none()
@@ -583,6 +598,28 @@ impl Engine {
 
     /// Why the calibration file could not be read, applied or written, if it could not: for the
     /// shell's log. The engine runs on with the defaults (or what it could apply).
+    /// Changes the material of the artifact on screen (the material screen's sliders and
+    /// presets; sanitised): shown from the next frame, remembered for this artifact (written to
+    /// the library's `appearances.json`). A failure to write is returned; the change still shows.
+    pub fn set_appearance(&mut self, appearance: crate::render::Appearance) -> Result<(), EngineError> {
+        let appearance = appearance.sanitised();
+        self.renderer.appearance = appearance;
+        self.appearances
+            .set(&appearance_key(&self.model_info), appearance)
+            .map_err(|e| EngineError::InvalidArgument(format!("the material change could not be saved: {e}")))
+    }
+
+    /// Shows `appearance` on the artifact on screen without remembering it (the command line's
+    /// `--material`, a preview); the next artifact comes with its own.
+    pub fn show_appearance(&mut self, appearance: crate::render::Appearance) {
+        self.renderer.appearance = appearance.sanitised();
+    }
+
+    /// The material of the artifact on screen (the default: as its glTF says).
+    pub fn appearance(&self) -> crate::render::Appearance {
+        self.renderer.appearance
+    }
+
     pub fn calibration_warning(&self) -> Option<&str> {
         self.calibration_warning.as_deref()
     }
@@ -950,6 +987,7 @@ impl Engine {
         let model = scene.model();
         self.bounds = model.bounds().unwrap_or(self.bounds);
         self.model_info = ModelInfo::of(model, Some(diorama_entry()));
+        self.renderer.appearance = self.appearances.get(&appearance_key(&self.model_info));
         self.smoother = ContainmentSmoother::default();
         self.diorama = Some(Box::new(scene));
         self.diorama_grab = None;
@@ -1027,6 +1065,7 @@ impl Engine {
                 self.diorama_grab = None;
                 self.bounds = prepared.bounds;
                 self.model_info = prepared.info;
+                self.renderer.appearance = self.appearances.get(&appearance_key(&self.model_info));
                 self.smoother = ContainmentSmoother::default();
                 true
             }

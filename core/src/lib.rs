@@ -67,7 +67,7 @@ pub use phantogram_sensing::{
 };
 
 #[cfg(feature = "models")]
-pub use phantogram_assets::{artifact, budget, builtin, ibl, library, model, parallel, progress};
+pub use phantogram_assets::{appearance, artifact, budget, builtin, ibl, library, model, parallel, progress, ward};
 #[cfg(feature = "render")]
 pub use phantogram_physics as physics;
 #[cfg(feature = "render")]
@@ -79,6 +79,8 @@ pub use phantogram_ui as calibration_ui;
 #[cfg(feature = "face")]
 pub use phantogram_vision as face;
 
+#[cfg(feature = "render")]
+pub mod appearances;
 #[cfg(feature = "render")]
 pub mod artifacts;
 #[cfg(feature = "render")]

@@ -21,6 +21,7 @@
 //! plain data. Files from outside never panic: they yield typed errors naming the file
 //! ([`model::ModelError`], [`ibl::EnvironmentError`]).
 
+pub mod appearance;
 pub mod artifact;
 pub mod budget;
 pub mod builtin;

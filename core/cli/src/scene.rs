@@ -34,6 +34,22 @@ pub struct SceneArgs {
     /// a generated neutral studio when omitted.
     #[arg(long)]
     environment: Option<PathBuf>,
+    /// Show the artifact in one of the Ward material presets instead of its own material (not
+    /// remembered): matte, glazed, polished, patinated, brushed-metal, silk or lacquer.
+    #[arg(long, value_name = "PRESET")]
+    material: Option<String>,
+}
+
+/// The preset called `name` on the command line (its name with dashes for spaces).
+fn material_preset(name: &str) -> Result<phantogram::ward::WardPreset> {
+    use phantogram::ward::WardPreset;
+    WardPreset::ALL
+        .into_iter()
+        .find(|p| p.name().replace(' ', "-") == name)
+        .ok_or_else(|| {
+            let names: Vec<String> = WardPreset::ALL.iter().map(|p| p.name().replace(' ', "-")).collect();
+            anyhow::anyhow!("--material {name:?} is not a preset (choose from {})", names.join(", "))
+        })
 }
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -64,6 +80,7 @@ impl SceneArgs {
             }
             None => None,
         };
+        let material = self.material.as_deref().map(material_preset).transpose()?;
         let config = EngineConfig {
             method,
             model_path: self.model.clone(),
@@ -84,7 +101,11 @@ impl SceneArgs {
             library_dir: phantogram::library_dir(),
             ..EngineConfig::default()
         };
-        let engine = Engine::new(config)?;
+        let mut engine = Engine::new(config)?;
+        if let Some(preset) = material {
+            // Shown, not remembered: the command line's library is the user's own.
+            engine.show_appearance(phantogram::render::Appearance::preset(preset));
+        }
         if let Some(path) = &self.model {
             let info = engine.model_info();
             for w in &info.warnings {

@@ -46,6 +46,7 @@ use glam::{Mat4, Vec3};
 use thiserror::Error;
 use wgpu::util::DeviceExt;
 
+pub use phantogram_assets::appearance::Appearance;
 use phantogram_assets::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
 use phantogram_geometry::anaglyph::Method;
 use phantogram_geometry::projection::OffAxisProjection;
@@ -124,6 +125,28 @@ struct EyeUniform {
     light_view_proj: [[f32; 4]; 4],
     shadow: [f32; 4],
     sh: [[f32; 4]; 9],
+    /// The artifact's [`Appearance`], as `Appearance` in `scene.wgsl` lays it out.
+    appearance: [[f32; 4]; 5],
+}
+
+/// `Appearance` in `scene.wgsl`: rgb tint and specular scale; roughness and metalness overrides
+/// (negative: keep), clear coat and its roughness; Ward ρd (w: 1 when on), ρs, and αx, αy.
+fn appearance_uniform(a: &Appearance) -> [[f32; 4]; 5] {
+    let a = a.sanitised();
+    let ward = a.ward.unwrap_or(phantogram_assets::ward::WardPreset::Matte.material());
+    let on = f32::from(u8::from(a.ward.is_some()));
+    [
+        [a.tint[0], a.tint[1], a.tint[2], a.specular],
+        [
+            a.roughness.unwrap_or(-1.0),
+            a.metalness.unwrap_or(-1.0),
+            a.clear_coat,
+            a.clear_coat_roughness,
+        ],
+        [ward.rho_d[0], ward.rho_d[1], ward.rho_d[2], on],
+        [ward.rho_s[0], ward.rho_s[1], ward.rho_s[2], 0.0],
+        [ward.alpha_x, ward.alpha_y, 0.0, 0.0],
+    ]
 }
 
 /// Matches `Compose` in `compose.wgsl`.
@@ -145,6 +168,7 @@ struct MaterialUniform {
     uv_sets: [f32; 4],
     flags: [f32; 4],
     transforms: [[f32; 4]; 10],
+    scene: [f32; 4],
 }
 
 impl MaterialUniform {
@@ -188,6 +212,7 @@ impl MaterialUniform {
                 f32::from(u8::from(m.unlit)),
             ],
             transforms,
+            scene: [f32::from(u8::from(m.scenery)), 0.0, 0.0, 0.0],
         }
     }
 }
@@ -597,6 +622,9 @@ pub struct Renderer {
     /// frames' full-size targets are not dropped and made again for each.
     side_targets: Option<Targets>,
     pub lighting: Lighting,
+    /// Changes over the model's materials (the material screen's), applied in the next frame;
+    /// sanitised on the way to the GPU.
+    pub appearance: Appearance,
 }
 
 impl Renderer {
@@ -843,6 +871,7 @@ impl Renderer {
             targets: None,
             side_targets: None,
             lighting: Lighting::default(),
+            appearance: Appearance::default(),
             gpu,
         }
     }
@@ -942,11 +971,14 @@ impl Renderer {
     ) -> Result<Vec<u8>, RenderError> {
         let gpu_model = self.upload_with_pipelines(model)?;
         let set_model = std::mem::replace(&mut self.model, gpu_model);
+        // The other model as authored: the appearance set is the shown artifact's.
+        let appearance = std::mem::take(&mut self.appearance);
         let side = self.side_targets.take();
         let frame_targets = std::mem::replace(&mut self.targets, side);
         let pixels = self.render_views(&[input.mono], input, Method::Mono, width, height);
         self.side_targets = std::mem::replace(&mut self.targets, frame_targets);
         self.model = set_model;
+        self.appearance = appearance;
         pixels
     }
 
@@ -1043,6 +1075,7 @@ impl Renderer {
             light_view_proj: shadow.0.to_cols_array_2d(),
             shadow: [shadow.1, f32::from(u8::from(l.shadows)), 0.0, 0.0],
             sh: self.environment_sh,
+            appearance: appearance_uniform(&self.appearance),
         }
     }
 
@@ -1542,11 +1575,25 @@ mod tests {
 
     #[test]
     fn uniform_layouts_match_the_shaders() {
-        // WGSL sizes: Eye = mat4 + 3 × vec4 + 3 × vec4 + mat4 + vec4 + 9 × vec4; Compose = 7 × vec4.
-        assert_eq!(std::mem::size_of::<EyeUniform>(), 384);
-        assert_eq!(std::mem::size_of::<ComposeUniform>(), 112);
-        // Material = 5 × vec4 + array<vec4, 10>.
-        assert_eq!(std::mem::size_of::<MaterialUniform>(), 240);
+        // Each uniform struct is as large as naga lays out its WGSL namesake.
+        let wgsl_size = |source: &str, name: &str| {
+            let module = naga::front::wgsl::parse_str(source).expect("valid WGSL");
+            module
+                .types
+                .iter()
+                .find(|(_, ty)| ty.name.as_deref() == Some(name))
+                .map(|(_, ty)| ty.inner.size(module.to_ctx()) as usize)
+                .unwrap_or_else(|| panic!("no struct {name}"))
+        };
+        assert_eq!(std::mem::size_of::<EyeUniform>(), wgsl_size(SCENE_WGSL, "Eye"));
+        assert_eq!(
+            std::mem::size_of::<ComposeUniform>(),
+            wgsl_size(COMPOSE_WGSL, "Compose")
+        );
+        assert_eq!(
+            std::mem::size_of::<MaterialUniform>(),
+            wgsl_size(SCENE_WGSL, "Material")
+        );
         // Vertex = 3 + 3 + 4 + 4 + 4 + 2 floats.
         assert_eq!(std::mem::size_of::<Vertex>(), 80);
     }

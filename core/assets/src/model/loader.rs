@@ -496,6 +496,7 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
         normal_texture,
         occlusion_texture,
         emissive_texture: m.emissive_texture().map(info),
+        scenery: false,
     }
 }
 

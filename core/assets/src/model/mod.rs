@@ -231,6 +231,9 @@ pub struct Material {
     /// `KHR_materials_unlit`: shown in its base colour, without lighting (scans whose lighting
     /// is baked into their colour).
     pub unlit: bool,
+    /// Part of the scene the artifact stands in (the diorama's floor), not of the artifact: the
+    /// material screen's changes leave it as it is.
+    pub scenery: bool,
 }
 
 impl Default for Material {
@@ -250,6 +253,7 @@ impl Default for Material {
             occlusion_texture: None,
             emissive_texture: None,
             unlit: false,
+            scenery: false,
         }
     }
 }
@@ -435,6 +439,7 @@ impl Model {
             base_color: [0.18, 0.18, 0.18, 1.0],
             metallic: 0.0,
             roughness: 0.9,
+            scenery: true,
             ..Material::default()
         });
         self.primitives.push(Primitive {
@@ -500,6 +505,7 @@ impl Model {
             metallic: 0.0,
             roughness: 1.0,
             unlit: true,
+            scenery: true,
             ..Material::default()
         });
         self.primitives.push(Primitive {

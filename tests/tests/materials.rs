@@ -1,0 +1,109 @@
+//! The material screen's changes as the engine shows them: each Ward preset on the default
+//! artifact matches its golden frame (the floor keeps its own material), a change shows in the
+//! very next frame, and an artifact's change is remembered across engines through the library's
+//! `appearances.json`.
+
+#[path = "support/golden.rs"]
+mod golden;
+
+use phantogram::anaglyph::Method;
+use phantogram::appearance::Appearance;
+use phantogram::engine::{Engine, EngineConfig};
+use phantogram::glam::{Quat, Vec3};
+use phantogram::sensors::SensorEvent;
+use phantogram::ward::WardPreset;
+
+const SIZE: (u32, u32) = (180, 400);
+/// When the frames are drawn: after a second held still at the tilt.
+const FRAME_T_NS: i64 = 1_000_000_000;
+
+/// Holds the phone tilted 50° towards the viewer (as a phantogram is held) for a second, so that
+/// the frames show the artifact's side, where the materials differ most.
+fn hold_tilted(engine: &Engine) {
+    let inbox = engine.inbox();
+    let up = Quat::from_rotation_x(50f32.to_radians()).inverse() * Vec3::Z * 9.81;
+    for k in 0..=200i64 {
+        let t = k * 5_000_000;
+        inbox.push(SensorEvent::accelerometer(t, up)).expect("accelerometer");
+        inbox.push(SensorEvent::gyroscope(t, Vec3::ZERO)).expect("gyroscope");
+    }
+}
+
+fn frame(engine: &mut Engine) -> Vec<u8> {
+    engine.draw(Some(FRAME_T_NS)).expect("draw");
+    engine.last_frame().expect("a frame").2.to_vec()
+}
+
+fn differing_pixels(a: &[u8], b: &[u8]) -> usize {
+    a.chunks(4)
+        .zip(b.chunks(4))
+        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count()
+}
+
+#[test]
+fn each_preset_matches_its_golden_frame_and_shows_in_the_next_frame() {
+    let config = EngineConfig {
+        method: Method::Mono,
+        ..EngineConfig::default()
+    };
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config) else {
+        return;
+    };
+    engine.resume_offscreen(SIZE.0, SIZE.1).expect("offscreen");
+    hold_tilted(&engine);
+    let authored = frame(&mut engine);
+    // The floor's corner (top left: nothing of the artifact there) never changes.
+    let corner = |f: &[u8]| f[..4].to_vec();
+    for preset in WardPreset::ALL {
+        engine
+            .set_appearance(Appearance::preset(preset))
+            .expect("in memory: nothing to save");
+        let shown = frame(&mut engine);
+        assert!(
+            differing_pixels(&authored, &shown) > 500,
+            "{preset:?} changed the artifact in the next frame"
+        );
+        assert_eq!(corner(&shown), corner(&authored), "{preset:?} left the floor alone");
+        golden::check(
+            &format!("material-{}", preset.name().replace(' ', "-")),
+            SIZE.0,
+            SIZE.1,
+            &shown,
+            3,
+            0.003,
+        );
+    }
+    // Back to the glTF's own material: the first frame again.
+    engine.set_appearance(Appearance::default()).expect("reset");
+    assert_eq!(differing_pixels(&authored, &frame(&mut engine)), 0);
+}
+
+#[test]
+fn a_change_is_remembered_for_its_artifact() {
+    let library = phantogram_testkit::Scratch::new("materials-library");
+    let config = || EngineConfig {
+        library_dir: Some(library.to_path_buf()),
+        ..EngineConfig::default()
+    };
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config()) else {
+        return;
+    };
+    let coat = Appearance {
+        clear_coat: 1.0,
+        tint: [0.8, 0.9, 1.0],
+        ..Appearance::default()
+    };
+    engine.set_appearance(coat).expect("saved");
+    assert_eq!(engine.appearance(), coat);
+    drop(engine);
+    let mut engine = Engine::new(config()).expect("a second engine");
+    assert_eq!(engine.appearance(), coat, "remembered for the default artifact");
+    // Another artifact comes with its own (here: none), and the first keeps its change.
+    engine.select_artifact("builtin:medal".parse().expect("id"));
+    assert!(engine.wait_for_artifact(std::time::Duration::from_secs(60)));
+    assert!(engine.appearance().is_default());
+    engine.select_artifact("builtin:amphora".parse().expect("id"));
+    assert!(engine.wait_for_artifact(std::time::Duration::from_secs(60)));
+    assert_eq!(engine.appearance(), coat);
+}
