@@ -335,6 +335,7 @@ enum Page {
     Help,
     Welcome(crate::calibration_ui::welcome::WelcomeUi),
     Settings(crate::calibration_ui::settings::SettingsUi),
+    Material(crate::calibration_ui::material::MaterialUi),
 }
 
 /// The screens' state on the render thread: the page open (if any), egui's context, the touches
@@ -894,7 +895,8 @@ impl Engine {
     /// The centre of a control of the screen showing, in the last frame drawn, in physical
     /// pixels: for tests and automation. Names are the open page's (`widget_rect` of
     /// [`crate::calibration_ui::CalibrationUi`], [`crate::calibration_ui::menu::MenuUi`],
-    /// [`crate::calibration_ui::settings::SettingsUi`] or
+    /// [`crate::calibration_ui::settings::SettingsUi`],
+    /// [`crate::calibration_ui::material::MaterialUi`] or
     /// [`crate::calibration_ui::welcome::WelcomeUi`]); `banner` is the status banner's button
     /// (Cancel or OK) whatever page shows.
     #[cfg(feature = "ui")]
@@ -905,6 +907,7 @@ impl Engine {
             (Some(Page::Calibration(ui)), _) => ui.widget_rect(name)?,
             (Some(Page::Menu(ui)), _) => ui.widget_rect(name)?,
             (Some(Page::Settings(ui)), _) => ui.widget_rect(name)?,
+            (Some(Page::Material(ui)), _) => ui.widget_rect(name)?,
             (Some(Page::Welcome(ui)), _) => ui.widget_rect(name)?,
             _ => return None,
         };
@@ -1475,6 +1478,7 @@ impl Engine {
         let (mut calibration_actions, mut menu_actions) = (Vec::new(), Vec::new());
         let mut welcome_actions = Vec::new();
         let mut settings_actions = Vec::new();
+        let mut material_actions = Vec::new();
         let filters = filter_colours(self.method);
         let mut card_closed = false;
         // Only the menu says how the eyes are found.
@@ -1501,6 +1505,7 @@ impl Engine {
                 }
                 Some(Page::Welcome(welcome)) => welcome_actions = welcome.show(root, filters),
                 Some(Page::Settings(settings)) => settings_actions = settings.show(root),
+                Some(Page::Material(material)) => material_actions = material.show(root),
                 Some(Page::Annotation(i)) => match annotations.get(*i) {
                     Some(a) => {
                         card_closed = crate::calibration_ui::menu::show_annotation(root.ctx(), &a.title, &a.lead).0
@@ -1547,6 +1552,17 @@ impl Engine {
         }
         for action in settings_actions {
             self.apply_settings_action(action);
+        }
+        for action in material_actions {
+            match action {
+                crate::calibration_ui::material::MaterialAction::Changed(a) => {
+                    if let Err(e) = self.set_appearance(a) {
+                        // Shown all the same; the banner says it will not be remembered.
+                        self.loader.fail(self.model_info.name.clone(), e.to_string());
+                    }
+                }
+                crate::calibration_ui::material::MaterialAction::Close => self.set_page(None),
+            }
         }
         match banner_action {
             Some(BannerAction::Cancel) => self.cancel_loading(),
@@ -1675,6 +1691,10 @@ impl Engine {
                 self.set_page(Some(Page::Settings(crate::calibration_ui::settings::SettingsUi::new(
                     settings,
                 ))));
+            }
+            A::Material => {
+                let ui = crate::calibration_ui::material::MaterialUi::new(self.appearance());
+                self.set_page(Some(Page::Material(ui)));
             }
             A::Close => self.set_page(None),
         }

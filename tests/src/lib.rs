@@ -45,6 +45,20 @@ pub fn engine_or_skip(config: phantogram::engine::EngineConfig) -> Option<phanto
     }
 }
 
+/// A finger's tap at display pixel `px` as a shell sends it, at `*t_ms` on the sensor clock:
+/// down, a frame, up 80 ms later, three frames to settle; `*t_ms` moves a second on.
+pub fn tap_at(e: &mut phantogram::engine::Engine, px: [f32; 2], t_ms: &mut i64) {
+    use phantogram::gesture::TouchPhase;
+    let ms = 1_000_000;
+    e.touch(TouchPhase::Down, 0, px[0], px[1], *t_ms * ms);
+    e.draw(Some((*t_ms + 16) * ms)).expect("draw");
+    e.touch(TouchPhase::Up, 0, px[0], px[1], (*t_ms + 80) * ms);
+    for k in 0..3 {
+        e.draw(Some((*t_ms + 96 + 16 * k) * ms)).expect("draw");
+    }
+    *t_ms += 1000;
+}
+
 /// A scratch folder unique to this process and `name`, emptied first, removed when the returned
 /// guard drops unless the test is failing (see [`Scratch`]).
 pub fn scratch(name: &str) -> Scratch {

@@ -7,6 +7,7 @@ use std::time::Duration;
 use phantogram::artifacts::LoadStatus;
 use phantogram::engine::{Engine, EngineConfig};
 use phantogram::library::{ArtifactId, Origin};
+use phantogram_integration::tap_at;
 use phantogram_testkit::{Scratch, tetrahedron_glb};
 
 const W: u32 = 180;
@@ -234,19 +235,6 @@ fn a_hundred_switches_leave_resident_memory_flat() {
 
 #[path = "support/golden.rs"]
 mod golden;
-
-/// Taps at `px` as a finger does: down, a frame, up, frames to settle.
-fn tap_at(e: &mut Engine, px: [f32; 2], t_ms: &mut i64) {
-    use phantogram::gesture::TouchPhase;
-    let ms = 1_000_000;
-    e.touch(TouchPhase::Down, 0, px[0], px[1], *t_ms * ms);
-    e.draw(Some((*t_ms + 16) * ms)).unwrap();
-    e.touch(TouchPhase::Up, 0, px[0], px[1], (*t_ms + 80) * ms);
-    for k in 0..3 {
-        e.draw(Some((*t_ms + 96 + 16 * k) * ms)).unwrap();
-    }
-    *t_ms += 1000;
-}
 
 /// The menu a single tap opens and the status banner, driven by simulated taps: choose an
 /// artifact, see a failure, dismiss it. Each screen is compared with its golden image.

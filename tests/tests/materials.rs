@@ -1,7 +1,7 @@
 //! The material screen's changes as the engine shows them: each Ward preset on the default
 //! artifact matches its golden frame (the floor keeps its own material), a change shows in the
-//! very next frame, and an artifact's change is remembered across engines through the library's
-//! `appearances.json`.
+//! very next frame, an artifact's change is remembered across engines through the library's
+//! `appearances.json`, and the screen itself is reached from the menu and driven by taps.
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -106,4 +106,42 @@ fn a_change_is_remembered_for_its_artifact() {
     engine.select_artifact("builtin:amphora".parse().expect("id"));
     assert!(engine.wait_for_artifact(std::time::Duration::from_secs(60)));
     assert_eq!(engine.appearance(), coat);
+}
+
+#[test]
+fn the_material_screen_is_reached_from_the_menu_and_driven_by_taps() {
+    let config = EngineConfig {
+        method: Method::Mono,
+        ..EngineConfig::default()
+    };
+    let Some(mut e) = phantogram_integration::engine_or_skip(config) else {
+        return;
+    };
+    let (w, h) = (360, 800);
+    e.resume_offscreen(w, h).expect("offscreen");
+    let mut t = 0i64;
+    assert!(e.open_menu());
+    for _ in 0..2 {
+        t += 16;
+        e.draw(Some(t * 1_000_000)).expect("draw");
+    }
+    let material = e.control_px("material").expect("the menu's material button");
+    phantogram_integration::tap_at(&mut e, material, &mut t);
+    let screen = e.last_frame().expect("frame").2.to_vec();
+    if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
+        image::save_buffer(
+            std::path::Path::new(&dir).join("material-screen.png"),
+            &screen,
+            w,
+            h,
+            image::ExtendedColorType::Rgba8,
+        )
+        .expect("save");
+    }
+    golden::check("menu-material", w, h, &screen, 3, 0.003);
+    let polished = e.control_px("preset-polished").expect("the polished preset");
+    phantogram_integration::tap_at(&mut e, polished, &mut t);
+    assert_eq!(e.appearance(), Appearance::preset(WardPreset::Polished));
+    let done = e.control_px("preset-matte").and(e.control_px("done"));
+    assert!(done.is_some(), "the screen stays open for more changes");
 }

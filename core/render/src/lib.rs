@@ -48,6 +48,7 @@ use wgpu::util::DeviceExt;
 
 pub use phantogram_assets::appearance::Appearance;
 use phantogram_assets::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
+pub use phantogram_assets::ward;
 use phantogram_geometry::anaglyph::Method;
 use phantogram_geometry::projection::OffAxisProjection;
 

@@ -47,6 +47,8 @@ pub enum MenuAction {
     Calibrate,
     /// Open the settings screen instead.
     Settings,
+    /// Open the material screen for the artifact on screen.
+    Material,
     /// Show what the gestures do.
     Help,
     Close,
@@ -65,8 +67,8 @@ impl MenuUi {
     }
 
     /// The rectangle (points) of a control drawn last frame: `item:<id>`, `thumb:<id>` (its
-    /// picture), `remove:<id>`, `open`, `share`, `share-pair`, `help`, `settings`, `calibrate`,
-    /// `close`.
+    /// picture), `remove:<id>`, `open`, `share`, `share-pair`, `help`, `material`, `settings`,
+    /// `calibrate`, `close`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.get(name)
     }
@@ -105,6 +107,7 @@ impl MenuUi {
             let buttons = [
                 ("open", "Open a file of your own…"),
                 ("help", "How to use it"),
+                ("material", "Material (glaze, metal, varnish…)"),
                 ("settings", "Settings (glasses, size, floor)"),
                 ("calibrate", "Calibration"),
                 ("close", "Done"),
@@ -120,6 +123,7 @@ impl MenuUi {
                         "open" => MenuAction::OpenFile,
                         "calibrate" => MenuAction::Calibrate,
                         "settings" => MenuAction::Settings,
+                        "material" => MenuAction::Material,
                         "help" => MenuAction::Help,
                         _ => MenuAction::Close,
                     });
