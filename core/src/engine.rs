@@ -102,6 +102,12 @@ pub struct EngineConfig {
     /// the first run is done, the engine opens on the first-run screens (how to hold the phone,
     /// the glasses check, "Start"); the desktop's `render` passes none.
     pub calibration_path: Option<PathBuf>,
+    /// Light the artifact with the room itself, as the camera sees it
+    /// ([`crate::room_light`]): camera frames ([`Engine::room_light_frame`], or every frame the
+    /// shell forwards) are blended into a map of the room whose light replaces the studio's (or
+    /// [`Self::environment_path`]'s) once the first update is made. Off by default: the shells
+    /// forward the luma plane only so far, which gives the room's light without its colour.
+    pub room_light: bool,
 }
 
 impl Default for EngineConfig {
@@ -121,6 +127,7 @@ impl Default for EngineConfig {
             floor: true,
             adapt_straight_on: true,
             calibration_path: None,
+            room_light: false,
         }
     }
 }
@@ -237,6 +244,10 @@ pub struct EngineStats {
     pub gestures: u64,
     /// Whether the last frame's eyes came from the camera.
     pub eyes_from_camera: bool,
+    /// Image-based lights made from the room so far, and the share of the sphere (0 to 1) the
+    /// newest had seen ([`EngineConfig::room_light`]).
+    pub room_light_updates: u64,
+    pub room_light_coverage: f32,
 }
 
 /// What a shell embeds; see the module docs.
@@ -292,6 +303,8 @@ pub struct Engine {
     thumbnails: crate::thumbnails::Thumbnails,
     /// The material screen's changes per artifact (`<library>/appearances.json`).
     appearances: crate::appearances::AppearanceStore,
+    /// The live room light's worker, when [`EngineConfig::room_light`] is on.
+    room_light: Option<Arc<crate::room_light::RoomLightWorker>>,
 }
 
 /// Something only the platform can do, asked for by the core's screens: the shell takes these
@@ -509,6 +522,20 @@ impl Engine {
         if config.face_models_dir.is_some() {
             return Err(EngineError::NoFaceSupport);
         }
+        let room_light = if config.room_light {
+            let camera = config
+                .camera_position_m
+                .unwrap_or(Vec3::new(0.0, screen.panel_height_m() * 0.5 + 0.004, 0.0));
+            let worker = crate::room_light::RoomLightWorker::spawn(
+                crate::camera::CameraPose::front(camera),
+                phantogram_roomlight::CaptureParams::default(),
+                crate::render::PREFILTERED_BASE_WIDTH,
+            )
+            .map_err(|e| EngineError::InvalidArgument(format!("the room light's thread could not start: {e}")))?;
+            Some(Arc::new(worker))
+        } else {
+            None
+        };
         let mut engine = Self {
             session,
             renderer,
@@ -550,6 +577,7 @@ impl Engine {
             #[cfg(feature = "ui")]
             thumbnails,
             appearances,
+            room_light,
         };
         engine.apply_calibration();
         if config.model_path.is_none()
@@ -608,6 +636,56 @@ impl Engine {
         self.appearances
             .set(&appearance_key(&self.model_info), appearance)
             .map_err(|e| EngineError::InvalidArgument(format!("the material change could not be saved: {e}")))
+    }
+
+    /// Hands a camera frame to the live room light (`exposure`: exposure time × sensor gain, when
+    /// the platform reports it); from any thread through [`SharedEngine::camera_frame`] too.
+    /// Returns `false` when the room light is off ([`EngineConfig::room_light`]).
+    pub fn room_light_frame(&self, frame: crate::camera::OwnedFrame, exposure: Option<f32>) -> bool {
+        match &self.room_light {
+            Some(worker) => {
+                worker.submit(frame, exposure);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// As [`Self::room_light_frame`], with the device's orientation (device → world) when the
+    /// frame was taken: a desktop replay whose camera follows a log of its own.
+    pub fn room_light_frame_oriented(
+        &self,
+        frame: crate::camera::OwnedFrame,
+        exposure: Option<f32>,
+        world_from_device: glam::Quat,
+    ) -> bool {
+        match &self.room_light {
+            Some(worker) => {
+                worker.submit_oriented(frame, exposure, Some(world_from_device));
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The live room light's worker (its counts, waiting for it), when it is on.
+    pub fn room_light(&self) -> Option<&crate::room_light::RoomLightWorker> {
+        self.room_light.as_deref()
+    }
+
+    /// Tells the room light where the device looks now and lights the scene with its newest
+    /// update (an upload only: the worker did the work).
+    fn update_room_light(&mut self, device_to_world: Option<glam::Quat>) {
+        let Some(worker) = &self.room_light else { return };
+        if let Some(q) = device_to_world {
+            worker.set_orientation(q);
+        }
+        if let Some(update) = worker.take_update() {
+            self.stats.room_light_updates += 1;
+            self.stats.room_light_coverage = update.coverage;
+            // A failed upload keeps the light there was; the next update tries again.
+            let _ = self.renderer.set_prefiltered_environment(&update.levels, &update.sh);
+        }
     }
 
     /// Shows `appearance` on the artifact on screen without remembering it (the command line's
@@ -1383,6 +1461,7 @@ impl Engine {
         };
         self.last_push_m = push;
         self.last_mono = Some(view.mono);
+        self.update_room_light(view.device_to_world);
         let input = self.oriented(frame_input(&view, Vec3::Z * -push));
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
@@ -1852,6 +1931,7 @@ pub struct SharedEngine {
     inbox: Arc<SensorInbox>,
     #[cfg(feature = "face")]
     face: Option<Arc<crate::face::FaceWorker>>,
+    room_light: Option<Arc<crate::room_light::RoomLightWorker>>,
     camera_frames: std::sync::atomic::AtomicU64,
     engine: Mutex<Engine>,
 }
@@ -1862,6 +1942,7 @@ impl SharedEngine {
             inbox: engine.inbox(),
             #[cfg(feature = "face")]
             face: engine.face_worker(),
+            room_light: engine.room_light.clone(),
             camera_frames: std::sync::atomic::AtomicU64::new(0),
             engine: Mutex::new(engine),
         }
@@ -1873,10 +1954,15 @@ impl SharedEngine {
     }
 
     /// From any thread, without waiting for inference: hands the frame to the face tracker
-    /// (replacing one not yet started). `Ok(false)` when face tracking is off.
+    /// (replacing one not yet started), and to the live room light when it is on. `Ok(false)`
+    /// when face tracking is off.
     #[cfg(feature = "face")]
     pub fn camera_frame(&self, frame: crate::face::OwnedFrame) -> Result<bool, EngineError> {
         crate::face::UprightImage::new(frame.as_frame())?;
+        if let Some(room) = &self.room_light {
+            // The exposure is not forwarded by the shells yet: estimated from the overlap.
+            room.submit(frame.clone(), None);
+        }
         match &self.face {
             Some(worker) => {
                 worker.submit(frame);

@@ -348,6 +348,9 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             artifact,
             library_dir: library.map(PathBuf::from),
             bundled_dir: bundled.map(PathBuf::from),
+            // TODO(issue 20): on once the shell forwards the camera's colour planes and exposure
+            // (it sends the luma plane only, for the face tracker).
+            room_light: false,
         };
         let engine = Engine::new(config)?;
         let handle = Box::new(PgEngine {

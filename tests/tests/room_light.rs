@@ -9,10 +9,21 @@
 //! estimated, is printed for comparison (up to the unknown overall scale).
 //!
 //! Needs the external data (`PHANTOGRAM_DATA`); without it the test prints a notice and returns.
+//!
+//! And the engine lit by two live rooms (generated here, so without the data too): a camera
+//! sweep into each through `Engine::room_light_frame_oriented` lights the frames drawn after it
+//! by that room: the generated studio the engine starts with gives the same frame again (to the
+//! pixel, almost: the capture reproduces it), a sunset a very different one (golden frames
+//! `room-light-studio`, `-sunset`).
 
+use phantogram::anaglyph::Method;
+use phantogram::engine::EngineConfig;
 use phantogram::glam::{Mat3, Quat, Vec3};
 use phantogram::ibl::{Environment, IrradianceSh};
 use phantogram_integration::data_subdir;
+
+#[path = "support/golden.rs"]
+mod golden;
 use phantogram_lab::synthetic_camera::{Metering, SyntheticCamera};
 
 /// The short frame of the room light's bracket: the highlights just below clipping, down to
@@ -211,4 +222,99 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
         worst_80.0 * 100.0,
         worst_80.1
     );
+}
+
+/// A warm evening room made here: a low orange sun in the west, a dim blue sky, a dark floor.
+fn sunset_room() -> Environment {
+    let (width, height) = (128usize, 64usize);
+    let mut env = Environment {
+        width,
+        height,
+        texels: Vec::with_capacity(width * height),
+    };
+    let sun = Vec3::new(-1.0, 0.1, 0.12).normalize();
+    for y in 0..height {
+        for x in 0..width {
+            let d = env.direction(x, y);
+            let glow = 6.0 * ((d.dot(sun) - 1.0) / 0.02).exp();
+            let sky = if d.z > 0.0 { 0.05 + 0.1 * d.z } else { 0.02 };
+            env.texels
+                .push([sky * 0.6 + glow, sky * 0.8 + glow * 0.45, sky * 1.4 + glow * 0.1]);
+        }
+    }
+    env
+}
+
+#[test]
+fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
+    let (w, h) = (180, 400);
+    let camera = SyntheticCamera::phone_front();
+    let mut frames = Vec::new();
+    for (name, room) in [("studio", Environment::studio()), ("sunset", sunset_room())] {
+        let config = EngineConfig {
+            method: Method::Mono,
+            room_light: true,
+            ..EngineConfig::default()
+        };
+        let Some(mut engine) = phantogram_integration::engine_or_skip(config) else {
+            return;
+        };
+        engine.resume_offscreen(w, h).expect("offscreen");
+        engine.draw(Some(0)).expect("draw");
+        let before = engine.last_frame().expect("frame").2.to_vec();
+        // Every other pose of the sweep: 15° apart is more than a frame needs.
+        for (k, pose) in sweep().into_iter().enumerate().filter(|(k, _)| k % 2 == 0) {
+            let metering = if k % 4 == 2 { BRACKET } else { Metering::Average };
+            let (frame, exposure) = camera.capture(&room, pose, metering, k as i64 * 100_000_000);
+            assert!(engine.room_light_frame_oriented(frame, Some(exposure), pose));
+            let worker = engine.room_light().expect("on");
+            assert!(
+                worker.wait_until(0, std::time::Duration::from_secs(120)),
+                "the worker keeps up"
+            );
+        }
+        let worker = engine.room_light().expect("on");
+        let (blended, refused, updates) = worker.counts();
+        assert_eq!(refused, 0);
+        assert!(blended > 50 && updates > 5, "{blended} frames, {updates} updates");
+        assert!(
+            worker.coverage() > 0.9,
+            "the sweep saw {:.2} of the room",
+            worker.coverage()
+        );
+        engine.draw(Some(0)).expect("draw");
+        assert!(
+            engine.stats().room_light_updates >= 1,
+            "the newest update reached the renderer"
+        );
+        let lit = engine.last_frame().expect("frame").2.to_vec();
+        let changed = before
+            .chunks(4)
+            .zip(lit.chunks(4))
+            .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
+            .count();
+        println!("{name}: {blended} frames, {updates} updates, {changed} pixels changed");
+        if name == "studio" {
+            // The engine starts lit by this very studio: the room it captured lights it the same.
+            assert!(
+                changed < (w * h / 100) as usize,
+                "{changed} pixels changed by the same room"
+            );
+        } else {
+            assert!(
+                changed > (w * h / 4) as usize,
+                "only {changed} pixels changed by the sunset"
+            );
+        }
+        golden::check(&format!("room-light-{name}"), w, h, &lit, 3, 0.003);
+        frames.push(lit);
+    }
+    if frames.len() == 2 {
+        let differing = frames[0]
+            .chunks(4)
+            .zip(frames[1].chunks(4))
+            .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
+            .count();
+        assert!(differing > 5000, "two rooms, two lights ({differing} pixels differ)");
+    }
 }

@@ -15,6 +15,7 @@ mod check_artifacts;
 mod face_eval;
 mod output;
 mod render_frames;
+mod room_capture;
 mod scene;
 mod viewer;
 

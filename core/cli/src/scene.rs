@@ -34,6 +34,11 @@ pub struct SceneArgs {
     /// a generated neutral studio when omitted.
     #[arg(long)]
     environment: Option<PathBuf>,
+    /// Light the artifact with the room as a phone's front camera would see it along this
+    /// sensor log, looking into --environment (which then is the room, not the light): the live
+    /// room light replayed on the desktop, captured before the first frame.
+    #[arg(long, value_name = "LOG", requires = "environment")]
+    environment_from_camera: Option<PathBuf>,
     /// Show the artifact in one of the Ward material presets instead of its own material (not
     /// remembered): matte, glazed, polished, patinated, brushed-metal, silk or lacquer.
     #[arg(long, value_name = "PRESET")]
@@ -81,11 +86,21 @@ impl SceneArgs {
             None => None,
         };
         let material = self.material.as_deref().map(material_preset).transpose()?;
+        let sweep = match (&self.environment_from_camera, &self.environment) {
+            (Some(log), Some(room)) => Some(crate::room_capture::RoomSweep::prepare(room, log)?),
+            _ => None,
+        };
         let config = EngineConfig {
             method,
             model_path: self.model.clone(),
             artifact,
-            environment_path: self.environment.clone(),
+            // With a camera replay the environment is the room the camera looks into.
+            environment_path: if self.environment_from_camera.is_some() {
+                None
+            } else {
+                self.environment.clone()
+            },
+            room_light: self.environment_from_camera.is_some(),
             fit: DioramaFit {
                 placement: match self.placement {
                     PlacementArg::Auto => Placement::Auto,
@@ -102,6 +117,9 @@ impl SceneArgs {
             ..EngineConfig::default()
         };
         let mut engine = Engine::new(config)?;
+        if let Some(sweep) = &sweep {
+            sweep.feed(&engine)?;
+        }
         if let Some(preset) = material {
             // Shown, not remembered: the command line's library is the user's own.
             engine.show_appearance(phantogram::render::Appearance::preset(preset));

@@ -141,6 +141,17 @@ fn bad_input_is_a_clear_error() {
             "--protrude must be a fraction between 0 and 1",
         ),
         (&["--environment", "/nonexistent/sky.hdr"], "/nonexistent/sky.hdr"),
+        (&["--material", "velvet"], "--material \"velvet\" is not a preset"),
+        (&["--environment-from-camera", "/nonexistent/log"], "--environment"),
+        (
+            &[
+                "--environment-from-camera",
+                "/nonexistent/log",
+                "--environment",
+                "/nonexistent/room.hdr",
+            ],
+            "/nonexistent/room.hdr",
+        ),
     ] {
         let out = bin().arg("view").args(args).output().unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
@@ -717,4 +728,47 @@ fn render_replays_a_log_into_the_diorama() {
             "{name:?} differs between two runs"
         );
     }
+}
+
+/// `render --material` and `--environment-from-camera` change the frame: a preset over the
+/// artifact, and the light of a room a synthetic camera swept along the log (with the external
+/// data's HDR rooms; the engine's own tests cover generated rooms).
+#[test]
+fn render_takes_a_material_and_a_room_seen_by_the_camera() {
+    let dir = Scratch::new("cli-material-room");
+    let plain = render_default_log(&[], "100000", &dir.join("plain"));
+    if plain.contains("no GPU adapter") && std::env::var_os("CI").is_none() {
+        eprintln!("no GPU adapter: skipping the render test");
+        return;
+    }
+    let read = |name: &str| image::open(dir.join(name).join("frame_00000.png")).unwrap().to_rgba8();
+    let differing = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        a.pixels()
+            .zip(b.pixels())
+            .filter(|(p, q)| p.0.iter().zip(q.0.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
+            .count()
+    };
+    render_default_log(&["--material", "brushed-metal"], "100000", &dir.join("metal"));
+    assert!(differing(&read("plain"), &read("metal")) > 1000);
+    let Some(data) = std::env::var_os("PHANTOGRAM_DATA") else {
+        eprintln!("PHANTOGRAM_DATA not set: the room part is skipped");
+        return;
+    };
+    let room = std::path::Path::new(&data).join("env/venice_sunset_1k.hdr");
+    let log = default_log();
+    let stderr = render_default_log(
+        &[
+            "--environment",
+            room.to_str().unwrap(),
+            "--environment-from-camera",
+            log.to_str().unwrap(),
+        ],
+        "100000",
+        &dir.join("room"),
+    );
+    assert!(
+        stderr.contains("room light: ") && stderr.contains("% of the room seen"),
+        "{stderr}"
+    );
+    assert!(differing(&read("plain"), &read("room")) > 1000);
 }

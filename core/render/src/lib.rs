@@ -62,7 +62,7 @@ pub use wgpu;
 
 pub use gpu::Gpu;
 use lighting_tables::*;
-pub use lighting_tables::{prepare_lighting_tables, prepare_lighting_tables_in_background};
+pub use lighting_tables::{PREFILTERED_BASE_WIDTH, prepare_lighting_tables, prepare_lighting_tables_in_background};
 pub use upload::mip_chain;
 use upload::*;
 
@@ -884,13 +884,26 @@ impl Renderer {
     /// Lights the scene with `env` (world frame) instead of the generated studio.
     ///
     /// Prefilters the environment for specular light on the CPU (a few tens of milliseconds in
-    /// release builds for the default 256-wide base level).
+    /// release builds for the default 256-wide base level); a live room light does that on its
+    /// own thread and hands the result to [`Self::set_prefiltered_environment`].
     pub fn set_environment(&mut self, env: &phantogram_assets::ibl::Environment) -> Result<(), RenderError> {
-        self.environment_sh = phantogram_assets::ibl::IrradianceSh::from_environment(env).shader_coefficients();
+        let sh = phantogram_assets::ibl::IrradianceSh::from_environment(env);
         let levels = phantogram_assets::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
+        self.set_prefiltered_environment(&levels, &sh)
+    }
+
+    /// Lights the scene with an environment already reduced: its specular levels (as
+    /// [`phantogram_assets::ibl::prefiltered_levels`] makes them, at [`PREFILTERED_BASE_WIDTH`])
+    /// and its irradiance. Only uploads: for the render thread.
+    pub fn set_prefiltered_environment(
+        &mut self,
+        levels: &[phantogram_assets::ibl::Environment],
+        sh: &phantogram_assets::ibl::IrradianceSh,
+    ) -> Result<(), RenderError> {
+        self.environment_sh = sh.shader_coefficients();
         let device = self.gpu.device.clone();
         checked(&device, "the environment map", || {
-            self.ibl = IblTextures::new(&self.gpu, &levels);
+            self.ibl = IblTextures::new(&self.gpu, levels);
             self.eye_bind = eye_bind_groups(
                 &device,
                 &self.eye_layout,

@@ -4,7 +4,7 @@
 use super::*;
 
 /// Width of the prefiltered environment's sharpest level (mirror-like reflections).
-pub(super) const PREFILTERED_BASE_WIDTH: usize = 256;
+pub const PREFILTERED_BASE_WIDTH: usize = 256;
 /// Size of the split-sum BRDF table (n·v × roughness).
 pub(super) const BRDF_LUT_SIZE: usize = 64;
 

@@ -1,0 +1,256 @@
+//! The live room light as the engine runs it: camera frames go to a worker thread that blends
+//! them into the room map (`phantogram_roomlight`) with the device's orientation at that moment,
+//! and every [`UPDATE_INTERVAL_NS`] of camera time reduces the map to the image-based light (nine
+//! SH coefficients and the specular levels, tens of milliseconds on the CPU), which the render
+//! thread then only uploads ([`crate::render::Renderer::set_prefiltered_environment`]).
+//!
+//! **Threading**: [`RoomLightWorker::submit`] and [`RoomLightWorker::set_orientation`] from any
+//! thread, never waiting for the worker (a frame arriving while one is being blended replaces the
+//! one waiting: the newest view of the room matters most); [`RoomLightWorker::take_update`] on
+//! the render thread. The worker stops when the handle drops. **Orientation**: the render
+//! thread publishes each frame's fused device → world orientation; a camera frame is placed with
+//! the newest one published (a frame or two old at 60 fps; while the phone turns fast that
+//! smears the map slightly, which its blending averages). **Panics**: none; a frame the capture
+//! refuses is counted and dropped.
+
+use std::sync::{Arc, Condvar, Mutex};
+
+use glam::Quat;
+use phantogram_assets::ibl::{Environment, IrradianceSh, prefiltered_levels};
+use phantogram_roomlight::{CaptureFrame, CaptureParams, RoomCapture, world_from_buffer_camera};
+use phantogram_sensing::camera::{CameraPose, OwnedFrame};
+
+/// Camera time between two updates of the image-based light: twice a second.
+pub const UPDATE_INTERVAL_NS: i64 = 500_000_000;
+
+/// A new image-based light made from the room map.
+pub struct RoomLightUpdate {
+    pub levels: Vec<Environment>,
+    pub sh: IrradianceSh,
+    /// Share of the sphere the map has seen, 0 to 1.
+    pub coverage: f32,
+    /// Frames blended so far.
+    pub frames: u64,
+}
+
+/// One camera frame waiting for the worker.
+struct Pending {
+    frame: OwnedFrame,
+    exposure: Option<f32>,
+    /// The device's orientation when the frame was taken, where known with it; else the newest
+    /// published.
+    world_from_device: Option<Quat>,
+}
+
+#[derive(Default)]
+struct Shared {
+    pending: Option<Pending>,
+    world_from_device: Option<Quat>,
+    update: Option<RoomLightUpdate>,
+    refused: u64,
+    /// Frames blended and updates made, for waiting in tests and tools.
+    blended: u64,
+    updates: u64,
+    /// The share of the sphere seen, after the newest frame.
+    coverage: f32,
+    stop: bool,
+}
+
+/// The worker thread and its mailbox (see the module docs).
+pub struct RoomLightWorker {
+    shared: Arc<(Mutex<Shared>, Condvar)>,
+    thread: Option<std::thread::JoinHandle<()>>,
+}
+
+impl RoomLightWorker {
+    /// Starts the worker for a camera at `pose` on the device.
+    pub fn spawn(pose: CameraPose, params: CaptureParams, base_width: usize) -> std::io::Result<Self> {
+        let shared = Arc::new((Mutex::new(Shared::default()), Condvar::new()));
+        let inner = shared.clone();
+        let thread = std::thread::Builder::new()
+            .name("room light".into())
+            .spawn(move || run(&inner, pose, params, base_width))?;
+        Ok(Self {
+            shared,
+            thread: Some(thread),
+        })
+    }
+
+    fn lock(&self) -> std::sync::MutexGuard<'_, Shared> {
+        self.shared.0.lock().unwrap_or_else(|p| p.into_inner())
+    }
+
+    /// Hands a camera frame to the worker (`exposure`: exposure time × gain when the platform
+    /// reports it), replacing one not yet started.
+    pub fn submit(&self, frame: OwnedFrame, exposure: Option<f32>) {
+        self.submit_oriented(frame, exposure, None);
+    }
+
+    /// As [`Self::submit`], with the device's orientation when the frame was taken (a desktop
+    /// replay; a platform that tracks the camera's pose per frame), used instead of the newest
+    /// published one.
+    pub fn submit_oriented(&self, frame: OwnedFrame, exposure: Option<f32>, world_from_device: Option<Quat>) {
+        self.lock().pending = Some(Pending {
+            frame,
+            exposure,
+            world_from_device,
+        });
+        self.shared.1.notify_all();
+    }
+
+    /// The device's orientation now (device → world), for the frames that follow.
+    pub fn set_orientation(&self, world_from_device: Quat) {
+        self.lock().world_from_device = Some(world_from_device);
+    }
+
+    /// The newest image-based light made since the last call, if any.
+    pub fn take_update(&self) -> Option<RoomLightUpdate> {
+        self.lock().update.take()
+    }
+
+    /// The share of the sphere the room map has seen, 0 to 1.
+    pub fn coverage(&self) -> f32 {
+        self.lock().coverage
+    }
+
+    /// Frames blended, frames refused, updates made so far.
+    pub fn counts(&self) -> (u64, u64, u64) {
+        let s = self.lock();
+        (s.blended, s.refused, s.updates)
+    }
+
+    /// Waits up to `timeout` until no frame is waiting and `updates` updates were made (for
+    /// tests and the desktop tools). Returns whether that happened.
+    pub fn wait_until(&self, updates: u64, timeout: std::time::Duration) -> bool {
+        let deadline = std::time::Instant::now() + timeout;
+        let mut s = self.lock();
+        while s.pending.is_some() || s.updates < updates {
+            let now = std::time::Instant::now();
+            if now >= deadline {
+                return false;
+            }
+            s = match self.shared.1.wait_timeout(s, deadline - now) {
+                Ok((g, _)) => g,
+                Err(p) => p.into_inner().0,
+            };
+        }
+        true
+    }
+}
+
+impl Drop for RoomLightWorker {
+    fn drop(&mut self) {
+        self.lock().stop = true;
+        self.shared.1.notify_all();
+        if let Some(t) = self.thread.take() {
+            let _ = t.join();
+        }
+    }
+}
+
+fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParams, base_width: usize) {
+    let lock = || shared.0.lock().unwrap_or_else(|p| p.into_inner());
+    let mut capture = RoomCapture::new(params);
+    let mut last_update_t_ns: Option<i64> = None;
+    loop {
+        let (pending, orientation) = {
+            let mut s = lock();
+            while s.pending.is_none() && !s.stop {
+                s = match shared.1.wait(s) {
+                    Ok(g) => g,
+                    Err(p) => p.into_inner(),
+                };
+            }
+            if s.stop {
+                return;
+            }
+            (s.pending.take(), s.world_from_device)
+        };
+        let Some(p) = pending else { continue };
+        let Some(q) = p.world_from_device.or(orientation) else {
+            // No orientation yet: the frame cannot be placed.
+            lock().refused += 1;
+            shared.1.notify_all();
+            continue;
+        };
+        let frame = CaptureFrame {
+            image: p.frame.as_frame(),
+            world_from_camera: world_from_buffer_camera(q, &pose, p.frame.rotation_cw_deg),
+            exposure: p.exposure,
+        };
+        let added = capture.add(&frame).is_ok();
+        let t = p.frame.capture_t_ns;
+        let due = added && last_update_t_ns.is_none_or(|last| t.saturating_sub(last) >= UPDATE_INTERVAL_NS || t < last);
+        let update = due.then(|| {
+            last_update_t_ns = Some(t);
+            let env = capture.environment();
+            RoomLightUpdate {
+                sh: IrradianceSh::from_environment(&env),
+                levels: prefiltered_levels(&env, base_width),
+                coverage: capture.coverage(),
+                frames: capture.frames(),
+            }
+        });
+        let coverage = capture.coverage();
+        let mut s = lock();
+        s.coverage = coverage;
+        if added {
+            s.blended += 1;
+        } else {
+            s.refused += 1;
+        }
+        if let Some(u) = update {
+            s.update = Some(u);
+            s.updates += 1;
+        }
+        drop(s);
+        shared.1.notify_all();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+    use phantogram_sensing::camera::{Intrinsics, PixelFormat};
+
+    fn grey(t_ns: i64, code: u8) -> OwnedFrame {
+        let (w, h) = (64u32, 48u32);
+        OwnedFrame {
+            width: w,
+            height: h,
+            row_stride: w as usize * 4,
+            format: PixelFormat::Rgba8,
+            data: vec![code; (w * h * 4) as usize],
+            rotation_cw_deg: 0,
+            intrinsics: Intrinsics::from_horizontal_fov(w, h, 1.2),
+            capture_t_ns: t_ns,
+        }
+    }
+
+    #[test]
+    fn frames_become_updates_twice_a_second_of_camera_time() {
+        let worker =
+            RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64).expect("thread");
+        // Without an orientation a frame cannot be placed.
+        worker.submit(grey(0, 118), Some(1.0));
+        assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
+        assert_eq!(worker.counts(), (0, 1, 0));
+        worker.set_orientation(Quat::IDENTITY);
+        let mut made = 0;
+        for k in 0..6i64 {
+            worker.submit(grey(k * 200_000_000, 118), Some(1.0));
+            assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
+            if let Some(u) = worker.take_update() {
+                made += 1;
+                assert_eq!(u.levels.len(), phantogram_assets::ibl::PREFILTER_LEVELS);
+                assert!(u.coverage > 0.05 && u.sh.irradiance(Vec3::Z)[0] > 0.0);
+            }
+        }
+        // Frames at 0, 0.2, … 1.0 s: an update with the first, then at least 0.5 s later (0.6 s).
+        let (blended, refused, updates) = worker.counts();
+        assert_eq!((blended, refused), (6, 1));
+        assert_eq!(updates, 2);
+        assert_eq!(made, 2);
+    }
+}
