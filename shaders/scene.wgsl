@@ -26,6 +26,13 @@ struct Eye {
     // cosine-lobe band weights and basis constants (see ibl.rs).
     sh: array<vec4<f32>, 9>,
     appearance: Appearance,
+    // A lamp in place of the directional light (render.rs `Lamp`), in mesh coordinates: xyz its
+    // position, w 1 when it is on; its cone's axis and, in w, the cosine of its outer half-angle
+    // (−2 for a point light); its radiant intensity (rgb, per steradian) and, in w, the cosine of
+    // the half-angle within which it shines fully.
+    lamp_position: vec4<f32>,
+    lamp_axis: vec4<f32>,
+    lamp_intensity: vec4<f32>,
 };
 
 // The visitor's changes over the glTF materials (appearance.rs; render.rs `appearance_uniform`).
@@ -203,7 +210,13 @@ fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     let texel = eye.shadow.x;
     let n_dot_l = clamp(dot(n, l), 0.05, 1.0);
     let offset = n * texel * (1.5 + 2.0 * sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l);
-    let p = eye.light_view_proj * vec4<f32>(world + offset, 1.0);
+    let clip = eye.light_view_proj * vec4<f32>(world + offset, 1.0);
+    // Behind a lamp's shadow view: outside its cone, lit by nothing it could shadow.
+    if (clip.w <= 1e-6) {
+        return 1.0;
+    }
+    // The directional light's view is orthographic (w = 1), a lamp's perspective.
+    let p = clip.xyz / clip.w;
     let uv = vec2<f32>(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5);
     // The map covers the casters only (render.rs, `shadow_casters`): a receiver outside it is lit,
     // and one beyond its far plane (the floor under a long shadow) lies behind every caster there,
@@ -321,7 +334,18 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     }
 
     let v = normalize(eye.eye_pos.xyz - in.world);
-    let l = normalize(eye.toward_light.xyz);
+    // The light arriving: the directional light's radiance from its direction, or a lamp's
+    // intensity over the squared distance, faded at its cone's edge.
+    var l = normalize(eye.toward_light.xyz);
+    var light_rgb = eye.light.rgb;
+    if (eye.lamp_position.w > 0.5) {
+        let to_lamp = eye.lamp_position.xyz - in.world;
+        let d2 = max(dot(to_lamp, to_lamp), 1e-6);
+        l = to_lamp * inverseSqrt(d2);
+        let cos_axis = dot(-l, normalize(eye.lamp_axis.xyz));
+        let cone = smoothstep(eye.lamp_axis.w, eye.lamp_intensity.w, cos_axis);
+        light_rgb = eye.lamp_intensity.rgb / d2 * select(cone, 1.0, eye.lamp_axis.w < -1.0);
+    }
     let h = normalize(l + v);
     var look = eye.appearance;
     if (material.scene.x > 0.5) {
@@ -343,7 +367,7 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     let n_dot_h = max(dot(n, h), 0.0);
     let v_dot_h = max(dot(v, h), 0.0);
     let geometric_n = normalize(select(-in.normal, in.normal, front));
-    let light_in = eye.light.rgb * n_dot_l * light_visibility(in.world, geometric_n, l);
+    let light_in = light_rgb * n_dot_l * light_visibility(in.world, geometric_n, l);
     let occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);
     let reflected = to_world(reflect(-v, n));
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));

@@ -305,6 +305,11 @@ pub struct Engine {
     appearances: crate::appearances::AppearanceStore,
     /// The live room light's worker, when [`EngineConfig::room_light`] is on.
     room_light: Option<Arc<crate::room_light::RoomLightWorker>>,
+    /// A lamp the visitor placed (in place of the room's light), and the finger moving it.
+    lamp: Option<crate::lamp::PlacedLamp>,
+    lamp_finger: Option<i32>,
+    /// The device → world orientation of the last frame drawn (for a touch between frames).
+    last_device_to_world: Option<glam::Quat>,
 }
 
 /// Something only the platform can do, asked for by the core's screens: the shell takes these
@@ -578,6 +583,9 @@ impl Engine {
             thumbnails,
             appearances,
             room_light,
+            lamp: None,
+            lamp_finger: None,
+            last_device_to_world: None,
         };
         engine.apply_calibration();
         if config.model_path.is_none()
@@ -726,7 +734,9 @@ impl Engine {
         #[cfg(feature = "ui")]
         {
             if !self.menu_open() {
-                self.screens().page = Some(Page::Menu(crate::calibration_ui::menu::MenuUi::new()));
+                let mut menu = crate::calibration_ui::menu::MenuUi::new();
+                menu.lamp_on = self.lamp.is_some();
+                self.screens().page = Some(Page::Menu(menu));
                 self.refresh_menu_items();
             }
             true
@@ -1293,11 +1303,72 @@ impl Engine {
                 }
             }
         }
+        if self.touch_lamp(phase, pointer_id, [x_px, y_px]) {
+            return None;
+        }
         self.drag_to_turn(phase, pointer_id, [x_px, y_px]);
         self.touch_diorama(phase, pointer_id, [x_px, y_px]);
         let g = self.gestures.touch(phase, pointer_id, x_px, y_px, t_ns)?;
         self.apply_gesture(g);
         Some(g)
+    }
+
+    /// A lamp on screen follows the first finger down (and takes its touches: no turning, no
+    /// grabbing meanwhile). Returns whether the touch was the lamp's.
+    fn touch_lamp(&mut self, phase: TouchPhase, pointer_id: i32, px: [f32; 2]) -> bool {
+        if self.lamp.is_none() {
+            self.lamp_finger = None;
+            return false;
+        }
+        match (phase, self.lamp_finger) {
+            (TouchPhase::Down, None) => self.lamp_finger = Some(pointer_id),
+            (TouchPhase::Move | TouchPhase::Down, Some(id)) if id == pointer_id => {}
+            (TouchPhase::Up | TouchPhase::Cancel, Some(id)) if id == pointer_id => {
+                self.lamp_finger = None;
+                return true;
+            }
+            (_, Some(_)) => return true,
+            _ => return false,
+        }
+        let [x_m, y_m] = self.glass_point_m(px);
+        let orientation = self.last_device_to_world;
+        if let Some(lamp) = self.lamp.as_mut() {
+            lamp.move_to(x_m, y_m, orientation);
+        }
+        true
+    }
+
+    /// The point of the glass under display pixel `px`, device frame metres (x right, y up).
+    fn glass_point_m(&self, px: [f32; 2]) -> [f32; 2] {
+        let screen = self.session.config().screen;
+        let (w_px, h_px) = self
+            .target_size()
+            .filter(|&(w, h)| w > 0 && h > 0)
+            .unwrap_or((screen.width_px(), screen.height_px()));
+        [
+            (px[0] / w_px as f32 - 0.5) * screen.width_m(),
+            (0.5 - px[1] / h_px as f32) * screen.height_m(),
+        ]
+    }
+
+    /// Puts a lamp over the diorama in place of the room's light (`None`: back to the room's
+    /// light): a raking light ([`crate::lamp::LampSetting::raking`]) starts at the screen's left
+    /// edge, a torch above its top edge; a finger then moves it ([`Self::touch`]).
+    pub fn set_lamp(&mut self, setting: Option<crate::lamp::LampSetting>) {
+        let screen = self.session.config().screen;
+        self.lamp_finger = None;
+        self.lamp = setting.map(|s| match s.anchor {
+            crate::lamp::LampAnchor::Room => crate::lamp::PlacedLamp::new(s, -0.5 * screen.width_m(), 0.0),
+            crate::lamp::LampAnchor::Torch => crate::lamp::PlacedLamp::new(s, 0.0, 0.5 * screen.height_m()),
+        });
+        if self.lamp.is_none() {
+            self.renderer.lamp = None;
+        }
+    }
+
+    /// The lamp placed, if any.
+    pub fn lamp(&self) -> Option<&crate::lamp::PlacedLamp> {
+        self.lamp.as_ref()
     }
 
     /// The Diorama's finger: a body under the first finger down (on the line from the eye
@@ -1462,6 +1533,9 @@ impl Engine {
         self.last_push_m = push;
         self.last_mono = Some(view.mono);
         self.update_room_light(view.device_to_world);
+        self.last_device_to_world = view.device_to_world;
+        let centre = (self.bounds.min + self.bounds.max) * 0.5 + Vec3::Z * -push;
+        self.renderer.lamp = self.lamp.as_mut().map(|l| l.lamp(view.device_to_world, centre));
         let input = self.oriented(frame_input(&view, Vec3::Z * -push));
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         #[cfg(feature = "ui")]
@@ -1774,6 +1848,12 @@ impl Engine {
             A::Material => {
                 let ui = crate::calibration_ui::material::MaterialUi::new(self.appearance());
                 self.set_page(Some(Page::Material(ui)));
+            }
+            A::Lamp => {
+                // Closed at once: the next finger on the glass moves the lamp.
+                let on = self.lamp.is_some();
+                self.set_lamp((!on).then(crate::lamp::LampSetting::raking));
+                self.set_page(None);
             }
             A::Close => self.set_page(None),
         }

@@ -39,6 +39,11 @@ pub struct SceneArgs {
     /// room light replayed on the desktop, captured before the first frame.
     #[arg(long, value_name = "LOG", requires = "environment")]
     environment_from_camera: Option<PathBuf>,
+    /// A lamp in place of the room's light: raking (a spot light low at the screen's left edge,
+    /// fixed in the room: for reading inscriptions) or torch (held by the phone above its top
+    /// edge).
+    #[arg(long, value_enum, value_name = "LAMP")]
+    lamp: Option<LampArg>,
     /// Show the artifact in one of the Ward material presets instead of its own material (not
     /// remembered): matte, glazed, polished, patinated, brushed-metal, silk or lacquer.
     #[arg(long, value_name = "PRESET")]
@@ -55,6 +60,12 @@ fn material_preset(name: &str) -> Result<phantogram::ward::WardPreset> {
             let names: Vec<String> = WardPreset::ALL.iter().map(|p| p.name().replace(' ', "-")).collect();
             anyhow::anyhow!("--material {name:?} is not a preset (choose from {})", names.join(", "))
         })
+}
+
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+enum LampArg {
+    Raking,
+    Torch,
 }
 
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -117,6 +128,11 @@ impl SceneArgs {
             ..EngineConfig::default()
         };
         let mut engine = Engine::new(config)?;
+        match self.lamp {
+            Some(LampArg::Raking) => engine.set_lamp(Some(phantogram::lamp::LampSetting::raking())),
+            Some(LampArg::Torch) => engine.set_lamp(Some(phantogram::lamp::LampSetting::torch())),
+            None => {}
+        }
         if let Some(sweep) = &sweep {
             sweep.feed(&engine)?;
         }

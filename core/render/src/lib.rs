@@ -128,6 +128,81 @@ struct EyeUniform {
     sh: [[f32; 4]; 9],
     /// The artifact's [`Appearance`], as `Appearance` in `scene.wgsl` lays it out.
     appearance: [[f32; 4]; 5],
+    /// The [`Lamp`], if one shines: position (w: 1 when on), axis (w: cos outer), intensity (w:
+    /// cos inner).
+    lamp: [[f32; 4]; 3],
+}
+
+/// A lamp in place of the directional light: a point light, or a spot light with a cone, in
+/// mesh coordinates (the device frame, metres), with its shadows from a perspective shadow map.
+/// The engine places it each frame (held like a torch, or fixed in the room, or where a finger
+/// put it); see `phantogram::lamp`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Lamp {
+    pub position_m: Vec3,
+    /// The cone's axis (any length; normalised here). Unused by a point light.
+    pub axis: Vec3,
+    /// Half-angle of the cone, radians (a spot light), up to just under 90°; `None`: a point
+    /// light shining every way.
+    pub cone_half_angle_rad: Option<f32>,
+    /// Radiant intensity, linear RGB per steradian: the irradiance at 1 m head-on.
+    pub intensity_rgb: Vec3,
+}
+
+impl Lamp {
+    /// The uniform's three rows (see `EyeUniform::lamp`); zero (off) for `None` or a lamp with
+    /// non-finite numbers.
+    fn uniform(lamp: Option<&Lamp>) -> [[f32; 4]; 3] {
+        let Some(l) = lamp.filter(|l| {
+            l.position_m.is_finite()
+                && l.axis.is_finite()
+                && l.intensity_rgb.is_finite()
+                && l.cone_half_angle_rad.is_none_or(f32::is_finite)
+        }) else {
+            return [[0.0; 4]; 3];
+        };
+        let axis = l.axis.normalize_or(-Vec3::Z);
+        let (cos_outer, cos_inner) = match l.cone_half_angle_rad {
+            // The last tenth of the cone fades (a soft edge, as a real spot has).
+            Some(a) => {
+                let a = a.clamp(0.01, 1.55);
+                (a.cos(), (a * 0.9).cos())
+            }
+            None => (-2.0, -1.0),
+        };
+        [
+            l.position_m.extend(1.0).to_array(),
+            axis.extend(cos_outer).to_array(),
+            l.intensity_rgb.max(Vec3::ZERO).extend(cos_inner).to_array(),
+        ]
+    }
+
+    /// Direction towards the lamp from `point`, for choosing what casts shadows.
+    fn toward_from(&self, point: Vec3) -> Vec3 {
+        (self.position_m - point).normalize_or(Vec3::Z)
+    }
+}
+
+/// The perspective shadow view of a lamp over `bounds` (mesh coordinates) and the size of a
+/// texel at the bounds' centre in metres; `None` when the lamp is within the bounds (no single
+/// view sees all it shadows: then it casts none).
+pub fn lamp_view_proj(bounds: &phantogram_geometry::containment::Aabb, lamp: &Lamp) -> Option<(Mat4, f32)> {
+    let centre = (bounds.min + bounds.max) * 0.5;
+    let radius = (bounds.max - bounds.min).length() * 0.5 + 1e-4;
+    let to_centre = centre - lamp.position_m;
+    let distance = to_centre.length();
+    if !distance.is_finite() || distance <= radius * 1.05 {
+        return None;
+    }
+    let forward = to_centre / distance;
+    let up = if forward.z.abs() < 0.9 { Vec3::Z } else { Vec3::Y };
+    let view = Mat4::look_at_rh(lamp.position_m, centre, up);
+    // The cone that holds the bounds' sphere, with a margin of a few texels.
+    let half = (radius / distance).asin() * (1.0 + 4.0 / SHADOW_SIZE as f32);
+    let near = (distance - radius).max(1e-3);
+    let proj = Mat4::perspective_rh(2.0 * half, 1.0, near, distance + radius);
+    let texel = 2.0 * distance * half.tan() / SHADOW_SIZE as f32;
+    Some((proj * view, texel))
 }
 
 /// `Appearance` in `scene.wgsl`: rgb tint and specular scale; roughness and metalness overrides
@@ -626,6 +701,8 @@ pub struct Renderer {
     /// Changes over the model's materials (the material screen's), applied in the next frame;
     /// sanitised on the way to the GPU.
     pub appearance: Appearance,
+    /// A lamp in place of the directional light (its shadows too), or `None`.
+    pub lamp: Option<Lamp>,
 }
 
 impl Renderer {
@@ -873,6 +950,7 @@ impl Renderer {
             side_targets: None,
             lighting: Lighting::default(),
             appearance: Appearance::default(),
+            lamp: None,
             gpu,
         }
     }
@@ -1090,6 +1168,7 @@ impl Renderer {
             shadow: [shadow.1, f32::from(u8::from(l.shadows)), 0.0, 0.0],
             sh: self.environment_sh,
             appearance: appearance_uniform(&self.appearance),
+            lamp: Lamp::uniform(self.lamp.as_ref()),
         }
     }
 
@@ -1250,9 +1329,26 @@ impl Renderer {
             })?;
             self.compose_pipelines.insert(format, pipeline);
         }
-        let (floor_casts, shadow_bounds) = self.model.shadow_casters(input.toward_light);
-        let shadow = light_view_proj(&shadow_bounds, input.toward_light);
-        let uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input, shadow)).collect();
+        let lamp = self.lamp.filter(|l| Lamp::uniform(Some(l))[0][3] > 0.5);
+        let toward = match &lamp {
+            Some(l) => l.toward_from((self.model.bounds.min + self.model.bounds.max) * 0.5),
+            None => input.toward_light,
+        };
+        let (floor_casts, shadow_bounds) = self.model.shadow_casters(toward);
+        // A lamp inside what it would shadow casts none (no single view holds it all).
+        let (shadow, lamp_shadows) = match &lamp {
+            Some(l) => match lamp_view_proj(&shadow_bounds, l) {
+                Some(s) => (s, true),
+                None => ((Mat4::IDENTITY, 1.0), false),
+            },
+            None => (light_view_proj(&shadow_bounds, input.toward_light), true),
+        };
+        let mut uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input, shadow)).collect();
+        if !lamp_shadows {
+            for u in &mut uniforms {
+                u.shadow[1] = 0.0;
+            }
+        }
         let (lm, rm) = method.matrices();
         let row = |m: [f32; 3]| [m[0], m[1], m[2], 0.0];
         let compose = ComposeUniform {
@@ -1268,7 +1364,7 @@ impl Renderer {
 
         let targets = self.targets.as_ref().expect("the caller sized the targets");
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        if self.lighting.shadows {
+        if self.lighting.shadows && lamp_shadows {
             // Once per frame, for both eyes.
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
@@ -1585,6 +1681,45 @@ mod tests {
                 .is_err(),
         };
         assert!(failed);
+    }
+
+    #[test]
+    fn a_lamps_shadow_view_holds_what_it_shadows() {
+        let bounds =
+            phantogram_geometry::containment::Aabb::new(Vec3::new(-0.02, -0.03, -0.01), Vec3::new(0.02, 0.03, 0.01));
+        let lamp = Lamp {
+            position_m: Vec3::new(-0.06, 0.0, 0.02),
+            axis: Vec3::X,
+            cone_half_angle_rad: Some(1.0),
+            intensity_rgb: Vec3::ONE,
+        };
+        let (m, texel) = lamp_view_proj(&bounds, &lamp).expect("outside the bounds");
+        assert!(texel > 0.0 && texel < 1e-3, "{texel}");
+        for c in bounds.corners() {
+            let p = m.project_point3(c);
+            assert!(
+                p.x.abs() <= 1.0 && p.y.abs() <= 1.0 && (0.0..=1.0).contains(&p.z),
+                "{c} → {p}"
+            );
+        }
+        // Inside what it would shadow: no single view, no shadows.
+        let inside = Lamp {
+            position_m: Vec3::ZERO,
+            ..lamp
+        };
+        assert!(lamp_view_proj(&bounds, &inside).is_none());
+        // Off or broken: the uniform says off.
+        assert_eq!(Lamp::uniform(None)[0][3], 0.0);
+        let broken = Lamp {
+            position_m: Vec3::NAN,
+            ..lamp
+        };
+        assert_eq!(Lamp::uniform(Some(&broken))[0][3], 0.0);
+        let point = Lamp {
+            cone_half_angle_rad: None,
+            ..lamp
+        };
+        assert_eq!(Lamp::uniform(Some(&point))[1][3], -2.0, "a point light has no cone");
     }
 
     #[test]

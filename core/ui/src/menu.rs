@@ -51,13 +51,19 @@ pub enum MenuAction {
     Material,
     /// Show what the gestures do.
     Help,
+    /// Put a lamp over the diorama that a finger moves, or take it away (back to the room's
+    /// light).
+    Lamp,
     Close,
 }
 
-/// The menu's state: which removal awaits confirmation, and where the controls were drawn.
+/// The menu's state: which removal awaits confirmation, whether a lamp is on (the lamp
+/// button's label), and where the controls were drawn.
 #[derive(Clone, Debug, Default)]
 pub struct MenuUi {
     confirm_remove: Option<String>,
+    /// A lamp shines in place of the room's light (set by the host when it opens the menu).
+    pub lamp_on: bool,
     widget_rects: crate::widget_rects::WidgetRects,
 }
 
@@ -67,8 +73,8 @@ impl MenuUi {
     }
 
     /// The rectangle (points) of a control drawn last frame: `item:<id>`, `thumb:<id>` (its
-    /// picture), `remove:<id>`, `open`, `share`, `share-pair`, `help`, `material`, `settings`,
-    /// `calibrate`, `close`.
+    /// picture), `remove:<id>`, `open`, `share`, `share-pair`, `help`, `material`, `lamp`,
+    /// `settings`, `calibrate`, `close`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.get(name)
     }
@@ -104,10 +110,16 @@ impl MenuUi {
                     }
                 }
             });
+            let lamp = if self.lamp_on {
+                "Back to the room's light"
+            } else {
+                "A lamp to move with your finger"
+            };
             let buttons = [
                 ("open", "Open a file of your own…"),
                 ("help", "How to use it"),
                 ("material", "Material (glaze, metal, varnish…)"),
+                ("lamp", lamp),
                 ("settings", "Settings (glasses, size, floor)"),
                 ("calibrate", "Calibration"),
                 ("close", "Done"),
@@ -124,6 +136,7 @@ impl MenuUi {
                         "calibrate" => MenuAction::Calibrate,
                         "settings" => MenuAction::Settings,
                         "material" => MenuAction::Material,
+                        "lamp" => MenuAction::Lamp,
                         "help" => MenuAction::Help,
                         _ => MenuAction::Close,
                     });
