@@ -91,6 +91,12 @@ pub fn prepare(
 ) -> Result<Prepared, crate::render::RenderError> {
     if !placed {
         model.fit_to_diorama(&placing.screen, &placing.fit);
+    } else if placing.fit.placement == crate::model::Placement::Surface
+        && let Some(b) = model.bounds()
+    {
+        // Built-ins come placed at their true size: in surface mode their front goes to the
+        // glass.
+        model.transform(glam::Mat4::from_translation(glam::Vec3::Z * -b.max.z));
     }
     let bounds = model.bounds().ok_or(crate::render::RenderError::EmptyModel)?;
     let info = ModelInfo::of(&model, entry);
@@ -512,5 +518,40 @@ impl LoadError {
             Self::Library(e) => e.is_cancelled(),
             Self::Render(_) | Self::Read { .. } => false,
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn surface_mode_puts_a_built_ins_front_in_the_glass() {
+        let screen = Screen::default();
+        let placing = |placement| Placing {
+            screen,
+            fit: DioramaFit {
+                placement,
+                ..DioramaFit::default()
+            },
+            floor: true,
+        };
+        let medal = || (crate::builtin::built_in("medal").expect("medal").make)();
+        let placed = prepare(medal(), None, true, &placing(crate::model::Placement::Auto)).expect("prepared");
+        assert!(
+            placed.bounds.max.z > 1e-4,
+            "as made, it stands a little out of the glass"
+        );
+        let surface = prepare(medal(), None, true, &placing(crate::model::Placement::Surface)).expect("prepared");
+        assert!(
+            surface.bounds.max.z.abs() < 1e-6,
+            "front in the glass: {:?}",
+            surface.bounds
+        );
+        let size = |b: &Aabb| b.max - b.min;
+        assert!(
+            size(&surface.bounds).distance(size(&placed.bounds)) < 1e-6,
+            "true size kept"
+        );
     }
 }

@@ -453,6 +453,11 @@ impl Engine {
         let fit = crate::model::DioramaFit {
             protrude_fraction: calibration.protrude_fraction.unwrap_or(config.fit.protrude_fraction),
             true_size: config.fit.true_size || calibration.true_size,
+            placement: if calibration.surface {
+                crate::model::Placement::Surface
+            } else {
+                config.fit.placement
+            },
             ..config.fit
         };
         // The GPU first: the model's budget takes the device's texture limit.
@@ -1742,12 +1747,22 @@ impl Engine {
         match action {
             A::Changed(s) => {
                 self.set_method(s.method);
+                let surface_now = self.fit.placement == crate::model::Placement::Surface;
                 let placing_changed = s.floor != self.floor
                     || s.protrude_fraction != self.fit.protrude_fraction
-                    || s.true_size != self.fit.true_size;
+                    || s.true_size != self.fit.true_size
+                    || s.surface != surface_now;
                 self.floor = s.floor;
                 self.fit.protrude_fraction = s.protrude_fraction;
                 self.fit.true_size = s.true_size;
+                if s.surface != surface_now {
+                    self.fit.placement = if s.surface {
+                        crate::model::Placement::Surface
+                    } else {
+                        crate::model::Placement::Auto
+                    };
+                }
+                self.calibration.surface = s.surface;
                 self.calibration.method = Some(s.method);
                 self.calibration.floor = Some(s.floor);
                 self.calibration.protrude_fraction = Some(s.protrude_fraction);
@@ -1839,6 +1854,7 @@ impl Engine {
                     floor: self.floor,
                     protrude_fraction: self.fit.protrude_fraction,
                     true_size: self.fit.true_size,
+                    surface: self.fit.placement == crate::model::Placement::Surface,
                     turn_by_touch: self.session.turning_by_touch(),
                 };
                 self.set_page(Some(Page::Settings(crate::calibration_ui::settings::SettingsUi::new(

@@ -450,6 +450,8 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
     assert_eq!(e.method(), Method::DuboisAmberBlue);
     let floor = e.control_px("floor").expect("the floor switch");
     tap_at(&mut e, floor, &mut t);
+    let surface = e.control_px("surface").expect("the surface-mode switch");
+    tap_at(&mut e, surface, &mut t);
     let done = e.control_px("done").expect("done");
     tap_at(&mut e, done, &mut t);
     // The amphora shown again without its floor (reloaded in the background: perhaps already
@@ -463,7 +465,7 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
     );
     let saved = std::fs::read_to_string(&calibration).unwrap();
     assert!(
-        saved.contains("anaglyph dubois-amber-blue") && saved.contains("floor 0"),
+        saved.contains("anaglyph dubois-amber-blue") && saved.contains("floor 0") && saved.contains("surface 1"),
         "{saved}"
     );
     drop(e);

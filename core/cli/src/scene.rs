@@ -23,8 +23,9 @@ pub struct SceneArgs {
     /// Fraction of a loaded model's height that stands in front of the glass.
     #[arg(long, default_value_t = 0.4)]
     protrude: f32,
-    /// How a loaded model is placed: standing out of the glass, facing the viewer from within
-    /// it (reliefs, tablets), or auto (facing when thin front to back).
+    /// How a model is placed: standing out of the glass, facing the viewer from within it
+    /// (reliefs, tablets), auto (facing when thin front to back), or surface (surface mode: true
+    /// size, its front in the glass, for coins, paintings and manuscripts; built-ins too).
     #[arg(long, value_enum, default_value = "auto")]
     placement: PlacementArg,
     /// Leave out the diorama floor under the model (and the shadow cast on it).
@@ -73,6 +74,7 @@ enum PlacementArg {
     Auto,
     Standing,
     Facing,
+    Surface,
 }
 
 impl SceneArgs {
@@ -117,6 +119,7 @@ impl SceneArgs {
                     PlacementArg::Auto => Placement::Auto,
                     PlacementArg::Standing => Placement::Standing,
                     PlacementArg::Facing => Placement::Facing,
+                    PlacementArg::Surface => Placement::Surface,
                 },
                 protrude_fraction: self.protrude,
                 ..DioramaFit::default()

@@ -143,6 +143,8 @@ pub struct Calibration {
     pub floor: Option<bool>,
     pub protrude_fraction: Option<f32>,
     pub true_size: bool,
+    /// Surface mode: flat artifacts at true size with their front in the glass.
+    pub surface: bool,
     /// "Reduce motion": the artifact is turned by touch, not by tilting the phone
     /// (`crate::turn_by_touch`).
     pub turn_by_touch: bool,
@@ -187,6 +189,9 @@ impl Calibration {
         }
         if self.true_size {
             s += "true_size 1\n";
+        }
+        if self.surface {
+            s += "surface 1\n";
         }
         if self.turn_by_touch {
             s += "turn_by_touch 1\n";
@@ -282,6 +287,10 @@ impl Calibration {
                 "true_size" => {
                     want(1)?;
                     c.true_size = values[0] != 0.0;
+                }
+                "surface" => {
+                    want(1)?;
+                    c.surface = values[0] != 0.0;
                 }
                 "turn_by_touch" => {
                     want(1)?;
@@ -417,6 +426,7 @@ mod tests {
             floor: Some(false),
             protrude_fraction: Some(0.25),
             true_size: true,
+            surface: true,
             turn_by_touch: true,
         };
         c.save(&path).unwrap();

@@ -1,7 +1,8 @@
 //! The settings screen, opened from the menu: which glasses (red/cyan, green/magenta,
 //! amber/blue, or none for a plain picture), whether tilting the phone or a finger turns the
 //! artifact ("reduce motion"), the diorama's floor, how much of a loaded model stands in front
-//! of the glass, and whether loaded models keep their true size. It scrolls when a large system
+//! of the glass, whether loaded models keep their true size, and surface mode (artifacts lying
+//! in the glass at true size). It scrolls when a large system
 //! text size makes it taller than the screen.
 //!
 //! The host gives the current settings when it opens the screen and applies (and saves) each
@@ -20,6 +21,8 @@ pub struct Settings {
     /// Fraction of a loaded model's height in front of the glass, 0 to 1.
     pub protrude_fraction: f32,
     pub true_size: bool,
+    /// Surface mode: artifacts at true size with their front in the glass (coins, paintings).
+    pub surface: bool,
     /// "Reduce motion": a finger turns the artifact; tilting the phone does nothing.
     pub turn_by_touch: bool,
 }
@@ -56,7 +59,7 @@ impl SettingsUi {
 
     /// The rectangle (points) of a control drawn last frame: the glasses by key (`red-cyan`,
     /// `green-magenta`, `amber-blue`, `none`), `turn-by-touch`, `floor`, `protrude`,
-    /// `true-size`, `done`.
+    /// `true-size`, `surface`, `done`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.get(name)
     }
@@ -136,6 +139,16 @@ impl SettingsUi {
                     "Size: fitted to the screen",
                 );
                 self.settings.true_size = true_size;
+                let mut surface = self.settings.surface;
+                self.switch(
+                    ui,
+                    "surface",
+                    full,
+                    &mut surface,
+                    "Surface mode: lying in the glass, true size",
+                    "Surface mode: off",
+                );
+                self.settings.surface = surface;
                 ui.add_space(10.0);
                 let r = ui.add_sized(
                     [full, CONTROL_HEIGHT_PT],
@@ -179,12 +192,21 @@ mod tests {
             floor: true,
             protrude_fraction: 0.4,
             true_size: false,
+            surface: false,
             turn_by_touch: false,
         };
         let mut s = SettingsUi::new(start);
         frame(&ctx, &mut s, vec![]);
         frame(&ctx, &mut s, vec![]);
-        for name in ["red-cyan", "none", "turn-by-touch", "floor", "true-size", "done"] {
+        for name in [
+            "red-cyan",
+            "none",
+            "turn-by-touch",
+            "floor",
+            "true-size",
+            "surface",
+            "done",
+        ] {
             assert!(
                 s.widget_rect(name).unwrap().height() >= CONTROL_HEIGHT_PT - 0.5,
                 "{name}"
@@ -196,6 +218,7 @@ mod tests {
                 floor,
                 protrude_fraction: 0.4,
                 true_size,
+                surface: false,
                 turn_by_touch: false,
             })
         };

@@ -341,6 +341,11 @@ pub enum Placement {
     /// +Z along the glass normal, +Y up the screen: the object lies in the glass, its front
     /// towards the viewer (reliefs, paintings, coins).
     Facing,
+    /// Surface mode (tangiBook's): turned as [`Placement::Facing`], at its true size (scaled
+    /// down only where it would not fit the screen), its front in the plane of the glass — a
+    /// painting, a coin, a manuscript page seen as if lying on the phone, its surface where the
+    /// eyes converge, its reflections following them.
+    Surface,
 }
 
 impl Placement {
@@ -348,7 +353,7 @@ impl Placement {
     pub fn rotation(self, extent: Vec3) -> Quat {
         let facing = match self {
             Placement::Standing => false,
-            Placement::Facing => true,
+            Placement::Facing | Placement::Surface => true,
             // Thin front to back: under a third of both its width and height.
             Placement::Auto => extent.z < extent.x.min(extent.y) / 3.0,
         };
@@ -528,13 +533,27 @@ impl Model {
             .into_iter()
             .filter(|s| s.is_finite() && *s > 0.0)
             .fold(f32::INFINITY, f32::min);
-        let scale = if scale.is_finite() && !fit.true_size {
-            scale
-        } else {
+        let scale = if !scale.is_finite() {
             1.0
+        } else if fit.placement == Placement::Surface {
+            // True size, unless larger than the screen: then as large as fits.
+            let whole = [screen.panel_width_m() / size.x, screen.panel_height_m() / size.y]
+                .into_iter()
+                .filter(|s| s.is_finite() && *s > 0.0)
+                .fold(1.0f32, f32::min);
+            whole.min(1.0)
+        } else if fit.true_size {
+            1.0
+        } else {
+            scale
         };
         let centre = (b.min + b.max) * 0.5;
-        let base_z = -size.z * scale * (1.0 - fit.protrude_fraction);
+        let base_z = if fit.placement == Placement::Surface {
+            // The front (the top of the bounds along +z) in the glass.
+            -size.z * scale
+        } else {
+            -size.z * scale * (1.0 - fit.protrude_fraction)
+        };
         let m = Mat4::from_translation(Vec3::new(0.0, 0.0, base_z))
             * Mat4::from_scale(Vec3::splat(scale))
             * Mat4::from_translation(Vec3::new(-centre.x, -centre.y, -b.min.z));
@@ -584,6 +603,45 @@ mod split;
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn surface_mode_lays_the_front_in_the_glass_at_true_size() {
+        let screen = Screen::default();
+        let cuboid = |size: Vec3| {
+            let mut mesh = Mesh::default();
+            mesh.push_cube(Vec3::ZERO, 0.5, [1.0; 4]);
+            mesh.transform(Mat4::from_scale(size));
+            mesh
+        };
+        // A tile 40 × 30 mm, 5 mm thick, facing +z in glTF axes.
+        let tile = || Model::from_painted_mesh("tile", cuboid(Vec3::new(0.04, 0.03, 0.005)));
+        let surface = DioramaFit {
+            placement: Placement::Surface,
+            ..DioramaFit::default()
+        };
+        let mut m = tile();
+        let scale = m.fit_to_diorama(&screen, &surface);
+        let b = m.bounds().expect("bounds");
+        assert_eq!(scale, 1.0, "true size");
+        assert!(
+            b.max.z.abs() < 1e-6 && (b.min.z + 0.005).abs() < 1e-6,
+            "front in the glass: {b:?}"
+        );
+        assert!((b.max.x - b.min.x - 0.04).abs() < 1e-6 && (b.max.y - b.min.y - 0.03).abs() < 1e-6);
+        // The same tile in the default fit is scaled to the diorama and stands partly out.
+        let mut d = tile();
+        d.fit_to_diorama(&screen, &DioramaFit::default());
+        assert!(d.bounds().expect("bounds").max.z > 1e-3);
+        // A painting a metre wide is shrunk to fit the screen, never enlarged.
+        let mut big = Model::from_painted_mesh("painting", cuboid(Vec3::new(1.0, 0.8, 0.02)));
+        let scale = big.fit_to_diorama(&screen, &surface);
+        let b = big.bounds().expect("bounds");
+        assert!(
+            scale < 0.1 && b.max.x - b.min.x <= screen.panel_width_m() + 1e-6,
+            "{scale}"
+        );
+        assert!(b.max.z.abs() < 1e-6);
+    }
 
     #[test]
     fn uv_transform_matches_the_extension_definition() {
