@@ -9,6 +9,7 @@
 use std::time::Instant;
 
 use glam::Vec3;
+use phantogram_assets::ibl::sh::reference_projection;
 use phantogram_assets::ibl::{Environment, IrradianceSh, prefiltered_levels};
 
 /// The renderer's prefiltered base width (`phantogram_render`'s `PREFILTERED_BASE_WIDTH`).
@@ -39,38 +40,6 @@ fn environment(width: usize) -> Environment {
     env
 }
 
-/// The projection as the basis is written, texel by texel on one thread (the starting point).
-fn naive_sh(env: &Environment) -> [[f64; 3]; 9] {
-    let mut c = [[0.0f64; 3]; 9];
-    let d_phi = std::f64::consts::TAU / env.width as f64;
-    let d_theta = std::f64::consts::PI / env.height as f64;
-    for y in 0..env.height {
-        let solid_angle = ((y as f64 + 0.5) * d_theta).sin() * d_theta * d_phi;
-        for x in 0..env.width {
-            let d = env.direction(x, y);
-            let (dx, dy, dz) = (d.x, d.y, d.z);
-            let b = [
-                0.282_095,
-                0.488_603 * dy,
-                0.488_603 * dz,
-                0.488_603 * dx,
-                1.092_548 * dx * dy,
-                1.092_548 * dy * dz,
-                0.315_392 * (3.0 * dz * dz - 1.0),
-                1.092_548 * dx * dz,
-                0.546_274 * (dx * dx - dy * dy),
-            ];
-            let l = env.texels[y * env.width + x];
-            for (k, bk) in b.iter().enumerate() {
-                for ch in 0..3 {
-                    c[k][ch] += f64::from(l[ch]) * f64::from(*bk) * solid_angle;
-                }
-            }
-        }
-    }
-    c
-}
-
 /// Median milliseconds of `runs` calls of `f`, after one warm-up call.
 fn median_ms<R>(runs: usize, mut f: impl FnMut() -> R) -> f64 {
     std::hint::black_box(f());
@@ -94,7 +63,7 @@ fn main() {
         let env = environment(width);
         let runs = (4096 / width) * 10 + 5;
         let fast = median_ms(runs * 4, || IrradianceSh::from_environment(&env));
-        let naive = median_ms(runs.min(9), || naive_sh(&env));
+        let naive = median_ms(runs.min(9), || reference_projection(&env));
         let prefilter = median_ms(5, || prefiltered_levels(&env, PREFILTERED_BASE_WIDTH));
         println!(
             "| {width}×{} | {fast:.3} | {naive:.2} | {:.1}× | {prefilter:.1} |",

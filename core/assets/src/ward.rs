@@ -222,9 +222,9 @@ mod tests {
         sum / (n * n) as f64
     }
 
-    /// The same integral by brute-force quadrature over the hemisphere (midpoints in cos θ and
-    /// φ), fine enough for lobes of α ≥ 0.1.
-    fn albedo_quadrature(lobe: &WardLobe, v: Vec3, steps: usize) -> f64 {
+    /// `∫ f(d) dω` over the upper hemisphere by brute-force quadrature: midpoints of `steps`
+    /// bands of cos θ and `2 × steps` of φ (equal solid angles), fine enough for α ≥ 0.1.
+    fn hemisphere_integral(steps: usize, f: impl Fn(Vec3) -> f64) -> f64 {
         let mut sum = 0.0f64;
         let (d_mu, d_phi) = (1.0 / steps as f64, std::f64::consts::TAU / (2 * steps) as f64);
         for i in 0..steps {
@@ -232,11 +232,15 @@ mod tests {
             let sin = (1.0 - mu * mu).sqrt();
             for j in 0..2 * steps {
                 let phi = (j as f64 + 0.5) * d_phi;
-                let l = Vec3::new((sin * phi.cos()) as f32, (sin * phi.sin()) as f32, mu as f32);
-                sum += f64::from(lobe.eval(l, v)) * mu * d_mu * d_phi;
+                sum += f(Vec3::new((sin * phi.cos()) as f32, (sin * phi.sin()) as f32, mu as f32)) * d_mu * d_phi;
             }
         }
         sum
+    }
+
+    /// The albedo by quadrature (see [`hemisphere_integral`]).
+    fn albedo_quadrature(lobe: &WardLobe, v: Vec3, steps: usize) -> f64 {
+        hemisphere_integral(steps, |l| f64::from(lobe.eval(l, v) * l.z))
     }
 
     #[test]
@@ -303,18 +307,7 @@ mod tests {
         // The half-vector density integrates to one.
         for (ax, ay) in [(0.1f32, 0.1f32), (0.2, 0.5), (0.6, 0.3)] {
             let lobe = WardLobe::new(ax, ay);
-            let steps = 1000;
-            let mut total = 0.0f64;
-            let (d_mu, d_phi) = (1.0 / steps as f64, std::f64::consts::TAU / (2 * steps) as f64);
-            for i in 0..steps {
-                let mu = (i as f64 + 0.5) * d_mu;
-                let sin = (1.0 - mu * mu).sqrt();
-                for j in 0..2 * steps {
-                    let phi = (j as f64 + 0.5) * d_phi;
-                    let h = Vec3::new((sin * phi.cos()) as f32, (sin * phi.sin()) as f32, mu as f32);
-                    total += f64::from(lobe.half_vector_pdf(h)) * d_mu * d_phi;
-                }
-            }
+            let total = hemisphere_integral(1000, |h| f64::from(lobe.half_vector_pdf(h)));
             assert!((total - 1.0).abs() < 2e-3, "α {ax}/{ay}: {total}");
             // The albedo by importance sampling equals the one by quadrature.
             for theta_deg in [0.0f32, 40.0, 70.0] {

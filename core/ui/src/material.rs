@@ -180,12 +180,7 @@ impl MaterialUi {
                     );
                     self.appearance = a.sanitised();
                     ui.add_space(10.0);
-                    let r = ui.add_sized(
-                        [full, CONTROL_HEIGHT_PT],
-                        egui::Button::new(RichText::new("Done").size(17.0)),
-                    );
-                    self.widget_rects.remember("done", r.rect);
-                    if r.clicked() {
+                    if self.widget_rects.wide_button(ui, "done", "Done", full) {
                         actions.push(MaterialAction::Close);
                     }
                 });

@@ -21,6 +21,17 @@ impl WidgetRects {
         self.0.iter().find(|(n, _)| n == name).map(|(_, r)| *r)
     }
 
+    /// A button `width` points wide and a finger's height tall with `label` (17 pt), drawn now
+    /// and remembered as `name`; whether it was tapped.
+    pub fn wide_button(&mut self, ui: &mut egui::Ui, name: &'static str, label: &str, width: f32) -> bool {
+        let r = ui.add_sized(
+            [width, crate::menu::CONTROL_HEIGHT_PT],
+            egui::Button::new(egui::RichText::new(label).size(17.0)),
+        );
+        self.remember(name, r.rect);
+        r.clicked()
+    }
+
     /// Notes that `name` was drawn in `rect` (replacing where it was before).
     pub fn remember(&mut self, name: impl Into<Cow<'static, str>>, rect: Rect) {
         let name = name.into();
