@@ -98,9 +98,11 @@ fn sweep() -> Vec<Quat> {
 
 /// Rooms where the capture is known to fall short of 5 % even when it has seen everything, with
 /// the error it must stay under meanwhile.
-/// TODO(issue 20): royal esplanade's sun is within the bracket's reach by its peak, yet its
-/// irradiance comes out 17 % off; not yet understood (a sun smaller than a camera pixel?).
-const KNOWN_SHORT: &[(&str, f32)] = &[("royal_esplanade_1k.hdr", 0.20)];
+/// TODO(issue 20): royal esplanade's sun (58 % of its light, in a few texels at the zenith)
+/// comes out 5.3 % off with the default 256-wide map — 8.5 % at 128, 3.7 % at 512: the map's
+/// point sampling of the camera's blocks does not keep a tiny source's energy exactly; an
+/// energy-conserving resampling (splatting each block by solid angle) is the cure, not yet built.
+const KNOWN_SHORT: &[(&str, f32)] = &[("royal_esplanade_1k.hdr", 0.08)];
 
 #[test]
 fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
@@ -214,8 +216,8 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
     );
     // TODO(issue 20): the goal is 5 % at 80 % seen; filling the unseen fifth (pull-push from the
     // nearest seen light) reaches it on five of the nine environments, not on rooms whose unseen
-    // floor differs from the lowest walls seen (apartment ~21 %, royal esplanade ~18 %). Until
-    // a better prior exists, this guards against regressions only.
+    // floor differs from the lowest walls seen (apartment ~21 %, studio small ~7 %, studio and
+    // royal esplanade ~5.6 %). Until a better prior exists, this guards against regressions only.
     assert!(
         worst_80.0 <= 0.25,
         "{:.1} % off at 80 % seen in {}",
