@@ -12,8 +12,9 @@
 //!    ratio over well-exposed texels) — so a camera's auto-exposure does not paint the room in
 //!    bands;
 //! 3. every map texel the camera sees is blended in with a weight that favours well-exposed
-//!    values — judged by the code the sampled value itself has in that frame, so a lamp beside
-//!    dark walls in a short exposure keeps its trust; near-black values, and any that draw on a
+//!    values (Debevec & Malik's hat over the code) — judged by the best exposed of the pixels
+//!    the sample draws on, as the brightest carries most of its value, so a lamp beside dark
+//!    walls in a short exposure keeps its trust; near-black samples, and any that draw on a
 //!    clipped pixel (a lower bound), count a thousandth: kept only where nothing better was
 //!    seen — and fades towards the frame's edges (no seams). The weights of a texel are capped at
 //!    [`CaptureParams::memory_frames`], so the map follows a room whose light changes.
@@ -107,15 +108,16 @@ fn exposure_weight(max_code: f32) -> f32 {
     (1.0 - t.powi(8)).max(1e-3)
 }
 
-/// A frame box-filtered to about the map's resolution, as linear RGB, with whether each block
-/// holds a clipped pixel.
+/// A frame box-filtered to about the map's resolution, as linear RGB, with the brightest code of
+/// each block.
 struct Linearised {
     width: usize,
     height: usize,
     /// Buffer pixels per pixel here.
     factor: f32,
     rgb: Vec<[f32; 3]>,
-    clipped: Vec<bool>,
+    /// The brightest code of each block's pixels.
+    code: Vec<u8>,
 }
 
 /// The code at and above which a pixel is taken as clipped.
@@ -143,7 +145,7 @@ impl Linearised {
         let factor = factor.clamp(1, w.min(h));
         let (lw, lh) = (w / factor, h / factor);
         let mut rgb = vec![[0.0f32; 3]; lw * lh];
-        let mut clipped = vec![false; lw * lh];
+        let mut codes = vec![0u8; lw * lh];
         let norm = 1.0 / (factor * factor) as f32;
         for ly in 0..lh {
             for lx in 0..lw {
@@ -163,8 +165,7 @@ impl Linearised {
                     }
                 }
                 rgb[ly * lw + lx] = acc.map(|v| v * norm);
-                // One clipped pixel makes the block's average a lower bound.
-                clipped[ly * lw + lx] = max_code >= CLIPPED_CODE;
+                codes[ly * lw + lx] = max_code;
             }
         }
         Ok(Self {
@@ -172,14 +173,14 @@ impl Linearised {
             height: lh,
             factor: factor as f32,
             rgb,
-            clipped,
+            code: codes,
         })
     }
 
-    /// Bilinear value at buffer pixel coordinates and how far it is trusted (`None` outside):
-    /// by the code the interpolated value itself would have (so that a lamp next to dark
-    /// neighbours in a short exposure keeps its trust), and hardly at all when any block it
-    /// draws on was clipped (then it is a lower bound).
+    /// Bilinear value at buffer pixel coordinates and how far it is trusted (`None` outside): as
+    /// far as the best exposed of the blocks it draws on — the brightest carries most of the
+    /// value, so a lamp beside dark walls in a short exposure keeps its trust — and hardly at
+    /// all when any of them holds a clipped pixel (the value is then a lower bound).
     fn sample(&self, u_px: f32, v_px: f32) -> Option<([f32; 3], f32)> {
         let (u, v) = (u_px / self.factor - 0.5, v_px / self.factor - 0.5);
         if !(u >= 0.0 && v >= 0.0 && u <= (self.width - 1) as f32 && v <= (self.height - 1) as f32) {
@@ -189,7 +190,7 @@ impl Linearised {
         let (x1, y1) = ((x0 + 1).min(self.width - 1), (y0 + 1).min(self.height - 1));
         let (fx, fy) = (u - x0 as f32, v - y0 as f32);
         let mut rgb = [0.0f32; 3];
-        let mut clipped = false;
+        let mut brightest = 0u8;
         for (x, y, w) in [
             (x0, y0, (1.0 - fx) * (1.0 - fy)),
             (x1, y0, fx * (1.0 - fy)),
@@ -200,13 +201,14 @@ impl Linearised {
             for (acc, v) in rgb.iter_mut().zip(self.rgb[i]) {
                 *acc += v * w;
             }
-            clipped |= w > 0.0 && self.clipped[i];
+            if w > 0.0 {
+                brightest = brightest.max(self.code[i]);
+            }
         }
-        let weight = if clipped {
+        let weight = if brightest >= CLIPPED_CODE {
             1e-3
         } else {
-            let brightest = rgb.iter().copied().fold(0.0f32, f32::max);
-            exposure_weight(f32::from(crate::tone::srgb8_from_linear(brightest)))
+            exposure_weight(f32::from(brightest))
         };
         Some((rgb, weight))
     }
