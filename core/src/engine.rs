@@ -157,6 +157,13 @@ pub enum EngineError {
     NoFrame,
     #[error("the picture could not be encoded: {0}")]
     Share(String),
+    /// A file the engine keeps could not be written, or a thread of its own not started.
+    #[error("{what}: {source}")]
+    Io {
+        what: &'static str,
+        #[source]
+        source: std::io::Error,
+    },
 }
 
 /// The key an artifact's material changes are kept under: its library id, or `file:NAME` for a
@@ -191,7 +198,8 @@ pub enum ErrorKind {
     InvalidState,
     /// This build or engine cannot do it (face tracking without the `face` feature).
     Unsupported,
-    /// A file or the face networks could not be loaded or run.
+    /// A file or the face networks could not be loaded or run, a file the engine keeps not
+    /// written, a thread of its own not started.
     Load,
     /// The GPU failed (device, surface, read-back).
     Render,
@@ -206,7 +214,7 @@ impl EngineError {
             #[cfg(feature = "face")]
             Self::Face(_) => ErrorKind::Load,
             Self::Library(crate::library::LibraryError::BadId { .. }) => ErrorKind::InvalidArgument,
-            Self::Model(_) | Self::Environment(_) | Self::Library(_) => ErrorKind::Load,
+            Self::Model(_) | Self::Environment(_) | Self::Library(_) | Self::Io { .. } => ErrorKind::Load,
             Self::Render(_) | Self::Share(_) => ErrorKind::Render,
             Self::NoFrame => ErrorKind::InvalidState,
             Self::NoFaceSupport => ErrorKind::Unsupported,
@@ -541,7 +549,10 @@ impl Engine {
                 phantogram_roomlight::CaptureParams::default(),
                 crate::render::PREFILTERED_BASE_WIDTH,
             )
-            .map_err(|e| EngineError::InvalidArgument(format!("the room light's thread could not start: {e}")))?;
+            .map_err(|source| EngineError::Io {
+                what: "the room light's thread could not start",
+                source,
+            })?;
             Some(Arc::new(worker))
         } else {
             None
@@ -648,7 +659,10 @@ impl Engine {
         self.renderer.appearance = appearance;
         self.appearances
             .set(&appearance_key(&self.model_info), appearance)
-            .map_err(|e| EngineError::InvalidArgument(format!("the material change could not be saved: {e}")))
+            .map_err(|source| EngineError::Io {
+                what: "the material change could not be saved",
+                source,
+            })
     }
 
     /// Hands a camera frame to the live room light (`exposure`: exposure time × sensor gain, when

@@ -145,3 +145,22 @@ fn the_material_screen_is_reached_from_the_menu_and_driven_by_taps() {
     let done = e.control_px("preset-matte").and(e.control_px("done"));
     assert!(done.is_some(), "the screen stays open for more changes");
 }
+
+#[test]
+fn a_change_that_cannot_be_saved_is_shown_and_reported() {
+    let library = phantogram_testkit::Scratch::new("materials-unwritable");
+    // A folder where the store's file would go: it cannot be written.
+    std::fs::create_dir_all(library.join("appearances.json")).expect("folder");
+    let config = EngineConfig {
+        library_dir: Some(library.to_path_buf()),
+        ..EngineConfig::default()
+    };
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config) else {
+        return;
+    };
+    let lacquer = Appearance::preset(WardPreset::Lacquer);
+    let err = engine.set_appearance(lacquer).expect_err("not saved");
+    assert_eq!(err.kind(), phantogram::engine::ErrorKind::Load, "{err}");
+    assert!(err.to_string().contains("could not be saved"), "{err}");
+    assert_eq!(engine.appearance(), lacquer, "shown all the same");
+}
