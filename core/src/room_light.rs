@@ -53,6 +53,8 @@ struct Shared {
     updates: u64,
     /// The share of the sphere seen, after the newest frame.
     coverage: f32,
+    /// A frame taken from `pending` is being blended.
+    busy: bool,
     stop: bool,
 }
 
@@ -119,12 +121,13 @@ impl RoomLightWorker {
         (s.blended, s.refused, s.updates)
     }
 
-    /// Waits up to `timeout` until no frame is waiting and `updates` updates were made (for
-    /// tests and the desktop tools). Returns whether that happened.
+    /// Waits up to `timeout` until every frame handed over has been blended (none waiting, none
+    /// being blended) and `updates` updates were made (for tests and the desktop tools).
+    /// Returns whether that happened.
     pub fn wait_until(&self, updates: u64, timeout: std::time::Duration) -> bool {
         let deadline = std::time::Instant::now() + timeout;
         let mut s = self.lock();
-        while s.pending.is_some() || s.updates < updates {
+        while s.pending.is_some() || s.busy || s.updates < updates {
             let now = std::time::Instant::now();
             if now >= deadline {
                 return false;
@@ -164,12 +167,19 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
             if s.stop {
                 return;
             }
+            s.busy = true;
             (s.pending.take(), s.world_from_device)
         };
-        let Some(p) = pending else { continue };
+        let Some(p) = pending else {
+            lock().busy = false;
+            continue;
+        };
         let Some(q) = p.world_from_device.or(orientation) else {
             // No orientation yet: the frame cannot be placed.
-            lock().refused += 1;
+            let mut s = lock();
+            s.refused += 1;
+            s.busy = false;
+            drop(s);
             shared.1.notify_all();
             continue;
         };
@@ -194,6 +204,7 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
         let coverage = capture.coverage();
         let mut s = lock();
         s.coverage = coverage;
+        s.busy = false;
         if added {
             s.blended += 1;
         } else {
