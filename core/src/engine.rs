@@ -1322,18 +1322,19 @@ impl Engine {
                 }
             }
         }
-        if self.touch_lamp(phase, pointer_id, [x_px, y_px]) {
-            return None;
+        // With a lamp on, a finger's drag moves the lamp (not the view, not the Diorama's
+        // bodies); taps and the other gestures still reach the recogniser (a tap opens the menu).
+        if !self.touch_lamp(phase, pointer_id, [x_px, y_px]) {
+            self.drag_to_turn(phase, pointer_id, [x_px, y_px]);
+            self.touch_diorama(phase, pointer_id, [x_px, y_px]);
         }
-        self.drag_to_turn(phase, pointer_id, [x_px, y_px]);
-        self.touch_diorama(phase, pointer_id, [x_px, y_px]);
         let g = self.gestures.touch(phase, pointer_id, x_px, y_px, t_ns)?;
         self.apply_gesture(g);
         Some(g)
     }
 
-    /// A lamp on screen follows the first finger down (and takes its touches: no turning, no
-    /// grabbing meanwhile). Returns whether the touch was the lamp's.
+    /// A lamp on screen follows the first finger down as it moves (a tap does not move it: taps
+    /// stay the menu's). Returns whether a lamp is on (its drags are then the lamp's).
     fn touch_lamp(&mut self, phase: TouchPhase, pointer_id: i32, px: [f32; 2]) -> bool {
         if self.lamp.is_none() {
             self.lamp_finger = None;
@@ -1341,18 +1342,15 @@ impl Engine {
         }
         match (phase, self.lamp_finger) {
             (TouchPhase::Down, None) => self.lamp_finger = Some(pointer_id),
-            (TouchPhase::Move | TouchPhase::Down, Some(id)) if id == pointer_id => {}
-            (TouchPhase::Up | TouchPhase::Cancel, Some(id)) if id == pointer_id => {
-                self.lamp_finger = None;
-                return true;
+            (TouchPhase::Move, Some(id)) if id == pointer_id => {
+                let [x_m, y_m] = self.glass_point_m(px);
+                let orientation = self.last_device_to_world;
+                if let Some(lamp) = self.lamp.as_mut() {
+                    lamp.move_to(x_m, y_m, orientation);
+                }
             }
-            (_, Some(_)) => return true,
-            _ => return false,
-        }
-        let [x_m, y_m] = self.glass_point_m(px);
-        let orientation = self.last_device_to_world;
-        if let Some(lamp) = self.lamp.as_mut() {
-            lamp.move_to(x_m, y_m, orientation);
+            (TouchPhase::Up | TouchPhase::Cancel, Some(id)) if id == pointer_id => self.lamp_finger = None,
+            _ => {}
         }
         true
     }

@@ -1,6 +1,7 @@
 //! A lamp the visitor places over the diorama: a raking light across the clay tablet matches its
 //! golden frame (its inscription's cuts in light and shadow), a finger's drag moves the lamp in
-//! the next frame drawn, and taking the lamp away gives the room's light back to the pixel.
+//! the next frame drawn (a tap still opens the menu), and taking the lamp away gives the room's
+//! light back to the pixel.
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -73,8 +74,19 @@ fn a_drag_moves_the_lamp_in_the_next_frame() {
         "the lamp is under the finger: {moved} vs {want:?}"
     );
     assert_eq!(moved.z, start.z, "at its height");
-    // The finger's touches were the lamp's: nothing else happened (no gesture completed).
+    // A drag is no gesture: nothing else happened.
     assert_eq!(e.touch(TouchPhase::Up, 0, 0.75 * w, 0.75 * h, 40_000_000), None);
+    // A tap still opens the menu, and does not move the lamp.
+    let mut t = 1000i64;
+    phantogram_integration::tap_at(&mut e, [0.5 * w, 0.2 * h], &mut t);
+    // A single tap is known once no second one followed (a frame later than the double tap's gap).
+    e.draw(Some(t * 1_000_000)).expect("draw");
+    assert!(e.menu_open(), "a single tap opens the menu with a lamp on");
+    let still = e.renderer().lamp.expect("a lamp").position_m;
+    assert!(
+        still.distance(moved) < 1e-6,
+        "the tap left the lamp where it was: {still}"
+    );
 }
 
 #[test]
