@@ -1051,8 +1051,9 @@ impl Renderer {
     }
 
     /// Renders `model` — not the one set — once from `input`'s mono eye at `width × height` (a
-    /// gallery thumbnail): uploads it, draws it in targets of its own and drops it again. The
-    /// model set and the frames' targets stay as they are; the scene pipelines it needed are
+    /// gallery thumbnail), as authored and without the lamp: uploads it, draws it in targets of
+    /// its own and drops it again. The model set, its appearance, the lamp and the frames'
+    /// targets stay as they are; the scene pipelines it needed are
     /// kept for later models.
     pub fn render_other_model(
         &mut self,
@@ -1063,14 +1064,17 @@ impl Renderer {
     ) -> Result<Vec<u8>, RenderError> {
         let gpu_model = self.upload_with_pipelines(model)?;
         let set_model = std::mem::replace(&mut self.model, gpu_model);
-        // The other model as authored: the appearance set is the shown artifact's.
+        // The other model as authored and in the room's light: the appearance and the lamp set
+        // are the shown artifact's.
         let appearance = std::mem::take(&mut self.appearance);
+        let lamp = self.lamp.take();
         let side = self.side_targets.take();
         let frame_targets = std::mem::replace(&mut self.targets, side);
         let pixels = self.render_views(&[input.mono], input, Method::Mono, width, height);
         self.side_targets = std::mem::replace(&mut self.targets, frame_targets);
         self.model = set_model;
         self.appearance = appearance;
+        self.lamp = lamp;
         pixels
     }
 
