@@ -523,15 +523,17 @@ impl Engine {
             crate::appearances::AppearanceStore::open(config.library_dir.as_ref().map(|d| d.join("appearances.json")));
         renderer.appearance = appearances.get(&appearance_key(&model_info));
         let calibration_warning = calibration_warning.or(appearance_warning);
+        // The front camera, for the face tracker and the room light alike.
+        let camera_pose = crate::camera::CameraPose::front(config.camera_position_m.unwrap_or(Vec3::new(
+            0.0,
+            screen.panel_height_m() * 0.5 + 0.004,
+            0.0,
+        )));
         #[cfg(feature = "face")]
         let face = match &config.face_models_dir {
             Some(dir) => {
                 let models = Arc::new(crate::face::FaceModels::load(dir)?);
-                let camera =
-                    config
-                        .camera_position_m
-                        .unwrap_or(Vec3::new(0.0, screen.panel_height_m() * 0.5 + 0.004, 0.0));
-                let tracker = crate::face::FaceTracker::new(models, crate::face::CameraPose::front(camera));
+                let tracker = crate::face::FaceTracker::new(models, camera_pose);
                 Some(Arc::new(crate::face::FaceWorker::spawn(tracker)))
             }
             None => None,
@@ -541,11 +543,8 @@ impl Engine {
             return Err(EngineError::NoFaceSupport);
         }
         let room_light = if config.room_light {
-            let camera = config
-                .camera_position_m
-                .unwrap_or(Vec3::new(0.0, screen.panel_height_m() * 0.5 + 0.004, 0.0));
             let worker = crate::room_light::RoomLightWorker::spawn(
-                crate::camera::CameraPose::front(camera),
+                camera_pose,
                 phantogram_roomlight::CaptureParams::default(),
                 crate::render::PREFILTERED_BASE_WIDTH,
             )
@@ -1343,10 +1342,10 @@ impl Engine {
         match (phase, self.lamp_finger) {
             (TouchPhase::Down, None) => self.lamp_finger = Some(pointer_id),
             (TouchPhase::Move, Some(id)) if id == pointer_id => {
-                let [x_m, y_m] = self.glass_point_m(px);
+                let at = self.glass_point_m(px);
                 let orientation = self.last_device_to_world;
                 if let Some(lamp) = self.lamp.as_mut() {
-                    lamp.move_to(x_m, y_m, orientation);
+                    lamp.move_to(at.x, at.y, orientation);
                 }
             }
             (TouchPhase::Up | TouchPhase::Cancel, Some(id)) if id == pointer_id => self.lamp_finger = None,
@@ -1355,17 +1354,10 @@ impl Engine {
         true
     }
 
-    /// The point of the glass under display pixel `px`, device frame metres (x right, y up).
-    fn glass_point_m(&self, px: [f32; 2]) -> [f32; 2] {
+    /// The point of the glass (device frame, z = 0) under display pixel `px` of the target.
+    fn glass_point_m(&self, px: [f32; 2]) -> Vec3 {
         let screen = self.session.config().screen;
-        let (w_px, h_px) = self
-            .target_size()
-            .filter(|&(w, h)| w > 0 && h > 0)
-            .unwrap_or((screen.width_px(), screen.height_px()));
-        [
-            (px[0] / w_px as f32 - 0.5) * screen.width_m(),
-            (0.5 - px[1] / h_px as f32) * screen.height_m(),
-        ]
+        screen.glass_point_of_pixel(glam::Vec2::from(px) / self.target_scale())
     }
 
     /// Puts a lamp over the diorama in place of the room's light (`None`: back to the room's
@@ -1374,9 +1366,14 @@ impl Engine {
     pub fn set_lamp(&mut self, setting: Option<crate::lamp::LampSetting>) {
         let screen = self.session.config().screen;
         self.lamp_finger = None;
-        self.lamp = setting.map(|s| match s.anchor {
-            crate::lamp::LampAnchor::Room => crate::lamp::PlacedLamp::new(s, -0.5 * screen.width_m(), 0.0),
-            crate::lamp::LampAnchor::Torch => crate::lamp::PlacedLamp::new(s, 0.0, 0.5 * screen.height_m()),
+        // The edges as the viewer sees them (the display may be turned).
+        let (w, h) = (screen.width_px() as f32, screen.height_px() as f32);
+        self.lamp = setting.map(|s| {
+            let at = match s.anchor {
+                crate::lamp::LampAnchor::Room => screen.glass_point_of_pixel(glam::Vec2::new(0.0, 0.5 * h)),
+                crate::lamp::LampAnchor::Torch => screen.glass_point_of_pixel(glam::Vec2::new(0.5 * w, 0.0)),
+            };
+            crate::lamp::PlacedLamp::new(s, at.x, at.y)
         });
         if self.lamp.is_none() {
             self.renderer.lamp = None;

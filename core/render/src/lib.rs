@@ -153,12 +153,7 @@ impl Lamp {
     /// The uniform's three rows (see `EyeUniform::lamp`); zero (off) for `None` or a lamp with
     /// non-finite numbers.
     fn uniform(lamp: Option<&Lamp>) -> [[f32; 4]; 3] {
-        let Some(l) = lamp.filter(|l| {
-            l.position_m.is_finite()
-                && l.axis.is_finite()
-                && l.intensity_rgb.is_finite()
-                && l.cone_half_angle_rad.is_none_or(f32::is_finite)
-        }) else {
+        let Some(l) = lamp.filter(|l| l.is_finite()) else {
             return [[0.0; 4]; 3];
         };
         let axis = l.axis.normalize_or(-Vec3::Z);
@@ -175,6 +170,14 @@ impl Lamp {
             axis.extend(cos_outer).to_array(),
             l.intensity_rgb.max(Vec3::ZERO).extend(cos_inner).to_array(),
         ]
+    }
+
+    /// Whether every number is finite (a lamp that is not shines nowhere: off).
+    fn is_finite(&self) -> bool {
+        self.position_m.is_finite()
+            && self.axis.is_finite()
+            && self.intensity_rgb.is_finite()
+            && self.cone_half_angle_rad.is_none_or(f32::is_finite)
     }
 
     /// Direction towards the lamp from `point`, for choosing what casts shadows.
@@ -1333,7 +1336,7 @@ impl Renderer {
             })?;
             self.compose_pipelines.insert(format, pipeline);
         }
-        let lamp = self.lamp.filter(|l| Lamp::uniform(Some(l))[0][3] > 0.5);
+        let lamp = self.lamp.filter(Lamp::is_finite);
         let toward = match &lamp {
             Some(l) => l.toward_from((self.model.bounds.min + self.model.bounds.max) * 0.5),
             None => input.toward_light,
