@@ -308,3 +308,50 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
         assert!(differing > 5000, "two rooms, two lights ({differing} pixels differ)");
     }
 }
+
+/// A synthetic stress case beyond the shared rooms: a dim grey room with one lamp a few texels
+/// across and 20 000 times brighter than the walls (most of the light), placed off the poles,
+/// high and low. With the bracket and the whole sphere seen, the irradiance is within 5 %.
+#[test]
+fn a_tiny_bright_lamp_anywhere_is_captured() {
+    let camera = SyntheticCamera::phone_front();
+    let normals = normals(2000);
+    for (azimuth_deg, elevation_deg) in [(30.0f32, 20.0f32), (200.0, -50.0), (110.0, 70.0)] {
+        let (width, height) = (256usize, 128usize);
+        let mut room = Environment {
+            width,
+            height,
+            texels: vec![[0.2, 0.19, 0.18]; width * height],
+        };
+        let (az, el) = (azimuth_deg.to_radians(), elevation_deg.to_radians());
+        let lamp = Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin());
+        for y in 0..height {
+            for x in 0..width {
+                if room.direction(x, y).dot(lamp) > 0.99985 {
+                    room.texels[y * width + x] = [4000.0, 3800.0, 3300.0];
+                }
+            }
+        }
+        let want = IrradianceSh::from_environment(&room);
+        let mut capture = RoomCapture::new(CaptureParams::default());
+        for (k, pose) in sweep().into_iter().enumerate() {
+            let metering = if k % 2 == 1 { BRACKET } else { Metering::Average };
+            let (frame, exposure) = camera.capture(&room, pose, metering, k as i64 * 33_000_000);
+            capture
+                .add(&CaptureFrame {
+                    image: frame.as_frame(),
+                    world_from_camera: camera.world_from_camera(pose),
+                    exposure: Some(exposure),
+                })
+                .expect("frame");
+        }
+        let got = IrradianceSh::from_environment(&capture.environment());
+        let err = relative_rms(&got, &want, 1.0, &normals);
+        println!("lamp at {azimuth_deg}°, {elevation_deg}°: {:.1} % off", err * 100.0);
+        assert!(
+            err <= 0.05,
+            "lamp at {azimuth_deg}°, {elevation_deg}°: {:.1} % off",
+            err * 100.0
+        );
+    }
+}
