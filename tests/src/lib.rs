@@ -45,6 +45,15 @@ pub fn engine_or_skip(config: phantogram::engine::EngineConfig) -> Option<phanto
     }
 }
 
+/// RGBA pixels of two equal-sized frames that differ by more than 8 levels in some channel:
+/// how much of a picture a change changed.
+pub fn differing_pixels(a: &[u8], b: &[u8]) -> usize {
+    a.chunks(4)
+        .zip(b.chunks(4))
+        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
+        .count()
+}
+
 /// A finger's tap at display pixel `px` as a shell sends it, at `*t_ms` on the sensor clock:
 /// down, a frame, up 80 ms later, three frames to settle; `*t_ms` moves a second on.
 pub fn tap_at(e: &mut phantogram::engine::Engine, px: [f32; 2], t_ms: &mut i64) {

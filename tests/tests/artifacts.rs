@@ -7,7 +7,7 @@ use std::time::Duration;
 use phantogram::artifacts::LoadStatus;
 use phantogram::engine::{Engine, EngineConfig};
 use phantogram::library::{ArtifactId, Origin};
-use phantogram_integration::tap_at;
+use phantogram_integration::{differing_pixels, tap_at};
 use phantogram_testkit::{Scratch, tetrahedron_glb};
 
 const W: u32 = 180;
@@ -37,13 +37,6 @@ fn engine(library: &Scratch) -> Option<Engine> {
 fn frame(engine: &mut Engine) -> Vec<u8> {
     engine.draw(None).unwrap();
     engine.last_frame().unwrap().2.to_vec()
-}
-
-fn differing_pixels(a: &[u8], b: &[u8]) -> usize {
-    a.chunks(4)
-        .zip(b.chunks(4))
-        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
-        .count()
 }
 
 /// Resident memory of this process, bytes (Linux).

@@ -336,11 +336,7 @@ fn the_diorama_at_rest_and_mid_slide_matches_its_golden_frames() {
         t += 50_000_000;
     }
     let sliding = engine.last_frame().unwrap().2.to_vec();
-    let differing = rest
-        .chunks(4)
-        .zip(sliding.chunks(4))
-        .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
-        .count();
+    let differing = phantogram_integration::differing_pixels(&rest, &sliding);
     assert!(differing > 2000, "the roll moved the bodies ({differing} pixels)");
     golden::check("diorama-rest", w, h, &rest, 3, 0.003);
     golden::check("diorama-sliding", w, h, &sliding, 3, 0.003);

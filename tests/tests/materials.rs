@@ -12,6 +12,7 @@ use phantogram::engine::{Engine, EngineConfig};
 use phantogram::glam::{Quat, Vec3};
 use phantogram::sensors::SensorEvent;
 use phantogram::ward::WardPreset;
+use phantogram_integration::differing_pixels;
 
 const SIZE: (u32, u32) = (180, 400);
 /// When the frames are drawn: after a second held still at the tilt.
@@ -32,13 +33,6 @@ fn hold_tilted(engine: &Engine) {
 fn frame(engine: &mut Engine) -> Vec<u8> {
     engine.draw(Some(FRAME_T_NS)).expect("draw");
     engine.last_frame().expect("a frame").2.to_vec()
-}
-
-fn differing_pixels(a: &[u8], b: &[u8]) -> usize {
-    a.chunks(4)
-        .zip(b.chunks(4))
-        .filter(|(p, q)| p.iter().zip(q.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
-        .count()
 }
 
 #[test]

@@ -278,11 +278,7 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
             "the newest update reached the renderer"
         );
         let lit = engine.last_frame().expect("frame").2.to_vec();
-        let changed = before
-            .chunks(4)
-            .zip(lit.chunks(4))
-            .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
-            .count();
+        let changed = phantogram_integration::differing_pixels(&before, &lit);
         println!("{name}: {blended} frames, {updates} updates, {changed} pixels changed");
         if name == "studio" {
             // The engine starts lit by this very studio: the room it captured lights it the same.
@@ -300,11 +296,7 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
         frames.push(lit);
     }
     if frames.len() == 2 {
-        let differing = frames[0]
-            .chunks(4)
-            .zip(frames[1].chunks(4))
-            .filter(|(a, b)| a.iter().zip(b.iter()).any(|(x, y)| x.abs_diff(*y) > 8))
-            .count();
+        let differing = phantogram_integration::differing_pixels(&frames[0], &frames[1]);
         assert!(differing > 5000, "two rooms, two lights ({differing} pixels differ)");
     }
 }
