@@ -31,7 +31,7 @@ use jni::sys::{JNI_VERSION_1_6, jboolean, jfloat, jfloatArray, jint, jintArray, 
 use jni::{Env, EnvUnowned, JavaVM, jni_str};
 use phantogram::anaglyph::Method;
 use phantogram::camera::android::{Camera2Characteristics, PixelRect};
-use phantogram::camera::{Intrinsics, OwnedFrame};
+use phantogram::camera::{ChromaPlanes, Intrinsics, OwnedFrame};
 use phantogram::engine::{Engine, EngineConfig, EngineError, ErrorKind, SharedEngine};
 use phantogram::gesture::{Gesture, TouchPhase};
 use phantogram::screen::{DisplayRotation, PanelSpec};
@@ -305,9 +305,11 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativePushSensor<'local>
     })
 }
 
-/// A front-camera frame's Y plane (CameraX `ImageProxy.planes[0]`, a direct buffer, pixel
-/// stride 1). Copied before returning, so the caller may close the image at once. Returns
-/// `false` when face tracking is off.
+/// A front-camera frame (CameraX `ImageProxy` in `YUV_420_888`): its Y plane (`planes[0]`, a
+/// direct buffer, pixel stride 1) and, for the room light's colour, its Cb and Cr planes
+/// (`planes[1]`, `planes[2]`, direct buffers with their shared row and pixel strides; both null
+/// for luma only). Copied before returning, so the caller may close the image at once; the core
+/// converts to colour on its own thread. Returns `false` when face tracking is off.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local>(
@@ -318,6 +320,10 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
     width: jint,
     height: jint,
     row_stride: jint,
+    cb: JByteBuffer<'local>,
+    cr: JByteBuffer<'local>,
+    chroma_row_stride: jint,
+    chroma_pixel_stride: jint,
     rotation_degrees: jint,
     fx_px: jfloat,
     fy_px: jfloat,
@@ -328,40 +334,113 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
     run(&mut env, |env| {
         let engine = engine(handle)?;
         let (width, height) = size(width, height)?;
-        let row_stride = usize::try_from(row_stride).map_err(|_| {
-            fail(
-                Kind::IllegalArgument,
-                format!("row stride must not be negative, got {row_stride}"),
-            )
-        })?;
+        let stride = |what: &str, value: jint| {
+            usize::try_from(value).map_err(|_| {
+                fail(
+                    Kind::IllegalArgument,
+                    format!("{what} must not be negative, got {value}"),
+                )
+            })
+        };
+        let row_stride = stride("row stride", row_stride)?;
         let rotation_cw_deg = u32::try_from(rotation_degrees).map_err(|_| {
             fail(
                 Kind::IllegalArgument,
                 format!("rotation must be 0, 90, 180 or 270, got {rotation_degrees}"),
             )
         })?;
-        if luma.is_null() {
-            return Err(fail(Kind::IllegalArgument, "the luma buffer is null"));
-        }
-        let address = env.get_direct_buffer_address(&luma)?;
-        let capacity = env.get_direct_buffer_capacity(&luma)?;
-        if address.is_null() {
-            return Err(fail(Kind::IllegalArgument, "the luma buffer is not a direct buffer"));
-        }
-        // SAFETY: a direct buffer's memory is valid for `capacity` bytes while `luma` is alive,
-        // which it is for this call; we copy before returning.
-        let data = unsafe { std::slice::from_raw_parts(address, capacity) };
         let intrinsics = Intrinsics::new(fx_px, fy_px, cx_px, cy_px);
-        let frame = OwnedFrame::luma8(
-            width,
-            height,
-            row_stride,
-            data,
-            rotation_cw_deg,
-            intrinsics,
-            timestamp_ns,
-        );
+        // SAFETY (for each call below): a direct buffer's memory is valid for its capacity while
+        // the buffer is alive, which it is for this call; every plane is copied before returning.
+        let luma = unsafe { direct_bytes(env, &luma, "luma") }?;
+        let frame = match (cb.is_null(), cr.is_null()) {
+            (true, true) => OwnedFrame::luma8(
+                width,
+                height,
+                row_stride,
+                luma,
+                rotation_cw_deg,
+                intrinsics,
+                timestamp_ns,
+            ),
+            (false, false) => {
+                // SAFETY: as above.
+                let (cb, cr) = unsafe { (direct_bytes(env, &cb, "Cb")?, direct_bytes(env, &cr, "Cr")?) };
+                let chroma = ChromaPlanes::separate(
+                    cb,
+                    cr,
+                    stride("chroma row stride", chroma_row_stride)?,
+                    stride("chroma pixel stride", chroma_pixel_stride)?,
+                );
+                OwnedFrame::yuv420(
+                    width,
+                    height,
+                    row_stride,
+                    luma,
+                    chroma,
+                    rotation_cw_deg,
+                    intrinsics,
+                    timestamp_ns,
+                )
+                .map_err(|e| fail(Kind::IllegalArgument, e.to_string()))?
+            }
+            _ => {
+                return Err(fail(
+                    Kind::IllegalArgument,
+                    "give both chroma planes (Cb and Cr) or neither",
+                ));
+            }
+        };
         Ok(engine.camera_frame(frame)?)
+    })
+}
+
+/// The bytes of a direct buffer, borrowed for the call.
+///
+/// # Safety
+/// The returned slice must not outlive the JNI call that received `buffer` (the Java object
+/// keeps the memory alive until then).
+unsafe fn direct_bytes<'a>(env: &mut Env<'_>, buffer: &JByteBuffer<'_>, what: &str) -> Result<&'a [u8], Thrown> {
+    if buffer.is_null() {
+        return Err(fail(Kind::IllegalArgument, format!("the {what} buffer is null")));
+    }
+    let address = env.get_direct_buffer_address(buffer)?;
+    let capacity = env.get_direct_buffer_capacity(buffer)?;
+    if address.is_null() {
+        return Err(fail(
+            Kind::IllegalArgument,
+            format!("the {what} buffer is not a direct buffer"),
+        ));
+    }
+    // SAFETY: the caller keeps the buffer alive for the slice's life; a direct buffer's memory is
+    // `capacity` bytes from `address`.
+    Ok(unsafe { std::slice::from_raw_parts(address, capacity) })
+}
+
+/// The exposure of the camera frame captured at `timestampNs` (Camera2's capture result:
+/// `SENSOR_EXPOSURE_TIME` in nanoseconds and `SENSOR_SENSITIVITY` as ISO), which arrives apart
+/// from the image; the room light matches it to its frame. Unknown values (0, negative) are
+/// ignored (returns `false`).
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraExposure<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    timestamp_ns: jlong,
+    exposure_time_ns: jlong,
+    iso: jint,
+) -> jboolean {
+    run(&mut env, |_| {
+        let engine = engine(handle)?;
+        Ok(
+            match phantogram::camera::Exposure::new(exposure_time_ns as f32 * 1e-9, iso as f32) {
+                Some(exposure) => {
+                    engine.camera_exposure(timestamp_ns, exposure);
+                    true
+                }
+                None => false,
+            },
+        )
     })
 }
 
@@ -889,11 +968,12 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSnapshotPng<'local
 
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 27] = [
+pub const NATIVE_METHODS: [&str; 28] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
     "nativeCameraFrame",
+    "nativeCameraExposure",
     "nativeCameraIntrinsics",
     "nativeTouch",
     "nativeSurfaceCreated",

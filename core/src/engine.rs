@@ -104,9 +104,11 @@ pub struct EngineConfig {
     pub calibration_path: Option<PathBuf>,
     /// Light the artifact with the room itself, as the camera sees it
     /// ([`crate::room_light`]): camera frames ([`Engine::room_light_frame`], or every frame the
-    /// shell forwards) are blended into a map of the room whose light replaces the studio's (or
-    /// [`Self::environment_path`]'s) once the first update is made. Off by default: the shells
-    /// forward the luma plane only so far, which gives the room's light without its colour.
+    /// shell forwards, in colour when it forwards the chroma planes) are blended into a map of the
+    /// room whose light replaces the studio's (or [`Self::environment_path`]'s) once the first
+    /// update is made. This is the start-up default; the calibration file's choice (the settings
+    /// screen's "Light" switch, [`Engine::set_room_light`]) overrides it. Off by default: on a
+    /// phone the map's reduction costs CPU time (see `benchmarks/ibl.md`), so the visitor opts in.
     pub room_light: bool,
 }
 
@@ -313,6 +315,8 @@ pub struct Engine {
     appearances: crate::appearances::AppearanceStore,
     /// The live room light's worker, when [`EngineConfig::room_light`] is on.
     room_light: Option<Arc<crate::room_light::RoomLightWorker>>,
+    /// The light when the room's is off: [`EngineConfig::environment_path`]'s, or the studio's.
+    static_environment: Option<crate::ibl::Environment>,
     /// A lamp the visitor placed (in place of the room's light), and the finger moving it.
     lamp: Option<crate::lamp::PlacedLamp>,
     lamp_finger: Option<i32>,
@@ -542,19 +546,24 @@ impl Engine {
         if config.face_models_dir.is_some() {
             return Err(EngineError::NoFaceSupport);
         }
-        let room_light = if config.room_light {
-            let worker = crate::room_light::RoomLightWorker::spawn(
-                camera_pose,
-                phantogram_roomlight::CaptureParams::default(),
-                crate::render::PREFILTERED_BASE_WIDTH,
-            )
-            .map_err(|source| EngineError::Io {
-                what: "the room light's thread could not start",
-                source,
-            })?;
-            Some(Arc::new(worker))
-        } else {
-            None
+        // The worker waits, idle, while the room light is off, so the setting can switch it on.
+        let room_light = match crate::room_light::RoomLightWorker::spawn(
+            camera_pose,
+            phantogram_roomlight::CaptureParams::default(),
+            crate::render::PREFILTERED_BASE_WIDTH,
+        ) {
+            Ok(worker) => {
+                worker.set_on(calibration.room_light.unwrap_or(config.room_light));
+                Some(Arc::new(worker))
+            }
+            Err(source) if config.room_light => {
+                return Err(EngineError::Io {
+                    what: "the room light's thread could not start",
+                    source,
+                });
+            }
+            // Asked for later only: the switch then keeps the studio's light.
+            Err(_) => None,
         };
         let mut engine = Self {
             session,
@@ -598,6 +607,7 @@ impl Engine {
             thumbnails,
             appearances,
             room_light,
+            static_environment: environment,
             lamp: None,
             lamp_finger: None,
             last_device_to_world: None,
@@ -664,37 +674,46 @@ impl Engine {
             })
     }
 
-    /// Hands a camera frame to the live room light (`exposure`: exposure time × sensor gain, when
-    /// the platform reports it); from any thread through [`SharedEngine::camera_frame`] too.
+    /// Hands a camera frame to the live room light (RGBA, YUV or luma; with its exposure when the
+    /// platform reports it); from any thread through [`SharedEngine::camera_frame`] too.
     /// Returns `false` when the room light is off ([`EngineConfig::room_light`]).
-    pub fn room_light_frame(&self, frame: crate::camera::OwnedFrame, exposure: Option<f32>) -> bool {
+    pub fn room_light_frame(&self, frame: crate::camera::OwnedFrame) -> bool {
         match &self.room_light {
-            Some(worker) => {
-                worker.submit(frame, exposure);
-                true
-            }
+            Some(worker) => worker.submit(frame),
             None => false,
         }
     }
 
     /// As [`Self::room_light_frame`], with the device's orientation (device → world) when the
     /// frame was taken: a desktop replay whose camera follows a log of its own.
-    pub fn room_light_frame_oriented(
-        &self,
-        frame: crate::camera::OwnedFrame,
-        exposure: Option<f32>,
-        world_from_device: glam::Quat,
-    ) -> bool {
+    pub fn room_light_frame_oriented(&self, frame: crate::camera::OwnedFrame, world_from_device: glam::Quat) -> bool {
         match &self.room_light {
-            Some(worker) => {
-                worker.submit_oriented(frame, exposure, Some(world_from_device));
-                true
-            }
+            Some(worker) => worker.submit_oriented(frame, Some(world_from_device)),
             None => false,
         }
     }
 
-    /// The live room light's worker (its counts, waiting for it), when it is on.
+    /// Switches the room's own light on or off (off: the studio's, or the configured
+    /// environment's, from the next frame; the map seen so far is kept for when it is on again).
+    /// Not saved: the settings screen saves its choice.
+    pub fn set_room_light(&mut self, on: bool) {
+        let Some(worker) = &self.room_light else { return };
+        let was_on = worker.is_on();
+        worker.set_on(on);
+        if was_on && !on && self.stats.room_light_updates > 0 {
+            // A failed upload keeps the room's light; the next switch tries again.
+            let _ = self
+                .renderer
+                .set_environment_or_studio(self.static_environment.as_ref());
+        }
+    }
+
+    /// Whether the room's own light is on.
+    pub fn room_light_on(&self) -> bool {
+        self.room_light.as_ref().is_some_and(|w| w.is_on())
+    }
+
+    /// The live room light's worker (its counts, waiting for it; on or off).
     pub fn room_light(&self) -> Option<&crate::room_light::RoomLightWorker> {
         self.room_light.as_deref()
     }
@@ -1778,6 +1797,10 @@ impl Engine {
                 self.calibration.true_size = s.true_size;
                 self.calibration.turn_by_touch = s.turn_by_touch;
                 self.session.set_turn_by_touch(s.turn_by_touch);
+                if s.room_light != self.room_light_on() {
+                    self.set_room_light(s.room_light);
+                    self.calibration.room_light = Some(s.room_light);
+                }
                 self.save_calibration();
                 if placing_changed && let Some(id) = self.model_info.artifact.as_ref().map(|a| a.id.clone()) {
                     self.select_artifact(id);
@@ -1865,6 +1888,7 @@ impl Engine {
                     true_size: self.fit.true_size,
                     surface: self.fit.placement == crate::model::Placement::Surface,
                     turn_by_touch: self.session.turning_by_touch(),
+                    room_light: self.room_light_on(),
                 };
                 self.set_page(Some(Page::Settings(crate::calibration_ui::settings::SettingsUi::new(
                     settings,
@@ -2064,9 +2088,10 @@ impl SharedEngine {
     #[cfg(feature = "face")]
     pub fn camera_frame(&self, frame: crate::face::OwnedFrame) -> Result<bool, EngineError> {
         crate::face::UprightImage::new(frame.as_frame())?;
-        if let Some(room) = &self.room_light {
-            // The exposure is not forwarded by the shells yet: estimated from the overlap.
-            room.submit(frame.clone(), None);
+        if let Some(room) = &self.room_light
+            && room.is_on()
+        {
+            room.submit(frame.clone());
         }
         match &self.face {
             Some(worker) => {
@@ -2075,6 +2100,15 @@ impl SharedEngine {
                 Ok(true)
             }
             None => Ok(false),
+        }
+    }
+
+    /// From any thread: the exposure of the camera frame captured at `capture_t_ns`, where the
+    /// platform reports it apart from the frame (Camera2's capture results); the room light
+    /// matches it to its frame. Ignored when the room light is off.
+    pub fn camera_exposure(&self, capture_t_ns: i64, exposure: crate::camera::Exposure) {
+        if let Some(room) = &self.room_light {
+            room.note_exposure(capture_t_ns, exposure);
         }
     }
 

@@ -4,8 +4,14 @@
 //! SH coefficients and the specular levels, tens of milliseconds on the CPU), which the render
 //! thread then only uploads ([`crate::render::Renderer::set_prefiltered_environment`]).
 //!
-//! **Threading**: [`RoomLightWorker::submit`] and [`RoomLightWorker::set_orientation`] from any
-//! thread, never waiting for the worker (a frame arriving while one is being blended replaces the
+//! **Colour and exposure**: a YUV frame (luma with its chroma planes, as the bridges hand it over)
+//! is turned into colour here, on the worker, never on the camera's thread; a luma-only frame
+//! lights in grey. A frame's exposure comes with it, or separately by its capture time
+//! ([`RoomLightWorker::note_exposure`]: Camera2 reports it in a capture result that may arrive after
+//! the image), or else the capture estimates it from the overlap with what the map has seen.
+//!
+//! **Threading**: [`RoomLightWorker::submit`], [`RoomLightWorker::note_exposure`] and
+//! [`RoomLightWorker::set_orientation`] from any thread, never waiting for the worker (a frame arriving while one is being blended replaces the
 //! one waiting: the newest view of the room matters most); [`RoomLightWorker::take_update`] on
 //! the render thread. The worker stops when the handle drops. **Orientation**: the render
 //! thread publishes each frame's fused device → world orientation; a camera frame is placed with
@@ -18,10 +24,13 @@ use std::sync::{Arc, Condvar, Mutex};
 use glam::Quat;
 use phantogram_assets::ibl::{Environment, IrradianceSh, prefiltered_levels};
 use phantogram_roomlight::{CaptureFrame, CaptureParams, RoomCapture, world_from_buffer_camera};
-use phantogram_sensing::camera::{CameraPose, OwnedFrame};
+use phantogram_sensing::camera::{CameraPose, Exposure, OwnedFrame};
 
 /// Camera time between two updates of the image-based light: twice a second.
 pub const UPDATE_INTERVAL_NS: i64 = 500_000_000;
+
+/// Exposures reported apart from their frames that are kept to be matched (a second at 30 fps).
+const EXPOSURES_KEPT: usize = 32;
 
 /// A new image-based light made from the room map.
 pub struct RoomLightUpdate {
@@ -36,7 +45,6 @@ pub struct RoomLightUpdate {
 /// One camera frame waiting for the worker.
 struct Pending {
     frame: OwnedFrame,
-    exposure: Option<f32>,
     /// The device's orientation when the frame was taken, where known with it; else the newest
     /// published.
     world_from_device: Option<Quat>,
@@ -45,6 +53,8 @@ struct Pending {
 #[derive(Default)]
 struct Shared {
     pending: Option<Pending>,
+    /// Exposures reported by capture time, newest last.
+    exposures: std::collections::VecDeque<(i64, Exposure)>,
     world_from_device: Option<Quat>,
     update: Option<RoomLightUpdate>,
     refused: u64,
@@ -55,6 +65,8 @@ struct Shared {
     coverage: f32,
     /// A frame taken from `pending` is being blended.
     busy: bool,
+    /// Off: frames handed over are dropped (the settings' studio light); the map is kept.
+    off: bool,
     stop: bool,
 }
 
@@ -82,22 +94,55 @@ impl RoomLightWorker {
         self.shared.0.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// Hands a camera frame to the worker (`exposure`: exposure time × gain when the platform
-    /// reports it), replacing one not yet started.
-    pub fn submit(&self, frame: OwnedFrame, exposure: Option<f32>) {
-        self.submit_oriented(frame, exposure, None);
+    /// Hands a camera frame to the worker (RGBA, YUV or luma; its exposure with it when the
+    /// platform reports it so), replacing one not yet started.
+    /// Returns whether it was taken (not while the worker is off).
+    pub fn submit(&self, frame: OwnedFrame) -> bool {
+        self.submit_oriented(frame, None)
+    }
+
+    /// The exposure of the frame captured at `capture_t_ns` (sensor clock), reported apart from
+    /// it; used for that frame when it comes without one.
+    pub fn note_exposure(&self, capture_t_ns: i64, exposure: Exposure) {
+        let mut s = self.lock();
+        if s.exposures.len() == EXPOSURES_KEPT {
+            s.exposures.pop_front();
+        }
+        s.exposures.push_back((capture_t_ns, exposure));
     }
 
     /// As [`Self::submit`], with the device's orientation when the frame was taken (a desktop
     /// replay; a platform that tracks the camera's pose per frame), used instead of the newest
     /// published one.
-    pub fn submit_oriented(&self, frame: OwnedFrame, exposure: Option<f32>, world_from_device: Option<Quat>) {
-        self.lock().pending = Some(Pending {
+    pub fn submit_oriented(&self, frame: OwnedFrame, world_from_device: Option<Quat>) -> bool {
+        let mut s = self.lock();
+        if s.off {
+            return false;
+        }
+        s.pending = Some(Pending {
             frame,
-            exposure,
             world_from_device,
         });
+        drop(s);
         self.shared.1.notify_all();
+        true
+    }
+
+    /// Switches the worker on or off (off: frames are dropped and no updates are made; the map
+    /// seen so far is kept for when it is on again).
+    pub fn set_on(&self, on: bool) {
+        let mut s = self.lock();
+        s.off = !on;
+        if !on {
+            s.pending = None;
+            s.update = None;
+        }
+        drop(s);
+        self.shared.1.notify_all();
+    }
+
+    pub fn is_on(&self) -> bool {
+        !self.lock().off
     }
 
     /// The device's orientation now (device → world), for the frames that follow.
@@ -168,7 +213,14 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
                 return;
             }
             s.busy = true;
-            (s.pending.take(), s.world_from_device)
+            let pending = s.pending.take().map(|mut p| {
+                if p.frame.exposure.is_none() {
+                    let t = p.frame.capture_t_ns;
+                    p.frame.exposure = s.exposures.iter().rev().find(|(at, _)| *at == t).map(|(_, e)| *e);
+                }
+                p
+            });
+            (pending, s.world_from_device)
         };
         let Some(p) = pending else {
             lock().busy = false;
@@ -183,13 +235,18 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
             shared.1.notify_all();
             continue;
         };
+        // Colour where the frame has it (YUV converted here, off the camera's thread); else grey.
+        let image = match p.frame.to_rgba8() {
+            Some(Ok(rgba)) => rgba,
+            Some(Err(_)) | None => p.frame,
+        };
         let frame = CaptureFrame {
-            image: p.frame.as_frame(),
-            world_from_camera: world_from_buffer_camera(q, &pose, p.frame.rotation_cw_deg),
-            exposure: p.exposure,
+            image: image.as_frame(),
+            world_from_camera: world_from_buffer_camera(q, &pose, image.rotation_cw_deg),
+            exposure: image.exposure.map(Exposure::relative),
         };
         let added = capture.add(&frame).is_ok();
-        let t = p.frame.capture_t_ns;
+        let t = image.capture_t_ns;
         let due = added && last_update_t_ns.is_none_or(|last| t.saturating_sub(last) >= UPDATE_INTERVAL_NS || t < last);
         let update = due.then(|| {
             last_update_t_ns = Some(t);
@@ -210,7 +267,10 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
         } else {
             s.refused += 1;
         }
-        if let Some(u) = update {
+        // Switched off while this frame was blended: its light is not shown.
+        if let Some(u) = update
+            && !s.off
+        {
             s.update = Some(u);
             s.updates += 1;
         }
@@ -236,6 +296,8 @@ mod tests {
             rotation_cw_deg: 0,
             intrinsics: Intrinsics::from_horizontal_fov(w, h, 1.2),
             capture_t_ns: t_ns,
+            chroma: None,
+            exposure: Exposure::new(1.0, 100.0),
         }
     }
 
@@ -244,13 +306,13 @@ mod tests {
         let worker =
             RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64).expect("thread");
         // Without an orientation a frame cannot be placed.
-        worker.submit(grey(0, 118), Some(1.0));
+        worker.submit(grey(0, 118));
         assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
         assert_eq!(worker.counts(), (0, 1, 0));
         worker.set_orientation(Quat::IDENTITY);
         let mut made = 0;
         for k in 0..6i64 {
-            worker.submit(grey(k * 200_000_000, 118), Some(1.0));
+            worker.submit(grey(k * 200_000_000, 118));
             assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
             if let Some(u) = worker.take_update() {
                 made += 1;
@@ -263,5 +325,40 @@ mod tests {
         assert_eq!((blended, refused), (6, 1));
         assert_eq!(updates, 2);
         assert_eq!(made, 2);
+    }
+
+    #[test]
+    fn an_exposure_reported_apart_is_matched_to_its_frame_by_time() {
+        // The same grey frame, once with its exposure on it (1 s at ISO 100) and once without,
+        // its exposure (twice as long) reported apart with a neighbour's: the second room is
+        // half as bright, so the noted exposure was used, and only the one of its own time.
+        let light = |frame: OwnedFrame, notes: &[(i64, Exposure)]| {
+            let worker =
+                RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64).expect("thread");
+            worker.set_orientation(Quat::IDENTITY);
+            for (t, e) in notes {
+                worker.note_exposure(*t, *e);
+            }
+            worker.submit(frame);
+            assert!(worker.wait_until(1, std::time::Duration::from_secs(10)));
+            worker.take_update().expect("an update").sh.irradiance(Vec3::NEG_Z)[0]
+        };
+        let reported = light(grey(5, 118), &[]);
+        let unreported = OwnedFrame {
+            exposure: None,
+            ..grey(5, 118)
+        };
+        let two_s = Exposure::new(2.0, 100.0).expect("valid");
+        let noted = light(
+            unreported.clone(),
+            &[(4, Exposure::new(8.0, 100.0).expect("valid")), (5, two_s), (6, two_s)],
+        );
+        assert!((noted / reported - 0.5).abs() < 0.01, "{noted} against {reported}");
+        // With none noted for its time the capture estimates (a first frame: as if 1 s).
+        let estimated = light(unreported, &[(4, two_s)]);
+        assert!(
+            (estimated / reported - 1.0).abs() < 0.01,
+            "{estimated} against {reported}"
+        );
     }
 }

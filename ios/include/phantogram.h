@@ -172,25 +172,33 @@ enum PgStatus pg_push_device_motion(const struct PgEngine *engine,
                                     double y,
                                     double z);
 
-// One front-camera frame's luma plane (`kCVPixelFormatType_420YpCbCr8BiPlanar*`, plane 0):
-// `width × height` bytes with `row_stride` bytes per row, turned clockwise by
-// `rotation_cw_deg` to be upright in portrait, with the intrinsics of the buffer as delivered
-// (`kCMSampleBufferAttachmentKey_CameraIntrinsicMatrix`: fx, fy, cx, cy in pixels) and the
-// capture time in seconds. The bytes are copied; the tracker runs on its own thread. Returns
-// `Unsupported` (harmless) when the engine was made without face models.
+// One front-camera frame (`kCVPixelFormatType_420YpCbCr8BiPlanarFullRange`): its luma plane
+// (plane 0), `width × height` bytes with `row_stride` bytes per row, and for the room light's
+// colour its interleaved CbCr plane (plane 1, `cbcr_row_stride` bytes per row; null for luma
+// only); turned clockwise by `rotation_cw_deg` to be upright in portrait, with the intrinsics
+// of the buffer as delivered (`kCMSampleBufferAttachmentKey_CameraIntrinsicMatrix`: fx, fy, cx,
+// cy in pixels), the exposure (the buffer's EXIF `ExposureTime` in seconds and
+// `ISOSpeedRatings`; NaN or 0 when unknown) and the capture time in seconds. The bytes are
+// copied; the tracker and the room light run on their own threads. Returns `Unsupported`
+// (harmless) when the engine was made without face models.
 //
 // # Safety
-// `engine` is a live handle; `luma` is valid for reads of `row_stride × height` bytes.
+// `engine` is a live handle; `luma` is valid for reads of `row_stride × height` bytes; `cbcr`
+// is null or valid for reads of `cbcr_row_stride × ⌈height / 2⌉` bytes.
 enum PgStatus pg_camera_frame(const struct PgEngine *engine,
                               const uint8_t *luma,
                               uint32_t width,
                               uint32_t height,
                               size_t row_stride,
+                              const uint8_t *cbcr,
+                              size_t cbcr_row_stride,
                               uint32_t rotation_cw_deg,
                               float fx_px,
                               float fy_px,
                               float cx_px,
                               float cy_px,
+                              double exposure_time_s,
+                              double iso,
                               double timestamp_s);
 
 // One touch (`UITouch`): `phase` 0 began, 1 moved, 2 ended, 3 cancelled; `pointer` a stable id

@@ -24,7 +24,7 @@ use std::panic::AssertUnwindSafe;
 use std::path::PathBuf;
 
 use phantogram::anaglyph::Method;
-use phantogram::camera::{Intrinsics, OwnedFrame};
+use phantogram::camera::{ChromaPlanes, Exposure, Intrinsics, OwnedFrame};
 use phantogram::engine::{Engine, EngineConfig, EngineError, ErrorKind, SharedEngine};
 use phantogram::gesture::{Gesture, TouchPhase};
 use phantogram::glam::Vec3;
@@ -474,15 +474,19 @@ pub unsafe extern "C" fn pg_push_device_motion(
     })
 }
 
-/// One front-camera frame's luma plane (`kCVPixelFormatType_420YpCbCr8BiPlanar*`, plane 0):
-/// `width × height` bytes with `row_stride` bytes per row, turned clockwise by
-/// `rotation_cw_deg` to be upright in portrait, with the intrinsics of the buffer as delivered
-/// (`kCMSampleBufferAttachmentKey_CameraIntrinsicMatrix`: fx, fy, cx, cy in pixels) and the
-/// capture time in seconds. The bytes are copied; the tracker runs on its own thread. Returns
-/// `Unsupported` (harmless) when the engine was made without face models.
+/// One front-camera frame (`kCVPixelFormatType_420YpCbCr8BiPlanarFullRange`): its luma plane
+/// (plane 0), `width × height` bytes with `row_stride` bytes per row, and for the room light's
+/// colour its interleaved CbCr plane (plane 1, `cbcr_row_stride` bytes per row; null for luma
+/// only); turned clockwise by `rotation_cw_deg` to be upright in portrait, with the intrinsics
+/// of the buffer as delivered (`kCMSampleBufferAttachmentKey_CameraIntrinsicMatrix`: fx, fy, cx,
+/// cy in pixels), the exposure (the buffer's EXIF `ExposureTime` in seconds and
+/// `ISOSpeedRatings`; NaN or 0 when unknown) and the capture time in seconds. The bytes are
+/// copied; the tracker and the room light run on their own threads. Returns `Unsupported`
+/// (harmless) when the engine was made without face models.
 ///
 /// # Safety
-/// `engine` is a live handle; `luma` is valid for reads of `row_stride × height` bytes.
+/// `engine` is a live handle; `luma` is valid for reads of `row_stride × height` bytes; `cbcr`
+/// is null or valid for reads of `cbcr_row_stride × ⌈height / 2⌉` bytes.
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pg_camera_frame(
     engine: *const PgEngine,
@@ -490,11 +494,15 @@ pub unsafe extern "C" fn pg_camera_frame(
     width: u32,
     height: u32,
     row_stride: usize,
+    cbcr: *const u8,
+    cbcr_row_stride: usize,
     rotation_cw_deg: u32,
     fx_px: f32,
     fy_px: f32,
     cx_px: f32,
     cy_px: f32,
+    exposure_time_s: f64,
+    iso: f64,
     timestamp_s: f64,
 ) -> PgStatus {
     guard(|| {
@@ -503,23 +511,42 @@ pub unsafe extern "C" fn pg_camera_frame(
         if luma.is_null() {
             return Err(Failure::new(PgStatus::NullPointer, "`luma` is null"));
         }
-        let len = row_stride
-            .checked_mul(height as usize)
-            .ok_or_else(|| Failure::new(PgStatus::InvalidArgument, "frame size overflows"))?;
+        let too_big = || Failure::new(PgStatus::InvalidArgument, "frame size overflows");
+        let len = row_stride.checked_mul(height as usize).ok_or_else(too_big)?;
         // SAFETY: the caller promises `row_stride × height` readable bytes at `luma`.
         let data = unsafe { std::slice::from_raw_parts(luma, len) };
         let capture_t_ns = crate::timestamp_ns(timestamp_s)
             .ok_or_else(|| Failure::new(PgStatus::InvalidArgument, "time stamp is not finite"))?;
         let intrinsics = Intrinsics::new(fx_px, fy_px, cx_px, cy_px);
-        let frame = OwnedFrame::luma8(
-            width,
-            height,
-            row_stride,
-            data,
-            rotation_cw_deg,
-            intrinsics,
-            capture_t_ns,
-        );
+        let frame = if cbcr.is_null() {
+            OwnedFrame::luma8(
+                width,
+                height,
+                row_stride,
+                data,
+                rotation_cw_deg,
+                intrinsics,
+                capture_t_ns,
+            )
+        } else {
+            let chroma_len = cbcr_row_stride
+                .checked_mul(height.div_ceil(2) as usize)
+                .ok_or_else(too_big)?;
+            // SAFETY: the caller promises `cbcr_row_stride × ⌈height / 2⌉` readable bytes.
+            let chroma = unsafe { std::slice::from_raw_parts(cbcr, chroma_len) };
+            OwnedFrame::yuv420(
+                width,
+                height,
+                row_stride,
+                data,
+                ChromaPlanes::interleaved(chroma, cbcr_row_stride),
+                rotation_cw_deg,
+                intrinsics,
+                capture_t_ns,
+            )
+            .map_err(|e| Failure::new(PgStatus::InvalidArgument, e.to_string()))?
+        };
+        let frame = frame.with_exposure(Exposure::new(exposure_time_s as f32, iso as f32));
         match engine.shared.camera_frame(frame)? {
             true => Ok(()),
             false => Err(Failure::new(

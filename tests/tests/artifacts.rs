@@ -445,6 +445,10 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
     tap_at(&mut e, floor, &mut t);
     let surface = e.control_px("surface").expect("the surface-mode switch");
     tap_at(&mut e, surface, &mut t);
+    assert!(!e.room_light_on(), "the studio's light by default");
+    let room_light = e.control_px("room-light").expect("the light switch");
+    tap_at(&mut e, room_light, &mut t);
+    assert!(e.room_light_on(), "the room's light switched on");
     let done = e.control_px("done").expect("done");
     tap_at(&mut e, done, &mut t);
     // The amphora shown again without its floor (reloaded in the background: perhaps already
@@ -458,12 +462,16 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
     );
     let saved = std::fs::read_to_string(&calibration).unwrap();
     assert!(
-        saved.contains("anaglyph dubois-amber-blue") && saved.contains("floor 0") && saved.contains("surface 1"),
+        saved.contains("anaglyph dubois-amber-blue")
+            && saved.contains("floor 0")
+            && saved.contains("surface 1")
+            && saved.contains("room_light 1"),
         "{saved}"
     );
     drop(e);
     let again = Engine::new(config()).unwrap();
     assert_eq!(again.method(), Method::DuboisAmberBlue, "kept for the next start");
+    assert!(again.room_light_on(), "the room's light kept for the next start");
 }
 
 /// The system's text size reaches the screens: the menu's controls grow with it, within

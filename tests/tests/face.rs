@@ -57,6 +57,8 @@ fn owned_frame(img: &image::RgbaImage, intrinsics: Intrinsics, capture_t_ns: i64
         rotation_cw_deg: f.rotation_cw_deg,
         intrinsics: f.intrinsics,
         capture_t_ns,
+        chroma: None,
+        exposure: None,
     }
 }
 
@@ -330,6 +332,8 @@ fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
         rotation_cw_deg: 0,
         intrinsics: k,
         capture_t_ns: 20,
+        chroma: None,
+        exposure: None,
     });
     while worker.last_error().is_none() {
         assert!(std::time::Instant::now() < deadline, "no error reported");

@@ -255,8 +255,19 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
         // Every other pose of the sweep: 15° apart is more than a frame needs.
         for (k, pose) in sweep().into_iter().enumerate().filter(|(k, _)| k % 2 == 0) {
             let metering = if k % 4 == 2 { BRACKET } else { Metering::Average };
-            let (frame, exposure) = camera.capture(&room, pose, metering, k as i64 * 100_000_000);
-            assert!(engine.room_light_frame_oriented(frame, Some(exposure), pose));
+            let (frame, _) = camera.capture(&room, pose, metering, k as i64 * 100_000_000);
+            // As the phones hand frames over: YUV, converted on the worker; every fourth frame's
+            // exposure reported apart, as Camera2's capture results come (matched by time).
+            let mut frame = phantogram_lab::synthetic_camera::as_yuv420(&frame);
+            if k % 8 == 0
+                && let Some(exposure) = frame.exposure.take()
+            {
+                engine
+                    .room_light()
+                    .expect("on")
+                    .note_exposure(frame.capture_t_ns, exposure);
+            }
+            assert!(engine.room_light_frame_oriented(frame, pose));
             let worker = engine.room_light().expect("on");
             assert!(
                 worker.wait_until(0, std::time::Duration::from_secs(120)),
@@ -293,6 +304,15 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
             );
         }
         golden::check(&format!("room-light-{name}"), w, h, &lit, 3, 0.003);
+        // The settings' "Light: the studio's": the frame is lit as before the sweep again, and
+        // camera frames are no longer taken.
+        engine.set_room_light(false);
+        assert!(!engine.room_light_on());
+        engine.draw(Some(0)).expect("draw");
+        let studio_again = engine.last_frame().expect("frame").2.to_vec();
+        assert_eq!(phantogram_integration::differing_pixels(&before, &studio_again), 0);
+        let (frame, _) = camera.capture(&room, Quat::IDENTITY, Metering::Average, 1);
+        assert!(!engine.room_light_frame_oriented(frame, Quat::IDENTITY));
         frames.push(lit);
     }
     if frames.len() == 2 {

@@ -140,11 +140,27 @@ public final class ReplayThroughJni {
             expect(IllegalArgumentException.class, "touch phase", () -> NativeBridge.nativeTouch(h, 9, 0, 0f, 0f, end));
             NativeBridge.nativeSetDisplay(h, 1080, 2400, 420f, 420f, 0);
             java.nio.ByteBuffer luma = java.nio.ByteBuffer.allocateDirect(64 * 48);
-            if (NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, 270, 50f, 50f, 32f, 24f, last)) {
+            // CameraX's usual chroma: two views of one interleaved plane, pixel stride 2.
+            java.nio.ByteBuffer cb = java.nio.ByteBuffer.allocateDirect(64 * 24 - 1);
+            java.nio.ByteBuffer cr = java.nio.ByteBuffer.allocateDirect(64 * 24 - 1);
+            if (NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, null, null, 0, 0, 270, 50f, 50f, 32f, 24f, last)) {
                 throw new AssertionError("face tracking is off: the frame must not be taken");
             }
+            if (NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, cr, 64, 2, 270, 50f, 50f, 32f, 24f, last)) {
+                throw new AssertionError("face tracking is off: the colour frame must not be taken");
+            }
             expect(IllegalArgumentException.class, "camera frame",
-                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, 45, 50f, 50f, 32f, 24f, end));
+                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, null, null, 0, 0, 45, 50f, 50f, 32f, 24f, end));
+            expect(IllegalArgumentException.class, "Cb row stride",
+                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, cr, 64, 4, 270, 50f, 50f, 32f, 24f, end));
+            expect(IllegalArgumentException.class, "chroma planes",
+                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, null, 64, 2, 270, 50f, 50f, 32f, 24f, end));
+            // The room light is off in this engine, but an exposure is taken (for when it is on);
+            // an unknown one is not.
+            if (!NativeBridge.nativeCameraExposure(h, last, 10_000_000L, 200)
+                    || NativeBridge.nativeCameraExposure(h, last, 0L, 200)) {
+                throw new AssertionError("camera exposure");
+            }
             NativeBridge.nativeSurfaceChanged(h, width / 2, height / 2);
             NativeBridge.nativeSurfaceDestroyed(h);
             if (NativeBridge.nativeDrawFrame(h, last)) {

@@ -70,14 +70,15 @@ impl RoomSweep {
     /// the room. Returns the share of the sphere seen.
     pub fn feed(&self, engine: &Engine) -> Result<f32> {
         let camera = SyntheticCamera::phone_front();
-        let Some(worker) = engine.room_light() else {
+        let Some(worker) = engine.room_light().filter(|w| w.is_on()) else {
             bail!("the engine's room light is off");
         };
         let bar = indicatif::ProgressBar::new(self.poses.len() as u64);
         for (k, (t, q)) in self.poses.iter().enumerate() {
             let metering = if k % 2 == 1 { BRACKET } else { Metering::Average };
-            let (frame, exposure) = camera.capture(&self.room, *q, metering, *t);
-            engine.room_light_frame_oriented(frame, Some(exposure), *q);
+            let (frame, _) = camera.capture(&self.room, *q, metering, *t);
+            // As a phone hands its frames over: YUV 4:2:0, turned into colour by the worker.
+            engine.room_light_frame_oriented(phantogram_lab::synthetic_camera::as_yuv420(&frame), *q);
             // One at a time: the worker would drop frames arriving faster than it blends them,
             // and the result would depend on this machine's speed.
             if !worker.wait_until(0, WORKER_TIMEOUT) {

@@ -3,6 +3,7 @@
 //! given the device's orientation it renders the frame the phone's camera would deliver — the
 //! buffer turned as the platform delivers it, exposed by its [`Metering`], clipped and encoded as
 //! 8-bit sRGB — and reports the exposure it chose, as Camera2 and AVFoundation report theirs.
+//! [`as_yuv420`] encodes such a frame as the phones deliver it (4:2:0 YCbCr, padded rows).
 //!
 //! Pure function of its inputs (no clock, no randomness). **Panics**: none.
 
@@ -10,7 +11,7 @@ use glam::{Quat, Vec3};
 use phantogram_assets::ibl::Environment;
 use phantogram_roomlight::tone::srgb8_from_linear;
 use phantogram_roomlight::world_from_buffer_camera;
-use phantogram_sensing::camera::{CameraPose, Intrinsics, OwnedFrame, PixelFormat};
+use phantogram_sensing::camera::{CameraPose, ChromaPlanes, Exposure, Intrinsics, OwnedFrame, PixelFormat};
 
 /// How a frame's exposure is chosen.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -110,8 +111,70 @@ impl SyntheticCamera {
             rotation_cw_deg: self.rotation_cw_deg,
             intrinsics: k,
             capture_t_ns,
+            chroma: None,
+            // Radiance × `exposure` is the linear value: a camera at ISO 100 exposing that long.
+            exposure: Exposure::new(exposure, 100.0),
         };
         (frame, exposure)
+    }
+}
+
+/// `frame` (RGBA) as a phone's camera delivers it: full-range BT.601 4:2:0, the luma plane with
+/// rows padded to a multiple of 64 bytes and one interleaved CbCr plane (iOS's `420f`; Android's
+/// `YUV_420_888` on most devices), each chroma sample the mean of its 2 × 2 pixels. Other frames
+/// come back as they are.
+pub fn as_yuv420(frame: &OwnedFrame) -> OwnedFrame {
+    if frame.format != PixelFormat::Rgba8 {
+        return frame.clone();
+    }
+    let (w, h) = (frame.width as usize, frame.height as usize);
+    let luma_stride = w.div_ceil(64) * 64;
+    let (cw, ch) = (w.div_ceil(2), h.div_ceil(2));
+    let chroma_stride = (cw * 2).div_ceil(64) * 64;
+    let rgb = |x: usize, y: usize| {
+        let i = y * frame.row_stride + x * 4;
+        [0, 1, 2].map(|c| f32::from(frame.data[i + c]))
+    };
+    let mut luma = vec![0u8; luma_stride * h];
+    let mut cbcr = vec![128u8; chroma_stride * ch];
+    let code = |v: f32| (v + 0.5).clamp(0.0, 255.0) as u8;
+    for y in 0..h {
+        for x in 0..w {
+            let [r, g, b] = rgb(x, y);
+            luma[y * luma_stride + x] = code(0.299 * r + 0.587 * g + 0.114 * b);
+        }
+    }
+    for cy in 0..ch {
+        for cx in 0..cw {
+            let (mut sum, mut n) = ([0.0f32; 3], 0.0);
+            for (x, y) in [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(dx, dy)| (2 * cx + dx, 2 * cy + dy)) {
+                if x < w && y < h {
+                    let c = rgb(x, y);
+                    (0..3).for_each(|i| sum[i] += c[i]);
+                    n += 1.0;
+                }
+            }
+            let [r, g, b] = sum.map(|v| v / n);
+            let i = cy * chroma_stride + cx * 2;
+            cbcr[i] = code(128.0 - 0.168_736 * r - 0.331_264 * g + 0.5 * b);
+            cbcr[i + 1] = code(128.0 + 0.5 * r - 0.418_688 * g - 0.081_312 * b);
+        }
+    }
+    let chroma = ChromaPlanes::interleaved(&cbcr, chroma_stride);
+    match OwnedFrame::yuv420(
+        frame.width,
+        frame.height,
+        luma_stride,
+        &luma,
+        chroma,
+        frame.rotation_cw_deg,
+        frame.intrinsics,
+        frame.capture_t_ns,
+    ) {
+        Ok(yuv) => yuv.with_exposure(frame.exposure),
+        // The planes were sized for the frame above; a refusal would be a bug here, shown as
+        // the frame unchanged rather than a panic.
+        Err(_) => frame.clone(),
     }
 }
 
@@ -164,5 +227,23 @@ mod tests {
         assert!((e_floor / e_average - 0.5).abs() < 1e-4);
         let (_, e_dark) = cam.capture(&env, upright, Metering::Highlights { min_ratio: 1e-4 }, 0);
         assert_eq!(e_dark, e_south);
+    }
+
+    #[test]
+    fn a_yuv_frame_decodes_close_to_its_rgb() {
+        let cam = SyntheticCamera::phone_front();
+        let env = Environment::studio();
+        let (rgb, exposure) = cam.capture(&env, Quat::from_rotation_x(0.3), Metering::Average, 5);
+        let yuv = as_yuv420(&rgb);
+        assert_eq!(
+            (yuv.format, yuv.exposure),
+            (PixelFormat::Luma8, Exposure::new(exposure, 100.0))
+        );
+        assert!(yuv.row_stride.is_multiple_of(64) && yuv.row_stride >= yuv.width as usize);
+        let back = yuv.to_rgba8().expect("colour").expect("decodes");
+        // Luma is exact to rounding; chroma is shared by 2 × 2 pixels, so edges differ more.
+        let diffs: Vec<u8> = rgb.data.iter().zip(&back.data).map(|(a, b)| a.abs_diff(*b)).collect();
+        let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;
+        assert!(mean < 1.5, "mean difference {mean:.2} codes");
     }
 }

@@ -973,6 +973,21 @@ impl Renderer {
         self.set_prefiltered_environment(&levels, &sh)
     }
 
+    /// Lights the scene with `environment`, or the generated studio when `None` (whose reduction
+    /// is made once per process and shared).
+    pub fn set_environment_or_studio(
+        &mut self,
+        environment: Option<&phantogram_assets::ibl::Environment>,
+    ) -> Result<(), RenderError> {
+        match environment {
+            Some(env) => self.set_environment(env),
+            None => self.set_prefiltered_environment(
+                default_prefiltered_environment(),
+                &phantogram_assets::ibl::IrradianceSh::from_environment(&phantogram_assets::ibl::Environment::studio()),
+            ),
+        }
+    }
+
     /// Lights the scene with an environment already reduced: its specular levels (as
     /// [`phantogram_assets::ibl::prefiltered_levels`] makes them, at [`PREFILTERED_BASE_WIDTH`])
     /// and its irradiance. Only uploads: for the render thread.

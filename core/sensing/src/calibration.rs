@@ -148,6 +148,9 @@ pub struct Calibration {
     /// "Reduce motion": the artifact is turned by touch, not by tilting the phone
     /// (`crate::turn_by_touch`).
     pub turn_by_touch: bool,
+    /// The light: the room's own, from the camera (`true`), or the studio's (`None`: the app's
+    /// default).
+    pub room_light: Option<bool>,
 }
 
 /// First line of a calibration file.
@@ -195,6 +198,9 @@ impl Calibration {
         }
         if self.turn_by_touch {
             s += "turn_by_touch 1\n";
+        }
+        if let Some(on) = self.room_light {
+            s += &format!("room_light {}\n", u8::from(on));
         }
         s
     }
@@ -295,6 +301,10 @@ impl Calibration {
                 "turn_by_touch" => {
                     want(1)?;
                     c.turn_by_touch = values[0] != 0.0;
+                }
+                "room_light" => {
+                    want(1)?;
+                    c.room_light = Some(values[0] != 0.0);
                 }
                 // Keys from newer versions are skipped, so a downgrade keeps what it understands.
                 _ => {}
@@ -428,6 +438,7 @@ mod tests {
             true_size: true,
             surface: true,
             turn_by_touch: true,
+            room_light: Some(false),
         };
         c.save(&path).unwrap();
         assert_eq!(Calibration::load(&path), (c, None));

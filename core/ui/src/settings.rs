@@ -1,8 +1,9 @@
 //! The settings screen, opened from the menu: which glasses (red/cyan, green/magenta,
 //! amber/blue, or none for a plain picture), whether tilting the phone or a finger turns the
 //! artifact ("reduce motion"), the diorama's floor, how much of a loaded model stands in front
-//! of the glass, whether loaded models keep their true size, and surface mode (artifacts lying
-//! in the glass at true size). It scrolls when a large system
+//! of the glass, whether loaded models keep their true size, surface mode (artifacts lying
+//! in the glass at true size), and the light (the studio's, or the room's own from the camera).
+//! It scrolls when a large system
 //! text size makes it taller than the screen.
 //!
 //! The host gives the current settings when it opens the screen and applies (and saves) each
@@ -25,6 +26,8 @@ pub struct Settings {
     pub surface: bool,
     /// "Reduce motion": a finger turns the artifact; tilting the phone does nothing.
     pub turn_by_touch: bool,
+    /// The light: the room's own, seen by the front camera (`true`), or the studio's.
+    pub room_light: bool,
 }
 
 /// What the host must do after a frame of the settings screen.
@@ -59,7 +62,7 @@ impl SettingsUi {
 
     /// The rectangle (points) of a control drawn last frame: the glasses by key (`red-cyan`,
     /// `green-magenta`, `amber-blue`, `none`), `turn-by-touch`, `floor`, `protrude`,
-    /// `true-size`, `surface`, `done`.
+    /// `true-size`, `surface`, `room-light`, `done`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.get(name)
     }
@@ -149,6 +152,16 @@ impl SettingsUi {
                     "Surface mode: off",
                 );
                 self.settings.surface = surface;
+                let mut room_light = self.settings.room_light;
+                self.switch(
+                    ui,
+                    "room-light",
+                    full,
+                    &mut room_light,
+                    "Light: your room's, seen by the camera",
+                    "Light: the studio's",
+                );
+                self.settings.room_light = room_light;
                 ui.add_space(10.0);
                 if self.widget_rects.wide_button(ui, "done", "Done", full) {
                     actions.push(SettingsAction::Close);
@@ -189,6 +202,7 @@ mod tests {
             true_size: false,
             surface: false,
             turn_by_touch: false,
+            room_light: false,
         };
         let mut s = SettingsUi::new(start);
         frame(&ctx, &mut s, vec![]);
@@ -200,6 +214,7 @@ mod tests {
             "floor",
             "true-size",
             "surface",
+            "room-light",
             "done",
         ] {
             assert!(
@@ -215,6 +230,7 @@ mod tests {
                 true_size,
                 surface: false,
                 turn_by_touch: false,
+                room_light: false,
             })
         };
         assert_eq!(
@@ -238,6 +254,14 @@ mod tests {
             })]
         );
         assert!(s.settings.turn_by_touch);
+        let before = s.settings;
+        assert_eq!(
+            tap(&ctx, &mut s, "room-light"),
+            vec![SettingsAction::Changed(Settings {
+                room_light: true,
+                ..before
+            })]
+        );
         assert_eq!(tap(&ctx, &mut s, "done"), vec![SettingsAction::Close]);
     }
 }

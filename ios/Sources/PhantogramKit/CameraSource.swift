@@ -1,10 +1,12 @@
 import AVFoundation
+import ImageIO
 import simd
 import PhantogramCore
 
-/// Front-camera frames (luma plane of 4:2:0 bi-planar buffers) with the camera's intrinsic
-/// matrix, pushed to the core, which tracks the face on its own thread. Without permission the
-/// app runs on tilt alone.
+/// Front-camera frames (both planes of 4:2:0 bi-planar full-range buffers: the face tracker reads
+/// the luma, the room light converts to colour in the core) with the camera's intrinsic matrix
+/// and the exposure from the buffer's EXIF attachment, pushed to the core, which works on its own
+/// threads. Without permission the app runs on tilt alone.
 final class CameraSource: NSObject, AVCaptureVideoDataOutputSampleBufferDelegate {
     private let session = AVCaptureSession()
     private let queue = DispatchQueue(label: "phantogram-camera")
@@ -75,10 +77,19 @@ final class CameraSource: NSObject, AVCaptureVideoDataOutputSampleBufferDelegate
         let width = CVPixelBufferGetWidthOfPlane(pixels, 0)
         let height = CVPixelBufferGetHeightOfPlane(pixels, 0)
         let stride = CVPixelBufferGetBytesPerRowOfPlane(pixels, 0)
+        // Plane 1 is the interleaved CbCr plane (nil: luma only, the room light is then grey).
+        let cbcr = CVPixelBufferGetPlaneCount(pixels) > 1 ? CVPixelBufferGetBaseAddressOfPlane(pixels, 1) : nil
+        let cbcrStride = cbcr == nil ? 0 : CVPixelBufferGetBytesPerRowOfPlane(pixels, 1)
+        // Exposure time (s) and ISO from the EXIF attachment; NaN when the buffer has none.
+        let exif = CMGetAttachment(sampleBuffer, key: kCGImagePropertyExifDictionary, attachmentModeOut: nil)
+            as? [String: Any]
+        let exposureS = (exif?[kCGImagePropertyExifExposureTime as String] as? Double) ?? .nan
+        let iso = ((exif?[kCGImagePropertyExifISOSpeedRatings as String] as? [Double])?.first) ?? .nan
         let time = CMTimeGetSeconds(CMSampleBufferGetPresentationTimeStamp(sampleBuffer))
         // The front camera's buffers are landscape; a quarter turn counter-clockwise (270° cw)
         // makes them upright in portrait. Column-major: k[0][0] = fx, k[1][1] = fy, k[2] = (cx, cy).
         pg_camera_frame(engine.handle, base.assumingMemoryBound(to: UInt8.self), UInt32(width), UInt32(height),
-                        stride, 270, k[0][0], k[1][1], k[2][0], k[2][1], time)
+                        stride, cbcr?.assumingMemoryBound(to: UInt8.self), cbcrStride, 270,
+                        k[0][0], k[1][1], k[2][0], k[2][1], exposureS, iso, time)
     }
 }

@@ -9,6 +9,7 @@
  */
 #include "phantogram.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -144,10 +145,16 @@ int main(int argc, char **argv) {
           "touch phase 7", "touch phase");
     check(pg_set_display(engine, 1080, 2400, 420.0f, 420.0f, 0), PG_STATUS_OK, "set display", NULL);
     uint8_t luma[64 * 48] = {0};
-    check(pg_camera_frame(engine, luma, 64, 48, 64, 270, 50.0f, 50.0f, 32.0f, 24.0f, (double)last * 1e-9),
+    uint8_t cbcr[64 * 24] = {0};
+    double t = (double)last * 1e-9;
+    check(pg_camera_frame(engine, luma, 64, 48, 64, NULL, 0, 270, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, t),
           PG_STATUS_UNSUPPORTED, "camera frame without face tracking", "face tracking is off");
-    check(pg_camera_frame(engine, luma, 64, 48, 64, 45, 50.0f, 50.0f, 32.0f, 24.0f, (double)last * 1e-9),
+    check(pg_camera_frame(engine, luma, 64, 48, 64, cbcr, 64, 270, 50.0f, 50.0f, 32.0f, 24.0f, 0.01, 200.0, t),
+          PG_STATUS_UNSUPPORTED, "colour camera frame without face tracking", "face tracking is off");
+    check(pg_camera_frame(engine, luma, 64, 48, 64, NULL, 0, 45, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, t),
           PG_STATUS_INVALID_ARGUMENT, "camera frame turned 45 degrees", "rotation");
+    check(pg_camera_frame(engine, luma, 64, 48, 64, cbcr, 32, 270, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, t),
+          PG_STATUS_INVALID_ARGUMENT, "CbCr rows narrower than the frame", "Cb row stride");
     check(pg_resize(engine, width / 2, height / 2), PG_STATUS_OK, "resize", NULL);
     check(pg_suspend(engine), PG_STATUS_OK, "suspend", NULL);
     size_t needed = 0;

@@ -9,6 +9,7 @@
 //! delivered (before [`CameraFrame::rotation_cw_deg`] turns it upright).
 
 pub mod android;
+pub mod yuv;
 
 use glam::{Quat, Vec3};
 
@@ -128,7 +129,80 @@ impl CameraPose {
     }
 }
 
-/// An owned camera frame, for handing to the face tracker's worker thread.
+/// A frame's exposure as the platform reports it (Camera2's `SENSOR_EXPOSURE_TIME` and
+/// `SENSOR_SENSITIVITY`; the EXIF `ExposureTime` and `ISOSpeedRatings` of an AVFoundation
+/// buffer): what turns its pixel values back into relative radiance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Exposure {
+    pub time_s: f32,
+    /// Sensor gain as an ISO speed (100 = unity on most phones).
+    pub iso: f32,
+}
+
+impl Exposure {
+    /// `None` unless both are finite and positive (platforms report 0 or leave a field out when
+    /// they do not know).
+    pub fn new(time_s: f32, iso: f32) -> Option<Self> {
+        (time_s.is_finite() && time_s > 0.0 && iso.is_finite() && iso > 0.0).then_some(Self { time_s, iso })
+    }
+
+    /// Exposure time × gain (seconds at ISO 100): pixel value ∝ radiance × this.
+    pub fn relative(self) -> f32 {
+        self.time_s * self.iso / 100.0
+    }
+}
+
+/// The chroma planes of a 4:2:0 frame beside its luma plane (copied as delivered: Android's
+/// `YUV_420_888` planes 1 and 2, iOS's interleaved CbCr plane), half the frame's size in each
+/// direction. [`OwnedFrame::to_rgba8`] turns the pair into colour.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ChromaPlanes {
+    /// Both planes; Cb is `data[cb]`, Cr `data[cr]` (overlapping when interleaved).
+    data: Vec<u8>,
+    cb: std::ops::Range<usize>,
+    cr: std::ops::Range<usize>,
+    /// Bytes from one chroma row to the next (both planes).
+    pub row_stride: usize,
+    /// Bytes from one chroma sample to the next in a row (1 planar, 2 interleaved).
+    pub pixel_stride: usize,
+}
+
+impl ChromaPlanes {
+    /// Two planes (Android's planes 1 and 2), each copied.
+    pub fn separate(cb: &[u8], cr: &[u8], row_stride: usize, pixel_stride: usize) -> Self {
+        let mut data = Vec::with_capacity(cb.len() + cr.len());
+        data.extend_from_slice(cb);
+        data.extend_from_slice(cr);
+        Self {
+            cb: 0..cb.len(),
+            cr: cb.len()..data.len(),
+            data,
+            row_stride,
+            pixel_stride,
+        }
+    }
+
+    /// One interleaved plane, Cb first (iOS's bi-planar plane 1, Android's NV12 layout), copied.
+    pub fn interleaved(cbcr: &[u8], row_stride: usize) -> Self {
+        Self {
+            data: cbcr.to_vec(),
+            cb: 0..cbcr.len(),
+            cr: 1.min(cbcr.len())..cbcr.len(),
+            row_stride,
+            pixel_stride: 2,
+        }
+    }
+
+    pub fn cb(&self) -> &[u8] {
+        &self.data[self.cb.clone()]
+    }
+
+    pub fn cr(&self) -> &[u8] {
+        &self.data[self.cr.clone()]
+    }
+}
+
+/// An owned camera frame, for handing to the face tracker's and the room light's worker threads.
 #[derive(Clone, Debug)]
 pub struct OwnedFrame {
     pub width: u32,
@@ -139,6 +213,9 @@ pub struct OwnedFrame {
     pub rotation_cw_deg: u32,
     pub intrinsics: Intrinsics,
     pub capture_t_ns: i64,
+    /// The chroma planes of a `Luma8` frame delivered as YUV (checked to fit the frame).
+    pub chroma: Option<ChromaPlanes>,
+    pub exposure: Option<Exposure>,
 }
 
 impl OwnedFrame {
@@ -163,7 +240,88 @@ impl OwnedFrame {
             rotation_cw_deg,
             intrinsics,
             capture_t_ns,
+            chroma: None,
+            exposure: None,
         }
+    }
+
+    /// A YUV 4:2:0 frame as the bridges receive it: the luma plane and the chroma planes, copied;
+    /// an error when the planes are too short for `width × height` or a stride is too narrow.
+    #[allow(clippy::too_many_arguments)]
+    pub fn yuv420(
+        width: u32,
+        height: u32,
+        row_stride: usize,
+        luma: &[u8],
+        chroma: ChromaPlanes,
+        rotation_cw_deg: u32,
+        intrinsics: Intrinsics,
+        capture_t_ns: i64,
+    ) -> Result<Self, yuv::YuvError> {
+        yuv::Yuv420 {
+            width,
+            height,
+            y: luma,
+            y_row_stride: row_stride,
+            cb: chroma.cb(),
+            cr: chroma.cr(),
+            chroma_row_stride: chroma.row_stride,
+            chroma_pixel_stride: chroma.pixel_stride,
+        }
+        .check()?;
+        Ok(Self {
+            chroma: Some(chroma),
+            ..Self::luma8(
+                width,
+                height,
+                row_stride,
+                luma,
+                rotation_cw_deg,
+                intrinsics,
+                capture_t_ns,
+            )
+        })
+    }
+
+    /// The same frame with its exposure, as reported.
+    pub fn with_exposure(self, exposure: Option<Exposure>) -> Self {
+        Self { exposure, ..self }
+    }
+
+    /// The frame's planes when it is YUV (luma with chroma).
+    fn yuv(&self) -> Option<yuv::Yuv420<'_>> {
+        let chroma = self.chroma.as_ref()?;
+        (self.format == PixelFormat::Luma8).then(|| yuv::Yuv420 {
+            width: self.width,
+            height: self.height,
+            y: &self.data,
+            y_row_stride: self.row_stride,
+            cb: chroma.cb(),
+            cr: chroma.cr(),
+            chroma_row_stride: chroma.row_stride,
+            chroma_pixel_stride: chroma.pixel_stride,
+        })
+    }
+
+    /// The frame in colour (`Rgba8`, rows packed, no chroma): converted when it is YUV, as it is
+    /// when it is RGBA already; `None` for a luma-only frame.
+    pub fn to_rgba8(&self) -> Option<Result<Self, yuv::YuvError>> {
+        if self.format == PixelFormat::Rgba8 {
+            return Some(Ok(self.clone()));
+        }
+        let planes = self.yuv()?;
+        Some(planes.to_rgba8().map(|data| Self {
+            width: self.width,
+            height: self.height,
+            row_stride: self.width as usize * 4,
+            format: PixelFormat::Rgba8,
+            data,
+            rotation_cw_deg: self.rotation_cw_deg,
+            intrinsics: self.intrinsics,
+            capture_t_ns: self.capture_t_ns,
+            chroma: None,
+            exposure: self.exposure,
+        }))
     }
 
     pub fn as_frame(&self) -> CameraFrame<'_> {

@@ -61,9 +61,20 @@ public final class NativeBridge {
     public static native boolean nativePushSensor(long handle, int sensorType, long timestampNs,
             float x, float y, float z, float w);
 
-    /** A front-camera Y plane (direct buffer, pixel stride 1); copied before returning. */
+    /**
+     * A front-camera YUV_420_888 frame: the Y plane (direct buffer, pixel stride 1) and the Cb and
+     * Cr planes (direct buffers with their row and pixel strides; both null for luma only); all
+     * copied before returning. Returns false when face tracking is off.
+     */
     public static native boolean nativeCameraFrame(long handle, ByteBuffer luma, int width, int height,
-            int rowStride, int rotationDegrees, float fx, float fy, float cx, float cy, long timestampNs);
+            int rowStride, ByteBuffer cb, ByteBuffer cr, int chromaRowStride, int chromaPixelStride,
+            int rotationDegrees, float fx, float fy, float cx, float cy, long timestampNs);
+
+    /**
+     * The exposure of the frame captured at timestampNs, from its capture result
+     * (SENSOR_EXPOSURE_TIME in ns, SENSOR_SENSITIVITY); matched to the frame by the core.
+     */
+    public static native boolean nativeCameraExposure(long handle, long timestampNs, long exposureTimeNs, int iso);
 
     /**
      * [fx, fy, cx, cy] of a width × height output image from Camera2's characteristics as

@@ -1,8 +1,13 @@
 package org.phantogram
 
 import android.content.Context
+import android.hardware.camera2.CameraCaptureSession
 import android.hardware.camera2.CameraCharacteristics
+import android.hardware.camera2.CaptureRequest
+import android.hardware.camera2.CaptureResult
+import android.hardware.camera2.TotalCaptureResult
 import androidx.camera.camera2.interop.Camera2CameraInfo
+import androidx.camera.camera2.interop.Camera2Interop
 import androidx.camera.camera2.interop.ExperimentalCamera2Interop
 import androidx.camera.core.CameraSelector
 import androidx.camera.core.ImageAnalysis
@@ -13,9 +18,11 @@ import androidx.lifecycle.LifecycleOwner
 import java.util.concurrent.Executors
 
 /**
- * Front-camera frames through CameraX image analysis: the luma plane (YUV_420_888 plane 0),
- * its rotation to upright, the intrinsics, and the capture time, handed to the core, which
- * tracks the face on its own thread and keeps only the newest frame.
+ * Front-camera frames through CameraX image analysis: the three YUV_420_888 planes as they are
+ * (the face tracker reads the luma, the room light converts to colour in the core), their
+ * rotation to upright, the intrinsics, and the capture time, handed to the core, which works on
+ * its own threads and keeps only the newest frame. Each frame's exposure (time and ISO) comes in
+ * its Camera2 capture result, forwarded with its time stamp; the core matches the two.
  *
  * Intrinsics: the camera's Camera2 characteristics (active and pre-correction arrays, pixel
  * array, physical size, focal length, LENS_INTRINSIC_CALIBRATION where published) are read once
@@ -40,10 +47,11 @@ class CameraForwarder(private val context: Context, private val engine: () -> Lo
         val future = ProcessCameraProvider.getInstance(context)
         future.addListener(Runnable {
             val provider = future.get()
-            val analysis = ImageAnalysis.Builder()
+            val builder = ImageAnalysis.Builder()
                 .setBackpressureStrategy(ImageAnalysis.STRATEGY_KEEP_ONLY_LATEST)
                 .setOutputImageFormat(ImageAnalysis.OUTPUT_IMAGE_FORMAT_YUV_420_888)
-                .build()
+            Camera2Interop.Extender(builder).setSessionCaptureCallback(exposures)
+            val analysis = builder.build()
             analysis.setAnalyzer(executor, ImageAnalysis.Analyzer { image -> forward(image) })
             provider.unbindAll()
             val camera = provider.bindToLifecycle(owner, CameraSelector.DEFAULT_FRONT_CAMERA, analysis)
@@ -52,6 +60,24 @@ class CameraForwarder(private val context: Context, private val engine: () -> Lo
     }
 
     fun close() = executor.shutdown()
+
+    /** Each capture's exposure, by its sensor time stamp (= the image's), to the core. */
+    private val exposures = object : CameraCaptureSession.CaptureCallback() {
+        override fun onCaptureCompleted(
+            session: CameraCaptureSession, request: CaptureRequest, result: TotalCaptureResult
+        ) {
+            val e = engine()
+            if (e == 0L) return
+            val time = result.get(CaptureResult.SENSOR_TIMESTAMP) ?: return
+            val exposure = result.get(CaptureResult.SENSOR_EXPOSURE_TIME) ?: return
+            val iso = result.get(CaptureResult.SENSOR_SENSITIVITY) ?: return
+            try {
+                NativeBridge.nativeCameraExposure(e, time, exposure, iso)
+            } catch (t: RuntimeException) {
+                android.util.Log.e("Phantogram", "camera exposure", t)
+            }
+        }
+    }
 
     @androidx.annotation.OptIn(markerClass = [ExperimentalCamera2Interop::class])
     private fun readLens(info: Camera2CameraInfo): Lens? {
@@ -96,11 +122,17 @@ class CameraForwarder(private val context: Context, private val engine: () -> Lo
         try {
             val e = engine()
             if (e == 0L) return
-            val plane = image.planes[0]
+            val planes = image.planes
+            val plane = planes[0]
             if (plane.pixelStride != 1) return
             val k = intrinsicsFor(image.width, image.height) ?: return
+            // YUV_420_888's chroma planes share their row and pixel strides.
+            val colour = planes.size >= 3
             NativeBridge.nativeCameraFrame(
-                e, plane.buffer, image.width, image.height, plane.rowStride, image.imageInfo.rotationDegrees,
+                e, plane.buffer, image.width, image.height, plane.rowStride,
+                if (colour) planes[1].buffer else null, if (colour) planes[2].buffer else null,
+                if (colour) planes[1].rowStride else 0, if (colour) planes[1].pixelStride else 0,
+                image.imageInfo.rotationDegrees,
                 k[0], k[1], k[2], k[3],
                 // CameraX time stamps are on the sensor-time-stamp clock (CLOCK_BOOTTIME on
                 // devices reporting SENSOR_INFO_TIMESTAMP_SOURCE_REALTIME, which phones do).
