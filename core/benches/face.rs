@@ -55,6 +55,7 @@ fn main() {
         rotation_cw_deg: 0,
         intrinsics: Intrinsics::from_horizontal_fov(640, 480, 60f32.to_radians()),
         capture_t_ns: 0,
+        chroma: None,
     };
     let mut tracker = FaceTracker::new(models, CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
     let mut measure = |detect: bool| {

@@ -72,6 +72,7 @@ fn camera_eyes_are_latency_compensated_and_continuous_through_loss() {
                 capture_t_ns: (t_c * NS) as i64,
                 eyes_m: seen,
                 confidence: if seen.is_some() { 0.95 } else { 0.0 },
+                glasses: None,
             });
             next_capture += 1;
         }

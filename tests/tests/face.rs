@@ -42,6 +42,7 @@ fn frame(img: &image::RgbaImage, intrinsics: Intrinsics) -> CameraFrame<'_> {
         rotation_cw_deg: 0,
         intrinsics,
         capture_t_ns: 0,
+        chroma: None,
     }
 }
 

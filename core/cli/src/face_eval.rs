@@ -61,6 +61,7 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
             rotation_cw_deg: 0,
             intrinsics,
             capture_t_ns: 0,
+            chroma: None,
         };
         let upright = UprightImage::new(frame)?;
         let faces = models.find_faces(&upright)?;
@@ -68,10 +69,23 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
             let faces: Vec<serde_json::Value> = faces
                 .iter()
                 .map(|f| {
+                    // A photo's subject faces the camera: the image's right eye is the viewer's left.
+                    let glasses = f.lenses.map(|l| {
+                        let seen = l.seen(false);
+                        serde_json::json!({
+                            "left": seen.left.name(),
+                            "right": seen.right.name(),
+                            "swapped": seen.swapped(),
+                            "strength": seen.strength,
+                        })
+                    });
+                    let ipd = f.ipd_for_distance(None);
                     serde_json::json!({
                         "left_eye": [f.left_eye_px.x, f.left_eye_px.y],
                         "right_eye": [f.right_eye_px.x, f.right_eye_px.y],
-                        "distance_mm": f.distance_m(&intrinsics, None).map(|d| d * 1000.0),
+                        "distance_mm": f.distance_m(&intrinsics, ipd).map(|d| d * 1000.0),
+                        "distance_from": if ipd.is_some() { "eye distance" } else { "iris" },
+                        "glasses": glasses,
                         "confidence": f.confidence,
                     })
                 })
@@ -86,11 +100,29 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
             });
             outln!("{}: {} face(s) [{camera}]", path.display(), faces.len());
             for (i, f) in faces.iter().enumerate() {
-                let distance = f
-                    .distance_m(&intrinsics, None)
-                    .map_or("-".to_owned(), |d| format!("{:.0} mm", d * 1000.0));
+                let ipd = f.ipd_for_distance(None);
+                let distance = f.distance_m(&intrinsics, ipd).map_or("-".to_owned(), |d| {
+                    format!(
+                        "{:.0} mm (from the {})",
+                        d * 1000.0,
+                        if ipd.is_some() { "eye distance" } else { "iris" }
+                    )
+                });
+                let glasses = f.lenses.map_or(String::new(), |l| {
+                    let seen = l.seen(false);
+                    format!(
+                        ", glasses {} over the left eye, {} over the right{}",
+                        seen.left.name(),
+                        seen.right.name(),
+                        if seen.swapped() {
+                            " (worn the other way round)"
+                        } else {
+                            ""
+                        }
+                    )
+                });
                 outln!(
-                    "  face {}: left eye ({:.1}, {:.1}) px, right eye ({:.1}, {:.1}) px, iris {:.1} px, distance {distance}, confidence {:.2}",
+                    "  face {}: left eye ({:.1}, {:.1}) px, right eye ({:.1}, {:.1}) px, iris {:.1} px, distance {distance}, confidence {:.2}{glasses}",
                     i + 1,
                     f.left_eye_px.x,
                     f.left_eye_px.y,

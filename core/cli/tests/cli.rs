@@ -411,6 +411,41 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
     assert!(face["distance_mm"].as_f64().unwrap() > 100.0);
     assert!((0.0..=1.0).contains(&face["confidence"].as_f64().unwrap()));
     assert_eq!(lines[1]["faces"].as_array().unwrap().len(), 0, "no face among the dogs");
+    assert_eq!(face["distance_from"], "iris");
+    assert!(face["glasses"].is_null(), "no glasses on the bare face");
+
+    // Red/cyan glasses drawn over the same face, red over the subject's left eye (the image's
+    // right): seen, named, and the distance taken from the eye distance.
+    let eye = |v: &serde_json::Value| {
+        phantogram::glam::Vec2::new(v[0].as_f64().unwrap() as f32, v[1].as_f64().unwrap() as f32)
+    };
+    let mut img = image::open(faces.join("astronaut.png")).unwrap().to_rgba8();
+    let (w, h) = img.dimensions();
+    let style = phantogram_lab::drawn_glasses::style_for(0);
+    assert_eq!(
+        style.filters,
+        (
+            phantogram::face::glasses::Filter::Cyan,
+            phantogram::face::glasses::Filter::Red
+        )
+    );
+    phantogram_lab::drawn_glasses::draw(&mut img, w, h, eye(l), eye(r), &style);
+    let glasses_dir = Scratch::new("cli-glasses");
+    let with = glasses_dir.join("astronaut-glasses.png");
+    img.save(&with).unwrap();
+    let out = bin()
+        .args(["eval", "face", "--json", "--models"])
+        .arg(&models)
+        .arg(&with)
+        .output()
+        .unwrap();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let line: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+    let face = &line["faces"][0];
+    assert_eq!(face["glasses"]["left"], "red", "{face}");
+    assert_eq!(face["glasses"]["right"], "cyan");
+    assert_eq!(face["glasses"]["swapped"], false);
+    assert_eq!(face["distance_from"], "eye distance");
 
     // A PNG whose header claims 60000 × 60000 pixels (14 GB to decode) and a Radiance HDR are
     // refused by name; the photo between them is still read.

@@ -13,6 +13,7 @@
 //! a bad track [`orientation_eval::TrackError`]. Single-threaded; replay may sleep between frames
 //! only when asked to (`Pace::RealTime`).
 
+pub mod drawn_glasses;
 pub mod orientation_eval;
 pub mod replay;
 pub mod sensorlog;

@@ -461,6 +461,7 @@ mod tests {
                 rotation_cw_deg: 0,
                 intrinsics: Intrinsics::from_horizontal_fov(width, height, 1.2),
                 capture_t_ns: 0,
+                chroma: None,
             },
             world_from_camera,
             exposure,

@@ -38,6 +38,8 @@ pub struct FaceObservation {
     pub eyes_m: Option<[Vec3; 2]>,
     /// In [0, 1]; 0 without a face.
     pub confidence: f32,
+    /// Anaglyph glasses on the viewer's face, when the frame had colour and they were seen.
+    pub glasses: Option<crate::glasses::GlassesSeen>,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -328,6 +330,7 @@ mod tests {
             capture_t_ns: 0,
             eyes_m: Some(eyes(0.4)),
             confidence: 0.9,
+            glasses: None,
         });
         let out = t.eyes_at(80 * MS, Some(q1), |_| unreachable!("the face is present"));
         let want = eyes(0.4).map(|p| q1.inverse() * p);
@@ -344,6 +347,7 @@ mod tests {
             capture_t_ns: 0,
             eyes_m: Some(eyes(0.45)),
             confidence: 0.9,
+            glasses: None,
         });
         let first = t.eyes_at(16 * MS, None, tilted);
         assert_eq!(first.source, EyeSource::Camera);
@@ -351,6 +355,7 @@ mod tests {
             capture_t_ns: 30 * MS,
             eyes_m: None,
             confidence: 0.0,
+            glasses: None,
         });
         let mut previous = first.left_m;
         let mut last = first;
@@ -380,6 +385,7 @@ mod tests {
                 capture_t_ns: k * frame_ns,
                 eyes_m: Some(eyes(0.4).map(|p| p + jitter)),
                 confidence: 0.9,
+                glasses: None,
             });
             let out = t.eyes_at(k * frame_ns, None, eyes);
             if k >= 30 {
@@ -401,6 +407,7 @@ mod tests {
                 capture_t_ns: t_ns,
                 eyes_m: Some(eyes(0.4).map(|p| p + Vec3::X * moved)),
                 confidence: 0.9,
+                glasses: None,
             });
             last = t.eyes_at(t_ns, None, eyes).left_m;
             // The head arrives at k = 7 (7 × 33 ms × 0.5 m/s ≥ 10 cm).
@@ -420,18 +427,21 @@ mod tests {
             capture_t_ns: 0,
             eyes_m: Some(eyes(0.4)),
             confidence: 0.2,
+            glasses: None,
         });
         assert_eq!(t.eyes_at(10 * MS, None, eyes).source, EyeSource::Tilt);
         t.observe(FaceObservation {
             capture_t_ns: 20 * MS,
             eyes_m: Some([Vec3::NAN; 2]),
             confidence: 1.0,
+            glasses: None,
         });
         assert_eq!(t.eyes_at(30 * MS, None, eyes).source, EyeSource::Tilt);
         t.observe(FaceObservation {
             capture_t_ns: 40 * MS,
             eyes_m: Some(eyes(0.4)),
             confidence: 1.0,
+            glasses: None,
         });
         assert_eq!(t.eyes_at(50 * MS, None, eyes).source, EyeSource::Camera);
         // The camera stopped delivering: after `stale_after_s` the tilt takes over.

@@ -29,6 +29,7 @@ pub mod camera;
 pub mod clock;
 pub mod eyetrack;
 pub mod fusion;
+pub mod glasses;
 pub mod lowpass;
 pub mod sensors;
 pub mod session;

@@ -488,6 +488,7 @@ mod tests {
             capture_t_ns: 0,
             eyes_m: Some(seen),
             confidence: 0.9,
+            glasses: None,
         });
         let first = s.frame_at(Some(10_000_000)).unwrap();
         assert_eq!(s.eye_source(), EyeSource::Camera);
@@ -501,6 +502,7 @@ mod tests {
                 capture_t_ns: k * 10_000_000,
                 eyes_m: Some(seen),
                 confidence: 0.9,
+                glasses: None,
             });
             last = s.frame_at(Some(k * 10_000_000)).unwrap();
         }
@@ -538,6 +540,7 @@ mod tests {
             capture_t_ns: 990_000_000,
             eyes_m: Some([Vec3::new(0.07, 0.0, 0.4), Vec3::new(0.13, 0.0, 0.4)]),
             confidence: 0.9,
+            glasses: None,
         });
         let later = s.frame_at(Some(1_000_000_000)).unwrap();
         assert_eq!(later.eyes, still.eyes);
@@ -569,6 +572,7 @@ mod tests {
                 capture_t_ns: t,
                 eyes_m: Some([Vec3::new(-0.03, 0.0, 0.4), Vec3::new(0.03, 0.0, 0.4)]),
                 confidence: 0.9,
+                glasses: None,
             });
             s.frame_at(Some(t)).unwrap();
         }

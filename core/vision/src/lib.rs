@@ -43,6 +43,8 @@ pub use phantogram_sensing::camera::{CameraFrame, CameraPose, Intrinsics, OwnedF
 pub use phantogram_sensing::eyetrack::FaceObservation;
 pub use worker::FaceWorker;
 
+pub mod glasses;
+mod prelu;
 mod worker;
 use tract_onnx::prelude::*;
 
@@ -86,6 +88,8 @@ impl FaceModels {
 
     /// Loads the three models from `dir` (a few tens of milliseconds each).
     pub fn load(dir: &Path) -> Result<Self, FaceError> {
+        let mut onnx = tract_onnx::onnx();
+        prelu::register(&mut onnx);
         let load = |file: &str, size: usize| -> Result<Plan, FaceError> {
             let path = dir.join(file);
             if !path.is_file() {
@@ -94,8 +98,7 @@ impl FaceModels {
                     dir: dir.to_path_buf(),
                 });
             }
-            tract_onnx::onnx()
-                .model_for_path(&path)
+            onnx.model_for_path(&path)
                 .and_then(|m| m.with_input_fact(0, f32::fact([1, 3, size, size]).into()))
                 .and_then(|m| m.into_optimized())
                 .and_then(|m| m.into_runnable())
@@ -191,16 +194,7 @@ impl<'a> UprightImage<'a> {
         if x < 0 || y < 0 || x >= self.width as i32 || y >= self.height as i32 {
             return [0.0; 3];
         }
-        let (w, h) = (self.frame.width as i32, self.frame.height as i32);
-        // Upright (x, y) back to the buffer: the inverse of the clockwise turn.
-        let (bx, by) = match self.frame.rotation_cw_deg {
-            90 => (y, h - 1 - x),
-            180 => (w - 1 - x, h - 1 - y),
-            270 => (w - 1 - y, x),
-            _ => (x, y),
-        };
-        let bpp = self.frame.format.bytes_per_pixel();
-        let at = by as usize * self.frame.row_stride + bx as usize * bpp;
+        let at = self.offset(x, y);
         let d = self.frame.data;
         match self.frame.format {
             PixelFormat::Luma8 => [f32::from(d[at]) / 255.0; 3],
@@ -212,24 +206,90 @@ impl<'a> UprightImage<'a> {
         }
     }
 
+    /// The buffer pixel of upright pixel `(x, y)`: the inverse of the clockwise turn.
+    #[inline]
+    fn buffer_xy(&self, x: i32, y: i32) -> (i32, i32) {
+        let (w, h) = (self.frame.width as i32, self.frame.height as i32);
+        match self.frame.rotation_cw_deg {
+            90 => (y, h - 1 - x),
+            180 => (w - 1 - x, h - 1 - y),
+            270 => (w - 1 - y, x),
+            _ => (x, y),
+        }
+    }
+
+    /// The buffer's byte offset of upright pixel `(x, y)`, which must be inside the image.
+    #[inline]
+    fn offset(&self, x: i32, y: i32) -> usize {
+        let (bx, by) = self.buffer_xy(x, y);
+        by as usize * self.frame.row_stride + bx as usize * self.frame.format.bytes_per_pixel()
+    }
+
+    /// Whether the frame has colour (RGBA, or luma with its chroma planes).
+    pub fn has_colour(&self) -> bool {
+        self.frame.format == PixelFormat::Rgba8 || self.frame.chroma.is_some()
+    }
+
+    /// The sRGB colour of the upright pixel nearest `p`, when the frame has colour and `p` is
+    /// inside it.
+    pub fn colour_at(&self, p: Vec2) -> Option<[u8; 3]> {
+        if !(p.x.is_finite() && p.y.is_finite()) || p.x < 0.0 || p.y < 0.0 {
+            return None;
+        }
+        let (x, y) = (p.x as i32, p.y as i32);
+        if x >= self.width as i32 || y >= self.height as i32 {
+            return None;
+        }
+        let (bx, by) = self.buffer_xy(x, y);
+        self.frame.rgb8_at(bx as u32, by as u32)
+    }
+
+    /// Bilinear RGB in [0, 1] at upright position `p` (pixel centres at half-integers).
     fn bilinear(&self, p: Vec2) -> [f32; 3] {
         let (x, y) = (p.x - 0.5, p.y - 0.5);
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (xi, yi) = (x0 as i32, y0 as i32);
-        let mut out = [0.0f32; 3];
-        for (dx, dy, w) in [
+        // floor without a libm call (the crops sample this hundreds of thousands of times).
+        let floor = |v: f32| {
+            let i = v as i32;
+            if (i as f32) > v { i - 1 } else { i }
+        };
+        let (xi, yi) = (floor(x), floor(y));
+        let (fx, fy) = (x - xi as f32, y - yi as f32);
+        let weights = [
             (0, 0, (1.0 - fx) * (1.0 - fy)),
             (1, 0, fx * (1.0 - fy)),
             (0, 1, (1.0 - fx) * fy),
             (1, 1, fx * fy),
-        ] {
-            let c = self.rgb(xi + dx, yi + dy);
-            for k in 0..3 {
-                out[k] += c[k] * w;
+        ];
+        let inside = xi >= 0 && yi >= 0 && xi < self.width as i32 - 1 && yi < self.height as i32 - 1;
+        if !(inside && x.is_finite() && y.is_finite()) {
+            // At the border (and for nonsense positions): black outside, as `rgb` reads it.
+            let mut out = [0.0f32; 3];
+            for (dx, dy, w) in weights {
+                let c = self.rgb(xi.saturating_add(dx), yi.saturating_add(dy));
+                for k in 0..3 {
+                    out[k] += c[k] * w;
+                }
+            }
+            return out;
+        }
+        // Inside: straight to the bytes, scaled to [0, 1] once.
+        let d = self.frame.data;
+        let mut out = [0.0f32; 3];
+        for (dx, dy, w) in weights {
+            let at = self.offset(xi + dx, yi + dy);
+            match self.frame.format {
+                PixelFormat::Luma8 => {
+                    let v = f32::from(d[at]) * w;
+                    out = [out[0] + v, out[1] + v, out[2] + v];
+                }
+                PixelFormat::Rgba8 => {
+                    out[0] += f32::from(d[at]) * w;
+                    out[1] += f32::from(d[at + 1]) * w;
+                    out[2] += f32::from(d[at + 2]) * w;
+                }
             }
         }
-        out
+        out.map(|v| v * (1.0 / 255.0))
     }
 }
 
@@ -254,6 +314,19 @@ impl Roi {
 
     /// The region resampled to `n × n`, NCHW, values mapped from [0, 1] to `range`.
     fn tensor(&self, image: &UprightImage, n: usize, range: (f32, f32), flip: bool) -> Vec<f32> {
+        self.tensor_with(image, n, range, flip, |_, c| c)
+    }
+
+    /// As [`Self::tensor`], each output pixel's colour (in [0, 1]) passed through `correct` with
+    /// its image position first (a lens's tint undone where it is).
+    fn tensor_with(
+        &self,
+        image: &UprightImage,
+        n: usize,
+        range: (f32, f32),
+        flip: bool,
+        correct: impl Fn(Vec2, [f32; 3]) -> [f32; 3],
+    ) -> Vec<f32> {
         let mut out = vec![0.0f32; 3 * n * n];
         // The pixel footprint may shrink a lot (a 1000-px face into 192): average a few
         // samples per output pixel so the crop does not alias.
@@ -274,8 +347,10 @@ impl Roi {
                     }
                 }
                 let norm = 1.0 / (taps * taps) as f32;
+                let centre = self.image_point((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32, flip);
+                let c = correct(centre, acc.map(|v| v * norm));
                 for k in 0..3 {
-                    out[k * n * n + j * n + i] = lo + (hi - lo) * acc[k] * norm;
+                    out[k * n * n + j * n + i] = lo + (hi - lo) * c[k];
                 }
             }
         }
@@ -316,6 +391,10 @@ pub struct FaceFound {
     pub confidence: f32,
     /// The 468 FaceMesh landmarks (x, y, pixels).
     pub landmarks: Vec<Vec2>,
+    /// Anaglyph glasses on the face, when the frame has colour and they are there
+    /// ([`glasses`]): the eyes were then found in crops with the lenses' tint undone, and the
+    /// distance comes from the eye distance, not the (tinted, smaller-looking) iris.
+    pub lenses: Option<glasses::Lenses>,
 }
 
 /// One face-detector hit: box and the six keypoints, pixels.
@@ -454,9 +533,19 @@ impl FaceModels {
         }
     }
 
-    /// FaceMesh in `roi`: the landmarks and the face flag, or `None` if not a face.
-    fn mesh(&self, image: &UprightImage, roi: &Roi) -> Result<Option<(Vec<Vec2>, f32)>, FaceError> {
-        let out = Self::run(&self.mesh, roi.tensor(image, 192, (0.0, 1.0), false), 192)?;
+    /// FaceMesh in `roi`: the landmarks and the face flag, or `None` if not a face. With
+    /// `lenses` (glasses seen where the eyes were expected), their tint is undone in the crop.
+    fn mesh(
+        &self,
+        image: &UprightImage,
+        roi: &Roi,
+        lenses: Option<&glasses::Lenses>,
+    ) -> Result<Option<(Vec<Vec2>, f32)>, FaceError> {
+        let crop = match lenses {
+            Some(l) => roi.tensor_with(image, 192, (0.0, 1.0), false, |p, c| l.untint_at(p, c)),
+            None => roi.tensor(image, 192, (0.0, 1.0), false),
+        };
+        let out = Self::run(&self.mesh, crop, 192)?;
         let [points, flag, ..] = out.as_slice() else {
             return Err(FaceError::Inference("face mesh: expected two outputs".into()));
         };
@@ -472,13 +561,25 @@ impl FaceModels {
         Ok(Some((landmarks, flag)))
     }
 
-    /// Iris in the eye between the two corner landmarks: centre and diameter, pixels.
-    fn iris(&self, image: &UprightImage, from: Vec2, to: Vec2, flip: bool) -> Result<Option<(Vec2, f32)>, FaceError> {
+    /// Iris in the eye between the two corner landmarks: centre and diameter, pixels. Under a
+    /// lens of `transmission`, the crop's tint is undone first.
+    fn iris(
+        &self,
+        image: &UprightImage,
+        from: Vec2,
+        to: Vec2,
+        flip: bool,
+        transmission: Option<[f32; 3]>,
+    ) -> Result<Option<(Vec2, f32)>, FaceError> {
         let roi = Roi::around([from, to].into_iter(), from, to, 2.3);
         if roi.size.is_nan() || roi.size <= 1.0 {
             return Ok(None);
         }
-        let out = Self::run(&self.iris, roi.tensor(image, 64, (0.0, 1.0), flip), 64)?;
+        let mut crop = roi.tensor(image, 64, (0.0, 1.0), flip);
+        if let Some(t) = transmission {
+            glasses::untint(&mut crop, 64, t);
+        }
+        let out = Self::run(&self.iris, crop, 64)?;
         let [_, iris, ..] = out.as_slice() else {
             return Err(FaceError::Inference("iris: expected two outputs".into()));
         };
@@ -495,15 +596,29 @@ impl FaceModels {
         Ok(Some((p[0], diameter)))
     }
 
-    /// Landmarks + irises for the face in `roi`.
-    fn face_in(&self, image: &UprightImage, roi: &Roi) -> Result<Option<FaceFound>, FaceError> {
-        let Some((landmarks, flag)) = self.mesh(image, roi)? else {
+    /// Landmarks + irises for the face in `roi`, whose eyes are expected near `eyes_hint` (image
+    /// left, image right: a detection's keypoints, or the last frame's eyes) when known.
+    fn face_in(
+        &self,
+        image: &UprightImage,
+        roi: &Roi,
+        eyes_hint: Option<[Vec2; 2]>,
+    ) -> Result<Option<FaceFound>, FaceError> {
+        let hinted = eyes_hint.and_then(|[l, r]| glasses::find_at(image, l, r));
+        let Some((landmarks, flag)) = self.mesh(image, roi, hinted.as_ref())? else {
             return Ok(None);
         };
         let (a0, a1) = IMAGE_LEFT_EYE_CORNERS;
         let (b0, b1) = IMAGE_RIGHT_EYE_CORNERS;
-        let left = self.iris(image, landmarks[a0], landmarks[a1], false)?;
-        let right = self.iris(image, landmarks[b0], landmarks[b1], true)?;
+        // Glasses, looked for around the eyes' corners' midpoints (the irises are not known yet).
+        let lenses = glasses::find_at(
+            image,
+            (landmarks[a0] + landmarks[a1]) * 0.5,
+            (landmarks[b0] + landmarks[b1]) * 0.5,
+        );
+        let t = lenses.map(|l| l.transmission);
+        let left = self.iris(image, landmarks[a0], landmarks[a1], false, t.map(|t| t[0]))?;
+        let right = self.iris(image, landmarks[b0], landmarks[b1], true, t.map(|t| t[1]))?;
         let (Some((left_eye_px, dl)), Some((right_eye_px, dr))) = (left, right) else {
             return Ok(None);
         };
@@ -513,12 +628,15 @@ impl FaceModels {
             iris_diameter_px: 0.5 * (dl + dr),
             confidence: flag,
             landmarks,
+            lenses,
         }))
     }
 
     /// The face a detection leads to, its confidence the lower of detector score and face flag.
     fn face_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<FaceFound>, FaceError> {
-        Ok(self.face_in(image, &roi_from_detection(d))?.map(|mut f| {
+        let [a, b] = [d.keypoints[0], d.keypoints[1]];
+        let eyes = if a.x <= b.x { [a, b] } else { [b, a] };
+        Ok(self.face_in(image, &roi_from_detection(d), Some(eyes))?.map(|mut f| {
             f.confidence = f.confidence.min(d.score);
             f
         }))
@@ -635,6 +753,13 @@ impl FaceFound {
         (depth.is_finite() && depth > 0.0).then(|| [a * depth, b * depth])
     }
 
+    /// The eye distance this face's distance is taken from: the viewer's calibrated one, or,
+    /// with glasses on (whose tint makes the iris look smaller than it is), the default
+    /// ([`phantogram_geometry::eyes::EyeModel::DEFAULT_IPD_M`]); `None`: the iris's size.
+    pub fn ipd_for_distance(&self, calibrated_ipd_m: Option<f32>) -> Option<f32> {
+        calibrated_ipd_m.or(self.lenses.map(|_| phantogram_geometry::eyes::EyeModel::DEFAULT_IPD_M))
+    }
+
     /// Distance from the camera to the midpoint between the eyes, metres.
     pub fn distance_m(&self, intrinsics: &Intrinsics, ipd_m: Option<f32>) -> Option<f32> {
         self.eyes_camera_m(intrinsics, ipd_m)
@@ -656,6 +781,9 @@ pub struct FaceTracker {
     /// The viewer's calibrated interpupillary distance; `None`: distance from the iris.
     pub ipd_m: Option<f32>,
     roi: Option<Roi>,
+    /// The last frame's eyes (image left, image right, pixels): where glasses are looked for
+    /// before FaceMesh runs.
+    last_eyes_px: Option<[Vec2; 2]>,
     last_mode: TrackingMode,
 }
 
@@ -666,6 +794,7 @@ impl FaceTracker {
             pose,
             ipd_m: None,
             roi: None,
+            last_eyes_px: None,
             last_mode: TrackingMode::Detecting,
         }
     }
@@ -678,6 +807,7 @@ impl FaceTracker {
     /// Forgets the tracked face: the next frame runs the detector.
     pub fn reset(&mut self) {
         self.roi = None;
+        self.last_eyes_px = None;
     }
 
     /// Finds the viewer's eyes in `frame` (the most confident face if several).
@@ -686,7 +816,7 @@ impl FaceTracker {
         let mut found = None;
         if let Some(roi) = self.roi {
             self.last_mode = TrackingMode::Tracking;
-            found = self.models.face_in(&image, &roi)?;
+            found = self.models.face_in(&image, &roi, self.last_eyes_px)?;
         }
         if found.is_none() {
             self.last_mode = TrackingMode::Detecting;
@@ -695,12 +825,15 @@ impl FaceTracker {
             }
         }
         self.roi = found.as_ref().map(|f| roi_from_landmarks(&f.landmarks));
+        self.last_eyes_px = found.as_ref().map(|f| [f.left_eye_px, f.right_eye_px]);
         let found = found.filter(|f| f.confidence >= MIN_FACE_CONFIDENCE);
+        let mut glasses = None;
         let eyes_m = found.as_ref().and_then(|f| {
-            let [image_left, image_right] = f.eyes_camera_m(&image.intrinsics, self.ipd_m)?;
+            let [image_left, image_right] = f.eyes_camera_m(&image.intrinsics, f.ipd_for_distance(self.ipd_m))?;
             let to_device = |p: Vec3| self.pose.position_m + self.pose.device_from_camera * p;
             let (a, b) = (to_device(image_left), to_device(image_right));
             // The viewer's left eye is the one further towards the device's −x.
+            glasses = f.lenses.map(|l| l.seen(a.x <= b.x));
             Some(if a.x <= b.x { [a, b] } else { [b, a] })
         });
         Ok(FaceObservation {
@@ -711,6 +844,7 @@ impl FaceTracker {
                 0.0
             },
             eyes_m,
+            glasses,
         })
     }
 }
@@ -729,6 +863,7 @@ mod tests {
             rotation_cw_deg: rot,
             intrinsics: Intrinsics::from_horizontal_fov(w, h, 1.0),
             capture_t_ns: 0,
+            chroma: None,
         }
     }
 
@@ -845,6 +980,7 @@ mod tests {
             iris_diameter_px: 500.0 * IRIS_DIAMETER_M / 0.4,
             confidence: 1.0,
             landmarks: Vec::new(),
+            lenses: None,
         };
         assert!((face.distance_m(&k, None).unwrap() - 0.4).abs() < 1e-4);
         assert!((face.distance_m(&k, Some(0.063)).unwrap() - 0.4).abs() < 1e-4);

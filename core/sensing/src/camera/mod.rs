@@ -107,6 +107,37 @@ pub struct CameraFrame<'a> {
     pub intrinsics: Intrinsics,
     /// When the exposure happened, on the sensor clock, nanoseconds.
     pub capture_t_ns: i64,
+    /// The chroma planes of a `Luma8` frame delivered as YUV 4:2:0 (checked to fit it), for
+    /// whoever wants colour at a few places ([`CameraFrame::rgb8_at`]); the networks read luma.
+    pub chroma: Option<ChromaView<'a>>,
+}
+
+/// The chroma planes of a YUV frame, borrowed ([`ChromaPlanes::view`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ChromaView<'a> {
+    pub cb: &'a [u8],
+    pub cr: &'a [u8],
+    pub row_stride: usize,
+    pub pixel_stride: usize,
+}
+
+impl CameraFrame<'_> {
+    /// The sRGB colour of buffer pixel `(x, y)` (as delivered, before the turn): from RGBA, or
+    /// from luma and chroma; `None` for a luma-only frame or a pixel outside the frame.
+    pub fn rgb8_at(&self, x: u32, y: u32) -> Option<[u8; 3]> {
+        if x >= self.width || y >= self.height {
+            return None;
+        }
+        let at = y as usize * self.row_stride + x as usize * self.format.bytes_per_pixel();
+        match (self.format, self.chroma) {
+            (PixelFormat::Rgba8, _) => Some([*self.data.get(at)?, *self.data.get(at + 1)?, *self.data.get(at + 2)?]),
+            (PixelFormat::Luma8, Some(c)) => {
+                let ca = (y / 2) as usize * c.row_stride + (x / 2) as usize * c.pixel_stride;
+                Some(yuv::rgb_from_ycbcr(*self.data.get(at)?, *c.cb.get(ca)?, *c.cr.get(ca)?))
+            }
+            (PixelFormat::Luma8, None) => None,
+        }
+    }
 }
 
 /// Where the camera sits in the device frame.
@@ -199,6 +230,15 @@ impl ChromaPlanes {
 
     pub fn cr(&self) -> &[u8] {
         &self.data[self.cr.clone()]
+    }
+
+    pub fn view(&self) -> ChromaView<'_> {
+        ChromaView {
+            cb: self.cb(),
+            cr: self.cr(),
+            row_stride: self.row_stride,
+            pixel_stride: self.pixel_stride,
+        }
     }
 }
 
@@ -334,6 +374,11 @@ impl OwnedFrame {
             rotation_cw_deg: self.rotation_cw_deg,
             intrinsics: self.intrinsics,
             capture_t_ns: self.capture_t_ns,
+            chroma: self
+                .chroma
+                .as_ref()
+                .filter(|_| self.format == PixelFormat::Luma8)
+                .map(ChromaPlanes::view),
         }
     }
 }

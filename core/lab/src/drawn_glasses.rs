@@ -1,0 +1,211 @@
+//! Anaglyph glasses drawn over a face photograph, for testing the glasses-aware face tracker
+//! with ground truth: the same photo without them is the reference.
+//!
+//! A lens is drawn as a filter is seen: in linear light each pixel under it is multiplied by the
+//! lens's transmission (mixed with clear for a partly transparent lens), then a frame rim
+//! (cardboard or plastic: dark, of a given width) around it, and optionally a specular
+//! reflection (a soft white streak) on it. The lens is centred on the eye's centre, of a width
+//! given as a fraction of the eye distance, and turned with the eye line.
+//!
+//! Pure function of its inputs. **Panics**: none (positions outside the image draw nothing).
+
+use glam::Vec2;
+use phantogram_sensing::glasses::Filter;
+
+/// A lens's outline.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LensShape {
+    Ellipse,
+    /// A rectangle with corners rounded by this fraction of the lens's height.
+    RoundedRect(f32),
+}
+
+/// How to draw one pair of glasses.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GlassesStyle {
+    /// The filters over the image-left and image-right eye.
+    pub filters: (Filter, Filter),
+    pub shape: LensShape,
+    /// Lens width / eye distance.
+    pub width_ipd: f32,
+    /// Lens height / lens width.
+    pub aspect: f32,
+    /// Share of the light the filter acts on (1: the full filter; 0.5: half passes unfiltered).
+    pub opacity: f32,
+    /// The rim's width / eye distance (0: rimless) and its colour (sRGB).
+    pub rim_ipd: f32,
+    pub rim_rgb: [u8; 3],
+    /// A specular reflection's peak brightness (0: none) — a soft streak across the lens.
+    pub reflection: f32,
+}
+
+/// Linear transmission of a drawn filter (measured shapes of cheap anaglyph gels, roughly).
+pub fn filter_transmission(filter: Filter) -> [f32; 3] {
+    match filter {
+        Filter::Red => [0.85, 0.06, 0.05],
+        Filter::Cyan => [0.05, 0.75, 0.85],
+        Filter::Green => [0.06, 0.8, 0.12],
+        Filter::Magenta => [0.8, 0.05, 0.8],
+        Filter::Amber => [0.9, 0.55, 0.04],
+        Filter::Blue => [0.04, 0.12, 0.85],
+    }
+}
+
+fn to_linear(code: u8) -> f32 {
+    let c = f32::from(code) / 255.0;
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+fn to_srgb(v: f32) -> u8 {
+    let v = v.clamp(0.0, 1.0);
+    let c = if v <= 0.003_130_8 {
+        12.92 * v
+    } else {
+        1.055 * v.powf(1.0 / 2.4) - 0.055
+    };
+    (c * 255.0 + 0.5) as u8
+}
+
+/// Draws `style`'s glasses into `rgba` (`width × height`, rows packed) over the eyes at
+/// `image_left_eye` and `image_right_eye` (pixels).
+pub fn draw(
+    rgba: &mut [u8],
+    width: u32,
+    height: u32,
+    image_left_eye: Vec2,
+    image_right_eye: Vec2,
+    style: &GlassesStyle,
+) {
+    let ipd = image_left_eye.distance(image_right_eye);
+    if !(ipd.is_finite() && ipd > 1.0) || rgba.len() < (width * height * 4) as usize {
+        return;
+    }
+    let across = (image_right_eye - image_left_eye) / ipd;
+    let down = Vec2::new(-across.y, across.x);
+    let half = Vec2::new(style.width_ipd * 0.5, style.width_ipd * style.aspect * 0.5) * ipd;
+    let rim = style.rim_ipd * ipd;
+    let lenses = [
+        (image_left_eye, filter_transmission(style.filters.0)),
+        (image_right_eye, filter_transmission(style.filters.1)),
+    ];
+    // Signed distance-like measure: < 1 inside the lens outline, scaled by the half sizes.
+    let inside = |q: Vec2, grow: f32| -> bool {
+        let h = half + Vec2::splat(grow);
+        match style.shape {
+            LensShape::Ellipse => (q.x / h.x).powi(2) + (q.y / h.y).powi(2) <= 1.0,
+            LensShape::RoundedRect(r) => {
+                let radius = (r.clamp(0.0, 0.5) * 2.0 * half.y).min(h.x).min(h.y);
+                let d = q.abs() - (h - Vec2::splat(radius));
+                let outside = d.max(Vec2::ZERO).length() + d.x.max(d.y).min(0.0);
+                outside <= radius
+            }
+        }
+    };
+    let reach = (half.x.max(half.y) + rim + 2.0).ceil();
+    for (centre, t) in lenses {
+        let (x0, x1) = (
+            (centre.x - reach).max(0.0) as u32,
+            ((centre.x + reach).max(0.0) as u32).min(width),
+        );
+        let (y0, y1) = (
+            (centre.y - reach).max(0.0) as u32,
+            ((centre.y + reach).max(0.0) as u32).min(height),
+        );
+        for y in y0..y1 {
+            for x in x0..x1 {
+                let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - centre;
+                let q = Vec2::new(p.dot(across), p.dot(down));
+                let at = ((y * width + x) * 4) as usize;
+                if inside(q, 0.0) {
+                    // A streak from upper left to lower right, brightest on its centre line.
+                    let streak = style.reflection
+                        * (-((q.x + q.y * 1.5 + 0.2 * half.x) / (0.12 * half.x)).powi(2)).exp()
+                        * (q.y < 0.0) as u8 as f32;
+                    for k in 0..3 {
+                        let v = to_linear(rgba[at + k]);
+                        let filtered = v * (1.0 - style.opacity + style.opacity * t[k]);
+                        rgba[at + k] = to_srgb(filtered + streak);
+                    }
+                } else if rim > 0.0 && inside(q, rim) {
+                    rgba[at..at + 3].copy_from_slice(&style.rim_rgb);
+                }
+            }
+        }
+    }
+}
+
+/// A spread of styles for one photo: shapes, sizes (0.6–0.8 of the eye distance), the three kinds
+/// of glasses either way round, full and partly transparent lenses, cardboard and plastic rims,
+/// with and without reflections. `seed` picks which (deterministic).
+pub fn style_for(seed: u32) -> GlassesStyle {
+    let pairs = [
+        (Filter::Cyan, Filter::Red),
+        (Filter::Magenta, Filter::Green),
+        (Filter::Blue, Filter::Amber),
+        (Filter::Red, Filter::Cyan),
+    ];
+    // The viewer's left eye is on the image's right: red, green or amber on the right is the
+    // usual way; the fourth pair is worn the other way round.
+    let shapes = [
+        LensShape::Ellipse,
+        LensShape::RoundedRect(0.3),
+        LensShape::RoundedRect(0.1),
+    ];
+    let pick =
+        |n: u32, salt: u32| ((seed.wrapping_mul(2_654_435_761).wrapping_add(salt.wrapping_mul(40_503))) >> 7) % n;
+    let cardboard = pick(2, 3) == 0;
+    GlassesStyle {
+        filters: pairs[(seed % 4) as usize],
+        shape: shapes[pick(3, 1) as usize],
+        width_ipd: 0.6 + 0.1 * pick(3, 2) as f32,
+        aspect: 0.6 + 0.1 * pick(3, 4) as f32,
+        opacity: [1.0, 0.85, 0.7][pick(3, 5) as usize],
+        rim_ipd: if cardboard {
+            0.06
+        } else {
+            [0.0, 0.025][pick(2, 6) as usize]
+        },
+        rim_rgb: if cardboard { [235, 232, 225] } else { [25, 22, 20] },
+        reflection: [0.0, 0.25][pick(2, 7) as usize],
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_lens_filters_what_is_under_it_and_nothing_else() {
+        let (w, h) = (64u32, 32u32);
+        let mut img = vec![180u8; (w * h * 4) as usize];
+        let style = GlassesStyle {
+            filters: (Filter::Red, Filter::Cyan),
+            shape: LensShape::Ellipse,
+            width_ipd: 0.7,
+            aspect: 0.7,
+            opacity: 1.0,
+            rim_ipd: 0.0,
+            rim_rgb: [0, 0, 0],
+            reflection: 0.0,
+        };
+        draw(&mut img, w, h, Vec2::new(16.0, 16.0), Vec2::new(48.0, 16.0), &style);
+        let px = |x: u32, y: u32| {
+            let i = ((y * w + x) * 4) as usize;
+            [img[i], img[i + 1], img[i + 2]]
+        };
+        let (red, cyan, between) = (px(16, 16), px(48, 16), px(32, 2));
+        assert!(red[0] > 150 && red[1] < 80 && red[2] < 80, "{red:?}");
+        assert!(cyan[0] < 80 && cyan[1] > 140 && cyan[2] > 150, "{cyan:?}");
+        assert_eq!(between, [180, 180, 180]);
+        // Eyes on one pixel, or nonsense: nothing drawn, no panic.
+        let before = img.clone();
+        draw(&mut img, w, h, Vec2::new(5.0, 5.0), Vec2::new(5.0, 5.0), &style);
+        draw(&mut img, w, h, Vec2::new(f32::NAN, 5.0), Vec2::new(5.0, 5.0), &style);
+        draw(&mut img, w, h, Vec2::new(-500.0, 5.0), Vec2::new(900.0, 5.0), &style);
+        assert!(img.len() == before.len());
+    }
+}
