@@ -283,6 +283,8 @@ pub struct Engine {
     #[cfg(feature = "face")]
     face: Option<Arc<crate::face::FaceWorker>>,
     last_face_t_ns: Option<i64>,
+    /// The glasses the face tracker saw last (with the newest face), for the glasses check.
+    last_glasses: Option<phantogram_sensing::glasses::GlassesSeen>,
     gestures: Gestures,
     last_frame: Option<(u32, u32, Vec<u8>)>,
     stats: EngineStats,
@@ -587,6 +589,7 @@ impl Engine {
             #[cfg(feature = "face")]
             face,
             last_face_t_ns: None,
+            last_glasses: None,
             gestures: Gestures::new(config.panel.xdpi),
             last_frame: None,
             stats: EngineStats::default(),
@@ -711,6 +714,13 @@ impl Engine {
     /// Whether the room's own light is on.
     pub fn room_light_on(&self) -> bool {
         self.room_light.as_ref().is_some_and(|w| w.is_on())
+    }
+
+    /// The anaglyph glasses the front camera saw on the viewer with the newest face (colour camera
+    /// frames and face tracking needed): which filter is over which eye. The first-run glasses
+    /// check says it beside its question.
+    pub fn glasses_seen(&self) -> Option<phantogram_sensing::glasses::GlassesSeen> {
+        self.last_glasses
     }
 
     /// The live room light's worker (its counts, waiting for it; on or off).
@@ -1666,6 +1676,7 @@ impl Engine {
         let mut settings_actions = Vec::new();
         let mut material_actions = Vec::new();
         let filters = filter_colours(self.method);
+        let camera_glasses = self.last_glasses;
         let mut card_closed = false;
         // Only the menu says how the eyes are found.
         let eyes_status = match &screens.page {
@@ -1689,7 +1700,10 @@ impl Engine {
                     )
                     .0
                 }
-                Some(Page::Welcome(welcome)) => welcome_actions = welcome.show(root, filters),
+                Some(Page::Welcome(welcome)) => {
+                    welcome.camera_glasses = camera_glasses;
+                    welcome_actions = welcome.show(root, filters)
+                }
                 Some(Page::Settings(settings)) => settings_actions = settings.show(root),
                 Some(Page::Material(material)) => material_actions = material.show(root),
                 Some(Page::Annotation(i)) => match annotations.get(*i) {
@@ -1939,6 +1953,9 @@ impl Engine {
         let newest = self.face.as_ref().and_then(|f| f.newest());
         if let Some(obs) = newest.filter(|o| self.last_face_t_ns != Some(o.capture_t_ns)) {
             self.last_face_t_ns = Some(obs.capture_t_ns);
+            if obs.eyes_m.is_some() {
+                self.last_glasses = obs.glasses;
+            }
             self.session.observe_face(obs);
         }
     }

@@ -312,3 +312,64 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
         }
     }
 }
+
+/// Through the engine as a phone drives it: a YUV frame (luma plus interleaved chroma, as the
+/// bridges hand it over) of a face with red/cyan glasses, red over the viewer's left eye; the
+/// engine reports the glasses the right way round.
+#[test]
+fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
+    use phantogram::engine::{Engine, EngineConfig, SharedEngine};
+    let (Some(dir), Some(_)) = (data_subdir("faces"), models()) else {
+        return;
+    };
+    let models_dir = std::path::PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked"));
+    let engine = match Engine::new(EngineConfig {
+        face_models_dir: Some(models_dir),
+        ..EngineConfig::default()
+    }) {
+        Ok(e) => e,
+        Err(phantogram::engine::EngineError::Render(e)) => {
+            eprintln!("no GPU ({e}): skipping");
+            return;
+        }
+        Err(e) => panic!("engine: {e}"),
+    };
+    let shared = SharedEngine::new(engine);
+    let img = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
+    let clean = faces(&models().expect("models"), &img);
+    let f = clean.first().expect("the astronaut's face");
+    let mut with = img.clone();
+    let (w, h) = with.dimensions();
+    let style = style_for(0);
+    assert_eq!(style.filters, (glasses::Filter::Cyan, glasses::Filter::Red));
+    draw(&mut with, w, h, f.left_eye_px, f.right_eye_px, &style);
+    let rgba = phantogram::face::OwnedFrame {
+        width: w,
+        height: h,
+        row_stride: 4 * w as usize,
+        format: PixelFormat::Rgba8,
+        data: with.into_raw(),
+        rotation_cw_deg: 0,
+        intrinsics: Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
+        capture_t_ns: 5_000_000,
+        chroma: None,
+        exposure: None,
+    };
+    let yuv = phantogram_lab::synthetic_camera::as_yuv420(&rgba);
+    assert_eq!(yuv.format, PixelFormat::Luma8);
+    assert!(shared.camera_frame(yuv).expect("a valid frame"), "face tracking is on");
+    let worker = shared.lock().face_worker().expect("face tracking is on");
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while worker.newest().is_none() {
+        assert!(std::time::Instant::now() < deadline, "the frame was never processed");
+        std::thread::sleep(std::time::Duration::from_millis(10));
+    }
+    let mut engine = shared.lock();
+    engine.resume_offscreen(54, 120).expect("offscreen");
+    engine.draw(Some(10_000_000)).expect("drawing");
+    let seen = engine.glasses_seen().expect("glasses seen through the YUV frame");
+    assert_eq!(
+        (seen.left, seen.right, seen.swapped()),
+        (glasses::Filter::Red, glasses::Filter::Cyan, false)
+    );
+}

@@ -60,6 +60,9 @@ pub type FilterColours = ([u8; 3], [u8; 3]);
 #[derive(Clone, Debug)]
 pub struct WelcomeUi {
     pub page: WelcomePage,
+    /// The glasses the front camera sees on the viewer, when it does: the check then says
+    /// which way round they look to be on (the viewer still answers).
+    pub camera_glasses: Option<phantogram_sensing::glasses::GlassesSeen>,
     widget_rects: crate::widget_rects::WidgetRects,
 }
 
@@ -67,6 +70,7 @@ impl Default for WelcomeUi {
     fn default() -> Self {
         Self {
             page: WelcomePage::Intro,
+            camera_glasses: None,
             widget_rects: crate::widget_rects::WidgetRects::new(),
         }
     }
@@ -81,7 +85,7 @@ impl WelcomeUi {
     pub fn camera() -> Self {
         Self {
             page: WelcomePage::Camera,
-            widget_rects: crate::widget_rects::WidgetRects::new(),
+            ..Self::default()
         }
     }
 
@@ -157,6 +161,9 @@ impl WelcomeUi {
                     ui.label(
                         RichText::new("Close your LEFT eye. Which ring do you see with your right eye?").size(17.0),
                     );
+                    if let Some(seen) = self.camera_glasses {
+                        ui.label(RichText::new(camera_glasses_note(&seen)).size(15.0));
+                    }
                     let (rect, _) =
                         ui.allocate_exact_size(Vec2::new(ui.available_width(), 180.0), egui::Sense::hover());
                     let (left, right) = filters.unwrap_or(([255, 0, 0], [0, 255, 255]));
@@ -341,6 +348,20 @@ fn camera_picture(painter: &egui::Painter, rect: Rect) {
     }
 }
 
+/// What the camera's view of the glasses says, in words for the check.
+fn camera_glasses_note(seen: &phantogram_sensing::glasses::GlassesSeen) -> String {
+    let way = if seen.swapped() {
+        "so they look to be on the other way round"
+    } else {
+        "the usual way"
+    };
+    format!(
+        "The camera sees {} over your left eye and {} over your right: {way}.",
+        seen.left.name(),
+        seen.right.name()
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -408,5 +429,26 @@ mod tests {
         for name in ["allow-camera", "not-now"] {
             assert!(w.widget_rect(name).unwrap().height() >= CONTROL_HEIGHT_PT - 0.5);
         }
+    }
+
+    #[test]
+    fn the_check_says_which_way_round_the_camera_sees_the_glasses() {
+        use phantogram_sensing::glasses::{Filter, GlassesSeen};
+        let usual = GlassesSeen {
+            left: Filter::Red,
+            right: Filter::Cyan,
+            strength: 2.0,
+        };
+        assert_eq!(
+            camera_glasses_note(&usual),
+            "The camera sees red over your left eye and cyan over your right: the usual way."
+        );
+        let swapped = GlassesSeen {
+            left: Filter::Blue,
+            right: Filter::Amber,
+            strength: 1.0,
+        };
+        assert!(camera_glasses_note(&swapped).contains("blue over your left eye"));
+        assert!(camera_glasses_note(&swapped).contains("other way round"));
     }
 }
