@@ -141,6 +141,9 @@ pub struct UprightImage<'a> {
     pub width: u32,
     pub height: u32,
     pub intrinsics: Intrinsics,
+    /// Buffer bytes from an upright pixel to its right-hand and to its lower neighbour.
+    step_x: isize,
+    step_y: isize,
 }
 
 impl<'a> UprightImage<'a> {
@@ -181,11 +184,21 @@ impl<'a> UprightImage<'a> {
         } else {
             (frame.width, frame.height)
         };
+        let (bpp, row) = (bpp as isize, frame.row_stride as isize);
+        // Upright +x and +y in the buffer, through the inverse turn (see `buffer_xy`).
+        let (step_x, step_y) = match frame.rotation_cw_deg {
+            90 => (-row, bpp),
+            180 => (-bpp, -row),
+            270 => (row, -bpp),
+            _ => (bpp, row),
+        };
         Ok(Self {
             frame,
             width,
             height,
             intrinsics: i.turned_cw(frame.width, frame.height, turns),
+            step_x,
+            step_y,
         })
     }
 
@@ -272,11 +285,13 @@ impl<'a> UprightImage<'a> {
             }
             return out;
         }
-        // Inside: straight to the bytes, scaled to [0, 1] once.
+        // Inside: straight to the bytes (the neighbours a fixed step away), scaled to [0, 1] once.
         let d = self.frame.data;
+        let base = self.offset(xi, yi) as isize;
         let mut out = [0.0f32; 3];
         for (dx, dy, w) in weights {
-            let at = self.offset(xi + dx, yi + dy);
+            // In the image, so the offset is in the buffer (checked by `new`).
+            let at = (base + dx as isize * self.step_x + dy as isize * self.step_y) as usize;
             match self.frame.format {
                 PixelFormat::Luma8 => {
                     let v = f32::from(d[at]) * w;
@@ -329,10 +344,19 @@ impl Roi {
     ) -> Vec<f32> {
         let mut out = vec![0.0f32; 3 * n * n];
         // The pixel footprint may shrink a lot (a 1000-px face into 192): average a few
-        // samples per output pixel so the crop does not alias.
+        // samples per output pixel so the crop does not alias. A bilinear sample already
+        // averages over about two source pixels, so ⌈step / 2⌉ of them per axis cover one.
         let step = self.size / n as f32;
-        let taps = (step.ceil() as usize).clamp(1, 3);
+        let taps = ((step * 0.5).ceil() as usize).clamp(1, 3);
         let (lo, hi) = range;
+        // `image_point` is affine in (a, b): its origin and two steps, turned once (not per
+        // sample: a sine and cosine per sample cost more than the sampling).
+        let origin = self.image_point(0.0, 0.0, flip);
+        let (du, dv) = (
+            self.image_point(1.0, 0.0, flip) - origin,
+            self.image_point(0.0, 1.0, flip) - origin,
+        );
+        let at = |a: f32, b: f32| origin + du * a + dv * b;
         for j in 0..n {
             for i in 0..n {
                 let mut acc = [0.0f32; 3];
@@ -340,14 +364,14 @@ impl Roi {
                     for tx in 0..taps {
                         let a = (i as f32 + (tx as f32 + 0.5) / taps as f32) / n as f32;
                         let b = (j as f32 + (ty as f32 + 0.5) / taps as f32) / n as f32;
-                        let c = image.bilinear(self.image_point(a, b, flip));
+                        let c = image.bilinear(at(a, b));
                         for k in 0..3 {
                             acc[k] += c[k];
                         }
                     }
                 }
                 let norm = 1.0 / (taps * taps) as f32;
-                let centre = self.image_point((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32, flip);
+                let centre = at((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
                 let c = correct(centre, acc.map(|v| v * norm));
                 for k in 0..3 {
                     out[k * n * n + j * n + i] = lo + (hi - lo) * c[k];
@@ -894,6 +918,34 @@ mod tests {
                 _ => up.rgb(0, 2),
             };
             assert_eq!(back[0], 0.0, "rotation {rot}: buffer (0,0) lands at the turned corner");
+        }
+    }
+
+    #[test]
+    fn bilinear_reads_the_same_pixels_in_every_turn_as_the_pixel_reader() {
+        // A 7 × 5 luma buffer with padded rows, values from the position.
+        let (w, h, stride) = (7u32, 5u32, 9usize);
+        let data: Vec<u8> = (0..stride * h as usize).map(|i| ((i * 37) % 251) as u8).collect();
+        for rot in [0, 90, 180, 270] {
+            let mut f = frame(&data, w, h, rot);
+            f.row_stride = stride;
+            let up = UprightImage::new(f).unwrap();
+            for (x, y) in [(1.3f32, 1.7f32), (2.5, 3.25), (0.6, 0.6), (4.9, 2.2)] {
+                let p = Vec2::new(x, y);
+                if p.x + 1.0 > up.width as f32 || p.y + 1.0 > up.height as f32 {
+                    continue;
+                }
+                // The same weights over the four pixels, read one by one.
+                let (fx, fy) = (p.x - 0.5, p.y - 0.5);
+                let (x0, y0) = (fx.floor() as i32, fy.floor() as i32);
+                let (ax, ay) = (fx - x0 as f32, fy - y0 as f32);
+                let want = up.rgb(x0, y0)[0] * (1.0 - ax) * (1.0 - ay)
+                    + up.rgb(x0 + 1, y0)[0] * ax * (1.0 - ay)
+                    + up.rgb(x0, y0 + 1)[0] * (1.0 - ax) * ay
+                    + up.rgb(x0 + 1, y0 + 1)[0] * ax * ay;
+                let got = up.bilinear(p)[0];
+                assert!((got - want).abs() < 1e-5, "rotation {rot} at {p}: {got} vs {want}");
+            }
         }
     }
 
