@@ -45,6 +45,7 @@ pub mod eyes;
 pub mod light;
 pub mod projection;
 pub mod screen;
+pub mod srgb;
 pub mod viewpoint;
 
 pub use glam;

@@ -10,6 +10,7 @@
 //! Pure function of its inputs. **Panics**: none (positions outside the image draw nothing).
 
 use glam::Vec2;
+use phantogram_geometry::srgb::{code_to_linear, linear_to_code};
 use phantogram_sensing::glasses::Filter;
 
 /// A lens's outline.
@@ -49,25 +50,6 @@ pub fn filter_transmission(filter: Filter) -> [f32; 3] {
         Filter::Amber => [0.9, 0.55, 0.04],
         Filter::Blue => [0.04, 0.12, 0.85],
     }
-}
-
-fn to_linear(code: u8) -> f32 {
-    let c = f32::from(code) / 255.0;
-    if c <= 0.040_45 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn to_srgb(v: f32) -> u8 {
-    let v = v.clamp(0.0, 1.0);
-    let c = if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0 + 0.5) as u8
 }
 
 /// Draws `style`'s glasses into `rgba` (`width × height`, rows packed) over the eyes at
@@ -126,9 +108,9 @@ pub fn draw(
                         * (-((q.x + q.y * 1.5 + 0.2 * half.x) / (0.12 * half.x)).powi(2)).exp()
                         * (q.y < 0.0) as u8 as f32;
                     for k in 0..3 {
-                        let v = to_linear(rgba[at + k]);
+                        let v = code_to_linear(rgba[at + k]);
                         let filtered = v * (1.0 - style.opacity + style.opacity * t[k]);
-                        rgba[at + k] = to_srgb(filtered + streak);
+                        rgba[at + k] = linear_to_code(filtered + streak);
                     }
                 } else if rim > 0.0 && inside(q, rim) {
                     rgba[at..at + 3].copy_from_slice(&style.rim_rgb);

@@ -3,24 +3,7 @@
 
 use super::*;
 
-pub(super) fn srgb_to_linear(c: u8) -> f32 {
-    let c = c as f32 / 255.0;
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-pub(super) fn linear_to_srgb(c: f32) -> u8 {
-    let c = c.clamp(0.0, 1.0);
-    let s = if c <= 0.003_130_8 {
-        c * 12.92
-    } else {
-        1.055 * c.powf(1.0 / 2.4) - 0.055
-    };
-    (s * 255.0 + 0.5) as u8
-}
+pub(super) use phantogram_geometry::srgb::{code_to_linear as srgb_to_linear, linear_to_code as linear_to_srgb};
 
 /// The full mip chain of an RGBA8 image (2×2 box filter; odd sizes clamp at the edge). Colour
 /// data is averaged in linear light, alpha and data textures as stored.

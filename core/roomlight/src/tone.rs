@@ -7,32 +7,18 @@
 
 use std::sync::LazyLock;
 
-/// Linear value in [0, 1] of each 8-bit sRGB code.
-static SRGB_TO_LINEAR: LazyLock<[f32; 256]> = LazyLock::new(|| {
-    std::array::from_fn(|i| {
-        let c = i as f32 / 255.0;
-        if c <= 0.040_45 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    })
-});
+/// Linear value in [0, 1] of each 8-bit sRGB code (the curve: `phantogram_geometry::srgb`).
+static SRGB_TO_LINEAR: LazyLock<[f32; 256]> =
+    LazyLock::new(|| std::array::from_fn(|i| phantogram_geometry::srgb::code_to_linear(i as u8)));
 
-/// The linear value of an 8-bit sRGB code.
+/// The linear value of an 8-bit sRGB code (a table: the room map reads millions).
 pub fn linear_from_srgb8(code: u8) -> f32 {
     SRGB_TO_LINEAR[usize::from(code)]
 }
 
 /// The 8-bit sRGB code of a linear value (clipped to [0, 1], as a camera clips).
 pub fn srgb8_from_linear(v: f32) -> u8 {
-    let v = if v.is_nan() { 0.0 } else { v.clamp(0.0, 1.0) };
-    let c = if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
-    };
-    (c * 255.0 + 0.5).clamp(0.0, 255.0) as u8
+    phantogram_geometry::srgb::linear_to_code(v)
 }
 
 #[cfg(test)]

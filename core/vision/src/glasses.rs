@@ -27,15 +27,7 @@ pub const MIN_STRENGTH: f32 = 0.35;
 /// How closely (cosine) an eye's shift must point at its filter's colour.
 const MIN_COSINE: f32 = 0.8;
 
-/// sRGB code → linear light.
-fn linear(code: u8) -> f32 {
-    let c = f32::from(code) / 255.0;
-    if c <= 0.040_45 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
+use phantogram_geometry::srgb::{code_to_linear as linear, from_linear as linear_to_srgb, to_linear as srgb_to_linear};
 
 /// A filter's typical transmission (linear RGB): what its colour shift points at.
 fn transmission(filter: Filter) -> [f32; 3] {
@@ -247,24 +239,6 @@ impl Lenses {
             return rgb;
         }
         rgb
-    }
-}
-
-fn srgb_to_linear(c: f32) -> f32 {
-    let c = c.clamp(0.0, 1.0);
-    if c <= 0.040_45 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-fn linear_to_srgb(v: f32) -> f32 {
-    let v = v.clamp(0.0, 1.0);
-    if v <= 0.003_130_8 {
-        12.92 * v
-    } else {
-        1.055 * v.powf(1.0 / 2.4) - 0.055
     }
 }
 
