@@ -1,6 +1,7 @@
 //! `cargo bench -p phantogram --bench face` (or `cargo xtask bench face`): milliseconds per
 //! 640×480 camera frame in detection mode (BlazeFace + FaceMesh + 2 × Iris) and tracking mode
-//! (FaceMesh + 2 × Iris), one thread, median of 30 frames each, measured in the same run.
+//! (FaceMesh + 2 × Iris on one frame in `MESH_EVERY`, 2 × Iris alone between), one thread, median
+//! of 30 frames each (and of each kind of tracked frame), measured in the same run.
 //!
 //! Needs the models (`cargo xtask models`; `PHANTOGRAM_MODELS` or the default cache) and a face
 //! photograph: `$PHANTOGRAM_DATA/faces/astronaut.png`, letterboxed into 640×480. Skipped with a
@@ -58,8 +59,9 @@ fn main() {
         chroma: None,
     };
     let mut tracker = FaceTracker::new(models, CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
+    // Medians per frame kind: (all, FaceMesh run, irises alone).
     let mut measure = |detect: bool| {
-        let mut samples = Vec::new();
+        let (mut all, mut mesh, mut irises) = (Vec::new(), Vec::new(), Vec::new());
         for i in 0..33 {
             if detect {
                 tracker.reset();
@@ -79,13 +81,23 @@ fn main() {
             assert_eq!(tracker.last_mode(), want);
             // The first frames warm caches and allocators.
             if i >= 3 {
-                samples.push(ms);
+                all.push(ms);
+                if tracker.followed_irises_only() {
+                    irises.push(ms);
+                } else {
+                    mesh.push(ms);
+                }
             }
         }
-        median_ms(samples)
+        let median = |v: Vec<f64>| if v.is_empty() { f64::NAN } else { median_ms(v) };
+        (median(all), median(mesh), median(irises))
     };
-    let detection = measure(true);
-    let tracking = measure(false);
+    let (detection, _, _) = measure(true);
+    let (tracking, with_mesh, irises_only) = measure(false);
     println!("640×480 frame, one thread: detection mode {detection:.1} ms, tracking mode {tracking:.1} ms");
+    println!(
+        "tracking mode by frame: with FaceMesh {with_mesh:.1} ms, irises alone {irises_only:.1} ms (FaceMesh on one tracked frame in {})",
+        phantogram::face::MESH_EVERY
+    );
     println!("tracking / detection = {:.2}", tracking / detection);
 }

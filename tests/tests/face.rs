@@ -299,6 +299,47 @@ fn tracking_follows_the_face_from_its_landmarks_and_gives_metric_device_eyes() {
     }
 }
 
+/// A face moving across the frame, 3 pixels a frame: the tracker follows it with FaceMesh on one
+/// frame in `MESH_EVERY` and the irises alone between, and its eyes stay where a fresh detection
+/// on each frame puts them.
+#[test]
+fn a_moving_face_is_followed_by_its_irises_between_mesh_frames() {
+    let Some((models, dir)) = setup() else { return };
+    let img = rgba(&dir.join("astronaut.png"));
+    let small = image::imageops::resize(&img, 480, 480, image::imageops::FilterType::Triangle);
+    let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(Vec3::ZERO));
+    let mut fresh = FaceTracker::new(models, CameraPose::front(Vec3::ZERO));
+    let mut followed = 0;
+    for k in 0..12u32 {
+        let mut canvas = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
+        image::imageops::overlay(&mut canvas, &small, 50 + 3 * i64::from(k), 0);
+        let k_px = default_intrinsics(&canvas);
+        let tracked = tracker.process(frame(&canvas, k_px)).expect("a valid frame");
+        followed += usize::from(tracker.followed_irises_only());
+        fresh.reset();
+        let detected = fresh.process(frame(&canvas, k_px)).expect("a valid frame");
+        let (Some(a), Some(b)) = (tracked.eyes_m, detected.eyes_m) else {
+            panic!("frame {k}: the face was lost");
+        };
+        let ipd = b[0].distance(b[1]);
+        for i in 0..2 {
+            // Compared across the image (the distance along the axis differs by the iris size's
+            // noise, the same for both).
+            let (p, q) = (a[i] / a[i].z, b[i] / b[i].z);
+            assert!(
+                p.distance(q) * b[i].z < 0.03 * ipd,
+                "frame {k}, eye {i}: tracked {} vs detected {}",
+                a[i],
+                b[i]
+            );
+        }
+    }
+    // 12 frames: one detection, then of the 11 tracked frames every MESH_EVERY-th runs FaceMesh
+    // (the detection's own mesh counts as the first).
+    let mesh_every = phantogram::face::MESH_EVERY as usize;
+    assert_eq!(followed, 11 - 11 / mesh_every, "frames followed by the irises alone");
+}
+
 #[test]
 fn the_worker_runs_off_the_caller_thread_and_keeps_only_the_newest_frame() {
     use phantogram::face::FaceWorker;

@@ -656,6 +656,41 @@ impl FaceModels {
         }))
     }
 
+    /// The last frame's face followed by its irises alone (no FaceMesh): each iris crop placed
+    /// from the last frame's eye corners, the landmarks moved with the eyes. `None` when an iris
+    /// moved more than a quarter of its eye's width (the crop would cut it off soon) or the two
+    /// irises moved apart by more than 5 % of the eye distance (the head turned or rolled: the
+    /// corners no longer fit) — FaceMesh then runs.
+    fn follow_irises(&self, image: &UprightImage, last: &FaceFound) -> Result<Option<FaceFound>, FaceError> {
+        let (a0, a1) = IMAGE_LEFT_EYE_CORNERS;
+        let (b0, b1) = IMAGE_RIGHT_EYE_CORNERS;
+        let corner = |i: usize| last.landmarks.get(i).copied();
+        let (Some(la), Some(lb), Some(ra), Some(rb)) = (corner(a0), corner(a1), corner(b0), corner(b1)) else {
+            return Ok(None);
+        };
+        let t = last.lenses.map(|l| l.transmission);
+        let left = self.iris(image, la, lb, false, t.map(|t| t[0]))?;
+        let right = self.iris(image, ra, rb, true, t.map(|t| t[1]))?;
+        let (Some((left_eye_px, dl)), Some((right_eye_px, dr))) = (left, right) else {
+            return Ok(None);
+        };
+        let (ml, mr) = (left_eye_px - last.left_eye_px, right_eye_px - last.right_eye_px);
+        let ipd = last.left_eye_px.distance(last.right_eye_px);
+        let eye_width = la.distance(lb).min(ra.distance(rb));
+        if ml.distance(mr) > 0.05 * ipd || ml.length().max(mr.length()) > 0.25 * eye_width {
+            return Ok(None);
+        }
+        let shift = (ml + mr) * 0.5;
+        Ok(Some(FaceFound {
+            left_eye_px,
+            right_eye_px,
+            iris_diameter_px: 0.5 * (dl + dr),
+            confidence: last.confidence,
+            landmarks: last.landmarks.iter().map(|p| *p + shift).collect(),
+            lenses: last.lenses,
+        }))
+    }
+
     /// The face a detection leads to, its confidence the lower of detector score and face flag.
     fn face_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<FaceFound>, FaceError> {
         let [a, b] = [d.keypoints[0], d.keypoints[1]];
@@ -791,6 +826,12 @@ impl FaceFound {
     }
 }
 
+/// While tracking, FaceMesh runs on one frame in this many; the irises alone follow the eyes on
+/// the others (FaceMesh costs as much as both irises, `benchmarks/face.md`). At 30 frames/s the
+/// mesh still refreshes the face's outline and its face flag ten times a second, and any frame
+/// whose irises move apart or far runs it at once.
+pub const MESH_EVERY: u32 = 3;
+
 /// Whether the last frame ran the detector or followed the face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TrackingMode {
@@ -808,6 +849,9 @@ pub struct FaceTracker {
     /// The last frame's eyes (image left, image right, pixels): where glasses are looked for
     /// before FaceMesh runs.
     last_eyes_px: Option<[Vec2; 2]>,
+    /// The last frame's face, and how many frames in a row its irises alone have followed.
+    last_found: Option<FaceFound>,
+    iris_only_frames: u32,
     last_mode: TrackingMode,
 }
 
@@ -819,6 +863,8 @@ impl FaceTracker {
             ipd_m: None,
             roi: None,
             last_eyes_px: None,
+            last_found: None,
+            iris_only_frames: 0,
             last_mode: TrackingMode::Detecting,
         }
     }
@@ -828,10 +874,18 @@ impl FaceTracker {
         self.last_mode
     }
 
+    /// Whether the last [`Self::process`] followed the eyes by their irises alone (no FaceMesh;
+    /// see [`MESH_EVERY`]).
+    pub fn followed_irises_only(&self) -> bool {
+        self.last_mode == TrackingMode::Tracking && self.iris_only_frames > 0
+    }
+
     /// Forgets the tracked face: the next frame runs the detector.
     pub fn reset(&mut self) {
         self.roi = None;
         self.last_eyes_px = None;
+        self.last_found = None;
+        self.iris_only_frames = 0;
     }
 
     /// Finds the viewer's eyes in `frame` (the most confident face if several).
@@ -840,16 +894,30 @@ impl FaceTracker {
         let mut found = None;
         if let Some(roi) = self.roi {
             self.last_mode = TrackingMode::Tracking;
-            found = self.models.face_in(&image, &roi, self.last_eyes_px)?;
+            // FaceMesh on one tracked frame in MESH_EVERY; the irises alone follow the eyes in
+            // between, as long as they move together and stay well inside their crops.
+            if self.iris_only_frames + 1 < MESH_EVERY
+                && let Some(last) = &self.last_found
+            {
+                found = self.models.follow_irises(&image, last)?;
+            }
+            if found.is_some() {
+                self.iris_only_frames += 1;
+            } else {
+                found = self.models.face_in(&image, &roi, self.last_eyes_px)?;
+                self.iris_only_frames = 0;
+            }
         }
         if found.is_none() {
             self.last_mode = TrackingMode::Detecting;
+            self.iris_only_frames = 0;
             if let Some(d) = self.models.detect(&image)?.first() {
                 found = self.models.face_from_detection(&image, d)?;
             }
         }
         self.roi = found.as_ref().map(|f| roi_from_landmarks(&f.landmarks));
         self.last_eyes_px = found.as_ref().map(|f| [f.left_eye_px, f.right_eye_px]);
+        self.last_found = found.clone();
         let found = found.filter(|f| f.confidence >= MIN_FACE_CONFIDENCE);
         let mut glasses = None;
         let eyes_m = found.as_ref().and_then(|f| {
