@@ -45,6 +45,19 @@ pub fn engine_or_skip(config: phantogram::engine::EngineConfig) -> Option<phanto
     }
 }
 
+/// MediaPipe's face models from `$PHANTOGRAM_MODELS` (written by `cargo xtask models`), or
+/// `None` (the test skips, saying so) when it is unset; set but unloadable fails the test.
+pub fn face_models() -> Option<std::sync::Arc<phantogram::face::FaceModels>> {
+    let Some(dir) = std::env::var_os("PHANTOGRAM_MODELS") else {
+        eprintln!("PHANTOGRAM_MODELS is not set: skipping (run `cargo xtask models`)");
+        return None;
+    };
+    Some(std::sync::Arc::new(
+        phantogram::face::FaceModels::load(std::path::Path::new(&dir))
+            .expect("PHANTOGRAM_MODELS is set: the models must load"),
+    ))
+}
+
 /// RGBA pixels of two equal-sized frames that differ by more than 8 levels in some channel:
 /// how much of a picture a change changed.
 pub fn differing_pixels(a: &[u8], b: &[u8]) -> usize {

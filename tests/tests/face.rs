@@ -12,13 +12,7 @@ use phantogram::glam::{Vec2, Vec3};
 use phantogram_integration::data_subdir;
 
 fn models() -> Option<Arc<FaceModels>> {
-    let Some(dir) = std::env::var_os("PHANTOGRAM_MODELS") else {
-        eprintln!("PHANTOGRAM_MODELS is not set: skipping the face tests (run `cargo xtask models`)");
-        return None;
-    };
-    Some(Arc::new(
-        FaceModels::load(Path::new(&dir)).expect("PHANTOGRAM_MODELS is set: the models must load"),
-    ))
+    phantogram_integration::face_models()
 }
 
 fn setup() -> Option<(Arc<FaceModels>, PathBuf)> {

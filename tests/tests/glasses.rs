@@ -7,7 +7,6 @@
 //! at selfie scale turned by 20° (either way). Needs `$PHANTOGRAM_DATA/faces` and `$PHANTOGRAM_MODELS`;
 //! skipped with a notice without them.
 
-use std::path::Path;
 use std::sync::Arc;
 
 use phantogram::face::glasses;
@@ -17,13 +16,7 @@ use phantogram_integration::data_subdir;
 use phantogram_lab::drawn_glasses::{draw, style_for};
 
 fn models() -> Option<Arc<FaceModels>> {
-    let Some(dir) = std::env::var_os("PHANTOGRAM_MODELS") else {
-        eprintln!("PHANTOGRAM_MODELS is not set: skipping the glasses tests (run `cargo xtask models`)");
-        return None;
-    };
-    Some(Arc::new(
-        FaceModels::load(Path::new(&dir)).expect("PHANTOGRAM_MODELS is set: the models must load"),
-    ))
+    phantogram_integration::face_models()
 }
 
 fn frame(img: &image::RgbaImage) -> CameraFrame<'_> {
@@ -320,21 +313,16 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
 /// engine reports the glasses the right way round.
 #[test]
 fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
-    use phantogram::engine::{Engine, EngineConfig, SharedEngine};
+    use phantogram::engine::{EngineConfig, SharedEngine};
     let (Some(dir), Some(_)) = (data_subdir("faces"), models()) else {
         return;
     };
     let models_dir = std::path::PathBuf::from(std::env::var_os("PHANTOGRAM_MODELS").expect("checked"));
-    let engine = match Engine::new(EngineConfig {
+    let Some(engine) = phantogram_integration::engine_or_skip(EngineConfig {
         face_models_dir: Some(models_dir),
         ..EngineConfig::default()
-    }) {
-        Ok(e) => e,
-        Err(phantogram::engine::EngineError::Render(e)) => {
-            eprintln!("no GPU ({e}): skipping");
-            return;
-        }
-        Err(e) => panic!("engine: {e}"),
+    }) else {
+        return;
     };
     let shared = SharedEngine::new(engine);
     let img = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
