@@ -236,10 +236,7 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
             continue;
         };
         // Colour where the frame has it (YUV converted here, off the camera's thread); else grey.
-        let image = match p.frame.to_rgba8() {
-            Some(Ok(rgba)) => rgba,
-            Some(Err(_)) | None => p.frame,
-        };
+        let image = p.frame.into_colour();
         let frame = CaptureFrame {
             image: image.as_frame(),
             world_from_camera: world_from_buffer_camera(q, &pose, image.rotation_cw_deg),

@@ -176,8 +176,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
         let image = UprightImage::new(frame(&img)).expect("frame");
         for f in &clean {
             if let Some(shifts) = glasses::eye_shifts(&image, f) {
-                let len = |v: [f32; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
-                bare_strongest = bare_strongest.max(len(shifts[0]).min(len(shifts[1])));
+                bare_strongest = bare_strongest.max(shifts[0].length().min(shifts[1].length()));
             }
             assert!(
                 f.lenses.is_none(),

@@ -40,7 +40,9 @@ pub struct GlassesStyle {
     pub reflection: f32,
 }
 
-/// Linear transmission of a drawn filter (measured shapes of cheap anaglyph gels, roughly).
+/// Linear transmission of a drawn filter: values chosen to resemble cheap anaglyph gels (not
+/// measured), and on purpose not the detector's own prototypes (`phantogram_vision::glasses`),
+/// so that the test does not find exactly what it drew.
 pub fn filter_transmission(filter: Filter) -> [f32; 3] {
     match filter {
         Filter::Red => [0.85, 0.06, 0.05],

@@ -240,7 +240,8 @@ mod tests {
             (PixelFormat::Luma8, Exposure::new(exposure, 100.0))
         );
         assert!(yuv.row_stride.is_multiple_of(64) && yuv.row_stride >= yuv.width as usize);
-        let back = yuv.to_rgba8().expect("colour").expect("decodes");
+        let back = yuv.into_colour();
+        assert_eq!(back.format, PixelFormat::Rgba8);
         // Luma is exact to rounding; chroma is shared by 2 × 2 pixels, so edges differ more.
         let diffs: Vec<u8> = rgb.data.iter().zip(&back.data).map(|(a, b)| a.abs_diff(*b)).collect();
         let mean = diffs.iter().map(|&d| f64::from(d)).sum::<f64>() / diffs.len() as f64;

@@ -7,14 +7,15 @@
 //! median of the same side's cheek (below any lens), which cancels the skin's own colour and the
 //! light's. What is left is the lens's transmission `T`, up to brightness: its log-chromaticity
 //! `c = ln T − mean(ln T)` points towards the filter's colour and its length says how strongly it
-//! tints (about 0 with no lens or clear glass; ≈ 2.5 for a saturated red or cyan lens; ≈ 0.8 for
-//! 0.44–0.6 for one that passes half of what it should stop). Glasses are reported when both eyes' shifts are
-//! strong ([`MIN_STRENGTH`]) and point at the two filters of one kind of glasses.
+//! tints (about 0 with no lens or clear glass; ≈ 2.5 for a saturated red or cyan lens; 0.44–0.6
+//! for one that passes half of what it should stop). Glasses are reported when both eyes'
+//! shifts are strong ([`MIN_STRENGTH`]) and point at the two filters of one kind of glasses.
 //!
 //! Needs colour (an RGBA frame, or luma with its chroma planes); a grey frame gives no answer.
 //! Reads a few hundred pixels; no allocation beyond that, no panics.
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
+use phantogram_geometry::srgb::{code_to_linear as linear, from_linear as linear_to_srgb, to_linear as srgb_to_linear};
 pub use phantogram_sensing::glasses::{Filter, GlassesSeen};
 
 use crate::{FaceFound, UprightImage};
@@ -26,8 +27,6 @@ pub const MIN_STRENGTH: f32 = 0.35;
 
 /// How closely (cosine) an eye's shift must point at its filter's colour.
 const MIN_COSINE: f32 = 0.8;
-
-use phantogram_geometry::srgb::{code_to_linear as linear, from_linear as linear_to_srgb, to_linear as srgb_to_linear};
 
 /// A filter's typical transmission (linear RGB): what its colour shift points at.
 fn transmission(filter: Filter) -> [f32; 3] {
@@ -42,19 +41,13 @@ fn transmission(filter: Filter) -> [f32; 3] {
 }
 
 /// `ln v − mean(ln v)`: colour without brightness.
-fn log_chroma(v: [f32; 3]) -> [f32; 3] {
-    let l = v.map(|x| x.max(1e-4).ln());
-    let mean = (l[0] + l[1] + l[2]) / 3.0;
-    l.map(|x| x - mean)
+fn log_chroma(v: [f32; 3]) -> Vec3 {
+    let l = Vec3::from(v.map(|x| x.max(1e-4).ln()));
+    l - Vec3::splat(l.element_sum() / 3.0)
 }
 
-fn length(v: [f32; 3]) -> f32 {
-    (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt()
-}
-
-fn cosine(a: [f32; 3], b: [f32; 3]) -> f32 {
-    let d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-    d / (length(a) * length(b)).max(1e-6)
+fn cosine(a: Vec3, b: Vec3) -> f32 {
+    a.dot(b) / (a.length() * b.length()).max(1e-6)
 }
 
 /// Median per channel of the linear colours at `points` (`None` when fewer than half are in the
@@ -113,7 +106,7 @@ fn eye_transmission(
 }
 
 /// The filter whose colour an eye's shift points at, and how closely.
-fn nearest_filter(shift: [f32; 3]) -> (Filter, f32) {
+fn nearest_filter(shift: Vec3) -> (Filter, f32) {
     Filter::ALL
         .into_iter()
         .map(|f| (f, cosine(shift, log_chroma(transmission(f)))))
@@ -147,7 +140,7 @@ pub fn transmissions(image: &UprightImage, left: Vec2, right: Vec2) -> Option<[[
 }
 
 /// The colour shift (log-chromaticity of the transmission) of each eye of `face`.
-pub fn eye_shifts(image: &UprightImage, face: &FaceFound) -> Option<[[f32; 3]; 2]> {
+pub fn eye_shifts(image: &UprightImage, face: &FaceFound) -> Option<[Vec3; 2]> {
     transmissions(image, face.left_eye_px, face.right_eye_px).map(|t| t.map(log_chroma))
 }
 
@@ -175,7 +168,7 @@ pub fn find_at(image: &UprightImage, left: Vec2, right: Vec2) -> Option<Lenses> 
     let measured = transmissions_and_cheeks(image, left, right)?;
     let transmission = measured.map(|(t, _)| t);
     let [a, b] = transmission.map(log_chroma);
-    let strength = length(a).min(length(b));
+    let strength = a.length().min(b.length());
     if strength < MIN_STRENGTH {
         return None;
     }
@@ -233,7 +226,7 @@ impl Lenses {
             let lin = rgb.map(srgb_to_linear);
             let shift = log_chroma(self.transmission[i]);
             let here = log_chroma([0, 1, 2].map(|k| lin[k].max(1e-4) / self.cheek[i][k].max(1e-4)));
-            if cosine(here, shift) >= 0.7 && length(here) >= 0.5 * length(shift) {
+            if cosine(here, shift) >= 0.7 && here.length() >= 0.5 * shift.length() {
                 return untint_colour(rgb, self.transmission[i]);
             }
             return rgb;
@@ -279,9 +272,12 @@ mod tests {
             let half = transmission(f).map(|t| 0.5 + 0.5 * t);
             let (g, c) = nearest_filter(log_chroma(half));
             assert_eq!(g, f, "{f:?} at half strength");
-            assert!(c >= MIN_COSINE && length(log_chroma(half)) > MIN_STRENGTH, "{f:?}: {c}");
+            assert!(
+                c >= MIN_COSINE && log_chroma(half).length() > MIN_STRENGTH,
+                "{f:?}: {c}"
+            );
         }
         // Grey has no colour shift.
-        assert!(length(log_chroma([0.3, 0.3, 0.3])) < 1e-6);
+        assert!(log_chroma([0.3, 0.3, 0.3]).length() < 1e-6);
     }
 }

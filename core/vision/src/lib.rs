@@ -627,6 +627,21 @@ impl FaceModels {
         Ok(Some((p[0], diameter)))
     }
 
+    /// Both irises (image left, image right: centre and diameter, pixels) from the four eye
+    /// corners (image-left eye's outer and inner, image-right eye's inner and outer), each crop's
+    /// tint undone under `lenses`; `None` unless both are found.
+    fn irises(
+        &self,
+        image: &UprightImage,
+        [la, lb, ra, rb]: [Vec2; 4],
+        lenses: Option<&glasses::Lenses>,
+    ) -> Result<Option<[(Vec2, f32); 2]>, FaceError> {
+        let t = lenses.map(|l| l.transmission);
+        let left = self.iris(image, la, lb, false, t.map(|t| t[0]))?;
+        let right = self.iris(image, ra, rb, true, t.map(|t| t[1]))?;
+        Ok(left.zip(right).map(|(l, r)| [l, r]))
+    }
+
     /// Landmarks + irises for the face in `roi`, whose eyes are expected near `eyes_hint` (image
     /// left, image right: a detection's keypoints, or the last frame's eyes) when known.
     fn face_in(
@@ -639,18 +654,13 @@ impl FaceModels {
         let Some((landmarks, flag)) = self.mesh(image, roi, hinted.as_ref())? else {
             return Ok(None);
         };
-        let (a0, a1) = IMAGE_LEFT_EYE_CORNERS;
-        let (b0, b1) = IMAGE_RIGHT_EYE_CORNERS;
+        let Some([la, lb, ra, rb]) = eye_corners(&landmarks) else {
+            return Ok(None);
+        };
         // Glasses, looked for around the eyes' corners' midpoints (the irises are not known yet).
-        let lenses = glasses::find_at(
-            image,
-            (landmarks[a0] + landmarks[a1]) * 0.5,
-            (landmarks[b0] + landmarks[b1]) * 0.5,
-        );
-        let t = lenses.map(|l| l.transmission);
-        let left = self.iris(image, landmarks[a0], landmarks[a1], false, t.map(|t| t[0]))?;
-        let right = self.iris(image, landmarks[b0], landmarks[b1], true, t.map(|t| t[1]))?;
-        let (Some((left_eye_px, dl)), Some((right_eye_px, dr))) = (left, right) else {
+        let lenses = glasses::find_at(image, (la + lb) * 0.5, (ra + rb) * 0.5);
+        let Some([(left_eye_px, dl), (right_eye_px, dr)]) = self.irises(image, [la, lb, ra, rb], lenses.as_ref())?
+        else {
             return Ok(None);
         };
         Ok(Some(FaceFound {
@@ -669,16 +679,12 @@ impl FaceModels {
     /// irises moved apart by more than 5 % of the eye distance (the head turned or rolled: the
     /// corners no longer fit) — FaceMesh then runs.
     fn follow_irises(&self, image: &UprightImage, last: &FaceFound) -> Result<Option<FaceFound>, FaceError> {
-        let (a0, a1) = IMAGE_LEFT_EYE_CORNERS;
-        let (b0, b1) = IMAGE_RIGHT_EYE_CORNERS;
-        let corner = |i: usize| last.landmarks.get(i).copied();
-        let (Some(la), Some(lb), Some(ra), Some(rb)) = (corner(a0), corner(a1), corner(b0), corner(b1)) else {
+        let Some([la, lb, ra, rb]) = eye_corners(&last.landmarks) else {
             return Ok(None);
         };
-        let t = last.lenses.map(|l| l.transmission);
-        let left = self.iris(image, la, lb, false, t.map(|t| t[0]))?;
-        let right = self.iris(image, ra, rb, true, t.map(|t| t[1]))?;
-        let (Some((left_eye_px, dl)), Some((right_eye_px, dr))) = (left, right) else {
+        let Some([(left_eye_px, dl), (right_eye_px, dr)]) =
+            self.irises(image, [la, lb, ra, rb], last.lenses.as_ref())?
+        else {
             return Ok(None);
         };
         let (ml, mr) = (left_eye_px - last.left_eye_px, right_eye_px - last.right_eye_px);
@@ -790,6 +796,19 @@ fn roi_from_detection(d: &Detection) -> Roi {
     }
 }
 
+/// The four eye corners of FaceMesh's landmarks (image-left eye's outer and inner, image-right
+/// eye's inner and outer), or `None` when there are too few landmarks.
+fn eye_corners(landmarks: &[Vec2]) -> Option<[Vec2; 4]> {
+    let (a0, a1) = IMAGE_LEFT_EYE_CORNERS;
+    let (b0, b1) = IMAGE_RIGHT_EYE_CORNERS;
+    Some([
+        *landmarks.get(a0)?,
+        *landmarks.get(a1)?,
+        *landmarks.get(b0)?,
+        *landmarks.get(b1)?,
+    ])
+}
+
 /// The next frame's crop from this frame's landmarks (MediaPipe's landmarks-to-ROI).
 fn roi_from_landmarks(landmarks: &[Vec2]) -> Roi {
     Roi::around(landmarks.iter().copied(), landmarks[33], landmarks[263], 1.5)
@@ -852,11 +871,9 @@ pub struct FaceTracker {
     pub pose: CameraPose,
     /// The viewer's calibrated interpupillary distance; `None`: distance from the iris.
     pub ipd_m: Option<f32>,
-    roi: Option<Roi>,
-    /// The last frame's eyes (image left, image right, pixels): where glasses are looked for
-    /// before FaceMesh runs.
-    last_eyes_px: Option<[Vec2; 2]>,
-    /// The last frame's face, and how many frames in a row its irises alone have followed.
+    /// The last frame's face (its landmarks place this frame's crop, its eyes say where glasses
+    /// are looked for before FaceMesh runs), and how many frames in a row its irises alone have
+    /// followed.
     last_found: Option<FaceFound>,
     iris_only_frames: u32,
     last_mode: TrackingMode,
@@ -868,8 +885,6 @@ impl FaceTracker {
             models,
             pose,
             ipd_m: None,
-            roi: None,
-            last_eyes_px: None,
             last_found: None,
             iris_only_frames: 0,
             last_mode: TrackingMode::Detecting,
@@ -889,8 +904,6 @@ impl FaceTracker {
 
     /// Forgets the tracked face: the next frame runs the detector.
     pub fn reset(&mut self) {
-        self.roi = None;
-        self.last_eyes_px = None;
         self.last_found = None;
         self.iris_only_frames = 0;
     }
@@ -899,19 +912,20 @@ impl FaceTracker {
     pub fn process(&mut self, frame: CameraFrame) -> Result<FaceObservation, FaceError> {
         let image = UprightImage::new(frame)?;
         let mut found = None;
-        if let Some(roi) = self.roi {
+        if let Some(last) = &self.last_found {
             self.last_mode = TrackingMode::Tracking;
             // FaceMesh on one tracked frame in MESH_EVERY; the irises alone follow the eyes in
             // between, as long as they move together and stay well inside their crops.
-            if self.iris_only_frames + 1 < MESH_EVERY
-                && let Some(last) = &self.last_found
-            {
+            if self.iris_only_frames + 1 < MESH_EVERY {
                 found = self.models.follow_irises(&image, last)?;
             }
             if found.is_some() {
                 self.iris_only_frames += 1;
             } else {
-                found = self.models.face_in(&image, &roi, self.last_eyes_px)?;
+                let roi = roi_from_landmarks(&last.landmarks);
+                found = self
+                    .models
+                    .face_in(&image, &roi, Some([last.left_eye_px, last.right_eye_px]))?;
                 self.iris_only_frames = 0;
             }
         }
@@ -922,8 +936,6 @@ impl FaceTracker {
                 found = self.models.face_from_detection(&image, d)?;
             }
         }
-        self.roi = found.as_ref().map(|f| roi_from_landmarks(&f.landmarks));
-        self.last_eyes_px = found.as_ref().map(|f| [f.left_eye_px, f.right_eye_px]);
         self.last_found = found.clone();
         let found = found.filter(|f| f.confidence >= MIN_FACE_CONFIDENCE);
         let mut glasses = None;

@@ -343,14 +343,14 @@ impl OwnedFrame {
         })
     }
 
-    /// The frame in colour (`Rgba8`, rows packed, no chroma): converted when it is YUV, as it is
-    /// when it is RGBA already; `None` for a luma-only frame.
-    pub fn to_rgba8(&self) -> Option<Result<Self, yuv::YuvError>> {
-        if self.format == PixelFormat::Rgba8 {
-            return Some(Ok(self.clone()));
-        }
-        let planes = self.yuv()?;
-        Some(planes.to_rgba8().map(|data| Self {
+    /// The frame in colour where it has colour: a YUV frame converted to `Rgba8` (rows packed,
+    /// no chroma); an RGBA or a luma-only frame as it is (no copy), and so is a YUV frame whose
+    /// chroma planes were changed after [`Self::yuv420`] checked them and no longer fit (grey).
+    pub fn into_colour(self) -> Self {
+        let Some(Ok(data)) = self.yuv().map(|planes| planes.to_rgba8()) else {
+            return self;
+        };
+        Self {
             width: self.width,
             height: self.height,
             row_stride: self.width as usize * 4,
@@ -361,7 +361,7 @@ impl OwnedFrame {
             capture_t_ns: self.capture_t_ns,
             chroma: None,
             exposure: self.exposure,
-        }))
+        }
     }
 
     pub fn as_frame(&self) -> CameraFrame<'_> {

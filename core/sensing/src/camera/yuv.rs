@@ -182,7 +182,7 @@ mod tests {
             .with_exposure(Exposure::new(0.01, 200.0));
         assert_eq!(frame.format, PixelFormat::Luma8);
         assert_eq!(frame.data, y);
-        let rgba = frame.to_rgba8().expect("colour").expect("converts");
+        let rgba = frame.clone().into_colour();
         assert_eq!(
             (rgba.format, rgba.row_stride, rgba.rotation_cw_deg),
             (PixelFormat::Rgba8, 16, 90)
@@ -202,7 +202,7 @@ mod tests {
             7,
         )
         .expect("a whole frame");
-        assert_eq!(separate.to_rgba8().expect("colour").expect("converts").data, rgba.data);
+        assert_eq!(separate.into_colour().data, rgba.data);
         // Too short a chroma plane is refused up front; luma alone has no colour.
         assert!(matches!(
             OwnedFrame::yuv420(4, 4, 6, &[0; 24], ChromaPlanes::interleaved(&cbcr, 4), 0, k, 0),
@@ -213,7 +213,8 @@ mod tests {
             OwnedFrame::yuv420(4, 4, 6, &[0; 24], ChromaPlanes::interleaved(&cbcr, usize::MAX), 0, k, 0),
             Err(YuvError::ShortPlane { .. })
         ));
-        assert!(OwnedFrame::luma8(4, 2, 6, &y, 0, k, 0).to_rgba8().is_none());
+        let grey = OwnedFrame::luma8(4, 2, 6, &y, 0, k, 0).into_colour();
+        assert_eq!((grey.format, grey.data), (PixelFormat::Luma8, y.to_vec()));
         // Exposures the platforms cannot give are none.
         assert_eq!(Exposure::new(0.0, 100.0), None);
         assert_eq!(Exposure::new(0.01, f32::NAN), None);
