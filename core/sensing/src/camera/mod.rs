@@ -185,7 +185,7 @@ impl Exposure {
 
 /// The chroma planes of a 4:2:0 frame beside its luma plane (copied as delivered: Android's
 /// `YUV_420_888` planes 1 and 2, iOS's interleaved CbCr plane), half the frame's size in each
-/// direction. [`OwnedFrame::to_rgba8`] turns the pair into colour.
+/// direction. [`OwnedFrame::into_colour`] turns the pair into colour.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct ChromaPlanes {
     /// Both planes; Cb is `data[cb]`, Cr `data[cr]` (overlapping when interleaved).
