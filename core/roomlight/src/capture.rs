@@ -55,7 +55,7 @@ impl Default for CaptureParams {
 /// One frame for the map: the image as delivered, where its camera looked, and its exposure.
 #[derive(Clone, Copy, Debug)]
 pub struct CaptureFrame<'a> {
-    /// `Rgba8` (sRGB) or `Luma8` (grey light); YUV frames are converted first (`OwnedFrame::to_rgba8`).
+    /// `Rgba8` (sRGB) or `Luma8` (grey light); YUV frames are converted first (`OwnedFrame::into_colour`).
     pub image: CameraFrame<'a>,
     /// World from the camera of the buffer as delivered (x along its rows, y down its columns,
     /// z along the optical axis); see [`world_from_buffer_camera`].
