@@ -23,6 +23,8 @@ let package = Package(
                 .linkedFramework("QuartzCore"),
                 .linkedFramework("CoreMotion"),
                 .linkedFramework("AVFoundation"),
+                // The core's mesh simplifier (meshoptimizer, in phantogram-detail) is C++.
+                .linkedLibrary("c++"),
             ]
         ),
     ]

@@ -252,9 +252,10 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
                 .map_err(EngineError::from)?,
             library_dir: optional_string(env, &library_dir)?.map(Into::into),
             bundled_dir: optional_string(env, &bundled_dir)?.map(Into::into),
-            // TODO(issue 20): on once the shell forwards the camera's colour planes and exposure
-            // (it sends the luma plane only, for the face tracker).
+            // Off at start-up: the settings screen's "Light" switch turns it on (and the
+            // calibration file remembers it); the room map's reduction costs a phone CPU time.
             room_light: false,
+            side_hints: true,
         };
         let engine = Engine::new(config)?;
         Ok(Box::into_raw(Box::new(SharedEngine::new(engine))) as usize as jlong)

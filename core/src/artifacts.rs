@@ -65,6 +65,9 @@ impl ModelInfo {
     }
 }
 
+/// The folder, inside the library's storage, where big scans' parts and levels are kept.
+pub const DETAIL_CACHE_DIR: &str = "detail-cache";
+
 /// A model ready to upload: fitted into the diorama, floored, its bounds known.
 #[derive(Debug)]
 pub struct Prepared {
@@ -82,12 +85,16 @@ pub struct Placing {
     pub floor: bool,
 }
 
-/// Fits (unless the artifact comes placed), measures and floors a loaded model.
+/// Fits (unless the artifact comes placed), measures and floors a loaded model, and gives a big
+/// scan its parts and levels of detail (`progress` goes from where it is to 0.95 meanwhile),
+/// kept in and taken from `detail_cache` when given ([`phantogram_detail::cache`]).
 pub fn prepare(
     mut model: Model,
     entry: Option<ArtifactEntry>,
     placed: bool,
     placing: &Placing,
+    progress: &Progress,
+    detail_cache: Option<&std::path::Path>,
 ) -> Result<Prepared, crate::render::RenderError> {
     if !placed {
         model.fit_to_diorama(&placing.screen, &placing.fit);
@@ -100,6 +107,17 @@ pub fn prepare(
     }
     let bounds = model.bounds().ok_or(crate::render::RenderError::EmptyModel)?;
     let info = ModelInfo::of(&model, entry);
+    // A big scan: parts with levels of detail, made here on the loader thread (seconds for
+    // millions of triangles), in the diorama's frame so that their errors are in its metres.
+    // TODO(issue 22): the coarser levels' indices (about a third more index memory) are not
+    // charged to the resource budget the loader checked the file against.
+    let span = crate::progress::Span::new(progress, progress.fraction(), 0.95);
+    phantogram_detail::prepare_cached(
+        &mut model,
+        &phantogram_detail::DetailParams::default(),
+        detail_cache,
+        |f| span.advance(f),
+    );
     if placing.floor {
         model.add_floor(&placing.screen, Model::FLOOR_REACH);
     }
@@ -219,7 +237,15 @@ fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, res
         if let Request::Select(id) = &request {
             let preview = || {
                 let loaded = library.load_preview(id, budget, &Progress::new())?.ok()?;
-                let mut prepared = prepare(loaded.model, Some(loaded.entry), loaded.placed, &placing).ok()?;
+                let mut prepared = prepare(
+                    loaded.model,
+                    Some(loaded.entry),
+                    loaded.placed,
+                    &placing,
+                    &Progress::new(),
+                    None,
+                )
+                .ok()?;
                 prepared.info.preview = true;
                 Some(prepared)
             };
@@ -248,7 +274,15 @@ fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, res
             if progress.is_cancelled() {
                 return Err(LoadError::Cancelled);
             }
-            let prepared = prepare(loaded.model, Some(loaded.entry), loaded.placed, &placing)?;
+            let cache = library.storage().map(|d| d.join(DETAIL_CACHE_DIR));
+            let prepared = prepare(
+                loaded.model,
+                Some(loaded.entry),
+                loaded.placed,
+                &placing,
+                &progress,
+                cache.as_deref(),
+            )?;
             progress.advance_to(0.95);
             Ok(prepared)
         };
@@ -320,7 +354,15 @@ impl Loader {
     /// Loads synchronously, on the calling thread (the engine's first artifact).
     pub fn load_now(&self, id: &ArtifactId, placing: &Placing) -> Result<Prepared, LoadError> {
         let loaded = self.library.load(id, self.budget, &Progress::new())?;
-        Ok(prepare(loaded.model, Some(loaded.entry), loaded.placed, placing)?)
+        let cache = self.library.storage().map(|d| d.join(DETAIL_CACHE_DIR));
+        Ok(prepare(
+            loaded.model,
+            Some(loaded.entry),
+            loaded.placed,
+            placing,
+            &Progress::new(),
+            cache.as_deref(),
+        )?)
     }
 
     /// Starts loading `request`, cancelling a load under way.
@@ -537,12 +579,28 @@ mod tests {
             floor: true,
         };
         let medal = || (crate::builtin::built_in("medal").expect("medal").make)();
-        let placed = prepare(medal(), None, true, &placing(crate::model::Placement::Auto)).expect("prepared");
+        let placed = prepare(
+            medal(),
+            None,
+            true,
+            &placing(crate::model::Placement::Auto),
+            &Progress::new(),
+            None,
+        )
+        .expect("prepared");
         assert!(
             placed.bounds.max.z > 1e-4,
             "as made, it stands a little out of the glass"
         );
-        let surface = prepare(medal(), None, true, &placing(crate::model::Placement::Surface)).expect("prepared");
+        let surface = prepare(
+            medal(),
+            None,
+            true,
+            &placing(crate::model::Placement::Surface),
+            &Progress::new(),
+            None,
+        )
+        .expect("prepared");
         assert!(
             surface.bounds.max.z.abs() < 1e-6,
             "front in the glass: {:?}",

@@ -165,6 +165,7 @@ fn tray_model(screen: &Screen, depth_m: f32) -> Model {
         mesh,
         material: 0,
         is_floor,
+        lods: Vec::new(),
     };
     Model {
         name: "diorama".into(),

@@ -62,6 +62,11 @@ use crate::{Session, SessionConfig, SessionError};
 /// Largest offscreen or surface side accepted (wgpu's downlevel limit).
 pub const MAX_SIDE_PX: u32 = 8192;
 
+/// The frame time a big scan's level-of-detail budget aims at by default, seconds: 30 frames a
+/// second, both eyes (the relief-texture paper holds at least 10; a phantogram that lags the
+/// hand by more than a frame at 30 Hz no longer looks fixed in the room).
+pub const DEFAULT_FRAME_TARGET_S: f64 = 1.0 / 30.0;
+
 /// How a shell starts an engine.
 #[derive(Clone, Debug)]
 pub struct EngineConfig {
@@ -110,6 +115,10 @@ pub struct EngineConfig {
     /// screen's "Light" switch, [`Engine::set_room_light`]) overrides it. Off by default: on a
     /// phone the map's reduction costs CPU time (see `benchmarks/ibl.md`), so the visitor opts in.
     pub room_light: bool,
+    /// When the viewer lingers on one view of an artifact, point at a side not seen yet
+    /// ([`phantogram_detail::seen`]): an arrow at the picture's edge, drawn at the glass. On by
+    /// default, as on the phones; a recording (`phantogram render`) turns it off.
+    pub side_hints: bool,
 }
 
 impl Default for EngineConfig {
@@ -130,6 +139,7 @@ impl Default for EngineConfig {
             adapt_straight_on: true,
             calibration_path: None,
             room_light: false,
+            side_hints: true,
         }
     }
 }
@@ -266,6 +276,16 @@ pub struct Engine {
     renderer: Renderer,
     model_info: ModelInfo,
     bounds: Aabb,
+    /// A big scan's levels of detail and their per-frame choice ([`phantogram_detail`]); `None`
+    /// for a model drawn whole (and for the Diorama).
+    detail: Option<phantogram_detail::Detail>,
+    /// The frame time the detail's budget aims at, seconds ([`Engine::set_frame_target_s`]).
+    frame_target_s: f64,
+    /// Which sides of the artifact the viewer has seen (`None`: hints off, or the Diorama), and
+    /// the hint toward an unseen one this frame.
+    seen: Option<phantogram_detail::seen::SeenSides>,
+    side_hints: bool,
+    side_hint: Option<phantogram_detail::seen::Hint>,
     loader: crate::artifacts::Loader,
     /// How loaded files are fitted and floored (the configuration's).
     fit: crate::model::DioramaFit,
@@ -494,7 +514,7 @@ impl Engine {
         let prepared = match (&config.model_path, &config.artifact) {
             (Some(path), _) => {
                 let model = crate::model::load_model_within(path, budget)?;
-                crate::artifacts::prepare(model, None, false, &placing)?
+                crate::artifacts::prepare(model, None, false, &placing, &crate::progress::Progress::new(), None)?
             }
             // The Diorama is made once the engine exists (below); the default artifact first.
             (None, Some(id)) if id.to_string() == crate::diorama::DIORAMA_ID => loader
@@ -520,6 +540,10 @@ impl Engine {
             bounds,
             info: model_info,
         } = prepared;
+        let detail = phantogram_detail::Detail::new(&model, DEFAULT_FRAME_TARGET_S);
+        let seen = config
+            .side_hints
+            .then(|| phantogram_detail::seen::SeenSides::new(&model));
         let environment = match &config.environment_path {
             Some(path) => Some(crate::ibl::Environment::load(path)?),
             None => None,
@@ -572,6 +596,11 @@ impl Engine {
             renderer,
             model_info,
             bounds,
+            detail,
+            frame_target_s: DEFAULT_FRAME_TARGET_S,
+            seen,
+            side_hints: config.side_hints,
+            side_hint: None,
             loader,
             fit,
             floor,
@@ -1127,6 +1156,9 @@ impl Engine {
         self.model_info = ModelInfo::of(model, Some(diorama_entry()));
         self.renderer.appearance = self.appearances.get(&appearance_key(&self.model_info));
         self.smoother = ContainmentSmoother::default();
+        self.detail = None;
+        self.seen = None;
+        self.side_hint = None;
         self.diorama = Some(Box::new(scene));
         self.diorama_grab = None;
     }
@@ -1201,6 +1233,11 @@ impl Engine {
             Ok(()) => {
                 self.diorama = None;
                 self.diorama_grab = None;
+                self.detail = phantogram_detail::Detail::new(&prepared.model, self.frame_target_s);
+                self.seen = self
+                    .side_hints
+                    .then(|| phantogram_detail::seen::SeenSides::new(&prepared.model));
+                self.side_hint = None;
                 self.bounds = prepared.bounds;
                 self.model_info = prepared.info;
                 self.renderer.appearance = self.appearances.get(&appearance_key(&self.model_info));
@@ -1580,7 +1617,73 @@ impl Engine {
         let centre = (self.bounds.min + self.bounds.max) * 0.5 + Vec3::Z * -push;
         self.renderer.lamp = self.lamp.as_mut().map(|l| l.lamp(view.device_to_world, centre));
         let input = self.oriented(frame_input(&view, Vec3::Z * -push));
+        self.follow_seen_sides(&view, centre, display_t_ns);
+        let levels = self.choose_levels(&input);
+        let input = FrameInput {
+            levels: &levels,
+            ..input
+        };
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
+        let started = std::time::Instant::now();
+        let outcome = self.draw_input(&input);
+        if let (Some(detail), Ok(DrawOutcome::Presented)) = (self.detail.as_mut(), &outcome) {
+            detail.frame_took(started.elapsed().as_secs_f64());
+        }
+        outcome
+    }
+
+    /// Marks what this frame's view shows of the artifact (centred at `centre`, device frame)
+    /// and takes the hint toward an unseen side. Needs display times: without them (frames
+    /// drawn on request) no one can be said to linger.
+    fn follow_seen_sides(&mut self, view: &crate::session::FrameView, centre: Vec3, display_t_ns: Option<i64>) {
+        self.side_hint = None;
+        let (Some(seen), Some(t_ns)) = (self.seen.as_mut(), display_t_ns) else {
+            return;
+        };
+        let [left, right] = view.stereo_eyes_m();
+        let t_s = t_ns as f64 * 1e-9;
+        seen.look((left + right) * 0.5 - centre, t_s);
+        self.side_hint = seen.hint(t_s);
+    }
+
+    /// The hint toward an unseen side shown this frame, if any (see [`EngineConfig::side_hints`]).
+    pub fn side_hint(&self) -> Option<phantogram_detail::seen::Hint> {
+        self.side_hint
+    }
+
+    /// Each part's level of detail for the frame `input` shows (empty: all at full detail).
+    fn choose_levels(&mut self, input: &FrameInput) -> Vec<u8> {
+        let size = self.target_size();
+        let (Some(detail), Some((w, h))) = (self.detail.as_mut(), size) else {
+            return Vec::new();
+        };
+        let eyes = input.eyes_drawn(self.method);
+        detail
+            .choose(&eyes, input.offset, glam::Vec2::new(w as f32, h as f32), None)
+            .to_vec()
+    }
+
+    /// The frame time the budget for big scans aims at, seconds (default
+    /// [`DEFAULT_FRAME_TARGET_S`]): their parts' levels of detail follow the measured frame
+    /// times towards it. Not a finite positive number: unchanged.
+    pub fn set_frame_target_s(&mut self, target_s: f64) {
+        if target_s.is_finite() && target_s > 0.0 {
+            self.frame_target_s = target_s;
+            if let Some(d) = self.detail.as_mut() {
+                d.set_target(target_s);
+            }
+        }
+    }
+
+    /// What the big scan's chooser did in the last frame: triangles drawn per eye, the budget,
+    /// and switches (`None` for a model drawn whole).
+    pub fn detail_stats(&self) -> Option<(phantogram_detail::ChoiceStats, u64)> {
+        self.detail.as_ref().map(|d| (d.last_choice(), d.budget_triangles()))
+    }
+
+    /// The screens (when a page or the banner is up) and the frame, presented.
+    fn draw_input(&mut self, input: &FrameInput) -> Result<DrawOutcome, EngineError> {
+        let input = *input;
         #[cfg(feature = "ui")]
         {
             self.open_pending_camera_page();
@@ -1589,7 +1692,7 @@ impl Engine {
             }
             let page_open = self.screens.as_ref().is_some_and(|s| s.page.is_some());
             let status = self.loader.status();
-            if page_open || status != LoadStatus::Idle {
+            if page_open || status != LoadStatus::Idle || self.side_hint.is_some() {
                 return self.draw_with_screens(&input, status);
             } else if let Some(screens) = self.screens.as_mut() {
                 screens.banner_pt = None;
@@ -1684,6 +1787,11 @@ impl Engine {
             _ => String::new(),
         };
         let annotations = &self.model_info.annotations;
+        // The hint only over the bare picture: in the picture's axes (x right, y down).
+        let side_hint = self.side_hint.filter(|_| screens.page.is_none()).map(|h| {
+            let toward = glam::Vec3::new(h.toward.x, h.toward.y, 0.0);
+            [toward.dot(screen.right_device()), -toward.dot(screen.up_device())]
+        });
         let mut banner_action = None;
         let mut banner_pt = None;
         let mut banner_button_pt = None;
@@ -1712,7 +1820,11 @@ impl Engine {
                     }
                     None => card_closed = true,
                 },
-                None => {}
+                None => {
+                    if let Some(toward) = side_hint {
+                        crate::calibration_ui::side_hint::show_side_hint(root.ctx(), toward, 16.0);
+                    }
+                }
             }
             if let Some(b) = &banner {
                 let (action, area, button) = show_banner(root.ctx(), b);
@@ -2192,6 +2304,7 @@ pub fn frame_input(view: &crate::session::FrameView, offset: Vec3) -> FrameInput
         toward_light: view.toward_light_device,
         device_to_world: view.device_to_world.unwrap_or(glam::Quat::IDENTITY),
         offset,
+        levels: &[],
     }
 }
 

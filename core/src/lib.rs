@@ -98,6 +98,9 @@ pub mod room_light;
 pub mod thumbnails;
 
 pub use glam;
+/// Big scans under a frame budget: parts, levels of detail, the chooser, seen sides.
+#[cfg(feature = "render")]
+pub use phantogram_detail as detail;
 /// The wgpu the renderer is built on, for shells that hand it window handles.
 #[cfg(feature = "render")]
 pub use phantogram_render::wgpu;

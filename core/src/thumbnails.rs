@@ -117,6 +117,7 @@ pub fn render(renderer: &mut crate::render::Renderer, posed: &Posed) -> Option<V
         toward_light: toward_light(),
         device_to_world: Quat::IDENTITY,
         offset: Vec3::ZERO,
+        levels: &[],
     };
     renderer
         .render_other_model(&posed.model, &input, THUMBNAIL_PX, THUMBNAIL_PX)

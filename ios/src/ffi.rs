@@ -348,9 +348,10 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             artifact,
             library_dir: library.map(PathBuf::from),
             bundled_dir: bundled.map(PathBuf::from),
-            // TODO(issue 20): on once the shell forwards the camera's colour planes and exposure
-            // (it sends the luma plane only, for the face tracker).
+            // Off at start-up, as on Android: the settings screen's "Light" switch turns it on
+            // (and the calibration file remembers it).
             room_light: false,
+            side_hints: true,
         };
         let engine = Engine::new(config)?;
         let handle = Box::new(PgEngine {

@@ -100,7 +100,8 @@ fn c_program_replays_a_log_through_the_abi() {
     let dir = std::env::temp_dir().join(format!("phantogram-c-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp folder");
     let program = dir.join("replay");
-    // The libraries rustc lists for a static library on Linux (`--print native-static-libs`).
+    // The libraries rustc lists for a static library on Linux (`--print native-static-libs`),
+    // and the C++ runtime for the mesh simplifier (meshoptimizer, in phantogram-detail).
     let output = Command::new(&cc)
         .args(["-std=c99", "-Wall", "-Wextra", "-Werror", "-o"])
         .arg(&program)
@@ -108,7 +109,16 @@ fn c_program_replays_a_log_through_the_abi() {
         .arg("-I")
         .arg(crate_dir().join("include"))
         .arg(static_library())
-        .args(["-lgcc_s", "-lutil", "-lrt", "-lpthread", "-lm", "-ldl", "-lc"])
+        .args([
+            "-lstdc++",
+            "-lgcc_s",
+            "-lutil",
+            "-lrt",
+            "-lpthread",
+            "-lm",
+            "-ldl",
+            "-lc",
+        ])
         .output()
         .expect("running the C compiler");
     assert!(

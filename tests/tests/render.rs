@@ -231,6 +231,7 @@ fn gpu_composition_matches_the_cpu_reference() {
         toward_light: Vec3::Z,
         device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
+        levels: &[],
     };
     let centre = ((H / 2) * W + W / 2) as usize * 4;
     let to_linear = |c: u8| {
@@ -296,6 +297,7 @@ fn render_over_floor(mut model: Model, shadows: bool, toward_light: Vec3) -> Opt
         toward_light,
         device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
+        levels: &[],
     };
     Some((renderer.render(&input, Method::Mono, W, H).unwrap(), mono))
 }
@@ -361,6 +363,7 @@ fn alpha_masked_surfaces_shadow_only_where_they_are_kept() {
             mesh,
             material: model.materials.len() - 1,
             is_floor: false,
+            lods: Vec::new(),
         });
     }
     let Some((pixels, proj)) = render_over_floor(model, true, OBLIQUE_LIGHT) else {
@@ -475,6 +478,7 @@ fn environment_light_turns_with_the_device() {
             toward_light: Vec3::Z,
             device_to_world: q,
             offset: Vec3::ZERO,
+            levels: &[],
         };
         renderer.render(&input, Method::Mono, W, H).unwrap()
     };
@@ -553,6 +557,7 @@ fn mirror_metal_reflects_the_environment_and_rough_metal_blurs_it() {
             toward_light: Vec3::Z,
             device_to_world: phantogram::glam::Quat::IDENTITY,
             offset: Vec3::ZERO,
+            levels: &[],
         };
         let px = renderer.render(&input, Method::Mono, W, H).unwrap();
         luminance_at(&px, &mono, Vec3::new(0.0, 0.0, -0.01))

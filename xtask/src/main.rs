@@ -6,6 +6,9 @@
 //! * `bench render` — cold load-to-first-frame of the Draco turtle, the turtle chosen in a running
 //!   engine's gallery (tap to first frame), stereo/mono frame-time ratio at 1080×2400, peak
 //!   memory (`PHANTOGRAM_DATA` for the turtle).
+//! * `bench detail` — a 2.4 M-triangle scan made from the turtle under the frame budget: stereo
+//!   frame times against the 150k turtle's, SSIM against full detail, the budget controller over
+//!   a replayed tilt (`benchmarks/detail.md`; `PHANTOGRAM_DATA` for the turtle).
 //! * `bench diorama` — ms per physics step of the Diorama with 50 bodies, moving and at rest
 //!   (`benchmarks/diorama.md`).
 //! * `bench ibl` — ms to update the image-based light (SH9, specular levels) from 1024-, 2048-
@@ -53,6 +56,7 @@ fn main() -> Result<()> {
         ["bench", "core"] | ["bench"] => cargo(&["bench", "-p", "phantogram", "--bench", "core"]),
         ["bench", "orientation"] => bench_orientation(),
         ["bench", "render"] => cargo(&["bench", "-p", "phantogram", "--bench", "render"]),
+        ["bench", "detail"] => cargo(&["bench", "-p", "phantogram", "--bench", "detail"]),
         ["bench", "face"] => cargo(&["bench", "-p", "phantogram", "--bench", "face"]),
         ["bench", "diorama"] => cargo(&["bench", "-p", "phantogram-physics", "--bench", "step"]),
         ["bench", "ibl"] => cargo(&["bench", "-p", "phantogram-assets", "--bench", "ibl"]),
@@ -82,7 +86,7 @@ fn main() -> Result<()> {
         }
         [] | ["help"] | ["--help"] => {
             println!(
-                "usage: cargo xtask <assets | bench core | bench render | bench face | bench diorama | bench orientation | models [--force] | android | ios | header | fuzz [TARGET…] [--seconds N] [--record] | ci>"
+                "usage: cargo xtask <assets | bench core | bench render | bench detail | bench face | bench diorama | bench orientation | models [--force] | android | ios | header | fuzz [TARGET…] [--seconds N] [--record] | ci>"
             );
             Ok(())
         }

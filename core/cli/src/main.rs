@@ -278,7 +278,7 @@ fn run(cli: Cli) -> Result<()> {
                 None => None,
             };
             // The calibration is the user's, kept where the desktop tools keep it.
-            let engine = scene.engine(anaglyph, phantogram::calibration::Calibration::default_path())?;
+            let engine = scene.engine(anaglyph, phantogram::calibration::Calibration::default_path(), true)?;
             viewer::run(viewer::ViewerArgs {
                 engine,
                 log,

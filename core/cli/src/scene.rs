@@ -80,7 +80,9 @@ enum PlacementArg {
 impl SceneArgs {
     /// Checks the settings and makes the engine (files are read before any GPU work, so a bad
     /// one is reported at once, with or without a GPU). Prints what was loaded and on what.
-    pub fn engine(&self, method: Method, calibration_path: Option<PathBuf>) -> Result<Engine> {
+    /// `interactive`: someone looks at it (the viewer: hints toward unseen sides), rather than a
+    /// recording being made (`render`).
+    pub fn engine(&self, method: Method, calibration_path: Option<PathBuf>, interactive: bool) -> Result<Engine> {
         if !(0.0..=1.0).contains(&self.protrude) {
             bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
         }
@@ -128,6 +130,7 @@ impl SceneArgs {
             calibration_path,
             // Files dropped on the viewer's window are kept, as a phone keeps those it opens.
             library_dir: phantogram::library_dir(),
+            side_hints: interactive,
             ..EngineConfig::default()
         };
         let mut engine = Engine::new(config)?;

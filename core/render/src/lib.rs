@@ -331,11 +331,16 @@ pub struct FrameInput<'a> {
     pub device_to_world: glam::Quat,
     /// Translation applied to the mesh this frame (containment's push-back).
     pub offset: Vec3,
+    /// The level of detail drawn for each of the model's primitives (index into its
+    /// `lods` + 1: 0 is the full mesh; `phantogram-detail` chooses them). Missing entries and
+    /// levels past a primitive's chain draw its coarsest level or the full mesh respectively:
+    /// empty draws everything at full detail.
+    pub levels: &'a [u8],
 }
 
 impl<'a> FrameInput<'a> {
     /// The projections a method draws: both eyes for stereo, the cyclopean eye for mono.
-    fn eyes_for(&self, method: Method) -> Vec<&'a OffAxisProjection> {
+    pub fn eyes_drawn(&self, method: Method) -> Vec<&'a OffAxisProjection> {
         if method.is_stereo() {
             vec![self.left, self.right]
         } else {
@@ -406,19 +411,28 @@ struct GpuPrimitive {
     vertices: wgpu::Buffer,
     /// Vertices in `vertices` (for [`Renderer::update_vertices`]).
     vertex_count: usize,
+    /// The full mesh's indices, then each coarser level's.
     indices: wgpu::Buffer,
-    index_count: u32,
+    /// Each level's range of `indices`, the full mesh first.
+    levels: Vec<std::ops::Range<u32>>,
+    /// Which of the model's primitives this is (a piece of, for a mesh larger than a buffer).
+    source: usize,
     material: usize,
     centre: Vec3,
     is_floor: bool,
 }
 
 impl GpuPrimitive {
-    /// Binds the buffers and draws, with whatever pipeline and bind groups are set.
-    fn draw(&self, pass: &mut wgpu::RenderPass<'_>) {
+    /// Binds the buffers and draws the level `levels` chooses for it (see
+    /// [`FrameInput::levels`]), with whatever pipeline and bind groups are set.
+    fn draw(&self, pass: &mut wgpu::RenderPass<'_>, levels: &[u8]) {
+        let level = usize::from(levels.get(self.source).copied().unwrap_or(0));
+        let Some(range) = self.levels.get(level).or(self.levels.last()) else {
+            return;
+        };
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..self.index_count, 0, 0..1);
+        pass.draw_indexed(range.clone(), 0, 0..1);
     }
 }
 
@@ -1203,7 +1217,7 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> Result<Vec<u8>, RenderError> {
-        self.render_views(&input.eyes_for(method), input, method, width, height)
+        self.render_views(&input.eyes_drawn(method), input, method, width, height)
     }
 
     /// Renders `projection` alone (no stereo composition), e.g. one eye's image for tests.
@@ -1243,7 +1257,7 @@ impl Renderer {
         height: u32,
         overlay: impl FnOnce(&Gpu, &wgpu::TextureView, wgpu::TextureFormat, [u32; 2]),
     ) -> Result<Vec<u8>, RenderError> {
-        self.render_views_with(&input.eyes_for(method), input, method, width, height, Some(overlay))
+        self.render_views_with(&input.eyes_drawn(method), input, method, width, height, Some(overlay))
     }
 
     fn render_views(
@@ -1330,7 +1344,7 @@ impl Renderer {
         height: u32,
     ) -> Result<(), RenderError> {
         self.targets(width, height)?;
-        let encoder = self.encode_frame(&input.eyes_for(method), input, method, target, format)?;
+        let encoder = self.encode_frame(&input.eyes_drawn(method), input, method, target, format)?;
         let queue = &self.gpu.queue;
         checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()])).map(drop)
     }
@@ -1409,7 +1423,7 @@ impl Renderer {
                 let v = variant(p);
                 !v.blend && !v.mask && (floor_casts || !p.is_floor)
             }) {
-                p.draw(&mut pass);
+                p.draw(&mut pass, input.levels);
             }
             let mut masked = self
                 .model
@@ -1425,7 +1439,7 @@ impl Renderer {
                         pass.set_pipeline(pipeline);
                         for p in masked {
                             pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
-                            p.draw(&mut pass);
+                            p.draw(&mut pass, input.levels);
                         }
                     }
                     None => debug_assert!(false, "no shadow pipeline for masked materials"),
@@ -1463,7 +1477,7 @@ impl Renderer {
                 if self.model.materials[p.material].variant.blend {
                     blended.push(p);
                 } else {
-                    self.draw_primitive(&mut pass, p);
+                    self.draw_primitive(&mut pass, p, input.levels);
                 }
             }
             blended.sort_by(|a, b| {
@@ -1472,7 +1486,7 @@ impl Renderer {
                     .total_cmp(&a.centre.distance_squared(eye_at))
             });
             for p in blended {
-                self.draw_primitive(&mut pass, p);
+                self.draw_primitive(&mut pass, p, input.levels);
             }
         }
         {
@@ -1528,7 +1542,7 @@ fn create_compose_pipeline(
 }
 
 impl Renderer {
-    fn draw_primitive(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive) {
+    fn draw_primitive(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive, levels: &[u8]) {
         let m = &self.model.materials[p.material];
         // Every material's variant was prepared with its model; a miss would be our bug, and
         // skipping the primitive beats a panic in the middle of a frame.
@@ -1538,7 +1552,7 @@ impl Renderer {
         };
         pass.set_pipeline(pipeline);
         pass.set_bind_group(1, &m.bind, &[]);
-        p.draw(pass);
+        p.draw(pass, levels);
     }
 }
 

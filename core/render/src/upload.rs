@@ -217,35 +217,65 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let max_bytes = device.limits().max_buffer_size;
     let max_vertices = (max_bytes / std::mem::size_of::<phantogram_assets::model::Vertex>() as u64) as usize;
     let max_indices = (max_bytes / 4) as usize;
-    let piece = |p: &phantogram_assets::model::Primitive, mesh: &phantogram_assets::model::Mesh| GpuPrimitive {
-        vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("vertices"),
-            contents: bytemuck::cast_slice(&mesh.vertices),
-            // COPY_DST: moving bodies (the Diorama) rewrite them in place each frame.
-            usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
-        }),
-        vertex_count: mesh.vertices.len(),
-        indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some("indices"),
-            contents: bytemuck::cast_slice(&mesh.indices),
-            usage: wgpu::BufferUsages::INDEX,
-        }),
-        index_count: mesh.indices.len() as u32,
-        material: p.material.min(model.materials.len().saturating_sub(1)),
-        // The whole primitive's centre, for the transparent pieces' back-to-front order.
-        centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
-        is_floor: p.is_floor,
+    // `lods`: the primitive's coarser levels, over the same vertices (none for a piece).
+    let piece = |source: usize,
+                 p: &phantogram_assets::model::Primitive,
+                 mesh: &phantogram_assets::model::Mesh,
+                 lods: &[phantogram_assets::model::Lod]| {
+        // One index buffer: the full mesh's, then each level's (copied only when there are
+        // levels: a big mesh without them is uploaded from where it is).
+        let mut levels = Vec::with_capacity(lods.len() + 1);
+        levels.push(0..mesh.indices.len() as u32);
+        let indices: std::borrow::Cow<[u32]> = if lods.is_empty() {
+            std::borrow::Cow::Borrowed(&mesh.indices)
+        } else {
+            let mut all = mesh.indices.clone();
+            for lod in lods {
+                let start = all.len() as u32;
+                all.extend_from_slice(&lod.indices);
+                levels.push(start..all.len() as u32);
+            }
+            std::borrow::Cow::Owned(all)
+        };
+        GpuPrimitive {
+            vertices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("vertices"),
+                contents: bytemuck::cast_slice(&mesh.vertices),
+                // COPY_DST: moving bodies (the Diorama) rewrite them in place each frame.
+                usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            }),
+            vertex_count: mesh.vertices.len(),
+            indices: device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("indices"),
+                contents: bytemuck::cast_slice(&indices),
+                usage: wgpu::BufferUsages::INDEX,
+            }),
+            levels,
+            source,
+            material: p.material.min(model.materials.len().saturating_sub(1)),
+            // The whole primitive's centre, for the transparent pieces' back-to-front order.
+            centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
+            is_floor: p.is_floor,
+        }
     };
     let mut primitives = Vec::new();
-    for p in model.primitives.iter().filter(|p| !p.mesh.indices.is_empty()) {
-        if p.mesh.vertices.len() <= max_vertices && p.mesh.indices.len() <= max_indices {
-            primitives.push(piece(p, &p.mesh));
+    for (source, p) in model
+        .primitives
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| !p.mesh.indices.is_empty())
+    {
+        let all_indices = p.mesh.indices.len() + p.lods.iter().map(|l| l.indices.len()).sum::<usize>();
+        if p.mesh.vertices.len() <= max_vertices && all_indices <= max_indices {
+            primitives.push(piece(source, p, &p.mesh, &p.lods));
         } else {
+            // Pieces of a mesh too big for one buffer are drawn at full detail (a scan that
+            // big is split into parts with levels before it gets here: `phantogram-detail`).
             primitives.extend(
                 p.mesh
                     .split_to_fit(max_vertices, max_indices)
                     .iter()
-                    .map(|m| piece(p, m)),
+                    .map(|m| piece(source, p, m, &[])),
             );
         }
     }

@@ -21,6 +21,7 @@
 pub mod material;
 pub mod menu;
 pub mod settings;
+pub mod side_hint;
 #[cfg(test)]
 mod test_taps;
 pub mod welcome;

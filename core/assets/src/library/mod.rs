@@ -205,6 +205,12 @@ impl Library {
         Self { storage, bundled }
     }
 
+    /// The folder of imported artifacts (the app's private storage), if there is one: also
+    /// where derived data about artifacts is kept (`phantogram-detail`'s cache).
+    pub fn storage(&self) -> Option<&std::path::Path> {
+        self.storage.as_deref()
+    }
+
     /// Every artifact: built-in ones first, then bundled (by title), then imported (oldest
     /// first). A folder that cannot be read is left out, not an error: the rest stays usable.
     pub fn list(&self) -> Vec<ArtifactEntry> {

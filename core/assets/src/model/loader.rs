@@ -1284,6 +1284,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     mesh: m,
                     material: prim.material().index().unwrap_or(default_material),
                     is_floor: false,
+                    lods: Vec::new(),
                 });
             }
         }

@@ -300,6 +300,20 @@ pub struct Primitive {
     /// renderer fits its shadow map to the rest (what the floor receives shadows from), and draws
     /// the floor into it only when the light is below the floor's plane.
     pub is_floor: bool,
+    /// Coarser versions of `mesh`, finest first, over the same vertices (empty: drawn only at
+    /// full detail). Made by `phantogram-detail` for big scans; the renderer draws the level the
+    /// engine chooses each frame. Everything else (bounds, picking, physics) uses `mesh`.
+    pub lods: Vec<Lod>,
+}
+
+/// A coarser level of detail of a [`Primitive`]: triangles over the primitive's own vertices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Lod {
+    /// Counter-clockwise triangles, indices into the primitive's `mesh.vertices`.
+    pub indices: Vec<u32>,
+    /// How far this level's surface may lie from the full mesh's, metres in the model's frame
+    /// (the simplifier's measured error; scaled with [`Model::transform`]).
+    pub error_m: f32,
 }
 
 /// A whole model: primitives, materials and images, all positions in one frame.
@@ -403,6 +417,7 @@ impl Model {
                 mesh,
                 material: 0,
                 is_floor: false,
+                lods: Vec::new(),
             }],
             materials: vec![Material::vertex_painted()],
             images: Vec::new(),
@@ -451,6 +466,7 @@ impl Model {
             mesh,
             material: self.materials.len() - 1,
             is_floor: true,
+            lods: Vec::new(),
         });
     }
 
@@ -472,10 +488,25 @@ impl Model {
     }
 
     pub fn transform(&mut self, m: Mat4) {
+        let linear = Mat3::from_mat4(m);
+        // A length grows by at most the largest singular value; the columns' largest length is
+        // that exactly for the similarity transforms models get (rotation, uniform scale).
+        let scale = linear
+            .x_axis
+            .length()
+            .max(linear.y_axis.length())
+            .max(linear.z_axis.length());
         for p in &mut self.primitives {
             p.mesh.transform(m);
+            for lod in &mut p.lods {
+                lod.error_m *= scale;
+                if linear.determinant() < 0.0 {
+                    for tri in lod.indices.chunks_mut(3) {
+                        tri.swap(1, 2);
+                    }
+                }
+            }
         }
-        let linear = Mat3::from_mat4(m);
         let normal_m = linear.inverse().transpose();
         for a in &mut self.annotations {
             a.position = m.transform_point3(a.position);
@@ -517,6 +548,7 @@ impl Model {
             mesh,
             material: self.materials.len() - 1,
             is_floor: false,
+            lods: Vec::new(),
         });
     }
 
