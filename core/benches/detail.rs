@@ -117,7 +117,13 @@ fn main() {
     let mut detail = Detail::new(&big, 1.0).expect("levels");
     let image = Vec2::new(W as f32, H as f32);
     let levels = detail
-        .choose(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, image, None)
+        .choose_within(
+            &input.eyes_drawn(Method::DuboisRedCyan),
+            input.offset,
+            image,
+            None,
+            u64::MAX,
+        )
         .to_vec();
     let unbound = detail.last_choice();
     let mixed = FrameInput {

@@ -75,6 +75,11 @@ pub struct Prepared {
     /// The artifact's bounds without the floor (what containment keeps in the front frustum).
     pub bounds: Aabb,
     pub info: ModelInfo,
+    /// A big scan's per-frame choice of levels (`None`: drawn whole), and what the viewer will
+    /// have seen of it: both summarise every triangle, so they are made here, off the render
+    /// thread.
+    pub detail: Option<phantogram_detail::Detail>,
+    pub seen: phantogram_detail::seen::SeenSides,
 }
 
 /// How the worker places what it loads (the engine's settings when the load starts).
@@ -122,7 +127,15 @@ pub fn prepare(
         model.add_floor(&placing.screen, Model::FLOOR_REACH);
     }
     model.add_annotation_pins();
-    Ok(Prepared { model, bounds, info })
+    let detail = phantogram_detail::Detail::new(&model, crate::engine::DEFAULT_FRAME_TARGET_S);
+    let seen = phantogram_detail::seen::SeenSides::new(&model);
+    Ok(Prepared {
+        model,
+        bounds,
+        info,
+        detail,
+        seen,
+    })
 }
 
 /// What the shells show about loading.

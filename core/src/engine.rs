@@ -539,11 +539,10 @@ impl Engine {
             model,
             bounds,
             info: model_info,
+            detail,
+            seen,
         } = prepared;
-        let detail = phantogram_detail::Detail::new(&model, DEFAULT_FRAME_TARGET_S);
-        let seen = config
-            .side_hints
-            .then(|| phantogram_detail::seen::SeenSides::new(&model));
+        let seen = config.side_hints.then_some(seen);
         let environment = match &config.environment_path {
             Some(path) => Some(crate::ibl::Environment::load(path)?),
             None => None,
@@ -1233,10 +1232,11 @@ impl Engine {
             Ok(()) => {
                 self.diorama = None;
                 self.diorama_grab = None;
-                self.detail = phantogram_detail::Detail::new(&prepared.model, self.frame_target_s);
-                self.seen = self
-                    .side_hints
-                    .then(|| phantogram_detail::seen::SeenSides::new(&prepared.model));
+                self.detail = prepared.detail.map(|mut d| {
+                    d.set_target(self.frame_target_s);
+                    d
+                });
+                self.seen = self.side_hints.then_some(prepared.seen);
                 self.side_hint = None;
                 self.bounds = prepared.bounds;
                 self.model_info = prepared.info;

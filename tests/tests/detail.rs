@@ -60,11 +60,12 @@ fn compare(gpu: Gpu, mut big: Model) -> Compared {
     let mut renderer = Renderer::new(gpu, &big).unwrap();
     let mut detail = Detail::new(&big, 1.0).expect("levels");
     let levels = detail
-        .choose(
+        .choose_within(
             &input.eyes_drawn(Method::DuboisRedCyan),
             input.offset,
             Vec2::new(W as f32, H as f32),
             None,
+            u64::MAX,
         )
         .to_vec();
     let mixed_triangles = detail.last_choice().triangles;

@@ -52,6 +52,12 @@ impl BudgetController {
         }
     }
 
+    /// Starts from `triangles` (within the bounds) instead of full detail.
+    pub fn starting_at(mut self, triangles: u64) -> Self {
+        self.budget = (triangles as f64).clamp(self.min, self.max);
+        self
+    }
+
     /// Triangles the next frame may draw.
     pub fn budget(&self) -> u64 {
         self.budget as u64

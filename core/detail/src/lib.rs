@@ -241,7 +241,10 @@ impl Detail {
         Some(Self {
             parts,
             chooser: Chooser::default(),
-            budget: BudgetController::new(target_frame_s, min, max),
+            // The first frames at what a phone draws twice within a frame (the size from which
+            // scans are split), not at full detail: the controller takes it from there.
+            budget: BudgetController::new(target_frame_s, min, max)
+                .starting_at(DetailParams::default().min_model_triangles as u64),
             last: ChoiceStats::default(),
         })
     }
@@ -271,13 +274,27 @@ impl Detail {
         image_px: Vec2,
         attention_px: Option<Vec2>,
     ) -> &[u8] {
+        let budget = self.budget.budget();
+        self.choose_within(eyes, offset_m, image_px, attention_px, budget)
+    }
+
+    /// [`Detail::choose`] within `budget_triangles` per eye instead of the controller's budget
+    /// (`u64::MAX`: every part at the coarsest level whose error is invisible).
+    pub fn choose_within(
+        &mut self,
+        eyes: &[&OffAxisProjection],
+        offset_m: Vec3,
+        image_px: Vec2,
+        attention_px: Option<Vec2>,
+        budget_triangles: u64,
+    ) -> &[u8] {
         let view = ChoiceView {
             eyes,
             offset_m,
             attention_px: attention_px.unwrap_or(image_px * 0.5),
             attention_reach_px: image_px.length() * 0.5,
         };
-        self.last = self.chooser.choose(&self.parts, &view, self.budget.budget());
+        self.last = self.chooser.choose(&self.parts, &view, budget_triangles);
         self.chooser.levels()
     }
 

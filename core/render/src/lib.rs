@@ -331,10 +331,10 @@ pub struct FrameInput<'a> {
     pub device_to_world: glam::Quat,
     /// Translation applied to the mesh this frame (containment's push-back).
     pub offset: Vec3,
-    /// The level of detail drawn for each of the model's primitives (index into its
-    /// `lods` + 1: 0 is the full mesh; `phantogram-detail` chooses them). Missing entries and
-    /// levels past a primitive's chain draw its coarsest level or the full mesh respectively:
-    /// empty draws everything at full detail.
+    /// The level of detail drawn for each of the model's primitives, by index (0 is the full
+    /// mesh, l its `lods[l − 1]`; `phantogram-detail` chooses them). A level past a primitive's
+    /// chain draws its coarsest; a primitive without an entry (all of them, for an empty slice)
+    /// is drawn at full detail.
     pub levels: &'a [u8],
 }
 
