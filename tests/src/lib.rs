@@ -45,6 +45,19 @@ pub fn engine_or_skip(config: phantogram::engine::EngineConfig) -> Option<phanto
     }
 }
 
+/// A headless GPU (lavapipe on the desktop); `None` (the test skips, saying so) where no adapter
+/// is found, except under CI (`CI` set), where that fails the test.
+pub fn gpu_or_skip() -> Option<phantogram::render::Gpu> {
+    match phantogram::render::Gpu::headless() {
+        Ok(g) => Some(g),
+        Err(e) if std::env::var_os("CI").is_none() => {
+            eprintln!("no GPU adapter ({e}): skipping rendering tests");
+            None
+        }
+        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
+    }
+}
+
 /// MediaPipe's face models from `$PHANTOGRAM_MODELS` (written by `cargo xtask models`), or
 /// `None` (the test skips, saying so) when it is unset; set but unloadable fails the test.
 pub fn face_models() -> Option<std::sync::Arc<phantogram::face::FaceModels>> {

@@ -19,14 +19,7 @@ const W: u32 = 360;
 const H: u32 = 800;
 
 fn gpu() -> Option<Gpu> {
-    match Gpu::headless() {
-        Ok(g) => Some(g),
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no GPU adapter ({e}): skipping rendering tests");
-            None
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
-    }
+    phantogram_integration::gpu_or_skip()
 }
 
 fn oblique_view() -> FrameView {

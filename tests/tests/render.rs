@@ -21,14 +21,7 @@ use phantogram::screen::Screen;
 use phantogram::{FrameView, Session, SessionConfig};
 
 fn gpu() -> Option<Gpu> {
-    match Gpu::headless() {
-        Ok(g) => Some(g),
-        Err(e) if std::env::var_os("CI").is_none() => {
-            eprintln!("no GPU adapter ({e}): skipping rendering tests");
-            None
-        }
-        Err(e) => panic!("CI needs a GPU adapter (lavapipe): {e}"),
-    }
+    phantogram_integration::gpu_or_skip()
 }
 
 /// The output size used by the tests: the default phone's aspect, small for lavapipe.

@@ -213,7 +213,7 @@ fn fibonacci_sphere(n: usize) -> Vec<Vec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use phantogram_assets::model::{Material, Mesh, Primitive};
+    use phantogram_assets::model::Mesh;
 
     /// A box standing on the glass (base at z = 0): `sides` are the half-extents, so a longer
     /// x extent means larger ±y faces.
@@ -225,16 +225,7 @@ mod tests {
             glam::Quat::IDENTITY,
             Vec3::Z * half.z,
         ));
-        Model {
-            primitives: vec![Primitive {
-                mesh,
-                material: 0,
-                is_floor: false,
-                lods: Vec::new(),
-            }],
-            materials: vec![Material::default()],
-            ..Model::default()
-        }
+        Model::from_painted_mesh("box", mesh)
     }
 
     #[test]

@@ -119,7 +119,6 @@ fn recompute_normals(mesh: &mut Mesh) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use phantogram_assets::model::{Material, Primitive};
 
     fn octahedron() -> Model {
         let mut mesh = Mesh::default();
@@ -134,16 +133,7 @@ mod tests {
             });
         }
         mesh.indices = vec![0, 2, 4, 2, 1, 4, 1, 3, 4, 3, 0, 4, 2, 0, 5, 1, 2, 5, 3, 1, 5, 0, 3, 5];
-        Model {
-            primitives: vec![Primitive {
-                mesh,
-                material: 0,
-                is_floor: false,
-                lods: Vec::new(),
-            }],
-            materials: vec![Material::default()],
-            ..Model::default()
-        }
+        Model::from_painted_mesh("octahedron", mesh)
     }
 
     #[test]
