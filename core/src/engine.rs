@@ -1627,7 +1627,15 @@ impl Engine {
         let started = std::time::Instant::now();
         let outcome = self.draw_input(&input);
         if let (Some(detail), Ok(DrawOutcome::Presented)) = (self.detail.as_mut(), &outcome) {
-            detail.frame_took(started.elapsed().as_secs_f64());
+            // GPU time where the device measures it (each reading once, when it arrives); the
+            // frame's wall time otherwise.
+            if self.renderer.times_gpu() {
+                if let Some(gpu_s) = self.renderer.take_gpu_time_s() {
+                    detail.frame_took(gpu_s);
+                }
+            } else {
+                detail.frame_took(started.elapsed().as_secs_f64());
+            }
         }
         outcome
     }

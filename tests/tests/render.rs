@@ -887,3 +887,29 @@ fn annotation_markers_land_on_their_pixel_in_each_eye_and_hide_behind_the_artifa
         );
     }
 }
+
+/// Where the adapter has timestamp queries (lavapipe has), each frame's GPU time is read back
+/// once, without waiting, and is no longer than the frame took on the clock.
+#[test]
+fn frames_are_timed_on_the_gpu_once_per_reading() {
+    let Some(gpu) = gpu() else { return };
+    let mut renderer = Renderer::new(gpu, &default_model()).unwrap();
+    if !renderer.times_gpu() {
+        eprintln!("the adapter has no timestamp queries: frames are timed by the clock");
+        return;
+    }
+    let view = oblique_view();
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
+    let mut readings = 0;
+    for _ in 0..4 {
+        let start = std::time::Instant::now();
+        renderer.render(&input, Method::DuboisRedCyan, W, H).unwrap();
+        let wall_s = start.elapsed().as_secs_f64();
+        // `render` waits for its frame to be read back, so the frame's own reading is ready.
+        let gpu_s = renderer.take_gpu_time_s().expect("a reading for the frame just drawn");
+        assert!(gpu_s > 0.0 && gpu_s <= wall_s * 1.05, "GPU {gpu_s} s, wall {wall_s} s");
+        assert_eq!(renderer.take_gpu_time_s(), None, "each reading is handed out once");
+        readings += 1;
+    }
+    assert_eq!(readings, 4);
+}

@@ -67,6 +67,8 @@ impl Gpu {
         let adapter = adapter.ok_or(RenderError::NoAdapter)?;
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("phantogram"),
+            // Timestamp queries where offered: the frame budget of big scans follows GPU time.
+            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
             required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
             ..Default::default()
         }))

@@ -53,6 +53,7 @@ use phantogram_geometry::anaglyph::Method;
 use phantogram_geometry::projection::OffAxisProjection;
 
 mod gpu;
+mod gpu_timer;
 mod lighting_tables;
 pub mod surface;
 mod upload;
@@ -720,6 +721,8 @@ pub struct Renderer {
     pub appearance: Appearance,
     /// A lamp in place of the directional light (its shadows too), or `None`.
     pub lamp: Option<Lamp>,
+    /// The frames' GPU time, where the device has timestamp queries.
+    timer: Option<gpu_timer::GpuTimer>,
 }
 
 impl Renderer {
@@ -968,8 +971,23 @@ impl Renderer {
             lighting: Lighting::default(),
             appearance: Appearance::default(),
             lamp: None,
+            timer: gpu_timer::GpuTimer::new(&gpu.device, &gpu.queue),
             gpu,
         }
+    }
+
+    /// Whether frames are timed on the GPU (the device has timestamp queries).
+    pub fn times_gpu(&self) -> bool {
+        self.timer.is_some()
+    }
+
+    /// The GPU time of a recent frame, seconds, once per reading (`None` until a new one has
+    /// arrived, and always where the device has no timestamp queries): from the first pass's
+    /// start to the composition's end, without the overlay. Frames are timed while no earlier
+    /// reading is in flight.
+    pub fn take_gpu_time_s(&mut self) -> Option<f64> {
+        let device = &self.gpu.device;
+        self.timer.as_mut()?.take_s(device)
     }
 
     pub fn gpu(&self) -> &Gpu {
@@ -1303,7 +1321,7 @@ impl Renderer {
         if let Some(overlay) = overlay {
             // The frame first, then the overlay's own submission over it, then the copy.
             let queue = &self.gpu.queue;
-            checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()]))?;
+            self.submit_timed(|| queue.submit([encoder.finish()]))?;
             overlay(&self.gpu, &output_view, OUTPUT_FORMAT, [width, height]);
             encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("read-back"),
@@ -1328,7 +1346,7 @@ impl Renderer {
             },
         );
         let queue = &self.gpu.queue;
-        checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()]))?;
+        self.submit_timed(|| queue.submit([encoder.finish()]))?;
         read_back(&self.gpu.device, offscreen, width, height)
     }
 
@@ -1346,7 +1364,20 @@ impl Renderer {
         self.targets(width, height)?;
         let encoder = self.encode_frame(&input.eyes_drawn(method), input, method, target, format)?;
         let queue = &self.gpu.queue;
-        checked(&self.gpu.device, "the frame", || queue.submit([encoder.finish()])).map(drop)
+        self.submit_timed(|| queue.submit([encoder.finish()]))
+    }
+
+    /// Submits a frame's commands (inside a validation scope) and asks for its GPU time, if the
+    /// frame was timed; a failed submission frees the timer for the next frame.
+    fn submit_timed(&self, submit: impl FnOnce() -> wgpu::SubmissionIndex) -> Result<(), RenderError> {
+        let result = checked(&self.gpu.device, "the frame", submit).map(drop);
+        if let Some(timer) = &self.timer {
+            match result {
+                Ok(()) => timer.submitted(),
+                Err(_) => timer.abandon(),
+            }
+        }
+        result
     }
 
     /// Writes the uniforms and records the shadow, scene and composition passes into `target`.
@@ -1398,12 +1429,17 @@ impl Renderer {
         }
         queue.write_buffer(&self.compose_buffer, 0, bytemuck::bytes_of(&compose));
 
+        // Timed (where the device can) from the first pass's start to the composition's end.
+        let timed = self.timer.as_mut().is_some_and(|t| t.start_frame());
+        let timer = self.timer.as_ref().filter(|_| timed);
+        let shadow_pass = self.lighting.shadows && lamp_shadows;
         let targets = self.targets.as_ref().expect("the caller sized the targets");
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
-        if self.lighting.shadows && lamp_shadows {
+        if shadow_pass {
             // Once per frame, for both eyes.
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("shadow"),
+                timestamp_writes: timer.map(|t| t.writes(true, false)),
                 color_attachments: &[],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &self.shadow_view,
@@ -1447,8 +1483,10 @@ impl Renderer {
             }
         }
         for (i, u) in uniforms.iter().enumerate() {
+            let first = i == 0 && !shadow_pass;
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("scene"),
+                timestamp_writes: timer.filter(|_| first).map(|t| t.writes(true, false)),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: &targets.hdr[i],
                     depth_slice: None,
@@ -1492,6 +1530,7 @@ impl Renderer {
         {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("compose"),
+                timestamp_writes: timer.map(|t| t.writes(false, true)),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: target,
                     depth_slice: None,
@@ -1507,6 +1546,9 @@ impl Renderer {
             let bind = if uniforms.len() == 2 { 0 } else { 1 };
             pass.set_bind_group(0, &targets.compose_bind[bind], &[]);
             pass.draw(0..3, 0..1);
+        }
+        if let Some(t) = timer {
+            t.resolve(&mut encoder);
         }
         Ok(encoder)
     }
