@@ -1236,7 +1236,14 @@ impl Engine {
                     d.set_target(self.frame_target_s);
                     d
                 });
-                self.seen = self.side_hints.then_some(prepared.seen);
+                // The best scan taking over from its preview is the same artifact: what was
+                // seen of it stays seen.
+                let same_artifact = self.model_info.preview
+                    && self.model_info.artifact.as_ref().map(|a| &a.id)
+                        == prepared.info.artifact.as_ref().map(|a| &a.id);
+                if !(same_artifact && self.seen.is_some()) {
+                    self.seen = self.side_hints.then_some(prepared.seen);
+                }
                 self.side_hint = None;
                 self.bounds = prepared.bounds;
                 self.model_info = prepared.info;
