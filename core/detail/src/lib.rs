@@ -13,8 +13,9 @@
 //! ([`cache`], [`prepare_cached`]).
 //!
 //! Not here yet: the paper's relief-texture impostors (six orthographic colour, depth and normal
-//! maps per part, relief-mapped per eye), and cross-fades between levels (switches happen only where both levels' errors are below the
-//! visible threshold, or under budget pressure; [`ChoiceStats::switched_px`] measures them).
+//! maps per part, relief-mapped per eye), and cross-fades between levels (switches happen only
+//! where both levels' errors are below the visible threshold, or under budget pressure;
+//! [`ChoiceStats::switched_px`] measures them).
 //!
 //! Frames and units: the model's frame is the device frame (metres), as everywhere in the
 //! engine. Threading: [`prepare`] runs on the loader thread (seconds for millions of triangles);

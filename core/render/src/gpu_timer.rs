@@ -139,11 +139,8 @@ impl GpuTimer {
         match self.state() {
             State::Mapped => {
                 if let Ok(view) = self.readback.get_mapped_range(..) {
-                    let ticks = |k: usize| {
-                        let b = &view[k * 8..k * 8 + 8];
-                        u64::from_le_bytes([b[0], b[1], b[2], b[3], b[4], b[5], b[6], b[7]])
-                    };
-                    let (start, end) = (ticks(0), ticks(1));
+                    let ticks: [u64; 2] = bytemuck::pod_read_unaligned(&view[..BYTES as usize]);
+                    let [start, end] = ticks;
                     // A reading that runs backwards or past ten seconds is no frame's.
                     let s = end.checked_sub(start).map(|t| t as f64 * self.period_ns * 1e-9);
                     if let Some(s) = s.filter(|s| *s > 0.0 && *s < 10.0) {

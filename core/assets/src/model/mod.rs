@@ -496,11 +496,12 @@ impl Model {
             .length()
             .max(linear.y_axis.length())
             .max(linear.z_axis.length());
+        let mirrors = linear.determinant() < 0.0;
         for p in &mut self.primitives {
             p.mesh.transform(m);
             for lod in &mut p.lods {
                 lod.error_m *= scale;
-                if linear.determinant() < 0.0 {
+                if mirrors {
                     for tri in lod.indices.chunks_mut(3) {
                         tri.swap(1, 2);
                     }
