@@ -26,7 +26,7 @@ use std::time::Instant;
 
 use phantogram::anaglyph::Method;
 use phantogram::detail::{Detail, DetailParams};
-use phantogram::glam::{Vec2, Vec3};
+use phantogram::glam::Vec3;
 use phantogram::model::DioramaFit;
 use phantogram::render::{FrameInput, Gpu, Renderer};
 use phantogram::{Session, SessionConfig};
@@ -115,15 +115,8 @@ fn main() {
 
     renderer.set_model(&big).expect("the big scan uploads");
     let mut detail = Detail::new(&big, 1.0).expect("levels");
-    let image = Vec2::new(W as f32, H as f32);
     let levels = detail
-        .choose_within(
-            &input.eyes_drawn(Method::DuboisRedCyan),
-            input.offset,
-            image,
-            None,
-            u64::MAX,
-        )
+        .choose_within(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, None, u64::MAX)
         .to_vec();
     let unbound = detail.last_choice();
     let mixed = FrameInput {
@@ -187,7 +180,7 @@ fn main() {
     let mut levels = Vec::new();
     for k in 0..settle {
         levels = detail
-            .choose(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, image, None)
+            .choose(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, None)
             .to_vec();
         let frame = FrameInput {
             levels: &levels,
@@ -232,7 +225,7 @@ fn main() {
         let view = tilted_session(frame_s);
         let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
         let levels = detail
-            .choose(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, image, None)
+            .choose(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, None)
             .to_vec();
         let stats = detail.last_choice();
         let frame = FrameInput {

@@ -1668,14 +1668,11 @@ impl Engine {
 
     /// Each part's level of detail for the frame `input` shows (empty: all at full detail).
     fn choose_levels(&mut self, input: &FrameInput) -> Vec<u8> {
-        let size = self.target_size();
-        let (Some(detail), Some((w, h))) = (self.detail.as_mut(), size) else {
+        let Some(detail) = self.detail.as_mut() else {
             return Vec::new();
         };
         let eyes = input.eyes_drawn(self.method);
-        detail
-            .choose(&eyes, input.offset, glam::Vec2::new(w as f32, h as f32), None)
-            .to_vec()
+        detail.choose(&eyes, input.offset, None).to_vec()
     }
 
     /// The frame time the budget for big scans aims at, seconds (default

@@ -65,8 +65,9 @@ pub struct ChoiceView<'a> {
     pub eyes: &'a [&'a OffAxisProjection],
     /// The frame's translation of the mesh (containment's push-back), metres.
     pub offset_m: Vec3,
-    /// Where the viewer's attention is, in pixels of the first eye's image (the image's centre
-    /// without a gaze), and the distance at which attention has fallen to ½ (the half-diagonal).
+    /// Where the viewer's attention is, in the first eye's projected pixels (the glass's,
+    /// [`OffAxisProjection::image_px`]; its centre without a gaze), and the distance at which
+    /// attention has fallen to ½ (the half-diagonal).
     pub attention_px: Vec2,
     pub attention_reach_px: f32,
 }

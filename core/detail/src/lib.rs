@@ -266,17 +266,11 @@ impl Detail {
     }
 
     /// Chooses the levels for a frame seen by `eyes` with the mesh moved by `offset_m`, attention
-    /// at `attention_px` (pixels of the first eye's image; `None`: the image's centre). Returns
-    /// one level per model primitive.
-    pub fn choose(
-        &mut self,
-        eyes: &[&OffAxisProjection],
-        offset_m: Vec3,
-        image_px: Vec2,
-        attention_px: Option<Vec2>,
-    ) -> &[u8] {
+    /// at `attention_px` (in the first eye's projected pixels, the glass's whatever size the
+    /// frame is rendered at; `None`: the glass's centre). Returns one level per model primitive.
+    pub fn choose(&mut self, eyes: &[&OffAxisProjection], offset_m: Vec3, attention_px: Option<Vec2>) -> &[u8] {
         let budget = self.budget.budget();
-        self.choose_within(eyes, offset_m, image_px, attention_px, budget)
+        self.choose_within(eyes, offset_m, attention_px, budget)
     }
 
     /// [`Detail::choose`] within `budget_triangles` per eye instead of the controller's budget
@@ -285,10 +279,10 @@ impl Detail {
         &mut self,
         eyes: &[&OffAxisProjection],
         offset_m: Vec3,
-        image_px: Vec2,
         attention_px: Option<Vec2>,
         budget_triangles: u64,
     ) -> &[u8] {
+        let image_px = eyes.first().map_or(Vec2::ONE, |e| e.image_px());
         let view = ChoiceView {
             eyes,
             offset_m,
@@ -447,6 +441,35 @@ mod tests {
         assert!(!third.from_cache);
         assert_eq!(again, made);
         std::fs::remove_dir_all(&dir).unwrap();
+    }
+
+    #[test]
+    fn without_a_gaze_attention_is_at_the_glass_centre() {
+        // Two like parts 1.6 cm across, one at the glass's centre, one near its corner, with
+        // room in the budget for one refinement: the centre's gets it.
+        let part_at = |at: Vec3| {
+            let mut p = bumpy_grid(16, 16, 0.3);
+            p.mesh.transform(glam::Mat4::from_scale_rotation_translation(
+                Vec3::splat(0.001),
+                glam::Quat::IDENTITY,
+                at - Vec3::new(0.008, 0.008, 0.0),
+            ));
+            lod::build(&mut p, 16);
+            p
+        };
+        let model = Model {
+            primitives: vec![part_at(Vec3::ZERO), part_at(Vec3::new(0.024, 0.06, 0.0))],
+            materials: vec![Material::default()],
+            ..Model::default()
+        };
+        let mut detail = Detail::new(&model, 0.033).expect("levels");
+        let summary = PartSummary::of(&model.primitives[0]);
+        let k = summary.levels.len() - 1;
+        let coarsest: u64 = 2 * u64::from(summary.levels[k].0);
+        let step = u64::from(summary.levels[k - 1].0 - summary.levels[k].0);
+        let (l, r) = eyes_at(Vec3::new(0.0, 0.0, 0.35));
+        let levels = detail.choose_within(&[&l, &r], Vec3::ZERO, None, coarsest + step);
+        assert!(levels[0] < levels[1], "{levels:?}");
     }
 
     #[test]

@@ -114,6 +114,12 @@ impl OffAxisProjection {
         })
     }
 
+    /// The size of the image [`Self::project`]'s pixels are in: the glass's pixels (the panel's,
+    /// as the displayed image is oriented), whatever size a frame is rendered at.
+    pub fn image_px(&self) -> Vec2 {
+        Vec2::new(self.width_px, self.height_px)
+    }
+
     /// Projects a device-frame point. `None` for points at or behind the eye's plane.
     pub fn project(&self, p_m: Vec3) -> Option<ProjectedPoint> {
         let clip = self.view_proj * p_m.extend(1.0);
