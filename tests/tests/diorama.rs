@@ -1,9 +1,11 @@
 //! The Diorama over recorded and synthetic tilting (issue 19's goals):
 //!
-//! * ten minutes of recorded phone handling (`imu/phone`, needs `PHANTOGRAM_DATA`): no body
-//!   ever reaches out of either eye's pyramid in front of the glass (checked every frame from
-//!   the planes through the eyes and the screen's edges, not from pixels), none leaves the
-//!   tray through a wall, the floor or the lid, no NaN;
+//! * sixteen minutes of recorded handling (`imu/phone`, and two BROAD trials that turn the
+//!   sensor over and round; needs `PHANTOGRAM_DATA`): no body ever reaches out of either eye's
+//!   pyramid in front of the glass — as stepped, and as drawn (interpolated between steps)
+//!   against the frame's own eyes — checked every frame from the planes through the eyes and
+//!   the screen's edges, not from pixels; none leaves the tray through a wall, the floor or
+//!   the lid, no NaN;
 //! * the same log gives bit-identical final poses on two runs;
 //! * tilt the phone so that a side of it is lower in the room, from any holding pose: the
 //!   bodies end up on that side, in the world frame (synthetic orientations, and every steady
@@ -18,7 +20,8 @@ use phantogram::diorama::DioramaScene;
 use phantogram::glam::{Quat, Vec3};
 use phantogram::physics::apparent_gravity::gravity_device;
 use phantogram::physics::bodies::default_scene;
-use phantogram::physics::diorama::{CONTAINMENT_TOLERANCE_M, Diorama, DioramaParams};
+use phantogram::physics::diorama::{BodyPose, CONTAINMENT_TOLERANCE_M, Diorama, DioramaParams, reach_out_of_view_m};
+use phantogram::physics::frustum::{EyePlane, stereo_pyramids};
 use phantogram::screen::Screen;
 use phantogram::sensors::{SensorEvent, SensorKind};
 use phantogram::{Session, SessionConfig};
@@ -32,7 +35,8 @@ const FRAME_NS: i64 = 33_333_333;
 #[derive(Default)]
 struct Findings {
     frames: usize,
-    /// The largest reach of a body out of an eye's pyramid in front of the glass, metres.
+    /// The largest reach of a body out of an eye's pyramid in front of the glass, metres, as
+    /// stepped and as drawn.
     worst_escape_m: f32,
     /// Bodies found outside the tray (through a wall, the floor or the lid).
     outside_tray: usize,
@@ -47,19 +51,24 @@ fn escape_m(world: &Diorama) -> f32 {
     let Some(planes) = world.pyramid_planes() else {
         return 0.0;
     };
-    let mut worst = f32::MIN;
-    for (pose, spec) in world.stepped_poses().iter().zip(world.specs()) {
-        let to_body = pose.rotation.inverse();
-        let front = pose.translation_m.z + spec.shape.support_m(to_body * Vec3::Z);
-        if front <= 0.0 {
-            continue; // behind the glass: seen through the window, which may frame it
-        }
-        for p in &planes {
-            let reach = spec.shape.support_m(to_body * -p.normal);
-            worst = worst.max(reach - p.distance_m(pose.translation_m));
-        }
-    }
-    worst
+    worst_reach_m(world.stepped_poses(), world, &planes)
+}
+
+/// How far a body *as drawn* (interpolated between steps) reaches out of the pyramids of the
+/// frame's own eyes, the planes through each eye and the screen's edges (≤ 0: inside).
+fn drawn_escape_m(world: &Diorama, screen: &Screen, eyes: [Vec3; 2]) -> f32 {
+    let Some(planes) = stereo_pyramids(screen, eyes) else {
+        return 0.0;
+    };
+    worst_reach_m(&world.poses(), world, &planes)
+}
+
+fn worst_reach_m(poses: &[BodyPose], world: &Diorama, planes: &[EyePlane]) -> f32 {
+    poses
+        .iter()
+        .zip(world.specs())
+        .filter_map(|(pose, spec)| reach_out_of_view_m(&spec.shape, pose, planes))
+        .fold(0.0, f32::max)
 }
 
 /// Bodies reaching through the tray's floor or a wall, or its lid, by more than the
@@ -135,7 +144,11 @@ fn replay(events: &[SensorEvent], max_s: f64) -> Findings {
         scene.update(&view, session.newest_specific_force(), t);
         let world = scene.world();
         found.frames += 1;
-        found.worst_escape_m = found.worst_escape_m.max(escape_m(world));
+        found.worst_escape_m =
+            found
+                .worst_escape_m
+                .max(escape_m(world))
+                .max(drawn_escape_m(world, &screen, view.stereo_eyes_m()));
         let out = outside_tray(world, &screen, view.stereo_eyes_m());
         found.outside_tray += out;
         found.non_finite += world
@@ -170,20 +183,37 @@ fn phone_trials() -> Option<Vec<(String, Vec<SensorEvent>)>> {
     let dir = data_subdir("imu/phone")?;
     let mut names: Vec<_> = std::fs::read_dir(&dir).ok()?.flatten().map(|e| e.path()).collect();
     names.sort();
-    Some(
-        names
-            .iter()
-            .map(|p| {
-                let events = import(p).unwrap_or_else(|e| panic!("{e}")).events;
-                (p.file_name().unwrap().to_string_lossy().into_owned(), events)
-            })
-            .collect(),
-    )
+    Some(imported(&names))
+}
+
+/// BROAD trials that turn the sensor over and round (face down too), slowly and fast: the
+/// bodies fall out of the tray into the front space, where the pyramids must hold them.
+fn turning_trials() -> Option<Vec<(String, Vec<SensorEvent>)>> {
+    let dir = data_subdir("imu/broad")?;
+    let names = [
+        "02_undisturbed_slow_rotation_B.csv.gz",
+        "07_undisturbed_fast_rotation_B.csv.gz",
+    ]
+    .map(|n| dir.join(n));
+    Some(imported(&names))
+}
+
+fn imported(names: &[std::path::PathBuf]) -> Vec<(String, Vec<SensorEvent>)> {
+    names
+        .iter()
+        .map(|p| {
+            let events = import(p).unwrap_or_else(|e| panic!("{}: {e}", p.display())).events;
+            (p.file_name().unwrap().to_string_lossy().into_owned(), events)
+        })
+        .collect()
 }
 
 #[test]
 fn ten_minutes_of_recorded_handling_keep_every_body_in_view_and_in_the_tray() {
-    let Some(trials) = phone_trials() else { return };
+    let (Some(mut trials), Some(turning)) = (phone_trials(), turning_trials()) else {
+        return;
+    };
+    trials.extend(turning);
     let mut total_s = 0.0;
     let (mut downhill, mut steady) = (0, 0);
     for (name, events) in &trials {

@@ -37,6 +37,24 @@ pub const CONTAINMENT_TOLERANCE_M: f32 = 0.0002;
 const SIDE_THICKNESS_M: f32 = 0.05;
 const SIDE_OVERLAP_M: f32 = 0.02;
 
+/// How far a body of `shape` at `pose` reaches out of the planes (an eye's pyramid sides) in
+/// front of the glass, metres (≤ 0: inside them all); `None` when it lies wholly behind the
+/// glass, where the window may frame it. The whole body is measured, not only its part in
+/// front of the glass: a conservative test, the one [`Diorama`]'s containment holds to.
+pub fn reach_out_of_view_m(shape: &BodyShape, pose: &BodyPose, planes: &[EyePlane]) -> Option<f32> {
+    let to_body = pose.rotation.inverse();
+    let front = pose.translation_m.z + shape.support_m(to_body * Vec3::Z);
+    if front <= 0.0 {
+        return None;
+    }
+    Some(
+        planes
+            .iter()
+            .map(|p| shape.support_m(to_body * -p.normal) - p.distance_m(pose.translation_m))
+            .fold(f32::MIN, f32::max),
+    )
+}
+
 /// The diorama's settings.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DioramaParams {
@@ -521,14 +539,27 @@ impl Diorama {
     }
 
     /// The bodies' poses for the frame at the last [`Self::advance_to`], interpolated between
-    /// the last two steps.
+    /// the last two steps. A body whose interpolated pose would reach out of the eyes' view in
+    /// front of the glass (by more than [`CONTAINMENT_TOLERANCE_M`]) is drawn at its last
+    /// step instead: the step was held inside the pyramids, the blend of two held poses need
+    /// not be (the view in front of the glass and the tray behind it together are not convex:
+    /// a body moved from under the window's frame onto the pyramids passes outside both).
     pub fn poses(&self) -> Vec<BodyPose> {
+        let planes = self.pyramid_planes();
         self.previous
             .iter()
             .zip(&self.current)
-            .map(|(a, b)| BodyPose {
-                translation_m: a.translation_m.lerp(b.translation_m, self.alpha),
-                rotation: a.rotation.slerp(b.rotation, self.alpha),
+            .zip(&self.specs)
+            .map(|((a, b), spec)| {
+                let blended = BodyPose {
+                    translation_m: a.translation_m.lerp(b.translation_m, self.alpha),
+                    rotation: a.rotation.slerp(b.rotation, self.alpha),
+                };
+                let escapes = planes
+                    .as_ref()
+                    .and_then(|planes| reach_out_of_view_m(&spec.shape, &blended, planes))
+                    .is_some_and(|reach| reach > CONTAINMENT_TOLERANCE_M);
+                if escapes { *b } else { blended }
             })
             .collect()
     }

@@ -1,6 +1,5 @@
 use super::*;
 use crate::bodies::default_scene;
-use crate::frustum::EyePlane;
 
 const MS: i64 = 1_000_000;
 
@@ -12,30 +11,15 @@ fn scene(n: usize) -> (Screen, Diorama) {
     (screen, d)
 }
 
-/// How far body `i` reaches out of `plane` (positive: outside), metres.
-fn outside_m(d: &Diorama, i: usize, plane: &EyePlane) -> f32 {
-    let pose = d.stepped_poses()[i];
-    let shape = &d.specs()[i].shape;
-    let reach = shape.support_m(pose.rotation.inverse() * -plane.normal);
-    -(plane.distance_m(pose.translation_m) - reach)
-}
-
 /// The largest amount by which any body's part in front of the glass leaves either eye's
 /// pyramid, metres (≤ 0: none does).
 fn worst_escape_m(d: &Diorama) -> f32 {
     let Some(planes) = d.pyramid_planes() else { return 0.0 };
-    let mut worst = f32::MIN;
-    for i in 0..d.specs().len() {
-        let pose = d.stepped_poses()[i];
-        let front = pose.translation_m.z + d.specs()[i].shape.support_m(pose.rotation.inverse() * Vec3::Z);
-        if front <= 0.0 {
-            continue; // wholly behind the glass: the window may frame it
-        }
-        for p in &planes {
-            worst = worst.max(outside_m(d, i, p));
-        }
-    }
-    worst
+    d.stepped_poses()
+        .iter()
+        .zip(d.specs())
+        .filter_map(|(pose, spec)| reach_out_of_view_m(&spec.shape, pose, &planes))
+        .fold(f32::MIN, f32::max)
 }
 
 #[test]
