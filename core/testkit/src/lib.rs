@@ -70,9 +70,19 @@ pub fn tetrahedron_glb(size_m: f32, asset_extra: &str) -> Vec<u8> {
         s = s,
         len = bin.len()
     );
-    let mut json = json.into_bytes();
+    glb(&json, &bin)
+}
+
+/// A GLB container of `json` and the binary chunk `bin` (each padded to 4 bytes as the format
+/// asks: the JSON with spaces, the binary with zeros).
+pub fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
+    let mut json = json.as_bytes().to_vec();
     while json.len() % 4 != 0 {
         json.push(b' ');
+    }
+    let mut bin = bin.to_vec();
+    while bin.len() % 4 != 0 {
+        bin.push(0);
     }
     let total = 12 + 8 + json.len() + 8 + bin.len();
     let mut glb = Vec::with_capacity(total);

@@ -9,6 +9,7 @@ use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
+use super::meshopt_views::{self, DecodedViews};
 use super::*;
 use crate::budget::{OverBudget, ResourceBudget, Spending};
 use crate::progress::{Progress, Span};
@@ -23,8 +24,10 @@ pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load, one merely
 /// using another loads with a warning naming it.
-pub const SUPPORTED_EXTENSIONS: [&str; 5] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 7] = [
     "KHR_draco_mesh_compression",
+    "EXT_meshopt_compression",
+    "KHR_meshopt_compression",
     "KHR_mesh_quantization",
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
@@ -40,8 +43,9 @@ pub enum ModelError {
     #[error("{}: not a valid glTF file: {message}", path.display())]
     Parse { path: PathBuf, message: String },
     #[error(
-            "{}: requires the glTF extension {name}, which is not supported (supported: KHR_draco_mesh_compression, KHR_mesh_quantization, KHR_texture_transform, KHR_materials_emissive_strength, KHR_materials_unlit)",
-            path.display()
+            "{}: requires the glTF extension {name}, which is not supported (supported: {})",
+            path.display(),
+            SUPPORTED_EXTENSIONS.join(", ")
         )]
     UnsupportedExtension { path: PathBuf, name: String },
     #[error("{}: {what}: {message}", path.display())]
@@ -73,8 +77,16 @@ fn over_budget(path: &Path, error: OverBudget) -> ModelError {
     }
 }
 
-/// The bytes of a buffer view, checked against its buffer.
-fn view_bytes_of<'b>(path: &Path, buffers: &'b [Vec<u8>], view: &gltf::buffer::View) -> Result<&'b [u8], ModelError> {
+/// The bytes of a buffer view, checked against its buffer (decoded first if compressed).
+fn view_bytes_of<'b>(
+    path: &Path,
+    buffers: &'b [Vec<u8>],
+    decoded: &'b DecodedViews,
+    view: &gltf::buffer::View,
+) -> Result<&'b [u8], ModelError> {
+    if let Some(bytes) = decoded.bytes(view) {
+        return Ok(bytes);
+    }
     let data = |message: &str| ModelError::Data {
         path: path.to_path_buf(),
         what: format!("bufferView {}", view.index()),
@@ -91,6 +103,7 @@ fn view_bytes_of<'b>(path: &Path, buffers: &'b [Vec<u8>], view: &gltf::buffer::V
 struct Ctx<'a> {
     path: &'a Path,
     buffers: Vec<Vec<u8>>,
+    decoded: DecodedViews,
     spending: std::cell::RefCell<Spending>,
 }
 
@@ -112,7 +125,7 @@ impl Ctx<'_> {
     }
 
     fn view_bytes(&self, view: &gltf::buffer::View) -> Result<&[u8], ModelError> {
-        view_bytes_of(self.path, &self.buffers, view)
+        view_bytes_of(self.path, &self.buffers, &self.decoded, view)
     }
 
     /// Reads an accessor as `f32` rows of `n` components (normalised integers mapped to
@@ -1039,6 +1052,12 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     })?;
     let mut buffers = Vec::new();
     for b in doc.buffers() {
+        // A compressed file's fallback (for readers without meshopt) is not needed, and
+        // usually has no data at all.
+        if meshopt_views::is_fallback(&b) {
+            buffers.push(Vec::new());
+            continue;
+        }
         let data = match b.source() {
             gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| ModelError::Parse {
                 path: path.to_path_buf(),
@@ -1060,6 +1079,14 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         buffers.push(data);
     }
     let views: Vec<gltf::buffer::View> = doc.views().collect();
+    let decoded = meshopt_views::decode_all(doc, &buffers, &spending).map_err(|e| match e {
+        meshopt_views::DecodeError::Data { view, message } => ModelError::Data {
+            path: path.to_path_buf(),
+            what: format!("bufferView {view} ({})", meshopt_views::NAMES[0]),
+            message,
+        },
+        meshopt_views::DecodeError::OverBudget(error) => over_budget(path, error),
+    })?;
     read.step(1.0).map_err(cancelled)?;
 
     // Read the encoded images in order, then decode them on every core (the largest part of
@@ -1070,7 +1097,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     for img in doc.images() {
         let (raw, name): (Vec<u8>, String) = match img.source() {
             gltf::image::Source::View { view, .. } => {
-                let bytes = view_bytes_of(path, &buffers, &view)?;
+                let bytes = view_bytes_of(path, &buffers, &decoded, &view)?;
                 (bytes.to_vec(), format!("image {}", img.index()))
             }
             gltf::image::Source::Uri { uri, .. } => (load_uri(path, uri, budget.memory_bytes)?, excerpt(uri)),
@@ -1172,6 +1199,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     let ctx = Ctx {
         path,
         buffers,
+        decoded,
         spending: std::cell::RefCell::new(spending),
     };
 

@@ -6,7 +6,9 @@
 //! * Geometry through our own accessor reader, which handles every component type, normalised or
 //!   not, byte strides and sparse accessors, so `KHR_mesh_quantization` needs no special case.
 //!   `KHR_draco_mesh_compression` primitives are decoded with `draco-core` (pure Rust: no C++
-//!   toolchain on the phone builds).
+//!   toolchain on the phone builds). `EXT_meshopt_compression` / `KHR_meshopt_compression`
+//!   buffer views (gltfpack's `-c`) are decoded with meshoptimizer before any accessor reads
+//!   them; their fallback buffers are never read (`meshopt_views`).
 //! * Node transforms are baked into the vertices (negative determinants flip the winding).
 //! * Materials: base colour, metallic–roughness, normal (with scale), occlusion (with strength)
 //!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform` on every
@@ -631,6 +633,7 @@ pub use loader::{
 };
 
 mod loader;
+mod meshopt_views;
 mod split;
 
 #[cfg(test)]
