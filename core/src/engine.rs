@@ -325,6 +325,9 @@ pub struct Engine {
     /// needed and kept, so egui's fonts are uploaded once.
     #[cfg(feature = "ui")]
     screens: Option<Box<Screens>>,
+    /// What a screen reader can land on in the last frame ([`Engine::accessibility_nodes`]).
+    #[cfg(feature = "ui")]
+    access: crate::calibration_ui::accessibility::AccessTree,
     /// What the core asks of the shell (a file picker), until taken.
     requests: Vec<ShellRequest>,
     /// The camera page waits for the screens in front of it to close.
@@ -631,6 +634,8 @@ impl Engine {
             diorama_grab: None,
             #[cfg(feature = "ui")]
             screens: None,
+            #[cfg(feature = "ui")]
+            access: Default::default(),
             requests: Vec::new(),
             #[cfg(feature = "ui")]
             camera_page_pending: false,
@@ -801,6 +806,74 @@ impl Engine {
         }
         #[cfg(not(feature = "ui"))]
         false
+    }
+
+    /// What a screen reader (TalkBack, VoiceOver) can land on in the last frame drawn, in
+    /// reading order: the open screen's text and controls, or the picture itself (activating it
+    /// opens the menu, as a tap does). See [`crate::calibration_ui::accessibility`].
+    #[cfg(feature = "ui")]
+    pub fn accessibility_nodes(&self) -> &[crate::calibration_ui::accessibility::AccessNode] {
+        self.access.nodes()
+    }
+
+    /// Changes whenever [`Self::accessibility_nodes`] do: the shells re-read them then.
+    #[cfg(feature = "ui")]
+    pub fn accessibility_generation(&self) -> u64 {
+        self.access.generation()
+    }
+
+    /// A screen reader's "activate" on node `id`: the control acts in the next frame as if
+    /// tapped. `false` for an id not among the current nodes, or one that does nothing.
+    #[cfg(feature = "ui")]
+    pub fn accessibility_click(&mut self, id: i32) -> bool {
+        if self.picture_access_node().is_some_and(|p| p.id == id)
+            && self.screens.as_ref().is_none_or(|s| s.page.is_none())
+        {
+            return self.open_menu();
+        }
+        match self.access.click_event(id) {
+            Some(event) => {
+                self.screens().events.push(event);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// A screen reader's step up (`steps` > 0) or down on slider `id` (a swipe up or down on
+    /// it): the slider moves by its step in the next frame. `false` for an id that is not an
+    /// adjustable node now.
+    #[cfg(feature = "ui")]
+    pub fn accessibility_adjust(&mut self, id: i32, steps: i32) -> bool {
+        match self.access.adjust_event(id, steps) {
+            Some(event) => {
+                self.screens().events.push(event);
+                true
+            }
+            None => false,
+        }
+    }
+
+    /// The picture as a screen reader finds it: the artifact's title, the whole surface.
+    #[cfg(feature = "ui")]
+    fn picture_access_node(&mut self) -> Option<crate::calibration_ui::accessibility::AccessNode> {
+        use crate::calibration_ui::accessibility::{AccessNode, AccessRole};
+        let (w, h) = self.target_size().filter(|&(w, h)| w > 0 && h > 0)?;
+        let title = match &self.model_info.artifact {
+            Some(a) => a.title.clone(),
+            None => self.model_info.name.clone(),
+        };
+        Some(AccessNode {
+            id: self.access.id_for("picture"),
+            role: AccessRole::Image,
+            label: format!("{title}, in 3-D for red and cyan glasses. Activate for the menu."),
+            value: None,
+            checked: None,
+            disabled: false,
+            clickable: true,
+            adjustable: false,
+            bounds_px: [0.0, 0.0, w as f32, h as f32],
+        })
     }
 
     /// Opens the menu: the artifact gallery, opening a file, the way to the calibration (also a
@@ -1710,6 +1783,9 @@ impl Engine {
                 screens.banner_pt = None;
                 screens.banner_button_pt = None;
             }
+            // The bare picture: one thing for a screen reader to land on.
+            let picture = self.picture_access_node();
+            self.access.replace(picture.into_iter().collect());
         }
         self.present(&input, None)
     }
@@ -1773,6 +1849,9 @@ impl Engine {
             return self.present(input, None);
         };
         screens.ctx.set_pixels_per_point(ppp);
+        // AccessKit nodes for the screen readers, every frame (a flag; egui re-enables nothing
+        // by itself after the context is made anew).
+        screens.ctx.enable_accesskit();
         let raw = egui::RawInput {
             screen_rect: Some(egui::Rect::from_min_size(
                 egui::Pos2::ZERO,
@@ -1847,6 +1926,17 @@ impl Engine {
         });
         screens.banner_pt = banner_pt;
         screens.banner_button_pt = banner_button_pt;
+        if let Some(update) = output.platform_output.accesskit_update.take() {
+            self.access.update(&update, ppp);
+        }
+        if screens.page.is_none()
+            && let Some(picture) = self.picture_access_node()
+        {
+            // Under a banner or the hint, the picture is still there to land on (first).
+            let mut nodes = self.access.nodes().to_vec();
+            nodes.insert(0, picture);
+            self.access.replace(nodes);
+        }
         screens.overlay.begin(&mut output);
         let drawn = {
             let ctx = screens.ctx.clone();

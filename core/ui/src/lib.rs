@@ -18,6 +18,7 @@
 //!
 //! **Threading**: lives on the render thread with the egui context. **Panics**: none.
 
+pub mod accessibility;
 pub mod material;
 pub mod menu;
 pub mod settings;

@@ -64,13 +64,15 @@ impl MaterialUi {
 
     /// A labelled percentage slider over `value` in [0, `max`]; returns whether it moved.
     fn slider(&mut self, ui: &mut egui::Ui, name: &'static str, label: &str, value: &mut f32, max: f32) -> bool {
-        ui.label(RichText::new(label).size(16.0));
+        let text = ui.label(RichText::new(label).size(16.0));
         let mut percent = *value * 100.0;
-        let r = ui.add(
-            egui::Slider::new(&mut percent, 0.0..=max * 100.0)
-                .step_by(1.0)
-                .suffix(" %"),
-        );
+        let r = ui
+            .add(
+                egui::Slider::new(&mut percent, 0.0..=max * 100.0)
+                    .step_by(1.0)
+                    .suffix(" %"),
+            )
+            .labelled_by(text.id);
         self.widget_rects.remember(name, r.rect);
         if r.changed() {
             *value = (percent / 100.0).clamp(0.0, max);
@@ -80,13 +82,15 @@ impl MaterialUi {
 
     /// A roughness slider (1–100 %, logarithmic: the sharp end matters most).
     fn roughness_slider(&mut self, ui: &mut egui::Ui, name: &'static str, label: &str, value: &mut f32) -> bool {
-        ui.label(RichText::new(label).size(16.0));
+        let text = ui.label(RichText::new(label).size(16.0));
         let mut percent = *value * 100.0;
-        let r = ui.add(
-            egui::Slider::new(&mut percent, 1.0..=100.0)
-                .logarithmic(true)
-                .suffix(" %"),
-        );
+        let r = ui
+            .add(
+                egui::Slider::new(&mut percent, 1.0..=100.0)
+                    .logarithmic(true)
+                    .suffix(" %"),
+            )
+            .labelled_by(text.id);
         self.widget_rects.remember(name, r.rect);
         if r.changed() {
             *value = (percent / 100.0).clamp(0.01, 1.0);

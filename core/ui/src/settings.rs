@@ -124,12 +124,16 @@ impl SettingsUi {
                 );
                 self.settings.floor = floor;
                 ui.add_space(6.0);
-                ui.label(RichText::new("Your own files: how much stands in front of the glass (%)").size(16.0));
+                let name =
+                    ui.label(RichText::new("Your own files: how much stands in front of the glass (%)").size(16.0));
                 // Room for the value box beside the slider.
                 ui.spacing_mut().slider_width = (full - 80.0).max(100.0);
                 ui.spacing_mut().interact_size.y = CONTROL_HEIGHT_PT;
                 let mut percent = self.settings.protrude_fraction * 100.0;
-                let r = ui.add(egui::Slider::new(&mut percent, 0.0..=100.0).step_by(5.0));
+                // Named for a screen reader by the text above it.
+                let r = ui
+                    .add(egui::Slider::new(&mut percent, 0.0..=100.0).step_by(5.0))
+                    .labelled_by(name.id);
                 self.widget_rects.remember("protrude", r.rect);
                 self.settings.protrude_fraction = (percent / 100.0).clamp(0.0, 1.0);
                 let mut true_size = self.settings.true_size;
