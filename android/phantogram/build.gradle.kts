@@ -50,6 +50,8 @@ dependencies {
     api("androidx.camera:camera-lifecycle:$camerax")
     api("androidx.lifecycle:lifecycle-runtime-ktx:2.8.7")
     implementation("androidx.core:core-ktx:1.15.0")
+    // ScreenReader: the core's screens as TalkBack's virtual views (ExploreByTouchHelper).
+    implementation("androidx.customview:customview:1.1.0")
 }
 
 /**

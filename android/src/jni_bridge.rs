@@ -24,7 +24,7 @@ use std::ffi::c_void;
 use std::sync::OnceLock;
 
 use jni::errors::ThrowRuntimeExAndDefault;
-use jni::objects::{JByteBuffer, JClass, JFloatArray, JIntArray, JObject, JString};
+use jni::objects::{JByteBuffer, JClass, JFloatArray, JIntArray, JObject, JString, JValue};
 use jni::refs::Global;
 use jni::strings::JNIString;
 use jni::sys::{JNI_VERSION_1_6, jboolean, jfloat, jfloatArray, jint, jintArray, jlong, jlongArray};
@@ -75,12 +75,15 @@ pub(crate) fn fail(kind: Kind, message: impl Into<String>) -> Thrown {
     Thrown::Java(kind, message.into())
 }
 
-/// Exception classes, resolved in `JNI_OnLoad`.
+/// Exception classes and the classes the bridge makes, resolved in `JNI_OnLoad`.
 struct Classes {
     illegal_argument: Global<JClass<'static>>,
     illegal_state: Global<JClass<'static>>,
     unsupported: Global<JClass<'static>>,
     runtime: Global<JClass<'static>>,
+    /// `NativeBridge.AccessibilityNode`, found through the app's class loader (only
+    /// `JNI_OnLoad`'s thread sees it).
+    accessibility_node: Global<JClass<'static>>,
 }
 
 static CLASSES: OnceLock<Classes> = OnceLock::new();
@@ -95,6 +98,7 @@ fn cache_classes(env: &mut Env) -> jni::errors::Result<Classes> {
         illegal_state: global(jni_str!("java/lang/IllegalStateException"))?,
         unsupported: global(jni_str!("java/lang/UnsupportedOperationException"))?,
         runtime: global(jni_str!("java/lang/RuntimeException"))?,
+        accessibility_node: global(jni_str!("org/phantogram/NativeBridge$AccessibilityNode"))?,
     })
 }
 
@@ -967,9 +971,97 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSnapshotPng<'local
     })
 }
 
+/// What a screen reader can land on in the last frame, as `NativeBridge.AccessibilityNode`s
+/// in reading order (see `phantogram::calibration_ui::accessibility`).
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeAccessibilityNodes<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jni::sys::jobjectArray {
+    run(&mut env, |env| {
+        // Copied out so that the engine is not held while Java objects are made.
+        let nodes = engine(handle)?.lock().accessibility_nodes().to_vec();
+        let class = &CLASSES
+            .get()
+            .ok_or_else(|| fail(Kind::IllegalState, "the library was loaded without JNI_OnLoad"))?
+            .accessibility_node;
+        let len = i32::try_from(nodes.len()).map_err(|_| fail(Kind::Runtime, "too many accessibility nodes"))?;
+        let array = env.new_object_array(len, class, JObject::null())?;
+        for (i, n) in nodes.iter().enumerate() {
+            // The same numbers as `NativeBridge.AccessibilityNode`'s ROLE_ and FLAG_ constants.
+            let (role, flags) = (n.role as jint, n.flags() as jint);
+            // A frame per node: a gallery of many artifacts must not fill the local
+            // reference table.
+            env.with_local_frame(4, |env| -> Result<(), Thrown> {
+                let label = env.new_string(&n.label)?;
+                let value = match &n.value {
+                    Some(v) => JObject::from(env.new_string(v)?),
+                    None => JObject::null(),
+                };
+                let [left, top, right, bottom] = n.bounds_px;
+                let node = env.new_object(
+                    class,
+                    jni::jni_sig!("(IIIFFFFLjava/lang/String;Ljava/lang/String;)V"),
+                    &[
+                        JValue::Int(n.id),
+                        JValue::Int(role),
+                        JValue::Int(flags),
+                        JValue::Float(left),
+                        JValue::Float(top),
+                        JValue::Float(right),
+                        JValue::Float(bottom),
+                        JValue::Object(&label),
+                        JValue::Object(&value),
+                    ],
+                )?;
+                array.set_element(env, i, &node)?;
+                Ok(())
+            })?;
+        }
+        Ok(array.into_raw())
+    })
+}
+
+/// Changes whenever `nativeAccessibilityNodes` would return something else.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeAccessibilityGeneration<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+) -> jlong {
+    run(&mut env, |_| {
+        // A count of changes: far below i64::MAX in any app's life.
+        Ok(engine(handle)?.lock().accessibility_generation() as jlong)
+    })
+}
+
+/// A screen reader's activation of node `id` (acts in the next frame, as a tap would).
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeAccessibilityClick<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    id: jint,
+) -> jboolean {
+    run(&mut env, |_| Ok(engine(handle)?.lock().accessibility_click(id)))
+}
+
+/// A screen reader's step up (`steps` > 0) or down on slider `id`.
+#[unsafe(no_mangle)]
+pub extern "system" fn Java_org_phantogram_NativeBridge_nativeAccessibilityAdjust<'local>(
+    mut env: EnvUnowned<'local>,
+    _class: JClass<'local>,
+    handle: jlong,
+    id: jint,
+    steps: jint,
+) -> jboolean {
+    run(&mut env, |_| Ok(engine(handle)?.lock().accessibility_adjust(id, steps)))
+}
+
 /// Names of the native methods this library implements, for the test that keeps them and
 /// `NativeBridge.java` in step.
-pub const NATIVE_METHODS: [&str; 28] = [
+pub const NATIVE_METHODS: [&str; 32] = [
     "nativeCreate",
     "nativeDestroy",
     "nativePushSensor",
@@ -998,4 +1090,8 @@ pub const NATIVE_METHODS: [&str; 28] = [
     "nativeTakeShellRequest",
     "nativeLoadingState",
     "nativeSnapshotPng",
+    "nativeAccessibilityNodes",
+    "nativeAccessibilityGeneration",
+    "nativeAccessibilityClick",
+    "nativeAccessibilityAdjust",
 ];

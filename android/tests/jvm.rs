@@ -205,3 +205,41 @@ fn java_declarations_match_the_exported_methods() {
     assert_eq!(declared, exported, "NativeBridge.java and jni_bridge.rs disagree");
     assert_eq!(listed, exported, "NATIVE_METHODS is out of date");
 }
+
+/// `NativeBridge.AccessibilityNode`'s role and flag numbers are the core's.
+#[test]
+fn java_accessibility_constants_are_the_cores() {
+    use phantogram::calibration_ui::accessibility::{self as a, AccessRole};
+    let java =
+        std::fs::read_to_string(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
+            .expect("NativeBridge.java");
+    let constant = |name: &str| -> i64 {
+        let at = java
+            .find(&format!("int {name} = "))
+            .unwrap_or_else(|| panic!("{name} not declared"));
+        let rest = &java[at + name.len() + 7..];
+        rest[..rest.find(';').expect("a value")]
+            .trim()
+            .parse()
+            .expect("a number")
+    };
+    for (name, role) in [
+        ("ROLE_TEXT", AccessRole::Text),
+        ("ROLE_BUTTON", AccessRole::Button),
+        ("ROLE_CHECK_BOX", AccessRole::CheckBox),
+        ("ROLE_RADIO_BUTTON", AccessRole::RadioButton),
+        ("ROLE_SLIDER", AccessRole::Slider),
+        ("ROLE_IMAGE", AccessRole::Image),
+    ] {
+        assert_eq!(constant(name), role as i64, "{name}");
+    }
+    for (name, flag) in [
+        ("FLAG_CLICKABLE", a::FLAG_CLICKABLE),
+        ("FLAG_ADJUSTABLE", a::FLAG_ADJUSTABLE),
+        ("FLAG_CHECKABLE", a::FLAG_CHECKABLE),
+        ("FLAG_CHECKED", a::FLAG_CHECKED),
+        ("FLAG_DISABLED", a::FLAG_DISABLED),
+    ] {
+        assert_eq!(constant(name), i64::from(flag), "{name}");
+    }
+}

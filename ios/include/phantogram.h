@@ -33,6 +33,10 @@ typedef enum PgStatus {
   PG_STATUS_PANIC = 9,
 } PgStatus;
 
+// The screen reader's nodes of one frame (opaque to C): `pg_accessibility_snapshot` makes it,
+// `pg_access_snapshot_free` frees it.
+typedef struct PgAccessSnapshot PgAccessSnapshot;
+
 // The engine behind the handle (opaque to C).
 typedef struct PgEngine PgEngine;
 
@@ -70,6 +74,28 @@ typedef struct PgConfig {
   // default, and the on-screen banner says why.
   const char *artifact;
 } PgConfig;
+
+// One thing a screen reader (VoiceOver) can land on in the core's screens, from a
+// [`PgAccessSnapshot`]. Bounds in the drawing surface's pixels (divide by the view's
+// `contentScaleFactor` for points).
+typedef struct PgAccessNode {
+  // Small, positive, stable for a control while the engine lives.
+  int32_t id;
+  // 0 text, 1 button, 2 check box or switch, 3 one choice of several, 4 slider, 5 the
+  // picture itself.
+  int32_t role;
+  // Bits: 1 activating it acts (`pg_accessibility_click`), 2 it steps up and down
+  // (`pg_accessibility_adjust`), 4 it has an on/off state, 8 it is on, 16 disabled.
+  uint32_t flags;
+  float left;
+  float top;
+  float right;
+  float bottom;
+  // What to say, UTF-8, never empty; valid until the snapshot is freed.
+  const char *label;
+  // A slider's value as text, or null; valid until the snapshot is freed.
+  const char *value;
+} PgAccessNode;
 
 // Counters, for logs and debug overlays.
 typedef struct PgStats {
@@ -382,6 +408,65 @@ enum PgStatus pg_snapshot_png(const struct PgEngine *engine,
                               uint8_t *buffer,
                               size_t capacity,
                               size_t *len);
+
+// What a screen reader can land on in the last frame, in reading order (the open screen's
+// text and controls, or the picture itself, whose activation opens the menu): `*out`
+// receives a snapshot to read with `pg_access_snapshot_len` / `pg_access_snapshot_node` and
+// free with `pg_access_snapshot_free`; `*generation` (if not null) the number
+// `pg_accessibility_generation` returns for it.
+//
+// # Safety
+// `engine` is a live handle; `out` is valid for a write; `generation` is null or valid for a
+// write.
+enum PgStatus pg_accessibility_snapshot(const struct PgEngine *engine,
+                                        struct PgAccessSnapshot **out,
+                                        uint64_t *generation);
+
+// How many nodes a snapshot holds (0 for null).
+//
+// # Safety
+// `snapshot` is null or a live snapshot from `pg_accessibility_snapshot`.
+size_t pg_access_snapshot_len(const struct PgAccessSnapshot *snapshot);
+
+// Node `index` of a snapshot into `*out` (its strings belong to the snapshot).
+//
+// # Safety
+// `snapshot` is a live snapshot from `pg_accessibility_snapshot`; `out` is valid for a write.
+enum PgStatus pg_access_snapshot_node(const struct PgAccessSnapshot *snapshot,
+                                      size_t index,
+                                      struct PgAccessNode *out);
+
+// Frees a snapshot (null is ignored); its nodes' strings go with it.
+//
+// # Safety
+// `snapshot` is null or a live snapshot from `pg_accessibility_snapshot`, not used afterwards.
+void pg_access_snapshot_free(struct PgAccessSnapshot *snapshot);
+
+// Changes whenever the screen reader's nodes do (check after each `pg_draw`; on a change,
+// take a new snapshot and post `UIAccessibility.Notification.layoutChanged`).
+//
+// # Safety
+// `engine` is a live handle; `out` is valid for a write.
+enum PgStatus pg_accessibility_generation(const struct PgEngine *engine, uint64_t *out);
+
+// A screen reader's activation of node `id` (VoiceOver's double tap, `accessibilityActivate`):
+// it acts in the next frame as if tapped. `*acted` (if not null) is 0 for an id not on
+// screen now, or one that does nothing.
+//
+// # Safety
+// `engine` is a live handle; `acted` is null or valid for a write.
+enum PgStatus pg_accessibility_click(const struct PgEngine *engine, int32_t id, uint8_t *acted);
+
+// A screen reader's step up (`steps` > 0) or down on slider `id` (VoiceOver's
+// `accessibilityIncrement` / `accessibilityDecrement`), applied in the next frame. `*acted`
+// (if not null) is 0 for an id that is not an adjustable node now.
+//
+// # Safety
+// `engine` is a live handle; `acted` is null or valid for a write.
+enum PgStatus pg_accessibility_adjust(const struct PgEngine *engine,
+                                      int32_t id,
+                                      int32_t steps,
+                                      uint8_t *acted);
 
 // Fills `*out` with the engine's counters.
 //

@@ -19,7 +19,7 @@
 //! handle.
 
 use std::cell::RefCell;
-use std::ffi::{CStr, c_char, c_void};
+use std::ffi::{CStr, CString, c_char, c_void};
 use std::panic::AssertUnwindSafe;
 use std::path::PathBuf;
 
@@ -1020,6 +1020,201 @@ pub unsafe extern "C" fn pg_snapshot_png(
         // SAFETY: `capacity ≥ len` writable bytes at `buffer`, as the caller promises; `png` is
         // our own allocation.
         unsafe { std::ptr::copy_nonoverlapping(png.as_ptr(), buffer, png.len()) };
+        Ok(())
+    })
+}
+
+/// One thing a screen reader (VoiceOver) can land on in the core's screens, from a
+/// [`PgAccessSnapshot`]. Bounds in the drawing surface's pixels (divide by the view's
+/// `contentScaleFactor` for points).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct PgAccessNode {
+    /// Small, positive, stable for a control while the engine lives.
+    pub id: i32,
+    /// 0 text, 1 button, 2 check box or switch, 3 one choice of several, 4 slider, 5 the
+    /// picture itself.
+    pub role: i32,
+    /// Bits: 1 activating it acts (`pg_accessibility_click`), 2 it steps up and down
+    /// (`pg_accessibility_adjust`), 4 it has an on/off state, 8 it is on, 16 disabled.
+    pub flags: u32,
+    pub left: f32,
+    pub top: f32,
+    pub right: f32,
+    pub bottom: f32,
+    /// What to say, UTF-8, never empty; valid until the snapshot is freed.
+    pub label: *const c_char,
+    /// A slider's value as text, or null; valid until the snapshot is freed.
+    pub value: *const c_char,
+}
+
+/// The screen reader's nodes of one frame (opaque to C): `pg_accessibility_snapshot` makes it,
+/// `pg_access_snapshot_free` frees it.
+pub struct PgAccessSnapshot {
+    nodes: Vec<phantogram::calibration_ui::accessibility::AccessNode>,
+    labels: Vec<CString>,
+    values: Vec<Option<CString>>,
+}
+
+/// A C string of `text` (a NUL inside becomes a space: labels are for reading aloud).
+fn c_text(text: &str) -> CString {
+    CString::new(text.replace('\0', " ")).unwrap_or_default()
+}
+
+/// What a screen reader can land on in the last frame, in reading order (the open screen's
+/// text and controls, or the picture itself, whose activation opens the menu): `*out`
+/// receives a snapshot to read with `pg_access_snapshot_len` / `pg_access_snapshot_node` and
+/// free with `pg_access_snapshot_free`; `*generation` (if not null) the number
+/// `pg_accessibility_generation` returns for it.
+///
+/// # Safety
+/// `engine` is a live handle; `out` is valid for a write; `generation` is null or valid for a
+/// write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_accessibility_snapshot(
+    engine: *const PgEngine,
+    out: *mut *mut PgAccessSnapshot,
+    generation: *mut u64,
+) -> PgStatus {
+    guard(|| {
+        // SAFETY: the caller promises a writable `out` (null is reported).
+        let out = unsafe { out.as_mut() }.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`out` is null"))?;
+        // SAFETY: forwarded caller promise.
+        let engine = unsafe { engine_ref(engine) }?;
+        let (nodes, now) = {
+            let e = engine.shared.lock();
+            (e.accessibility_nodes().to_vec(), e.accessibility_generation())
+        };
+        let labels = nodes.iter().map(|n| c_text(&n.label)).collect();
+        let values = nodes.iter().map(|n| n.value.as_deref().map(c_text)).collect();
+        *out = Box::into_raw(Box::new(PgAccessSnapshot { nodes, labels, values }));
+        // SAFETY: null or writable, as the caller promises.
+        if let Some(g) = unsafe { generation.as_mut() } {
+            *g = now;
+        }
+        Ok(())
+    })
+}
+
+/// How many nodes a snapshot holds (0 for null).
+///
+/// # Safety
+/// `snapshot` is null or a live snapshot from `pg_accessibility_snapshot`.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_access_snapshot_len(snapshot: *const PgAccessSnapshot) -> usize {
+    // SAFETY: the caller promises null or a live snapshot.
+    unsafe { snapshot.as_ref() }.map_or(0, |s| s.nodes.len())
+}
+
+/// Node `index` of a snapshot into `*out` (its strings belong to the snapshot).
+///
+/// # Safety
+/// `snapshot` is a live snapshot from `pg_accessibility_snapshot`; `out` is valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_access_snapshot_node(
+    snapshot: *const PgAccessSnapshot,
+    index: usize,
+    out: *mut PgAccessNode,
+) -> PgStatus {
+    guard(|| {
+        // SAFETY: the caller promises null or a live snapshot.
+        let s =
+            unsafe { snapshot.as_ref() }.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`snapshot` is null"))?;
+        // SAFETY: the caller promises a writable `out` (null is reported).
+        let out = unsafe { out.as_mut() }.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`out` is null"))?;
+        let (Some(n), Some(label), Some(value)) = (s.nodes.get(index), s.labels.get(index), s.values.get(index)) else {
+            return Err(Failure::new(
+                PgStatus::InvalidArgument,
+                format!("node {index} of a snapshot of {}", s.nodes.len()),
+            ));
+        };
+        let [left, top, right, bottom] = n.bounds_px;
+        *out = PgAccessNode {
+            id: n.id,
+            role: n.role as i32,
+            flags: n.flags(),
+            left,
+            top,
+            right,
+            bottom,
+            label: label.as_ptr(),
+            value: value.as_ref().map_or(std::ptr::null(), |v| v.as_ptr()),
+        };
+        Ok(())
+    })
+}
+
+/// Frees a snapshot (null is ignored); its nodes' strings go with it.
+///
+/// # Safety
+/// `snapshot` is null or a live snapshot from `pg_accessibility_snapshot`, not used afterwards.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_access_snapshot_free(snapshot: *mut PgAccessSnapshot) {
+    if !snapshot.is_null() {
+        // SAFETY: a live snapshot made by `Box::into_raw` in `pg_accessibility_snapshot`,
+        // freed once, as the caller promises.
+        drop(unsafe { Box::from_raw(snapshot) });
+    }
+}
+
+/// Changes whenever the screen reader's nodes do (check after each `pg_draw`; on a change,
+/// take a new snapshot and post `UIAccessibility.Notification.layoutChanged`).
+///
+/// # Safety
+/// `engine` is a live handle; `out` is valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_accessibility_generation(engine: *const PgEngine, out: *mut u64) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let generation = unsafe { engine_ref(engine) }?.shared.lock().accessibility_generation();
+        // SAFETY: the caller promises a writable `out` (null is reported).
+        *unsafe { out.as_mut() }.ok_or_else(|| Failure::new(PgStatus::NullPointer, "`out` is null"))? = generation;
+        Ok(())
+    })
+}
+
+/// A screen reader's activation of node `id` (VoiceOver's double tap, `accessibilityActivate`):
+/// it acts in the next frame as if tapped. `*acted` (if not null) is 0 for an id not on
+/// screen now, or one that does nothing.
+///
+/// # Safety
+/// `engine` is a live handle; `acted` is null or valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_accessibility_click(engine: *const PgEngine, id: i32, acted: *mut u8) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let done = unsafe { engine_ref(engine) }?.shared.lock().accessibility_click(id);
+        // SAFETY: null or writable, as the caller promises.
+        if let Some(a) = unsafe { acted.as_mut() } {
+            *a = u8::from(done);
+        }
+        Ok(())
+    })
+}
+
+/// A screen reader's step up (`steps` > 0) or down on slider `id` (VoiceOver's
+/// `accessibilityIncrement` / `accessibilityDecrement`), applied in the next frame. `*acted`
+/// (if not null) is 0 for an id that is not an adjustable node now.
+///
+/// # Safety
+/// `engine` is a live handle; `acted` is null or valid for a write.
+#[unsafe(no_mangle)]
+pub unsafe extern "C" fn pg_accessibility_adjust(
+    engine: *const PgEngine,
+    id: i32,
+    steps: i32,
+    acted: *mut u8,
+) -> PgStatus {
+    guard(|| {
+        // SAFETY: forwarded caller promise.
+        let done = unsafe { engine_ref(engine) }?
+            .shared
+            .lock()
+            .accessibility_adjust(id, steps);
+        // SAFETY: null or writable, as the caller promises.
+        if let Some(a) = unsafe { acted.as_mut() } {
+            *a = u8::from(done);
+        }
         Ok(())
     })
 }

@@ -242,6 +242,41 @@ public final class ReplayThroughJni {
             expect(IllegalArgumentException.class, "snapshot kind", () -> NativeBridge.nativeSnapshotPng(a, 5));
             System.out.println("ok: library: damaged import reported, tablet shown, side-by-side PNG "
                     + png.length + " bytes");
+            // What TalkBack is given: every node named and placed; activating one moves the
+            // screens on (the generation tells the shell to read them again).
+            NativeBridge.nativeDrawFrame(a, -1);
+            NativeBridge.AccessibilityNode[] nodes = NativeBridge.nativeAccessibilityNodes(a);
+            long generation = NativeBridge.nativeAccessibilityGeneration(a);
+            NativeBridge.AccessibilityNode done = null;
+            StringBuilder read = new StringBuilder();
+            for (NativeBridge.AccessibilityNode n : nodes) {
+                read.append(n.role).append(':').append(n.label).append(n.has(NativeBridge.AccessibilityNode.FLAG_CHECKED)
+                        ? " (on)" : "").append("; ");
+                if (n.label.isEmpty() || !(n.right > n.left) || !(n.bottom > n.top) || n.id <= 0) {
+                    throw new AssertionError("a node without a name or a place: " + n.label + " " + n.id);
+                }
+                if (n.role == NativeBridge.AccessibilityNode.ROLE_BUTTON
+                        && n.has(NativeBridge.AccessibilityNode.FLAG_CLICKABLE) && n.label.equals("Done")) {
+                    done = n;
+                }
+            }
+            System.out.println("read: " + read);
+            if (done == null) {
+                throw new AssertionError("no way to close the menu: " + read);
+            }
+            if (NativeBridge.nativeAccessibilityClick(a, 99999) || NativeBridge.nativeAccessibilityAdjust(a, done.id, 1)) {
+                throw new AssertionError("an unknown node or a button's step was taken");
+            }
+            if (!NativeBridge.nativeAccessibilityClick(a, done.id)) {
+                throw new AssertionError("activating '" + done.label + "' was refused");
+            }
+            NativeBridge.nativeDrawFrame(a, -1);
+            NativeBridge.nativeDrawFrame(a, -1);
+            if (NativeBridge.nativeAccessibilityGeneration(a) == generation) {
+                throw new AssertionError("activating '" + done.label + "' changed nothing");
+            }
+            System.out.println("ok: accessibility: " + nodes.length + " nodes read, '" + done.label
+                    + "' activated, " + NativeBridge.nativeAccessibilityNodes(a).length + " nodes after");
         } finally {
             NativeBridge.nativeDestroy(a);
         }

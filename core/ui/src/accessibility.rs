@@ -81,6 +81,30 @@ struct Scale {
     step: Option<f64>,
 }
 
+/// [`AccessNode::flags`]' bits, as both bridges hand them to the shells.
+pub const FLAG_CLICKABLE: u32 = 1;
+pub const FLAG_ADJUSTABLE: u32 = 2;
+/// It has an on/off state, given by [`FLAG_CHECKED`].
+pub const FLAG_CHECKABLE: u32 = 4;
+pub const FLAG_CHECKED: u32 = 8;
+pub const FLAG_DISABLED: u32 = 16;
+
+impl AccessNode {
+    /// The node's states as [`FLAG_CLICKABLE`] … bits.
+    pub fn flags(&self) -> u32 {
+        [
+            (self.clickable, FLAG_CLICKABLE),
+            (self.adjustable, FLAG_ADJUSTABLE),
+            (self.checked.is_some(), FLAG_CHECKABLE),
+            (self.checked == Some(true), FLAG_CHECKED),
+            (self.disabled, FLAG_DISABLED),
+        ]
+        .into_iter()
+        .filter(|(on, _)| *on)
+        .fold(0, |bits, (_, flag)| bits | flag)
+    }
+}
+
 /// The nodes of the last frame (see the module docs).
 #[derive(Debug, Default)]
 pub struct AccessTree {
@@ -376,6 +400,9 @@ mod tests {
         assert!(ids[0] >= 1);
         // Text cannot be activated; unknown ids neither.
         assert!(tree.click_event(text.id).is_none() && tree.click_event(999).is_none());
+        assert_eq!(floor.flags(), FLAG_CLICKABLE | FLAG_CHECKABLE | FLAG_CHECKED);
+        assert_eq!(done.flags(), FLAG_CLICKABLE);
+        assert_eq!(slider.flags(), FLAG_ADJUSTABLE);
     }
 
     #[test]

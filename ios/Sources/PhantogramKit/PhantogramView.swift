@@ -17,6 +17,7 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
     private var camera: CameraSource?
     private var link: CADisplayLink?
     private var resumed = false
+    private lazy var screenReader = ScreenReader(view: self, engine: engine)
     private var observers: [NSObjectProtocol] = []
 
     public init(engine: Engine) {
@@ -122,6 +123,8 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
         case .share(let pair)?: presentShareSheet(pair: pair)
         case nil: break
         }
+        // VoiceOver reads the core's screens as elements of this view.
+        screenReader.refreshIfChanged()
     }
 
     /// The core's menu: the view through the system's share sheet, as a named PNG file.

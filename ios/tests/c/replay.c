@@ -268,6 +268,55 @@ int main(int argc, char **argv) {
     }
     free(png);
     printf("ok: library: damaged import reported, tablet shown, side-by-side PNG %zu bytes\n", png_len);
+
+    /* What VoiceOver is given: the menu's nodes, each named and placed; "Done" activated moves
+       the screens on (the generation says so). */
+    check(pg_draw(engine, -1.0, NULL), PG_STATUS_OK, "draw the menu", NULL);
+    PgAccessSnapshot *snapshot = NULL;
+    uint64_t generation = 0, later = 0;
+    check(pg_accessibility_snapshot(engine, NULL, NULL), PG_STATUS_NULL_POINTER, "snapshot to null", "out");
+    check(pg_accessibility_snapshot(engine, &snapshot, &generation), PG_STATUS_OK, "accessibility snapshot", NULL);
+    size_t count = pg_access_snapshot_len(snapshot);
+    int done_id = -1;
+    for (size_t i = 0; i < count; i++) {
+        PgAccessNode node;
+        check(pg_access_snapshot_node(snapshot, i, &node), PG_STATUS_OK, "accessibility node", NULL);
+        if (!node.label || !node.label[0] || !(node.right > node.left) || !(node.bottom > node.top) || node.id <= 0) {
+            fprintf(stderr, "node %zu without a name or a place\n", i);
+            return 1;
+        }
+        if (node.role == 1 && (node.flags & 1) && !strcmp(node.label, "Done")) {
+            done_id = node.id;
+        }
+    }
+    PgAccessNode beyond;
+    check(pg_access_snapshot_node(snapshot, count, &beyond), PG_STATUS_INVALID_ARGUMENT, "node past the end", "node");
+    pg_access_snapshot_free(snapshot);
+    pg_access_snapshot_free(NULL);
+    if (count < 5 || done_id < 0) {
+        fprintf(stderr, "%zu accessibility nodes, \"Done\" %s\n", count, done_id < 0 ? "missing" : "found");
+        return 1;
+    }
+    uint8_t acted = 1;
+    check(pg_accessibility_click(engine, 99999, &acted), PG_STATUS_OK, "activate an unknown node", NULL);
+    if (acted) {
+        fprintf(stderr, "an unknown node was activated\n");
+        return 1;
+    }
+    check(pg_accessibility_adjust(engine, done_id, 1, &acted), PG_STATUS_OK, "step a button", NULL);
+    if (acted) {
+        fprintf(stderr, "a button was stepped like a slider\n");
+        return 1;
+    }
+    check(pg_accessibility_click(engine, done_id, &acted), PG_STATUS_OK, "activate Done", NULL);
+    check(pg_draw(engine, -1.0, NULL), PG_STATUS_OK, "draw after Done", NULL);
+    check(pg_draw(engine, -1.0, NULL), PG_STATUS_OK, "draw after Done", NULL);
+    check(pg_accessibility_generation(engine, &later), PG_STATUS_OK, "generation", NULL);
+    if (!acted || later == generation) {
+        fprintf(stderr, "activating Done changed nothing (acted %d)\n", acted);
+        return 1;
+    }
+    printf("ok: accessibility: %zu nodes read, Done activated\n", count);
     pg_engine_destroy(engine);
     printf("done\n");
     return 0;

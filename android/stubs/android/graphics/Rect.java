@@ -1,2 +1,2 @@
 // Host stub of the Android/AndroidX API surface the shell uses; see android/stubs/README.md.
-package android.graphics; public final class Rect { public int left, top, right, bottom; public int width() { return right - left; } public int height() { return bottom - top; } }
+package android.graphics; public final class Rect { public int left, top, right, bottom; public Rect() {} public Rect(int left, int top, int right, int bottom) { this.left = left; this.top = top; this.right = right; this.bottom = bottom; } public int width() { return right - left; } public int height() { return bottom - top; } }

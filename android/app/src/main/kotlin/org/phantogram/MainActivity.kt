@@ -64,6 +64,10 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         val view = SurfaceView(this)
         view.holder.addCallback(this)
         setContentView(view)
+        // TalkBack reads the core's screens as virtual views of the surface.
+        val screenReader = ScreenReader(view) { render.engine }
+        screenReader.attach()
+        render.onAccessibilityChanged = { screenReader.changed() }
         val prefs = getSharedPreferences(PREFS, Context.MODE_PRIVATE)
         refreshBundledAssets(prefs)
         render.create(extractFaceModels(), panel(), "dubois", File(filesDir, "calibration.txt").path,

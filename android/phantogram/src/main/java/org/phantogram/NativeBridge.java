@@ -163,4 +163,72 @@ public final class NativeBridge {
 
     /** The current view as PNG bytes for the share sheet: 0 anaglyph, 1 side by side. */
     public static native byte[] nativeSnapshotPng(long handle, int kind);
+
+    /**
+     * One thing a screen reader (TalkBack) can land on in the core's screens: a virtual view of
+     * the drawing surface. Bounds in the surface's pixels. The ids are small, positive and
+     * stable for a control while the engine lives.
+     */
+    public static final class AccessibilityNode {
+        public static final int ROLE_TEXT = 0;
+        public static final int ROLE_BUTTON = 1;
+        public static final int ROLE_CHECK_BOX = 2;
+        public static final int ROLE_RADIO_BUTTON = 3;
+        public static final int ROLE_SLIDER = 4;
+        public static final int ROLE_IMAGE = 5;
+
+        /** Activating it does something (nativeAccessibilityClick). */
+        public static final int FLAG_CLICKABLE = 1;
+        /** It steps up and down (nativeAccessibilityAdjust): a slider. */
+        public static final int FLAG_ADJUSTABLE = 2;
+        /** It has an on/off state, given by FLAG_CHECKED. */
+        public static final int FLAG_CHECKABLE = 4;
+        public static final int FLAG_CHECKED = 8;
+        public static final int FLAG_DISABLED = 16;
+
+        public final int id;
+        public final int role;
+        public final int flags;
+        public final float left;
+        public final float top;
+        public final float right;
+        public final float bottom;
+        /** What to say; never empty. */
+        public final String label;
+        /** A slider's value as text, or null. */
+        public final String value;
+
+        public AccessibilityNode(int id, int role, int flags, float left, float top, float right,
+                float bottom, String label, String value) {
+            this.id = id;
+            this.role = role;
+            this.flags = flags;
+            this.left = left;
+            this.top = top;
+            this.right = right;
+            this.bottom = bottom;
+            this.label = label;
+            this.value = value;
+        }
+
+        public boolean has(int flag) {
+            return (flags & flag) != 0;
+        }
+    }
+
+    /** What a screen reader can land on in the last frame, in reading order (the open screen's
+     *  text and controls, or the picture itself). Read it again when nativeAccessibilityGeneration
+     *  changes (after a frame). */
+    public static native AccessibilityNode[] nativeAccessibilityNodes(long handle);
+
+    /** Changes whenever nativeAccessibilityNodes would return something else. */
+    public static native long nativeAccessibilityGeneration(long handle);
+
+    /** A screen reader's activation of node id: it acts in the next frame as if tapped. False
+     *  for an id not on screen now, or one that does nothing. */
+    public static native boolean nativeAccessibilityClick(long handle, int id);
+
+    /** A screen reader's step up (steps > 0) or down on slider id, applied in the next frame.
+     *  False for an id that is not an adjustable node now. */
+    public static native boolean nativeAccessibilityAdjust(long handle, int id, int steps);
 }

@@ -36,6 +36,12 @@ class RenderLoop(
     private var running = false // render thread only
     private var refreshPeriodNs = 16_666_667L
 
+    /** Called (on the render thread) after a frame whose screen-reader nodes differ from the
+     *  last: hand it to [ScreenReader.changed]. */
+    @Volatile
+    var onAccessibilityChanged: (() -> Unit)? = null
+    private var accessibilityGeneration = -1L // render thread only
+
     fun create(
         facesDir: String?, panel: Panel, anaglyph: String, calibrationPath: String,
         libraryDir: String, bundledDir: String, artifact: String?
@@ -130,6 +136,11 @@ class RenderLoop(
                     // Taken here, on the thread that owns the engine, without the menu drawn over it.
                     NativeBridge.REQUEST_SHARE_PICTURE -> onShare(NativeBridge.nativeSnapshotPng(engine, 0), false)
                     NativeBridge.REQUEST_SHARE_PAIR -> onShare(NativeBridge.nativeSnapshotPng(engine, 1), true)
+                }
+                val generation = NativeBridge.nativeAccessibilityGeneration(engine)
+                if (generation != accessibilityGeneration) {
+                    accessibilityGeneration = generation
+                    onAccessibilityChanged?.invoke()
                 }
             }
         } catch (t: RuntimeException) {
