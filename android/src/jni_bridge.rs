@@ -409,16 +409,28 @@ unsafe fn direct_bytes<'a>(env: &mut Env<'_>, buffer: &JByteBuffer<'_>, what: &s
     if buffer.is_null() {
         return Err(fail(Kind::IllegalArgument, format!("the {what} buffer is null")));
     }
-    let address = env.get_direct_buffer_address(buffer)?;
-    let capacity = env.get_direct_buffer_capacity(buffer)?;
-    if address.is_null() {
-        return Err(fail(
+    let not_direct = || {
+        fail(
             Kind::IllegalArgument,
             format!("the {what} buffer is not a direct buffer"),
-        ));
+        )
+    };
+    // jni-rs reports a heap buffer's missing address as an error of its own (found by the
+    // random-call test: it reached Java as "Rust error: Null pointer …").
+    let address = match env.get_direct_buffer_address(buffer) {
+        Ok(address) => address,
+        Err(jni::errors::Error::NullPtr(_)) => return Err(not_direct()),
+        Err(e) => return Err(e.into()),
+    };
+    let capacity = env.get_direct_buffer_capacity(buffer)?;
+    if address.is_null() {
+        return Err(not_direct());
+    }
+    if capacity == 0 {
+        return Ok(&[]);
     }
     // SAFETY: the caller keeps the buffer alive for the slice's life; a direct buffer's memory is
-    // `capacity` bytes from `address`.
+    // `capacity` bytes from `address`, which is not null.
     Ok(unsafe { std::slice::from_raw_parts(address, capacity) })
 }
 

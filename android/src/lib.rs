@@ -33,14 +33,19 @@ mod platform;
 #[cfg(unix)]
 pub fn owned_fd_file(fd: i32) -> std::io::Result<std::fs::File> {
     use std::os::fd::{FromRawFd, OwnedFd};
-    if fd < 0 {
+    // SAFETY: `fcntl(F_GETFD)` only reads the descriptor's flags; any integer is a valid
+    // argument (a closed or negative one fails with EBADF).
+    let open = fd >= 0 && unsafe { libc::fcntl(fd, libc::F_GETFD) } != -1;
+    if !open {
+        // Owning a closed descriptor would close it (or, by then, someone else's) on drop.
         return Err(std::io::Error::new(
             std::io::ErrorKind::InvalidInput,
             format!("file descriptor {fd} is not open"),
         ));
     }
-    // SAFETY: the caller's contract (`nativeImportArtifactFd`): `fd` is an open descriptor that
-    // the caller detached and no longer uses or closes; it is owned by the `File` from here on.
+    // SAFETY: the caller's contract (`nativeImportArtifactFd`): `fd` is an open descriptor (just
+    // checked) that the caller detached and no longer uses or closes; it is owned by the `File`
+    // from here on.
     Ok(std::fs::File::from(unsafe { OwnedFd::from_raw_fd(fd) }))
 }
 
@@ -106,6 +111,15 @@ mod tests {
         assert_eq!(text, "glTF bytes");
         let _ = std::fs::remove_file(&path);
         assert!(owned_fd_file(-1).unwrap_err().to_string().contains("not open"));
+        // A descriptor that is not open is refused, not owned (dropping it would close it: std
+        // aborts on that, found by the random JNI calls). A number no process has open, rather
+        // than one just closed, which another test thread could reopen meanwhile.
+        assert!(
+            owned_fd_file(i32::MAX - 7)
+                .unwrap_err()
+                .to_string()
+                .contains("not open")
+        );
     }
 
     #[test]

@@ -243,3 +243,61 @@ fn java_accessibility_constants_are_the_cores() {
         assert_eq!(constant(name), i64::from(flag), "{name}");
     }
 }
+
+/// Random call sequences through every native method (`android/tests/java/RandomCalls.java`):
+/// only documented exceptions, no panic, no JNI error, no crash, and `-Xcheck:jni` silent.
+/// `PHANTOGRAM_JNI_CALLS` sets the calls per seed (default 400; a long run: a few hundred
+/// thousand), `PHANTOGRAM_JNI_SEEDS` the number of seeds (default 3).
+#[test]
+fn random_jni_call_sequences_end_only_in_documented_exceptions() {
+    let home = java_home();
+    if home.is_none() && Command::new("javac").arg("-version").output().is_err() {
+        skip("no JDK found");
+        return;
+    }
+    if let Err(e) = Engine::new(EngineConfig::default()) {
+        skip(&format!("no GPU engine ({e})"));
+        return;
+    }
+    let number = |var: &str, default: u64| {
+        std::env::var(var)
+            .ok()
+            .and_then(|v| v.parse::<u64>().ok())
+            .unwrap_or(default)
+    };
+    let (calls, seeds) = (number("PHANTOGRAM_JNI_CALLS", 400), number("PHANTOGRAM_JNI_SEEDS", 3));
+    let dir = std::env::temp_dir().join(format!("phantogram-jvm-random-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp folder");
+    let status = Command::new(tool(&home, "javac"))
+        .arg("-d")
+        .arg(&dir)
+        .arg(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
+        .arg(workspace().join("android/tests/java/RandomCalls.java"))
+        .status()
+        .expect("running javac");
+    assert!(status.success(), "javac failed");
+    for seed in 1..=seeds {
+        let library = dir.join(format!("library-{seed}"));
+        let output = Command::new(tool(&home, "java"))
+            .arg("-Xcheck:jni")
+            .arg("-cp")
+            .arg(&dir)
+            .arg("RandomCalls")
+            .arg(bridge_library())
+            .arg(seed.to_string())
+            .arg(calls.to_string())
+            .arg(&library)
+            .output()
+            .expect("running java");
+        let stdout = String::from_utf8_lossy(&output.stdout);
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        println!("{stdout}");
+        assert!(output.status.success(), "seed {seed}:\n{stdout}\n{stderr}");
+        assert!(stdout.contains("done"), "{stdout}");
+        assert!(
+            !stderr.contains("WARNING in native method"),
+            "seed {seed}: JNI misuse reported:\n{stderr}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

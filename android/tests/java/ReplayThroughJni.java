@@ -155,6 +155,10 @@ public final class ReplayThroughJni {
                     () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, cr, 64, 4, 270, 50f, 50f, 32f, 24f, end));
             expect(IllegalArgumentException.class, "chroma planes",
                     () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, null, 64, 2, 270, 50f, 50f, 32f, 24f, end));
+            // A heap buffer has no address to read (was a "Rust error" RuntimeException).
+            expect(IllegalArgumentException.class, "not a direct buffer",
+                    () -> NativeBridge.nativeCameraFrame(h, java.nio.ByteBuffer.allocate(64 * 48), 64, 48, 64, null, null, 0, 0,
+                            270, 50f, 50f, 32f, 24f, end));
             // The room light is off in this engine, but an exposure is taken (for when it is on);
             // an unknown one is not.
             if (!NativeBridge.nativeCameraExposure(h, last, 10_000_000L, 200)
