@@ -62,6 +62,11 @@ use crate::{Session, SessionConfig, SessionError};
 /// Largest offscreen or surface side accepted (wgpu's downlevel limit).
 pub const MAX_SIDE_PX: u32 = 8192;
 
+/// The least width and height, in points, the screens are laid out on (see
+/// `draw_with_screens`): any real phone window is larger.
+#[cfg(feature = "ui")]
+const MIN_SCREEN_PT: f32 = 240.0;
+
 /// The frame time a big scan's level-of-detail budget aims at by default, seconds: 30 frames a
 /// second, both eyes (the relief-texture paper holds at least 10; a phantogram that lags the
 /// hand by more than a frame at 30 Hz no longer looks fixed in the room).
@@ -1852,10 +1857,13 @@ impl Engine {
         // AccessKit nodes for the screen readers, every frame (a flag; egui re-enables nothing
         // by itself after the context is made anew).
         screens.ctx.enable_accesskit();
+        // On a sliver of a surface (split screen, mid-resize) the screens are laid out at a
+        // least size and cut off at its edges, rather than squeezed into negative widths
+        // (egui asserts on those; found by the random JNI calls on a 1-pixel surface).
         let raw = egui::RawInput {
             screen_rect: Some(egui::Rect::from_min_size(
                 egui::Pos2::ZERO,
-                egui::vec2(w as f32 / ppp, h as f32 / ppp),
+                egui::vec2((w as f32 / ppp).max(MIN_SCREEN_PT), (h as f32 / ppp).max(MIN_SCREEN_PT)),
             )),
             events: std::mem::take(&mut screens.events),
             ..Default::default()
