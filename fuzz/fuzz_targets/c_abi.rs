@@ -1,9 +1,11 @@
 //! Random call sequences through the C ABI (`ios/include/phantogram.h`), on one engine made at
 //! start: sensors with any time stamps and values, camera frames of any shape, touches, display
 //! and sensor-range changes, anaglyph names, offscreen lifecycles and draws, read-back into
-//! buffers of any size, stats and error messages. Every call returns a status; none panics,
-//! hangs or corrupts memory. (The JNI bridge drives the same `SharedEngine` and the same
-//! `Engine` calls; its argument conversion is covered by its JVM tests.)
+//! buffers of any size, the menu and the screen reader's nodes (snapshots read and freed,
+//! activations and slider steps on any id), stats and error messages. Every call returns a
+//! status; none panics, hangs or corrupts memory. (The JNI bridge drives the same
+//! `SharedEngine` and the same `Engine` calls; its argument conversion is covered by its JVM
+//! tests, random call sequences included: `android/tests/java/RandomCalls.java`.)
 #![no_main]
 
 use std::ffi::CString;
@@ -64,6 +66,9 @@ impl Bytes<'_> {
     }
 }
 
+/// A call's status, not needed: every status is an acceptable answer to random input.
+fn ignore(_: PgStatus) {}
+
 fuzz_target!(|data: &[u8]| {
     let e = engine();
     let mut b = Bytes(data);
@@ -76,33 +81,47 @@ fuzz_target!(|data: &[u8]| {
         // SAFETY (every call): `e` is a live handle; pointers are null or valid for the sizes
         // passed; strings are NUL-terminated.
         unsafe {
-            match b.u8() % 16 {
-                0 => drop(pg_push_accelerometer(e, b.f64(), b.f64(), b.f64(), b.f64())),
-                1 => drop(pg_push_gyroscope(e, b.f64(), b.f64(), b.f64(), b.f64())),
-                2 => drop(pg_push_magnetometer(e, b.f64(), b.f64(), b.f64(), b.f64())),
-                3 => drop(pg_push_device_motion(e, b.f64(), b.f64(), b.f64(), b.f64(), b.f64())),
-                4 => drop(pg_push_sensor_si(e, b.i32(), b.i64(), b.f32(), b.f32(), b.f32())),
+            match b.u8() % 19 {
+                0 => ignore(pg_push_accelerometer(e, b.f64(), b.f64(), b.f64(), b.f64())),
+                1 => ignore(pg_push_gyroscope(e, b.f64(), b.f64(), b.f64(), b.f64())),
+                2 => ignore(pg_push_magnetometer(e, b.f64(), b.f64(), b.f64(), b.f64())),
+                3 => ignore(pg_push_device_motion(e, b.f64(), b.f64(), b.f64(), b.f64(), b.f64())),
+                4 => ignore(pg_push_sensor_si(e, b.i32(), b.i64(), b.f32(), b.f32(), b.f32())),
                 5 => {
                     let (w, h) = (b.small(96), b.small(96));
                     let stride = (w as usize + b.small(16) as usize).max(1);
                     let luma = vec![b.u8(); stride * h as usize];
-                    drop(pg_camera_frame(
+                    // Colour half the time: an interleaved CbCr plane of its own stride, as
+                    // large as that stride and the luma's height say (the ABI's contract).
+                    let colour = b.u8() % 2 == 0;
+                    let cbcr_stride = (w as usize + b.small(16) as usize).max(1);
+                    let cbcr = vec![b.u8(); cbcr_stride * (h as usize).div_ceil(2)];
+                    let (cbcr_ptr, cbcr_stride) = if colour {
+                        (cbcr.as_ptr(), cbcr_stride)
+                    } else {
+                        (std::ptr::null(), 0)
+                    };
+                    ignore(pg_camera_frame(
                         e,
                         luma.as_ptr(),
                         w,
                         h,
                         stride,
+                        cbcr_ptr,
+                        cbcr_stride,
                         b.small(360),
                         b.f32(),
                         b.f32(),
                         b.f32(),
                         b.f32(),
                         b.f64(),
+                        b.f64(),
+                        b.f64(),
                     ));
                 }
                 6 => {
                     let mut gesture = 0i32;
-                    drop(pg_touch(
+                    ignore(pg_touch(
                         e,
                         b.i32() % 5,
                         b.i32() % 4,
@@ -112,7 +131,7 @@ fuzz_target!(|data: &[u8]| {
                         &mut gesture,
                     ));
                 }
-                7 => drop(pg_set_display(
+                7 => ignore(pg_set_display(
                     e,
                     b.small(4000),
                     b.small(4000),
@@ -120,27 +139,51 @@ fuzz_target!(|data: &[u8]| {
                     b.f32(),
                     b.i32() % 6,
                 )),
-                8 => drop(pg_set_sensor_ranges(e, b.f32(), b.f32())),
+                8 => ignore(pg_set_sensor_ranges(e, b.f32(), b.f32())),
                 9 => {
                     let name: Vec<u8> = (0..b.small(24)).map(|_| b.u8().max(1)).collect();
                     let name = CString::new(name).expect("no NUL");
-                    drop(pg_set_anaglyph(e, name.as_ptr()));
+                    ignore(pg_set_anaglyph(e, name.as_ptr()));
                 }
-                10 => drop(pg_resume_offscreen(e, b.small(72), b.small(160))),
-                11 => drop(pg_resize(e, b.small(72), b.small(160))),
-                12 => drop(pg_suspend(e)),
+                10 => ignore(pg_resume_offscreen(e, b.small(72), b.small(160))),
+                11 => ignore(pg_resize(e, b.small(72), b.small(160))),
+                12 => ignore(pg_suspend(e)),
                 13 => {
                     let mut presented = 0u8;
-                    drop(pg_draw(e, b.f64(), &mut presented));
+                    ignore(pg_draw(e, b.f64(), &mut presented));
                 }
                 14 => {
                     let capacity = (b.small(u16::MAX as u32) as usize).min(pixels.len());
                     let (mut w, mut h) = (0u32, 0u32);
-                    drop(pg_read_frame(e, pixels.as_mut_ptr(), capacity, &mut w, &mut h));
+                    ignore(pg_read_frame(e, pixels.as_mut_ptr(), capacity, &mut w, &mut h));
+                }
+                15 => ignore(pg_open_menu(e)),
+                16 => {
+                    // The screen reader's nodes: a snapshot, one node read through, freed.
+                    let mut snapshot = std::ptr::null_mut();
+                    let mut generation = 0u64;
+                    if pg_accessibility_snapshot(e, &mut snapshot, &mut generation) == PgStatus::Ok {
+                        let mut node = std::mem::zeroed::<PgAccessNode>();
+                        let index = b.small(64) as usize;
+                        if pg_access_snapshot_node(snapshot, index, &mut node) == PgStatus::Ok {
+                            assert!(index < pg_access_snapshot_len(snapshot));
+                            assert!(!std::ffi::CStr::from_ptr(node.label).to_bytes().is_empty());
+                        }
+                        pg_access_snapshot_free(snapshot);
+                    }
+                }
+                17 => {
+                    let mut acted = 0u8;
+                    let id = b.i32() % 64;
+                    if b.u8() % 2 == 0 {
+                        ignore(pg_accessibility_click(e, id, &mut acted));
+                    } else {
+                        ignore(pg_accessibility_adjust(e, id, b.i32() % 8, &mut acted));
+                    }
                 }
                 _ => {
                     let mut stats = std::mem::zeroed::<PgStats>();
-                    drop(pg_stats(e, &mut stats));
+                    ignore(pg_stats(e, &mut stats));
                     let mut message = [0 as std::ffi::c_char; 64];
                     let capacity = b.small(64) as usize;
                     pg_last_error(message.as_mut_ptr(), capacity);

@@ -19,6 +19,13 @@ public final class RandomCalls {
     private static Random random;
     private static long calls = 0;
     private static long thrown = 0;
+    /** The last calls made, for the report of a failure. */
+    private static final java.util.ArrayDeque<String> recent = new java.util.ArrayDeque<>();
+
+    private static void note(String what) {
+        if (recent.size() == 40) recent.removeFirst();
+        recent.addLast(what);
+    }
 
     private static float anyFloat() {
         switch (random.nextInt(8)) {
@@ -96,6 +103,7 @@ public final class RandomCalls {
     /** One random call on handle h. */
     private static void call(long h, String libraryDir) {
         int which = random.nextInt(33);
+        note("case " + which + (h == 0 ? " (handle 0)" : ""));
         switch (which) {
             case 0: NativeBridge.nativePushSensor(h, random.nextInt(40) - 2, anyTime(), anyFloat(), anyFloat(), anyFloat(), anyFloat()); break;
             case 1: {
@@ -109,17 +117,23 @@ public final class RandomCalls {
                     anyFloat(), anyFloats(6), anyInt(640), anyInt(480)); break;
             case 4: NativeBridge.nativeTouch(h, anyInt(4), anyInt(5), anyFloat(), anyFloat(), anyTime()); break;
             case 5: NativeBridge.nativeSurfaceCreated(h, random.nextBoolean() ? null : "not a surface", anyInt(400), anyInt(400)); break;
-            case 6: NativeBridge.nativeResumeOffscreen(h, anyInt(200), anyInt(300)); break;
-            case 7: NativeBridge.nativeSurfaceChanged(h, anyInt(200), anyInt(300)); break;
+            case 6: { int w = anyInt(200), hh = anyInt(300); note("resumeOffscreen " + w + "x" + hh); NativeBridge.nativeResumeOffscreen(h, w, hh); break; }
+            case 7: { int w = anyInt(200), hh = anyInt(300); note("surfaceChanged " + w + "x" + hh); NativeBridge.nativeSurfaceChanged(h, w, hh); break; }
             case 8: NativeBridge.nativeSurfaceDestroyed(h); break;
-            case 9: NativeBridge.nativeSetDisplay(h, anyInt(1440), anyInt(3200), anyFloat(), anyFloat(), anyInt(4)); break;
+            case 9: {
+                int pw = anyInt(1440), ph = anyInt(3200), rot = anyInt(4);
+                float xd = anyFloat(), yd = anyFloat();
+                note("setDisplay " + pw + "x" + ph + " " + xd + " " + yd + " rot " + rot);
+                NativeBridge.nativeSetDisplay(h, pw, ph, xd, yd, rot);
+                break;
+            }
             case 10: NativeBridge.nativeSetAnaglyph(h, anyString("dubois", "mono", "half-color", "sepia")); break;
             case 11: NativeBridge.nativeSetSensorRanges(h, anyFloat(), anyFloat()); break;
             case 12: NativeBridge.nativeDrawFrame(h, random.nextBoolean() ? -1 : anyTime()); break;
             case 13: NativeBridge.nativeReadFrame(h); break;
             case 14: NativeBridge.nativeStats(h); break;
             case 15: NativeBridge.nativeCalibrationWarning(h); break;
-            case 16: NativeBridge.nativeSetTextScale(h, anyFloat()); break;
+            case 16: { float scale = anyFloat(); note("setTextScale " + scale); NativeBridge.nativeSetTextScale(h, scale); break; }
             case 17: NativeBridge.nativeCameraPermissionNeeded(h); break;
             case 18: NativeBridge.nativeImportArtifact(h, anyString("a.glb", "b.gltf", "c.zip", "../../x.glb"), random.nextInt(8) == 0 ? null : anyBytes(2048)); break;
             // Never an open descriptor: the library would own and close it.
@@ -180,7 +194,8 @@ public final class RandomCalls {
                 String m = String.valueOf(e.getMessage());
                 // A panic or a JNI failure is a bug; a load or GPU failure is documented.
                 if (e.getClass() != RuntimeException.class || m.startsWith("Rust panic") || m.startsWith("Rust error")) {
-                    throw new AssertionError("call " + i + " (seed " + seed + "): " + e, e);
+                    throw new AssertionError("call " + i + " (seed " + seed + "): " + e + "\nthe calls before it: "
+                            + String.join("; ", recent), e);
                 }
                 thrown++;
             }

@@ -109,12 +109,13 @@ impl MaterialUi {
             .exact_size(height)
             .show(ui, |ui| {
                 egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
-                    let full = ui.available_width();
+                    let full = ui.available_width().max(0.0);
                     ui.heading(RichText::new("Material").size(24.0));
                     ui.label("Try the artifact in another material. It is kept for this artifact.");
                     ui.add_space(6.0);
                     // Presets, two to a row; "as found" first.
-                    let half = (full - ui.spacing().item_spacing.x) / 2.0;
+                    // Never negative, however narrow the screen (egui asserts on negative sizes).
+                    let half = ((full - ui.spacing().item_spacing.x) / 2.0).max(0.0);
                     let mut choices: Vec<(&'static str, &'static str, Option<WardPreset>)> =
                         vec![("as-found", "As found", None)];
                     choices.extend(WardPreset::ALL.map(|p| (preset_key(p), p.name(), Some(p))));

@@ -93,7 +93,8 @@ impl MenuUi {
             ui.add_space(6.0);
             // The view as it is now (the menu is not in the picture), two ways, side by side.
             ui.horizontal(|ui| {
-                let half = (ui.available_width() - ui.spacing().item_spacing.x) / 2.0;
+                // Never negative, however narrow the screen (egui asserts on negative sizes).
+                let half = ((ui.available_width() - ui.spacing().item_spacing.x) / 2.0).max(0.0);
                 for (name, label, side_by_side) in [
                     ("share", "Share the picture", false),
                     ("share-pair", "Share as a stereo pair", true),

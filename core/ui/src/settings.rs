@@ -85,7 +85,7 @@ impl SettingsUi {
         egui::CentralPanel::default().show(ui, |ui| {
             egui::ScrollArea::vertical().auto_shrink([false, false]).show(ui, |ui| {
                 // One width for every control (a slider's own layout may widen the rest).
-                let full = ui.available_width();
+                let full = ui.available_width().max(0.0);
                 ui.heading(RichText::new("Settings").size(24.0));
                 ui.add_space(6.0);
                 ui.label(RichText::new("Glasses").size(18.0));
