@@ -19,7 +19,9 @@
 //!   walls and the pyramids stop it); [`Diorama::release`] lets it go with that velocity (a
 //!   flick).
 //!
-//! **Threading**: plain data, one thread. **Panics**: none; non-finite inputs are ignored.
+//! **Threading**: plain data, one thread. **Panics**: none; non-finite inputs are ignored. A
+//! panic inside the physics engine (degenerate contact geometry in parry, found by fuzzing) is
+//! caught: the world is rebuilt at the last poses ([`Diorama::faults`] counts it).
 
 use glam::{Quat, Vec3};
 use phantogram_geometry::screen::Screen;
@@ -127,6 +129,11 @@ pub struct Diorama {
     /// Where the interpolation stands between `previous` and `current`, 0 to 1.
     alpha: f32,
     grab: Option<(usize, Vec3)>,
+    /// Steps the physics engine panicked in (see [`Diorama::faults`]).
+    faults: u64,
+    /// Tests: the next step panics inside the engine, as a degenerate contact once did.
+    #[cfg(test)]
+    fault_next_step: bool,
 }
 
 impl std::fmt::Debug for Diorama {
@@ -260,6 +267,9 @@ impl Diorama {
             current: Vec::new(),
             alpha: 1.0,
             grab: None,
+            faults: 0,
+            #[cfg(test)]
+            fault_next_step: false,
         };
         let default_eye = Vec3::Z * 0.3;
         diorama.place_planes([default_eye, default_eye], true);
@@ -411,11 +421,63 @@ impl Diorama {
             // Held, it neither falls nor spins away.
             body.set_angvel(to_rapier(Vec3::ZERO), true);
         }
-        self.world.step();
+        // rapier and parry can panic on degenerate contact geometry (parry's EPA indexed out
+        // of bounds once, found by fuzzing the C ABI with extreme display and sensor input):
+        // the world is then rebuilt from the last poses, at rest, and the frame goes on.
+        let stepped = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            #[cfg(test)]
+            if std::mem::take(&mut self.fault_next_step) {
+                panic!("a fault injected by a test");
+            }
+            self.world.step();
+        }));
+        if stepped.is_err() {
+            self.steps += 1;
+            self.recover();
+            return;
+        }
         self.enforce_pyramids();
         self.steps += 1;
         let now = self.read_poses();
         self.previous = std::mem::replace(&mut self.current, now);
+    }
+
+    /// After a panic inside the physics engine (whose world may be half-stepped): a fresh world
+    /// with the bodies where the last whole step left them, at rest, the same clock, gravity,
+    /// eyes and starting poses (for [`Self::reset`]).
+    fn recover(&mut self) {
+        self.faults += 1;
+        let here: Vec<BodySpec> = self
+            .specs
+            .iter()
+            .zip(&self.current)
+            .map(|(spec, pose)| BodySpec {
+                start_m: pose.translation_m,
+                start_rotation: pose.rotation,
+                ..spec.clone()
+            })
+            .collect();
+        // The specs were accepted once and the poses are finite (non-finite input is ignored
+        // before it reaches the world), so this cannot fail; if it did, the old world stays.
+        let Ok(mut fresh) = Diorama::new(&self.screen, here, self.params) else {
+            return;
+        };
+        fresh.specs = std::mem::take(&mut self.specs);
+        fresh.t0_ns = self.t0_ns;
+        fresh.steps = self.steps;
+        fresh.skipped_steps = self.skipped_steps;
+        fresh.faults = self.faults;
+        fresh.set_gravity(self.gravity);
+        if let Some(eyes) = self.eyes_m {
+            fresh.place_planes(eyes, true);
+        }
+        *self = fresh;
+    }
+
+    /// How many steps the physics engine panicked in, each recovered from by rebuilding the
+    /// world at the last poses (0 in normal use; a count for the logs and the tests).
+    pub fn faults(&self) -> u64 {
+        self.faults
     }
 
     /// The tray and the pyramids as hard limits: after the solver, a body reaching more than

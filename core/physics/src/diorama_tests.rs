@@ -185,3 +185,42 @@ fn a_long_pause_is_skipped_and_nonsense_ignored() {
         Err(DioramaError::Body { index: 0, .. })
     ));
 }
+
+#[test]
+fn a_panic_inside_the_physics_engine_rebuilds_the_world_where_the_bodies_were() {
+    let (_, mut d) = scene(20);
+    d.set_eyes([Vec3::new(-0.0315, 0.0, 0.3), Vec3::new(0.0315, 0.0, 0.3)]);
+    for k in 0..=100 {
+        d.advance_to(k * 10 * MS);
+    }
+    let before = d.stepped_poses().to_vec();
+    let steps = d.steps();
+    d.fault_next_step = true;
+    d.advance_to(101 * 10 * MS);
+    assert_eq!(d.faults(), 1);
+    assert_eq!(d.steps(), steps + 1, "the clock goes on");
+    for (a, b) in before.iter().zip(d.stepped_poses()) {
+        assert!(a.translation_m.distance(b.translation_m) < 1e-6, "{a:?} → {b:?}");
+    }
+    // And the rebuilt world runs on: tilted, the bodies slide, stay finite and in the tray.
+    d.set_gravity(crate::apparent_gravity::gravity_device(Quat::from_rotation_y(
+        -40f32.to_radians(),
+    )));
+    for k in 102..=300 {
+        d.advance_to(k * 10 * MS);
+    }
+    assert_eq!(d.faults(), 1);
+    let moved = before
+        .iter()
+        .zip(d.stepped_poses())
+        .filter(|(a, b)| a.translation_m.distance(b.translation_m) > 0.005)
+        .count();
+    assert!(moved > 10, "only {moved} bodies slid after the rebuild");
+    assert!(d.stepped_poses().iter().all(|p| p.translation_m.is_finite()));
+    assert!(worst_escape_m(&d) <= CONTAINMENT_TOLERANCE_M + 1e-6);
+    // The starting poses are the scene's, not the rebuild's.
+    d.reset();
+    assert_eq!(d.stepped_poses()[0].translation_m, d.specs()[0].start_m);
+    let (_, fresh) = scene(20);
+    assert_eq!(d.specs(), fresh.specs());
+}
