@@ -56,6 +56,22 @@ fn skip(reason: &str) -> bool {
     true
 }
 
+/// Compiles `NativeBridge.java` (the app's own) and the driver `android/tests/java/NAME.java`
+/// into a fresh folder `PREFIX-<pid>` in the temporary folder, returned.
+fn compile_driver(home: &Option<PathBuf>, name: &str, prefix: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("{prefix}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp folder");
+    let status = Command::new(tool(home, "javac"))
+        .arg("-d")
+        .arg(&dir)
+        .arg(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
+        .arg(workspace().join(format!("android/tests/java/{name}.java")))
+        .status()
+        .expect("running javac");
+    assert!(status.success(), "javac failed");
+    dir
+}
+
 /// The log's motion events, in file order (what the driver forwards).
 fn log_events(path: &Path) -> Vec<SensorEvent> {
     let text = std::fs::read_to_string(path).expect("reading the log");
@@ -117,16 +133,7 @@ fn jni_bridge_replays_a_log_on_the_desktop_jvm() {
         return;
     };
 
-    let dir = std::env::temp_dir().join(format!("phantogram-jvm-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp folder");
-    let status = Command::new(tool(&home, "javac"))
-        .arg("-d")
-        .arg(&dir)
-        .arg(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
-        .arg(workspace().join("android/tests/java/ReplayThroughJni.java"))
-        .status()
-        .expect("running javac");
-    assert!(status.success(), "javac failed");
+    let dir = compile_driver(&home, "ReplayThroughJni", "phantogram-jvm");
     let out = dir.join("frame.argb");
     let output = Command::new(tool(&home, "java"))
         .arg("-Xcheck:jni")
@@ -266,16 +273,7 @@ fn random_jni_call_sequences_end_only_in_documented_exceptions() {
             .unwrap_or(default)
     };
     let (calls, seeds) = (number("PHANTOGRAM_JNI_CALLS", 400), number("PHANTOGRAM_JNI_SEEDS", 3));
-    let dir = std::env::temp_dir().join(format!("phantogram-jvm-random-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp folder");
-    let status = Command::new(tool(&home, "javac"))
-        .arg("-d")
-        .arg(&dir)
-        .arg(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
-        .arg(workspace().join("android/tests/java/RandomCalls.java"))
-        .status()
-        .expect("running javac");
-    assert!(status.success(), "javac failed");
+    let dir = compile_driver(&home, "RandomCalls", "phantogram-jvm-random");
     for seed in 1..=seeds {
         let library = dir.join(format!("library-{seed}"));
         let output = Command::new(tool(&home, "java"))

@@ -36,18 +36,21 @@ fn every_control_is_named(e: &Engine, page: &str) {
     }
 }
 
-#[test]
-fn a_screen_reader_finds_names_and_activates_the_screens_controls() {
-    let dir = Scratch::new("engine-accessibility");
+/// An engine in `dir` whose viewer has been through the first run (so the bare picture shows).
+fn introduced_engine(dir: &Scratch) -> Option<Engine> {
     let calibration = dir.join("calibration.txt");
     std::fs::write(&calibration, "phantogram-calibration 1\nintroduced 1\n").unwrap();
-    let Some(mut e) = phantogram_integration::engine_or_skip(EngineConfig {
+    phantogram_integration::engine_or_skip(EngineConfig {
         library_dir: Some(dir.join("library")),
         calibration_path: Some(calibration),
         ..EngineConfig::default()
-    }) else {
-        return;
-    };
+    })
+}
+
+#[test]
+fn a_screen_reader_finds_names_and_activates_the_screens_controls() {
+    let dir = Scratch::new("engine-accessibility");
+    let Some(mut e) = introduced_engine(&dir) else { return };
     let (w, h) = (360, 800);
     e.resume_offscreen(w, h).unwrap();
     let mut t = 100;
@@ -190,15 +193,7 @@ fn the_first_run_page_is_read_and_started_by_a_screen_reader() {
 #[test]
 fn every_page_draws_on_a_sliver_of_a_surface() {
     let dir = Scratch::new("engine-sliver");
-    let calibration = dir.join("calibration.txt");
-    std::fs::write(&calibration, "phantogram-calibration 1\nintroduced 1\n").unwrap();
-    let Some(mut e) = phantogram_integration::engine_or_skip(EngineConfig {
-        library_dir: Some(dir.join("library")),
-        calibration_path: Some(calibration),
-        ..EngineConfig::default()
-    }) else {
-        return;
-    };
+    let Some(mut e) = introduced_engine(&dir) else { return };
     let mut t = 100;
     for (w, h) in [(360, 800), (1, 1), (3, 400), (400, 2), (40, 40)] {
         e.resume_offscreen(w, h).unwrap();
