@@ -7,6 +7,16 @@
 //! It is the artifact library's `builtin:diorama` entry (see [`crate::engine`]); the desktop
 //! replays a log into it with `phantogram render --artifact diorama`.
 //!
+//! **Two ways of keeping things inside the eyes' view, one for each case.** A single artifact
+//! is pushed back along −z as a whole ([`crate::containment`]'s smoothed push-back): it is the
+//! thing looked at, rigid and placed by its curator, so it keeps its shape, its footprint on the
+//! floor and its place on the screen, and only its depth changes as the eyes move. The
+//! Diorama's loose bodies are held per body by the physics (the pyramids as walls, the paper's
+//! way): pushing the whole scene back would lift the tray off the glass and push every body for
+//! the one that strays, while per body only the stray one is stopped, and as a body would be
+//! in a real box. So the engine uses the push-back for artifacts and the pyramids for the
+//! Diorama, never both (the Diorama's push is 0).
+//!
 //! **Threading**: plain data owned by the render thread. **Panics**: none.
 
 use glam::{Mat4, Quat, Vec3};
