@@ -1935,14 +1935,14 @@ impl Engine {
         screens.banner_pt = banner_pt;
         screens.banner_button_pt = banner_button_pt;
         if let Some(update) = output.platform_output.accesskit_update.take() {
-            self.access.update(&update, ppp);
-        }
-        if screens.page.is_none()
-            && let Some(picture) = self.picture_access_node()
-        {
-            // Under a banner or the hint, the picture is still there to land on (first).
-            let mut nodes = self.access.nodes().to_vec();
-            nodes.insert(0, picture);
+            let mut nodes = self.access.flatten(&update, ppp);
+            if screens.page.is_none()
+                && let Some(picture) = self.picture_access_node()
+            {
+                // Under a banner or the hint, the picture is still there to land on (first).
+                nodes.insert(0, picture);
+            }
+            // Once, with the picture in: the generation moves only when the nodes do.
             self.access.replace(nodes);
         }
         screens.overlay.begin(&mut output);

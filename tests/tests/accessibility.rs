@@ -224,3 +224,32 @@ fn every_page_draws_on_a_sliver_of_a_surface() {
         }
     }
 }
+
+/// A banner over the bare picture (a failed import): the picture is read first, then the
+/// banner, and the nodes' generation stands still while nothing changes — the shells re-read
+/// only on a change.
+#[test]
+fn under_a_banner_the_picture_and_the_banner_are_read_and_stand_still() {
+    let dir = Scratch::new("engine-banner-reader");
+    let Some(mut e) = introduced_engine(&dir) else { return };
+    e.resume_offscreen(360, 800).unwrap();
+    let mut t = 100;
+    draw_frames(&mut e, &mut t, 1);
+    e.import_artifact("broken scan.glb", b"glTF\x02\x00\x00\x00 not a model".to_vec());
+    e.wait_for_artifact(std::time::Duration::from_secs(60));
+    assert!(matches!(
+        e.loading_status(),
+        phantogram::engine::LoadStatus::Failed { .. }
+    ));
+    draw_frames(&mut e, &mut t, 3);
+    let nodes = e.accessibility_nodes().to_vec();
+    assert_eq!(nodes.first().map(|n| n.role), Some(AccessRole::Image), "{nodes:?}");
+    assert!(nodes.iter().any(|n| n.label == "OK" && n.clickable), "{nodes:?}");
+    let generation = e.accessibility_generation();
+    draw_frames(&mut e, &mut t, 3);
+    assert_eq!(
+        e.accessibility_generation(),
+        generation,
+        "nothing changed, yet the shells were told to re-read"
+    );
+}

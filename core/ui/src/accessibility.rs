@@ -118,10 +118,18 @@ pub struct AccessTree {
 }
 
 impl AccessTree {
-    /// Takes a frame's AccessKit tree (egui's bounds are in points: `pixels_per_point` turns
-    /// them into the surface's pixels). Nodes without a label or value, or off the tree, are
-    /// left out; the rest in reading order (depth first from the root).
+    /// Takes a frame's AccessKit tree as the nodes ([`Self::flatten`]).
     pub fn update(&mut self, update: &accesskit::TreeUpdate, pixels_per_point: f32) {
+        let nodes = self.flatten(update, pixels_per_point);
+        self.replace(nodes);
+    }
+
+    /// A frame's AccessKit tree as nodes, not yet the tree's (egui's bounds are in points:
+    /// `pixels_per_point` turns them into the surface's pixels): for a caller that adds its own
+    /// before [`Self::replace`], so that the generation moves once per real change. Nodes
+    /// without a label or value, or off the tree, are left out; the rest in reading order
+    /// (depth first from the root). Ids are given here, and the sliders' scales kept.
+    pub fn flatten(&mut self, update: &accesskit::TreeUpdate, pixels_per_point: f32) -> Vec<AccessNode> {
         let by_id: HashMap<NodeId, &accesskit::Node> = update.nodes.iter().map(|(id, n)| (*id, n)).collect();
         let root = update.tree.as_ref().map(|t| t.root);
         // Each node's parent, for the controls that egui names by a label beside them.
@@ -241,7 +249,7 @@ impl AccessTree {
             });
         }
         self.scales = scales;
-        self.replace(nodes);
+        nodes
     }
 
     /// Sets the nodes outright (the engine's picture node when no screen shows).
@@ -482,6 +490,39 @@ mod tests {
         let g = tree.generation();
         run(&mut tree, false);
         assert_eq!(tree.generation(), g, "nothing changed");
+        // A node of the caller's own put first each frame (the engine's picture): still no
+        // change from frame to frame once it is there.
+        let lead = |tree: &mut AccessTree| AccessNode {
+            id: tree.id_for("lead"),
+            role: AccessRole::Image,
+            label: "Lead".into(),
+            value: None,
+            checked: None,
+            disabled: false,
+            clickable: true,
+            adjustable: false,
+            bounds_px: [0.0, 0.0, 1.0, 1.0],
+        };
+        for _ in 0..3 {
+            let input = egui::RawInput {
+                screen_rect: Some(egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(400.0, 800.0))),
+                ..Default::default()
+            };
+            let mut out = ctx.run_ui(input, |ui| {
+                let _ = ui.button("Keep");
+            });
+            out.textures_delta.clear();
+            let mut nodes = tree.flatten(out.platform_output.accesskit_update.as_ref().unwrap(), 1.0);
+            nodes.insert(0, lead(&mut tree));
+            tree.replace(nodes);
+        }
+        assert_eq!(
+            tree.generation(),
+            g + 1,
+            "the lead node added once, then nothing changed"
+        );
+        run(&mut tree, false);
+        let g = tree.generation();
         run(&mut tree, true);
         assert!(tree.generation() > g);
         assert_eq!(tree.nodes().iter().find(|n| n.label == "Keep").unwrap().id, keep);
