@@ -279,10 +279,31 @@ fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
     return 0.5 / max(gv + gl, 1e-5);
 }
 
-@fragment
-fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    // Sample everything first: derivatives need uniform control flow (the pipeline constants are
-    // uniform). A missing slot reads as the default texture would: white, or a flat normal.
+// A surface point as the material describes it, before the visitor's `Appearance`: what the scene
+// pass computes from the mesh and textures, and what an impostor's maps store (impostor.rs).
+struct Surface {
+    base: vec3<f32>,
+    alpha: f32,
+    // Shading normal (normal map applied) and tangent (zero where the mesh has none), on the side
+    // that faces the eye; the geometric normal, for the shadow's lookup offset.
+    n: vec3<f32>,
+    t: vec3<f32>,
+    geometric_n: vec3<f32>,
+    metallic: f32,
+    roughness: f32,
+    occlusion: f32,
+    emissive: vec3<f32>,
+    // KHR_materials_unlit: the base colour as it is (lighting baked into a scan's colour).
+    unlit: bool,
+    // Scenery (the floor) keeps its own material under the visitor's `Appearance`.
+    scenery: bool,
+};
+
+// The material's surface at a fragment of the scene pass. Samples every texture first:
+// derivatives need uniform control flow (the pipeline constants are uniform). A missing slot
+// reads as the default texture would: white, or a flat normal. The caller discards by
+// `alpha_cut`.
+fn material_surface(in: VsOut, front: bool) -> Surface {
     var base_sample = vec4<f32>(1.0);
     if (HAS_BASE_TEXTURE) {
         base_sample = textureSample(base_texture, base_sampler, slot_uv(0u, material.uv_sets.x, in.uv));
@@ -304,27 +325,19 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
         emissive_sample = textureSample(emissive_texture, emissive_sampler, slot_uv(4u, material.flags.x, in.uv));
     }
 
+    var s: Surface;
     let base_rgba = in.color * material.base_color * base_sample;
-    if (ALPHA_MASK && material.params.z >= 0.0 && base_rgba.a < material.params.z) {
-        discard;
-    }
-    var out_alpha = 1.0;
-    if (material.flags.z > 0.5) {
-        out_alpha = base_rgba.a;
-    }
-    // KHR_materials_unlit: the base colour as it is (lighting baked into a scan's colour).
-    if (material.flags.w > 0.5) {
-        return vec4<f32>(base_rgba.rgb, out_alpha);
-    }
-
+    s.base = base_rgba.rgb;
+    s.alpha = base_rgba.a;
     // Open and double-sided surfaces are lit from the side that faces the eye.
     var n = normalize(in.normal);
     var t = in.tangent.xyz;
-    var handedness = in.tangent.w;
+    let handedness = in.tangent.w;
     if (!front) {
         n = -n;
         t = -t;
     }
+    s.geometric_n = n;
     if (HAS_NORMAL_TEXTURE && material.flags.y > 0.5 && dot(t, t) > 1e-8) {
         let tn = normalize(t - n * dot(n, t));
         let bn = cross(n, tn) * select(1.0, -1.0, handedness < 0.0);
@@ -332,14 +345,50 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
         m = vec3<f32>(m.xy * material.emissive.w, m.z);
         n = normalize(tn * m.x + bn * m.y + n * m.z);
     }
+    s.n = n;
+    s.t = t;
+    s.metallic = clamp(material.params.x * mr_sample.b * in.material.x, 0.0, 1.0);
+    s.roughness = clamp(material.params.y * mr_sample.g * in.material.y, 0.045, 1.0);
+    s.occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);
+    s.emissive = material.emissive.rgb * emissive_sample.rgb;
+    s.unlit = material.flags.w > 0.5;
+    s.scenery = material.scene.x > 0.5;
+    return s;
+}
 
-    let v = normalize(eye.eye_pos.xyz - in.world);
+// Whether an alpha-masked material cuts this fragment out.
+fn alpha_cut(s: Surface) -> bool {
+    return ALPHA_MASK && material.params.z >= 0.0 && s.alpha < material.params.z;
+}
+
+@fragment
+fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let s = material_surface(in, front);
+    if (alpha_cut(s)) {
+        discard;
+    }
+    var out_alpha = 1.0;
+    if (material.flags.z > 0.5) {
+        out_alpha = s.alpha;
+    }
+    return vec4<f32>(shade(in.world, s), out_alpha);
+}
+
+// Outgoing radiance towards the eye from surface `s` at `world` (mesh coordinates), under the
+// light, the lamp, the environment and the visitor's `Appearance`.
+fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
+    if (s.unlit) {
+        return s.base;
+    }
+    let n = s.n;
+    let t = s.t;
+    let v = normalize(eye.eye_pos.xyz - world);
     // The light arriving: the directional light's radiance from its direction, or a lamp's
     // intensity over the squared distance, faded at its cone's edge.
     var l = normalize(eye.toward_light.xyz);
     var light_rgb = eye.light.rgb;
     if (eye.lamp_position.w > 0.5) {
-        let to_lamp = eye.lamp_position.xyz - in.world;
+        let to_lamp = eye.lamp_position.xyz - world;
         let d2 = max(dot(to_lamp, to_lamp), 1e-6);
         l = to_lamp * inverseSqrt(d2);
         let cos_axis = dot(-l, normalize(eye.lamp_axis.xyz));
@@ -348,15 +397,15 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     }
     let h = normalize(l + v);
     var look = eye.appearance;
-    if (material.scene.x > 0.5) {
+    if (s.scenery) {
         look = Appearance(vec4<f32>(1.0), vec4<f32>(-1.0, -1.0, 0.0, 0.1), vec4<f32>(0.0), vec4<f32>(0.0), vec4<f32>(1.0));
     }
-    let base = base_rgba.rgb * look.tint.rgb;
-    var metallic = clamp(material.params.x * mr_sample.b * in.material.x, 0.0, 1.0);
+    let base = s.base * look.tint.rgb;
+    var metallic = s.metallic;
     if (look.params.y >= 0.0) {
         metallic = look.params.y;
     }
-    var roughness = clamp(material.params.y * mr_sample.g * in.material.y, 0.045, 1.0);
+    var roughness = s.roughness;
     if (look.params.x >= 0.0) {
         roughness = clamp(look.params.x, 0.045, 1.0);
     }
@@ -366,12 +415,10 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     let n_dot_v = max(dot(n, v), 1e-4);
     let n_dot_h = max(dot(n, h), 0.0);
     let v_dot_h = max(dot(v, h), 0.0);
-    let geometric_n = normalize(select(-in.normal, in.normal, front));
-    let light_in = light_rgb * n_dot_l * light_visibility(in.world, geometric_n, l);
-    let occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);
+    let light_in = light_rgb * n_dot_l * light_visibility(world, s.geometric_n, l);
+    let occlusion = s.occlusion;
     let reflected = to_world(reflect(-v, n));
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));
-
     var direct = vec3<f32>(0.0);
     var ambient_light = vec3<f32>(0.0);
     if (look.ward_rho_d.w > 0.5) {
@@ -430,6 +477,215 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
         ambient_light = ambient_light * (1.0 - fc_ambient) + prefiltered * (0.04 * scale_bias.x + scale_bias.y) * coat;
     }
     let ambient = eye.light.w * occlusion * ambient_light;
-    let emissive = material.emissive.rgb * emissive_sample.rgb;
-    return vec4<f32>(direct + ambient + emissive, out_alpha);
+    return direct + ambient + s.emissive;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Relief-texture impostors (render crate, impostor.rs; the relief-texture paper). A part of a big
+// scan is baked once into six orthographic views of its box, one per face, looking inwards: for
+// each texel the first surface's depth along the face's axis and its material (base colour,
+// metallic, normal, roughness, occlusion). Drawn, the box's front faces cast each eye's ray
+// through the six depth maps: a point is inside the relief when it lies at or behind the first
+// surface in all six views (the object's six-sided relief hull); the ray's first such point is
+// the surface, found by steps of half a texel and refined by bisection. Its material comes from
+// the view that sees it (the one whose depth it matches best), lit by `shade` like a polygon,
+// and its depth is written, so impostors and polygons hide each other correctly.
+//
+// Box coordinates: q = (p − lo) / (hi − lo) in [0, 1]³ (mesh coordinates p). Face 2a looks from
+// the box's +a side (depth 1 − q[a]), face 2a+1 from its −a side (depth q[a]); they map
+// (1 − q[(a+1)%3], q[(a+2)%3]) and (q[(a+1)%3], q[(a+2)%3]) to the texel's column and row (no
+// view is a mirror image). An empty texel holds depth 2.
+
+struct GBufferOut {
+    // Base colour (sRGB target) and metallic.
+    @location(0) colour: vec4<f32>,
+    // Octahedral normal (mesh coordinates), roughness (−1: unlit), occlusion.
+    @location(1) normal: vec4<f32>,
+    // Depth along the face's axis, 0 to 1 over the box.
+    @location(2) depth: vec4<f32>,
+};
+
+fn octahedral(n: vec3<f32>) -> vec2<f32> {
+    let p = n.xy / (abs(n.x) + abs(n.y) + abs(n.z));
+    if (n.z >= 0.0) {
+        return p;
+    }
+    return (vec2<f32>(1.0) - abs(p.yx)) * select(vec2<f32>(-1.0), vec2<f32>(1.0), p >= vec2<f32>(0.0));
+}
+
+fn from_octahedral(e: vec2<f32>) -> vec3<f32> {
+    var n = vec3<f32>(e, 1.0 - abs(e.x) - abs(e.y));
+    let t = max(-n.z, 0.0);
+    n = vec3<f32>(n.xy + select(vec2<f32>(t), vec2<f32>(-t), n.xy >= vec2<f32>(0.0)), n.z);
+    return normalize(n);
+}
+
+// Baking: `eye.view_proj` is the face's orthographic view (impostor.rs `ImpostorBox::face_view`).
+@fragment
+fn fs_gbuffer(in: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
+    let s = material_surface(in, front);
+    if (alpha_cut(s)) {
+        discard;
+    }
+    var out: GBufferOut;
+    out.colour = vec4<f32>(s.base, s.metallic);
+    out.normal = vec4<f32>(octahedral(s.n), select(s.roughness, -1.0, s.unlit), s.occlusion);
+    // In a fragment, `clip` is its window position: z is the depth in the face view.
+    out.depth = vec4<f32>(in.clip.z, 0.0, 0.0, 1.0);
+    return out;
+}
+
+struct Impostor {
+    // The box in mesh coordinates; lo.w: texels per side.
+    lo: vec4<f32>,
+    hi: vec4<f32>,
+};
+
+@group(2) @binding(0) var<uniform> impostor: Impostor;
+@group(2) @binding(1) var impostor_colour: texture_2d_array<f32>;
+@group(2) @binding(2) var impostor_normal: texture_2d_array<f32>;
+@group(2) @binding(3) var impostor_depth: texture_2d_array<f32>;
+
+struct ImpostorVsOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    // The box face's outward normal.
+    @location(1) @interpolate(flat) outward: vec3<f32>,
+};
+
+// The box as 36 vertices: face f (axis f / 2, + side for even f), two triangles.
+@vertex
+fn vs_impostor(@builtin(vertex_index) index: u32) -> ImpostorVsOut {
+    let f = index / 6u;
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
+    );
+    let corner = corners[index % 6u];
+    let a = f / 2u;
+    let side = select(0.0, 1.0, f % 2u == 0u);
+    var q = vec3<f32>(0.0);
+    q[a] = side;
+    q[(a + 1u) % 3u] = corner.x;
+    q[(a + 2u) % 3u] = corner.y;
+    var outward = vec3<f32>(0.0);
+    outward[a] = select(-1.0, 1.0, f % 2u == 0u);
+    let world = mix(impostor.lo.xyz, impostor.hi.xyz, q);
+    var out: ImpostorVsOut;
+    out.clip = eye.view_proj * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.outward = outward;
+    return out;
+}
+
+fn impostor_texel(q: vec3<f32>, f: u32, size: f32) -> vec2<i32> {
+    let a = f / 2u;
+    let u = q[(a + 1u) % 3u];
+    let uv = vec2<f32>(select(u, 1.0 - u, f % 2u == 0u), q[(a + 2u) % 3u]);
+    return vec2<i32>(clamp(floor(uv * size), vec2<f32>(0.0), vec2<f32>(size - 1.0)));
+}
+
+// How far behind face f's first surface the box point q lies (negative: in front of it), in
+// units of the box along the face's axis.
+fn impostor_behind(q: vec3<f32>, f: u32, size: f32) -> f32 {
+    let a = f / 2u;
+    let depth = select(q[a], 1.0 - q[a], f % 2u == 0u);
+    return depth - textureLoad(impostor_depth, impostor_texel(q, f, size), i32(f), 0).r;
+}
+
+fn impostor_inside(q: vec3<f32>, size: f32) -> bool {
+    for (var f = 0u; f < 6u; f = f + 1u) {
+        if (impostor_behind(q, f, size) < 0.0) {
+            return false;
+        }
+    }
+    return true;
+}
+
+struct ImpostorFsOut {
+    @location(0) radiance: vec4<f32>,
+    @builtin(frag_depth) depth: f32,
+};
+
+@fragment
+fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
+    let o = eye.eye_pos.xyz;
+    let d = normalize(in.world - o);
+    // Each ray is cast once, from the face it enters by.
+    if (dot(d, in.outward) >= 0.0) {
+        discard;
+    }
+    let lo = impostor.lo.xyz;
+    let extent = impostor.hi.xyz - lo;
+    let size = impostor.lo.w;
+    let inv = 1.0 / d;
+    let t_a = (lo - o) * inv;
+    let t_b = (impostor.hi.xyz - o) * inv;
+    let t_near = min(t_a, t_b);
+    let t_far = max(t_a, t_b);
+    let t0 = max(max(max(t_near.x, t_near.y), t_near.z), 0.0);
+    let t1 = min(min(t_far.x, t_far.y), t_far.z);
+    if (t1 <= t0) {
+        discard;
+    }
+    let texel = extent / size;
+    let step_m = 0.5 * min(texel.x, min(texel.y, texel.z));
+    let steps = u32(clamp(ceil((t1 - t0) / step_m), 1.0, 2048.0));
+    let dt = (t1 - t0) / f32(steps);
+    var before = t0;
+    var after = -1.0;
+    for (var i = 0u; i <= steps; i = i + 1u) {
+        let t = t0 + f32(i) * dt;
+        if (impostor_inside((o + d * t - lo) / extent, size)) {
+            after = t;
+            break;
+        }
+        before = t;
+    }
+    if (after < 0.0) {
+        discard;
+    }
+    // Bisection between the last point outside and the first inside (2^-12 of a step).
+    if (after > before) {
+        for (var i = 0u; i < 12u; i = i + 1u) {
+            let mid = 0.5 * (before + after);
+            if (impostor_inside((o + d * mid - lo) / extent, size)) {
+                after = mid;
+            } else {
+                before = mid;
+            }
+        }
+    }
+    let p = o + d * after;
+    let q = clamp((p - lo) / extent, vec3<f32>(0.0), vec3<f32>(1.0));
+    // The view that sees this point: the one whose first surface it lies on (nearest, in metres).
+    var face = 0u;
+    var best = 1e30;
+    for (var f = 0u; f < 6u; f = f + 1u) {
+        let off = abs(impostor_behind(q, f, size)) * extent[f / 2u];
+        if (off < best) {
+            best = off;
+            face = f;
+        }
+    }
+    let at = impostor_texel(q, face, size);
+    let colour = textureLoad(impostor_colour, at, i32(face), 0);
+    let normal = textureLoad(impostor_normal, at, i32(face), 0);
+    var s: Surface;
+    s.base = colour.rgb;
+    s.alpha = 1.0;
+    s.n = from_octahedral(normal.xy);
+    s.t = vec3<f32>(0.0);
+    s.geometric_n = s.n;
+    s.metallic = colour.a;
+    s.roughness = max(normal.z, 0.045);
+    s.occlusion = normal.w;
+    s.emissive = vec3<f32>(0.0);
+    s.unlit = normal.z < 0.0;
+    s.scenery = false;
+    var out: ImpostorFsOut;
+    out.radiance = vec4<f32>(shade(p, s), 1.0);
+    let clip = eye.view_proj * vec4<f32>(p, 1.0);
+    out.depth = clamp(clip.z / clip.w, 0.0, 1.0);
+    return out;
 }

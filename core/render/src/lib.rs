@@ -54,6 +54,7 @@ use phantogram_geometry::projection::OffAxisProjection;
 
 mod gpu;
 mod gpu_timer;
+pub mod impostor;
 mod lighting_tables;
 pub mod surface;
 mod upload;
@@ -62,6 +63,7 @@ mod upload;
 pub use wgpu;
 
 pub use gpu::Gpu;
+pub use impostor::{IMPOSTOR_LEVEL, ImpostorBox};
 use lighting_tables::*;
 pub use lighting_tables::{PREFILTERED_BASE_WIDTH, prepare_lighting_tables, prepare_lighting_tables_in_background};
 pub use upload::mip_chain;
@@ -452,6 +454,8 @@ struct GpuModel {
     bounds: phantogram_geometry::containment::Aabb,
     /// Everything but the floor (all of it if there is nothing else).
     standing: phantogram_geometry::containment::Aabb,
+    /// Baked impostors by the model's primitive index ([`Renderer::bake_impostors`]).
+    impostors: Vec<Option<impostor::GpuImpostor>>,
 }
 
 impl GpuModel {
@@ -723,6 +727,8 @@ pub struct Renderer {
     pub lamp: Option<Lamp>,
     /// The frames' GPU time, where the device has timestamp queries.
     timer: Option<gpu_timer::GpuTimer>,
+    /// Made with the first impostor baked.
+    impostor_pipelines: Option<impostor::ImpostorPipelines>,
 }
 
 impl Renderer {
@@ -972,6 +978,7 @@ impl Renderer {
             appearance: Appearance::default(),
             lamp: None,
             timer: gpu_timer::GpuTimer::new(&gpu.device, &gpu.queue),
+            impostor_pipelines: None,
             gpu,
         }
     }
@@ -1070,6 +1077,8 @@ impl Renderer {
                 .queue
                 .write_buffer(&g.vertices, 0, bytemuck::cast_slice(&p.mesh.vertices));
         }
+        // Baked from the vertices as they were.
+        self.model.impostors.clear();
         let fallback = phantogram_geometry::containment::Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05));
         self.model.bounds = model.bounds().unwrap_or(fallback);
         self.model.standing = model.bounds_of(|p| !p.is_floor).unwrap_or(self.model.bounds);
@@ -1511,9 +1520,16 @@ impl Renderer {
             // Opaque and masked first; then blended, farthest first, as this eye sees them.
             let eye_at = Vec3::from_slice(&u.eye_pos[..3]);
             let mut blended: Vec<&GpuPrimitive> = Vec::new();
+            let mut impostors_drawn: Vec<usize> = Vec::new();
             for p in &self.model.primitives {
                 if self.model.materials[p.material].variant.blend {
                     blended.push(p);
+                } else if let Some(imp) = self.impostor_drawn_for(p, input.levels) {
+                    // Once for the primitive, however many pieces it was uploaded in.
+                    if !impostors_drawn.contains(&p.source) {
+                        impostors_drawn.push(p.source);
+                        self.draw_impostor(&mut pass, imp);
+                    }
                 } else {
                     self.draw_primitive(&mut pass, p, input.levels);
                 }
@@ -1584,6 +1600,14 @@ fn create_compose_pipeline(
 }
 
 impl Renderer {
+    /// The impostor `levels` draws for `p` in place of its triangles, if any.
+    fn impostor_drawn_for(&self, p: &GpuPrimitive, levels: &[u8]) -> Option<&impostor::GpuImpostor> {
+        if levels.get(p.source) != Some(&IMPOSTOR_LEVEL) {
+            return None;
+        }
+        self.model.impostors.get(p.source)?.as_ref()
+    }
+
     fn draw_primitive(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive, levels: &[u8]) {
         let m = &self.model.materials[p.material];
         // Every material's variant was prepared with its model; a miss would be our bug, and
@@ -1633,37 +1657,46 @@ fn eye_bind_groups(
     shadow_sampler: &wgpu::Sampler,
     ibl: &IblTextures,
 ) -> [wgpu::BindGroup; 2] {
-    [0, 1].map(|i| {
-        device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("eye"),
-            layout,
-            entries: &[
-                wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: buffers[i].as_entire_binding(),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 1,
-                    resource: wgpu::BindingResource::TextureView(shadow_view),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 2,
-                    resource: wgpu::BindingResource::Sampler(shadow_sampler),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 3,
-                    resource: wgpu::BindingResource::TextureView(&ibl.environment),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 4,
-                    resource: wgpu::BindingResource::TextureView(&ibl.brdf_lut),
-                },
-                wgpu::BindGroupEntry {
-                    binding: 5,
-                    resource: wgpu::BindingResource::Sampler(&ibl.sampler),
-                },
-            ],
-        })
+    [0, 1].map(|i| eye_bind_group(device, layout, &buffers[i], shadow_view, shadow_sampler, ibl))
+}
+
+fn eye_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    buffer: &wgpu::Buffer,
+    shadow_view: &wgpu::TextureView,
+    shadow_sampler: &wgpu::Sampler,
+    ibl: &IblTextures,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("eye"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: buffer.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(shadow_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Sampler(shadow_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(&ibl.environment),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: wgpu::BindingResource::TextureView(&ibl.brdf_lut),
+            },
+            wgpu::BindGroupEntry {
+                binding: 5,
+                resource: wgpu::BindingResource::Sampler(&ibl.sampler),
+            },
+        ],
     })
 }
 

@@ -287,5 +287,6 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
         materials,
         bounds,
         standing,
+        impostors: Vec::new(),
     }
 }
