@@ -501,7 +501,8 @@ struct GBufferOut {
     @location(0) colour: vec4<f32>,
     // Octahedral normal (mesh coordinates), roughness (−1: unlit), occlusion.
     @location(1) normal: vec4<f32>,
-    // Depth along the face's axis, 0 to 1 over the box.
+    // Depth along the face's axis, 0 to 1 over the box (made conservative in green by
+    // impostor_dilate.wgsl).
     @location(2) depth: vec4<f32>,
 };
 
@@ -585,17 +586,26 @@ fn impostor_texel(q: vec3<f32>, f: u32, size: f32) -> vec2<i32> {
     return vec2<i32>(clamp(floor(uv * size), vec2<f32>(0.0), vec2<f32>(size - 1.0)));
 }
 
-// How far behind face f's first surface the box point q lies (negative: in front of it), in
-// units of the box along the face's axis.
-fn impostor_behind(q: vec3<f32>, f: u32, size: f32) -> f32 {
+fn impostor_depth_along(q: vec3<f32>, f: u32) -> f32 {
     let a = f / 2u;
-    let depth = select(q[a], 1.0 - q[a], f % 2u == 0u);
-    return depth - textureLoad(impostor_depth, impostor_texel(q, f, size), i32(f), 0).r;
+    return select(q[a], 1.0 - q[a], f % 2u == 0u);
 }
 
+// How far behind face f's first surface at its texel's centre the box point q lies (negative:
+// in front of it), in units of the box along the face's axis.
+fn impostor_behind(q: vec3<f32>, f: u32, size: f32) -> f32 {
+    return impostor_depth_along(q, f) - textureLoad(impostor_depth, impostor_texel(q, f, size), i32(f), 0).r;
+}
+
+// Inside the relief hull, read conservatively (the nearest depth around the texel, see
+// impostor_dilate.wgsl) and grown by one texel: an open or thin part (a patch of a scan's
+// shell) has a hull of no thickness, which steps of half a texel would pass through; one texel
+// thick, they cannot. The surface found lies up to a texel in front of the true one
+// (`ImpostorBox::error_m` counts it).
 fn impostor_inside(q: vec3<f32>, size: f32) -> bool {
     for (var f = 0u; f < 6u; f = f + 1u) {
-        if (impostor_behind(q, f, size) < 0.0) {
+        let nearest = textureLoad(impostor_depth, impostor_texel(q, f, size), i32(f), 0).g;
+        if (impostor_depth_along(q, f) < nearest - 1.0 / size) {
             return false;
         }
     }
@@ -658,17 +668,48 @@ fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
     }
     let p = o + d * after;
     let q = clamp((p - lo) / extent, vec3<f32>(0.0), vec3<f32>(1.0));
-    // The view that sees this point: the one whose first surface it lies on (nearest, in metres).
+    // The view that sees this point: one whose first surface it lies on — up to how far the
+    // hull reaches in front of that surface (the grown texel and the conservative depth's reach,
+    // `ImpostorBox::error_m`), or half a texel behind it — preferring views from the eye's side
+    // of the box (a thin shell's two sides lie on each other: the eye sees the side facing it),
+    // then the nearest in metres.
     var face = 0u;
     var best = 1e30;
     for (var f = 0u; f < 6u; f = f + 1u) {
-        let off = abs(impostor_behind(q, f, size)) * extent[f / 2u];
-        if (off < best) {
-            best = off;
+        let a = f / 2u;
+        let signed = impostor_behind(q, f, size);
+        let behind = abs(signed);
+        let eye_side = select(d[a] > 0.0, d[a] < 0.0, f % 2u == 0u);
+        var score = behind * extent[a];
+        if (signed < -3.2 / size || signed > 0.5 / size) {
+            score = score + 2e3;
+        } else if (!eye_side) {
+            score = score + 1e3;
+        }
+        if (score < best) {
+            best = score;
             face = f;
         }
     }
-    let at = impostor_texel(q, face, size);
+    var at = impostor_texel(q, face, size);
+    if (textureLoad(impostor_depth, at, i32(face), 0).r > 1.5) {
+        // On the hull's conservative rim, where the texel's centre saw nothing: the material of
+        // the neighbour that made the rim.
+        var nearest = 3.0;
+        var source = at;
+        let last = vec2<i32>(i32(size) - 1);
+        for (var dy = -1; dy <= 1; dy = dy + 1) {
+            for (var dx = -1; dx <= 1; dx = dx + 1) {
+                let p = clamp(at + vec2<i32>(dx, dy), vec2<i32>(0), last);
+                let r = textureLoad(impostor_depth, p, i32(face), 0).r;
+                if (r < nearest) {
+                    nearest = r;
+                    source = p;
+                }
+            }
+        }
+        at = source;
+    }
     let colour = textureLoad(impostor_colour, at, i32(face), 0);
     let normal = textureLoad(impostor_normal, at, i32(face), 0);
     var s: Surface;

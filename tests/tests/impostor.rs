@@ -181,8 +181,9 @@ fn an_impostors_surface_lands_within_a_pixel_of_the_polygons_in_each_eye() {
     let (w, h) = (screen.width_px() as usize, screen.height_px() as usize);
     let model = scene(true);
     let mut renderer = Renderer::new(gpu, &model).unwrap();
-    // 256 texels across the 12 mm ball: a texel is 0.05 mm, under the glass's 0.063 mm pixel.
-    let (polygons, impostor, bounds) = polygons_and_impostor(&mut renderer, &model, 256);
+    // 384 texels across the 12 mm ball: a texel is 0.03 mm, half the glass's 0.06 mm pixel,
+    // and the impostor's error (a texel along a view, half across) under a pixel.
+    let (polygons, impostor, bounds) = polygons_and_impostor(&mut renderer, &model, 384);
     // The frame's corner shows the background (the ball is at the glass's centre).
     let bg = [polygons[0][0], polygons[0][1], polygons[0][2]];
     let pixel_m = screen.panel_width_m() / screen.width_px() as f32;
@@ -193,7 +194,7 @@ fn an_impostors_surface_lands_within_a_pixel_of_the_polygons_in_each_eye() {
         bounds.error_m() * 1e3,
         pixel_m * 1e3
     );
-    assert!(bounds.error_m() < pixel_m);
+    assert!(bounds.texel_m().max_element() < 0.6 * pixel_m);
     for eye in 0..2 {
         let (unmatched, covered) = unmatched_within_a_pixel(&impostor[eye], &polygons[eye], w, h, bg);
         println!(
@@ -263,4 +264,69 @@ fn a_lit_impostor_looks_like_its_polygons() {
     let relief = renderer.render(&mixed, Method::DuboisRedCyan, gw, gh).unwrap();
     golden::check("impostor-polygons-dubois", gw, gh, &full, 3, 0.003);
     golden::check("impostor-relief-dubois", gw, gh, &relief, 3, 0.003);
+}
+
+/// A big scan's parts are patches of its shell, open and as thin as the scan's surface: each
+/// part's relief hull is that thin too. Every part drawn as its impostor still shows the whole
+/// amphora: as many pixels as the polygons (before the hull was grown by a texel and read
+/// conservatively, rays stepped through it: 87 % of them at 64 texels, holes where the shell
+/// was, and on the turtle most of the shell was gone), and close to their picture (SSIM 0.93 at
+/// 128 texels, 360×800; the subdivided relief is at the scale of a pixel there).
+#[test]
+fn a_big_scans_open_parts_drawn_as_impostors_keep_their_surface() {
+    let Some(gpu) = gpu() else { return };
+    let mut big = phantogram::artifact::default_model();
+    phantogram_lab::big_scan::subdivide_and_displace(&mut big, 2, 0.002, 0.01);
+    let report = phantogram::detail::prepare(&mut big, &Default::default(), |_| {});
+    assert!(report.parts > 10, "{report:?}");
+    let mut renderer = Renderer::new(gpu, &big).unwrap();
+    let boxes: Vec<(usize, ImpostorBox)> = (0..big.primitives.len())
+        .filter(|&i| !big.primitives[i].lods.is_empty())
+        .map(|i| (i, ball_box_of(&big, i, 128)))
+        .collect();
+    renderer.bake_impostors(&boxes).unwrap();
+    let levels: Vec<u8> = (0..big.primitives.len())
+        .map(|i| if renderer.has_impostor(i) { IMPOSTOR_LEVEL } else { 0 })
+        .collect();
+    let view = oblique_view();
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
+    let relief = FrameInput {
+        levels: &levels,
+        ..input
+    };
+    let (w, h) = (360, 800);
+    for (k, eye) in [&view.left, &view.right].into_iter().enumerate() {
+        let a = renderer.render_single(eye, &input, w, h).unwrap();
+        let b = renderer.render_single(eye, &relief, w, h).unwrap();
+        // The amphora's pixels: not the background (the frame's corner) in the polygons' frame.
+        let bg = [a[0], a[1], a[2]];
+        let covered = |img: &[u8]| img.chunks_exact(4).filter(|p| p[..3] != bg).count();
+        let (ca, cb) = (covered(&a), covered(&b));
+        let ssim = phantogram_lab::ssim::ssim_rgba8(&a, &b, w, h).unwrap();
+        println!("eye {k}: {ca} pixels of polygons, {cb} of impostors; SSIM {ssim:.4}");
+        if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_FRAMES") {
+            for (name, px) in [("polygons", &a), ("impostors", &b)] {
+                let path = std::path::Path::new(&dir).join(format!("big-{name}-{k}.png"));
+                image::save_buffer(path, px, w, h, image::ExtendedColorType::Rgba8).unwrap();
+            }
+        }
+        assert!(ca > 10_000, "{ca}");
+        assert!(
+            (cb as f64) > 0.97 * ca as f64 && (cb as f64) < 1.05 * ca as f64,
+            "{cb} of {ca}"
+        );
+        assert!(ssim > 0.9, "eye {k}: SSIM {ssim}");
+    }
+}
+
+fn ball_box_of(model: &Model, primitive: usize, texels: u32) -> ImpostorBox {
+    ImpostorBox::around(
+        model.primitives[primitive]
+            .mesh
+            .vertices
+            .iter()
+            .map(|v| Vec3::from(v.position)),
+        texels,
+    )
+    .expect("a box")
 }

@@ -416,8 +416,9 @@ struct GpuPrimitive {
     vertex_count: usize,
     /// The full mesh's indices, then each coarser level's.
     indices: wgpu::Buffer,
-    /// Each level's range of `indices`, the full mesh first.
+    /// Each level's range of `indices`, the full mesh first, and its geometric error, metres.
     levels: Vec<std::ops::Range<u32>>,
+    level_errors_m: Vec<f32>,
     /// Which of the model's primitives this is (a piece of, for a mesh larger than a buffer).
     source: usize,
     material: usize,
@@ -1462,6 +1463,12 @@ impl Renderer {
             });
             pass.set_pipeline(&self.shadow_pipeline);
             pass.set_bind_group(0, &self.shadow_bind, &[]);
+            // Impostors cast the shadow of the polygon level as exact as they are.
+            let shadow_levels = self.shadow_levels(input.levels);
+            let input = FrameInput {
+                levels: &shadow_levels,
+                ..*input
+            };
             let variant = |p: &GpuPrimitive| self.model.materials[p.material].variant;
             // Solid casters: opaque materials (masked ones follow, blended ones cast none).
             for p in self.model.primitives.iter().filter(|p| {
@@ -1600,6 +1607,18 @@ fn create_compose_pipeline(
 }
 
 impl Renderer {
+    /// `levels` with each impostor drawn replaced by the level its shadow is cast with.
+    fn shadow_levels(&self, levels: &[u8]) -> Vec<u8> {
+        levels
+            .iter()
+            .enumerate()
+            .map(|(source, &l)| match self.model.impostors.get(source) {
+                Some(Some(imp)) if l == IMPOSTOR_LEVEL => imp.shadow_level,
+                _ => l,
+            })
+            .collect()
+    }
+
     /// The impostor `levels` draws for `p` in place of its triangles, if any.
     fn impostor_drawn_for(&self, p: &GpuPrimitive, levels: &[u8]) -> Option<&impostor::GpuImpostor> {
         if levels.get(p.source) != Some(&IMPOSTOR_LEVEL) {
@@ -1777,13 +1796,14 @@ mod tests {
         assert!(n >= 2, "found {n} shaders in {}", dir.display());
         validate("scene", SCENE_WGSL);
         validate("compose", COMPOSE_WGSL);
+        validate("impostor_dilate", impostor::IMPOSTOR_DILATE_WGSL);
     }
 
     #[test]
     fn a_broken_shader_fails_validation() {
-        let good = "return vec4<f32>(direct + ambient + emissive, out_alpha);";
+        let good = "return direct + ambient + s.emissive;";
         assert!(SCENE_WGSL.contains(good), "the sabotage below must apply");
-        let bad = SCENE_WGSL.replace(good, "return vec3<f32>(direct);");
+        let bad = SCENE_WGSL.replace(good, "return vec4<f32>(direct, 1.0);");
         let parsed = naga::front::wgsl::parse_str(&bad);
         let failed = match parsed {
             Err(_) => true,

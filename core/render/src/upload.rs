@@ -226,6 +226,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
         // levels: a big mesh without them is uploaded from where it is).
         let mut levels = Vec::with_capacity(lods.len() + 1);
         levels.push(0..mesh.indices.len() as u32);
+        let level_errors_m: Vec<f32> = std::iter::once(0.0).chain(lods.iter().map(|l| l.error_m)).collect();
         let indices: std::borrow::Cow<[u32]> = if lods.is_empty() {
             std::borrow::Cow::Borrowed(&mesh.indices)
         } else {
@@ -251,6 +252,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                 usage: wgpu::BufferUsages::INDEX,
             }),
             levels,
+            level_errors_m,
             source,
             material: p.material.min(model.materials.len().saturating_sub(1)),
             // The whole primitive's centre, for the transparent pieces' back-to-front order.
