@@ -20,6 +20,11 @@
 //!   caused by switching alone, not by motion) is reported with the largest error, in pixels, of
 //!   a level switched to or from.
 //!
+//! * Impostors as the engine makes them (`phantogram::impostors`): baked for every part; every
+//!   part drawn as its impostor, its time over the coarsest frame against the full frame's over
+//!   it: what one step of an impostor's ray costs in triangles (the chooser's
+//!   `impostor_step_triangles`). The budget and tilt runs below have the impostors as options.
+//!
 //! Frame times include reading the frame back, as `phantogram render` does.
 
 use std::time::Instant;
@@ -172,6 +177,87 @@ fn main() {
     }
     drop(full_model);
 
+    // Impostors, as the engine makes them: every part, within what the model leaves of the
+    // artifact's memory budget; then every part drawn as its impostor, to measure what a ray's
+    // step costs against a triangle (the chooser's `impostor_step_triangles`).
+    let budget = phantogram::budget::ResourceBudget::PHONE.memory_bytes;
+    let left = budget.saturating_sub(phantogram::budget::model_bytes(&big));
+    let mut baker = phantogram::impostors::ImpostorBaker::plan(&big, left);
+    let planned = baker.pending();
+    let start = Instant::now();
+    while baker.pending() > 0 {
+        baker.step(&mut renderer, &mut detail).expect("impostors bake");
+    }
+    // The bakes are queued on the GPU: a frame waits for them.
+    stereo_ms(&mut renderer, &coarse);
+    let texels = detail
+        .parts()
+        .iter()
+        .find_map(|p| p.impostor.map(|i| i.texels))
+        .unwrap_or(0);
+    println!(
+        "impostors: {planned} parts at {texels}x{texels} texels per face ({:.1} MiB; {:.0} MiB of the budget left by the model), baked in {:.2} s",
+        baker.baked_bytes() as f64 / (1 << 20) as f64,
+        left as f64 / (1 << 20) as f64,
+        start.elapsed().as_secs_f64()
+    );
+    if planned > 0 {
+        let eyes = input.eyes_drawn(Method::DuboisRedCyan);
+        let image_px = eyes[0].image_px();
+        let choice_view = phantogram::detail::ChoiceView {
+            eyes: &eyes,
+            offset_m: input.offset,
+            attention_px: image_px * 0.5,
+            attention_reach_px: image_px.length() * 0.5,
+        };
+        let unit = phantogram::detail::ChooseParams {
+            impostor_step_triangles: 1.0,
+            ..Default::default()
+        };
+        let steps: u64 = detail
+            .parts()
+            .iter()
+            .filter_map(|p| {
+                p.impostor
+                    .map(|i| phantogram::detail::choose::impostor_cost(p, &i, &choice_view, &unit) - 12)
+            })
+            .sum();
+        let all_impostors: Vec<u8> = detail
+            .parts()
+            .iter()
+            .zip(&coarsest)
+            .map(|(p, &c)| {
+                if p.impostor.is_some() {
+                    phantogram::render::IMPOSTOR_LEVEL
+                } else {
+                    c
+                }
+            })
+            .collect();
+        let relief = FrameInput {
+            levels: &all_impostors,
+            ..input
+        };
+        stereo_ms(&mut renderer, &relief);
+        let relief_ms = median((0..frames.min(3)).map(|_| stereo_ms(&mut renderer, &relief)).collect());
+        let per_triangle = (full_ms - coarse_ms) / big.triangle_count() as f64;
+        let per_step = (relief_ms - coarse_ms) / steps.max(1) as f64;
+        println!(
+            "  every part as its impostor: {relief_ms:.1} ms; the chooser's estimate of the rays' steps, {steps} per eye; a step costs {:.4} triangles (a triangle {:.3} µs, a step {:.4} µs, over the coarsest frame)",
+            per_step / per_triangle,
+            per_triangle * 1e3,
+            per_step * 1e3
+        );
+        let a = renderer.render_single(&view.left, &input, W, H).expect("full");
+        let b = renderer.render_single(&view.left, &relief, W, H).expect("impostors");
+        let s = phantogram_lab::ssim::ssim_rgba8(&a, &b, W, H).expect("same sizes");
+        println!("  SSIM every part as its impostor vs full detail, left eye: {s:.4}");
+        if let Some(dir) = std::env::var_os("PHANTOGRAM_BENCH_PNG") {
+            let path = std::path::PathBuf::from(dir).join("detail-left-impostors.png");
+            image::save_buffer(path, &b, W, H, image::ColorType::Rgba8).expect("png");
+        }
+    }
+
     // The goal's case: the budget aims at 1.2× the turtle's frame time, same view.
     let target_ms = 1.2 * turtle_ms;
     detail.set_target(target_ms * 1e-3);
@@ -198,9 +284,10 @@ fn main() {
     };
     let settled_ms = median(settled);
     println!(
-        "budget aiming at 1.2x the turtle ({target_ms:.1} ms), same view, after {settle} frames: {settled_ms:.1} ms ({:.2}x the turtle), {} triangles per eye",
+        "budget aiming at 1.2x the turtle ({target_ms:.1} ms), same view, after {settle} frames: {settled_ms:.1} ms ({:.2}x the turtle), {} triangles per eye, {} parts as impostors",
         settled_ms / turtle_ms,
-        detail.last_choice().triangles
+        detail.last_choice().triangles,
+        detail.last_choice().impostors
     );
     for (name, eye) in [("left", &view.left), ("right", &view.right)] {
         let a = renderer.render_single(eye, &input, W, H).expect("full");
@@ -220,6 +307,7 @@ fn main() {
     let (mut switch_frames, mut min_switch_ssim, mut max_switched_px) = (0, 1.0f64, 0.0f32);
     let mut frame_s = 0.0f64;
     let mut times = Vec::new();
+    let mut most_impostors = 0;
     for _ in 0..frames_to_run {
         // Replay time advances by the frames' own times (the comparisons below do not count).
         let view = tilted_session(frame_s);
@@ -228,6 +316,7 @@ fn main() {
             .choose(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, None)
             .to_vec();
         let stats = detail.last_choice();
+        most_impostors = most_impostors.max(stats.impostors);
         let frame = FrameInput {
             levels: &levels,
             ..input
@@ -266,6 +355,6 @@ fn main() {
         times.iter().map(|t| format!("{t:.0}")).collect::<Vec<_>>().join(" ")
     );
     println!(
-        "  frames that switched levels: {switch_frames}; the switch alone (same view, previous vs new levels): SSIM ≥ {min_switch_ssim:.4}; largest error of a level switched, {max_switched_px:.2} px"
+        "  frames that switched levels: {switch_frames}; the switch alone (same view, previous vs new levels): SSIM ≥ {min_switch_ssim:.4}; largest error of a level switched, {max_switched_px:.2} px; at most {most_impostors} parts as impostors in a frame"
     );
 }

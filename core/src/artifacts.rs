@@ -88,6 +88,9 @@ pub struct Placing {
     pub screen: Screen,
     pub fit: DioramaFit,
     pub floor: bool,
+    /// The artifact's memory budget (`ResourceBudget::memory_bytes`): a big scan's levels of
+    /// detail are made only where they fit in it beside the model.
+    pub memory_bytes: u64,
 }
 
 /// Fits (unless the artifact comes placed), measures and floors a loaded model, and gives a big
@@ -111,18 +114,34 @@ pub fn prepare(
         model.transform(glam::Mat4::from_translation(glam::Vec3::Z * -b.max.z));
     }
     let bounds = model.bounds().ok_or(crate::render::RenderError::EmptyModel)?;
-    let info = ModelInfo::of(&model, entry);
+    let mut info = ModelInfo::of(&model, entry);
     // A big scan: parts with levels of detail, made here on the loader thread (seconds for
     // millions of triangles), in the diorama's frame so that their errors are in its metres.
-    // TODO(issue 22): the coarser levels' indices (about a third more index memory) are not
-    // charged to the resource budget the loader checked the file against.
+    // The coarser levels' indices (about a third more) and the vertices the parts share at
+    // their borders count against the artifact's memory budget: a scan that fits only whole
+    // is drawn whole (slower, the same picture), with a warning.
     let span = crate::progress::Span::new(progress, progress.fraction(), 0.95);
-    phantogram_detail::prepare_cached(
+    let whole_bytes = crate::budget::model_bytes(&model);
+    let report = phantogram_detail::prepare_cached(
         &mut model,
         &phantogram_detail::DetailParams::default(),
         detail_cache,
         |f| span.advance(f),
     );
+    let with_levels_bytes = crate::budget::model_bytes(&model);
+    if report.parts > 0 && with_levels_bytes > placing.memory_bytes.max(whole_bytes) {
+        for p in &mut model.primitives {
+            p.lods.clear();
+        }
+        let mib = |b: u64| b as f64 / f64::from(1u32 << 20);
+        let warning = format!(
+            "levels of detail left out: with them the scan would take {:.0} MiB, over the budget of {:.0} MiB; it is drawn whole",
+            mib(with_levels_bytes),
+            mib(placing.memory_bytes)
+        );
+        model.warnings.push(warning.clone());
+        info.warnings.push(warning);
+    }
     if placing.floor {
         model.add_floor(&placing.screen, Model::FLOOR_REACH);
     }
@@ -364,6 +383,11 @@ impl Loader {
         &self.library
     }
 
+    /// What one artifact may take.
+    pub fn budget(&self) -> ResourceBudget {
+        self.budget
+    }
+
     /// Loads synchronously, on the calling thread (the engine's first artifact).
     pub fn load_now(&self, id: &ArtifactId, placing: &Placing) -> Result<Prepared, LoadError> {
         let loaded = self.library.load(id, self.budget, &Progress::new())?;
@@ -590,6 +614,7 @@ mod tests {
                 ..DioramaFit::default()
             },
             floor: true,
+            memory_bytes: crate::budget::ResourceBudget::PHONE.memory_bytes,
         };
         let medal = || (crate::builtin::built_in("medal").expect("medal").make)();
         let placed = prepare(

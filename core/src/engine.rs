@@ -67,6 +67,16 @@ pub const MAX_SIDE_PX: u32 = 8192;
 #[cfg(feature = "ui")]
 const MIN_SCREEN_PT: f32 = 240.0;
 
+/// The impostors to bake for `model` (none unless it has levels of detail): within what the
+/// artifact's memory budget leaves of it.
+fn impostors_for(model: &crate::model::Model, has_detail: bool, memory_bytes: u64) -> crate::impostors::ImpostorBaker {
+    if !has_detail {
+        return Default::default();
+    }
+    let left = memory_bytes.saturating_sub(crate::budget::model_bytes(model));
+    crate::impostors::ImpostorBaker::plan(model, left)
+}
+
 /// The frame time a big scan's level-of-detail budget aims at by default, seconds: 30 frames a
 /// second, both eyes (the relief-texture paper holds at least 10; a phantogram that lags the
 /// hand by more than a frame at 30 Hz no longer looks fixed in the room).
@@ -284,6 +294,10 @@ pub struct Engine {
     /// A big scan's levels of detail and their per-frame choice ([`phantogram_detail`]); `None`
     /// for a model drawn whole (and for the Diorama).
     detail: Option<phantogram_detail::Detail>,
+    /// The big scan's parts' impostors still to bake, a few per frame ([`crate::impostors`]).
+    impostors: crate::impostors::ImpostorBaker,
+    /// This frame baked some (its time is not fed to the budget).
+    baked_this_frame: bool,
     /// The frame time the detail's budget aims at, seconds ([`Engine::set_frame_target_s`]).
     frame_target_s: f64,
     /// Which sides of the artifact the viewer has seen (`None`: hints off, or the Diorama), and
@@ -518,7 +532,12 @@ impl Engine {
             config.library_dir.as_ref().map(|d| d.join("thumbnails")),
         );
         let mut loader = crate::artifacts::Loader::new(library, budget);
-        let placing = crate::artifacts::Placing { screen, fit, floor };
+        let placing = crate::artifacts::Placing {
+            screen,
+            fit,
+            floor,
+            memory_bytes: budget.memory_bytes,
+        };
         let prepared = match (&config.model_path, &config.artifact) {
             (Some(path), _) => {
                 let model = crate::model::load_model_within(path, budget)?;
@@ -556,6 +575,7 @@ impl Engine {
             None => None,
         };
         let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
+        let impostors = impostors_for(&model, detail.is_some(), budget.memory_bytes);
         let (appearances, appearance_warning) =
             crate::appearances::AppearanceStore::open(config.library_dir.as_ref().map(|d| d.join("appearances.json")));
         renderer.appearance = appearances.get(&appearance_key(&model_info));
@@ -604,6 +624,8 @@ impl Engine {
             model_info,
             bounds,
             detail,
+            impostors,
+            baked_this_frame: false,
             frame_target_s: DEFAULT_FRAME_TARGET_S,
             seen,
             side_hints: config.side_hints,
@@ -1234,6 +1256,7 @@ impl Engine {
         self.renderer.appearance = self.appearances.get(&appearance_key(&self.model_info));
         self.smoother = ContainmentSmoother::default();
         self.detail = None;
+        self.impostors = Default::default();
         self.seen = None;
         self.side_hint = None;
         self.diorama = Some(Box::new(scene));
@@ -1300,6 +1323,7 @@ impl Engine {
             screen: self.session.config().screen,
             fit: self.fit,
             floor: self.floor,
+            memory_bytes: self.loader.budget().memory_bytes,
         }
     }
 
@@ -1314,6 +1338,11 @@ impl Engine {
                     d.set_target(self.frame_target_s);
                     d
                 });
+                self.impostors = impostors_for(
+                    &prepared.model,
+                    self.detail.is_some(),
+                    self.loader.budget().memory_bytes,
+                );
                 // The best scan taking over from its preview is the same artifact: what was
                 // seen of it stays seen.
                 let same_artifact = self.model_info.preview
@@ -1711,7 +1740,10 @@ impl Engine {
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
         let started = std::time::Instant::now();
         let outcome = self.draw_input(&input);
-        if let (Some(detail), Ok(DrawOutcome::Presented)) = (self.detail.as_mut(), &outcome) {
+        // A frame that baked impostors took longer than the budget's choice made it: it says
+        // nothing about the budget.
+        let baked = std::mem::take(&mut self.baked_this_frame);
+        if let (Some(detail), Ok(DrawOutcome::Presented), false) = (self.detail.as_mut(), &outcome, baked) {
             // GPU time where the device measures it (each reading once, when it arrives); the
             // frame's wall time otherwise.
             if self.renderer.times_gpu() {
@@ -1745,10 +1777,17 @@ impl Engine {
     }
 
     /// Each part's level of detail for the frame `input` shows (empty: all at full detail).
+    /// Bakes the next few parts' impostors first.
     fn choose_levels(&mut self, input: &FrameInput) -> Vec<u8> {
         let Some(detail) = self.detail.as_mut() else {
             return Vec::new();
         };
+        if self.impostors.pending() > 0 {
+            // A failed bake stops the baking: the parts without impostors keep their polygons,
+            // and the picture is the same.
+            let _ = self.impostors.step(&mut self.renderer, detail);
+            self.baked_this_frame = true;
+        }
         let eyes = input.eyes_drawn(self.method);
         detail.choose(&eyes, input.offset, None).to_vec()
     }
@@ -1763,6 +1802,16 @@ impl Engine {
                 d.set_target(target_s);
             }
         }
+    }
+
+    /// The big scan's impostors: baked, still to bake (a few each frame), and the GPU memory of
+    /// those baked, bytes ([`crate::impostors`]).
+    pub fn impostor_progress(&self) -> (usize, usize, u64) {
+        (
+            self.impostors.baked(),
+            self.impostors.pending(),
+            self.impostors.baked_bytes(),
+        )
     }
 
     /// What the big scan's chooser did in the last frame: triangles drawn per eye, the budget,

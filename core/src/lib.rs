@@ -91,6 +91,8 @@ pub mod diorama;
 pub mod engine;
 pub mod gesture;
 #[cfg(feature = "render")]
+pub mod impostors;
+#[cfg(feature = "render")]
 pub mod lamp;
 #[cfg(feature = "render")]
 pub mod room_light;

@@ -214,3 +214,170 @@ fn the_engine_points_to_an_unseen_side_when_the_viewer_lingers() {
     );
     assert_eq!(left_strip(&before), 0);
 }
+
+/// `model` as a GLB: positions, normals and vertex colours, one glTF primitive per primitive.
+fn glb_of(model: &Model) -> Vec<u8> {
+    let mut bin: Vec<u8> = Vec::new();
+    let (mut views, mut accessors, mut primitives) = (Vec::new(), Vec::new(), Vec::new());
+    for p in &model.primitives {
+        let mut attribute = |data: Vec<f32>, kind: &str, count: usize, bounds: bool| {
+            let offset = bin.len();
+            bin.extend(data.iter().flat_map(|f| f.to_le_bytes()));
+            views.push(format!(
+                r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{}}}"#,
+                data.len() * 4
+            ));
+            let minmax = if bounds {
+                let (mut lo, mut hi) = ([f32::MAX; 3], [f32::MIN; 3]);
+                for v in data.chunks_exact(3) {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(v[k]);
+                        hi[k] = hi[k].max(v[k]);
+                    }
+                }
+                format!(r#","min":{lo:?},"max":{hi:?}"#)
+            } else {
+                String::new()
+            };
+            accessors.push(format!(
+                r#"{{"bufferView":{},"componentType":5126,"count":{count},"type":"{kind}"{minmax}}}"#,
+                views.len() - 1
+            ));
+            accessors.len() - 1
+        };
+        let n = p.mesh.vertices.len();
+        let position = attribute(
+            p.mesh.vertices.iter().flat_map(|v| v.position).collect(),
+            "VEC3",
+            n,
+            true,
+        );
+        let normal = attribute(
+            p.mesh.vertices.iter().flat_map(|v| v.normal).collect(),
+            "VEC3",
+            n,
+            false,
+        );
+        let colour = attribute(p.mesh.vertices.iter().flat_map(|v| v.color).collect(), "VEC4", n, false);
+        let offset = bin.len();
+        bin.extend(p.mesh.indices.iter().flat_map(|i| i.to_le_bytes()));
+        views.push(format!(
+            r#"{{"buffer":0,"byteOffset":{offset},"byteLength":{}}}"#,
+            p.mesh.indices.len() * 4
+        ));
+        accessors.push(format!(
+            r#"{{"bufferView":{},"componentType":5125,"count":{},"type":"SCALAR"}}"#,
+            views.len() - 1,
+            p.mesh.indices.len()
+        ));
+        primitives.push(format!(
+            r#"{{"attributes":{{"POSITION":{position},"NORMAL":{normal},"COLOR_0":{colour}}},"indices":{}}}"#,
+            accessors.len() - 1
+        ));
+    }
+    let json = format!(
+        r#"{{"asset":{{"version":"2.0"}},"scene":0,"scenes":[{{"nodes":[0]}}],"nodes":[{{"mesh":0}}],"meshes":[{{"primitives":[{}]}}],"buffers":[{{"byteLength":{}}}],"bufferViews":[{}],"accessors":[{}]}}"#,
+        primitives.join(","),
+        bin.len(),
+        views.join(","),
+        accessors.join(",")
+    );
+    phantogram_testkit::glb(&json, &bin)
+}
+
+/// The amphora made big (650k triangles), as a file the engine opens.
+fn big_amphora_file(dir: &std::path::Path) -> std::path::PathBuf {
+    let mut big = phantogram::artifact::default_model();
+    phantogram_lab::big_scan::subdivide_and_displace(&mut big, 2, 0.002, 0.01);
+    assert!(big.triangle_count() > DetailParams::default().min_model_triangles);
+    let path = dir.join("big-amphora.glb");
+    std::fs::write(&path, glb_of(&big)).unwrap();
+    path
+}
+
+#[test]
+fn the_engine_bakes_a_big_scans_impostors_a_few_parts_a_frame() {
+    use phantogram::engine::EngineConfig;
+    let dir = phantogram_integration::scratch("detail-engine-impostors");
+    let config = EngineConfig {
+        model_path: Some(big_amphora_file(&dir)),
+        ..EngineConfig::default()
+    };
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config) else {
+        return;
+    };
+    engine.resume_offscreen(180, 400).unwrap();
+    let (baked, pending, _) = engine.impostor_progress();
+    assert_eq!(baked, 0, "nothing baked before the first frame");
+    let parts = pending;
+    assert!(parts > 10, "{parts} parts planned");
+    engine.draw(None).unwrap();
+    let (baked, pending, bytes) = engine.impostor_progress();
+    assert_eq!(
+        (baked, pending),
+        (phantogram::impostors::BAKED_PER_FRAME, parts - baked)
+    );
+    let per_part = bytes / baked as u64;
+    let mut frames = 1;
+    while engine.impostor_progress().1 > 0 {
+        engine.draw(None).unwrap();
+        frames += 1;
+        assert!(frames <= parts, "baking does not end");
+    }
+    let (baked, _, bytes) = engine.impostor_progress();
+    assert_eq!(baked, parts);
+    assert_eq!(bytes, per_part * parts as u64);
+    assert!(bytes <= phantogram::impostors::IMPOSTOR_MEMORY_BYTES);
+    // The chooser weighs them: at the glass, from arm's length, the polygons are the cheaper
+    // way to every error (see `phantogram_detail::choose`), and the frame is drawn.
+    let (stats, _) = engine.detail_stats().expect("a big scan");
+    assert!(stats.triangles > 0);
+    println!(
+        "{parts} parts, {baked} impostors in {frames} frames, {} KiB each; {stats:?}",
+        per_part >> 10
+    );
+}
+
+#[test]
+fn levels_that_do_not_fit_the_memory_budget_are_left_out_with_a_warning() {
+    let mut big = phantogram::artifact::default_model();
+    phantogram_lab::big_scan::subdivide_and_displace(&mut big, 2, 0.002, 0.01);
+    let whole = phantogram::budget::model_bytes(&big);
+    let prepare = |memory_bytes: u64| {
+        let placing = phantogram::artifacts::Placing {
+            screen: phantogram::screen::Screen::default(),
+            fit: Default::default(),
+            floor: false,
+            memory_bytes,
+        };
+        phantogram::artifacts::prepare(
+            big.clone(),
+            None,
+            false,
+            &placing,
+            &phantogram::progress::Progress::new(),
+            None,
+        )
+        .unwrap()
+    };
+    // The phone's budget has room for the levels.
+    let roomy = prepare(phantogram::budget::ResourceBudget::PHONE.memory_bytes);
+    assert!(roomy.detail.is_some());
+    assert!(roomy.info.warnings.is_empty(), "{:?}", roomy.info.warnings);
+    let with_levels = phantogram::budget::model_bytes(&roomy.model);
+    assert!(with_levels > whole, "{with_levels} vs {whole}");
+    // Room for the scan but not its levels: drawn whole, and the visitor's warnings say why.
+    let tight = prepare(whole + (with_levels - whole) / 2);
+    assert!(tight.detail.is_none());
+    assert!(tight.model.primitives.iter().all(|p| p.lods.is_empty()));
+    assert_eq!(tight.model.triangle_count(), big.triangle_count());
+    assert!(
+        tight
+            .info
+            .warnings
+            .iter()
+            .any(|w| w.contains("levels of detail left out")),
+        "{:?}",
+        tight.info.warnings
+    );
+}

@@ -70,6 +70,25 @@ impl ResourceBudget {
     }
 }
 
+/// Bytes `model` takes in memory, as the loader charged them: vertices, indices (every level
+/// of detail's too) and textures with their mip chains.
+pub fn model_bytes(model: &crate::model::Model) -> u64 {
+    let meshes = model
+        .primitives
+        .iter()
+        .map(|p| {
+            let indices = p.mesh.indices.len() + p.lods.iter().map(|l| l.indices.len()).sum::<usize>();
+            ResourceBudget::mesh_bytes(p.mesh.vertices.len() as u64, indices as u64)
+        })
+        .fold(0u64, u64::saturating_add);
+    let images = model
+        .images
+        .iter()
+        .map(|i| ResourceBudget::texture_bytes(i.width, i.height))
+        .fold(0u64, u64::saturating_add);
+    meshes.saturating_add(images)
+}
+
 impl Default for ResourceBudget {
     fn default() -> Self {
         Self::PHONE

@@ -21,9 +21,30 @@
 //! triangles more by a margin ([`ChooseParams::stickiness`]), so that a budget hovering at a
 //! boundary does not toggle parts every frame. Frames: everything in the device frame (metres),
 //! as the projections are.
+//!
+//! ## Impostors
+//! A part with a relief-texture impostor ([`ImpostorSummary`]) has it as one more option: its
+//! error is half a texel's diagonal, its cost is fill, not triangles — every pixel it covers
+//! casts a ray of about two steps per texel across the box — counted in triangles at
+//! [`ChooseParams::impostor_step_triangles`] per step. Each frame a part's options (its levels
+//! and the impostor) are reduced to those that no other option beats in both cost and error,
+//! and refinement walks that chain from the cheapest. So the impostor is drawn where it is the
+//! cheaper way to a given error: parts of many triangles that cover few pixels. A phantogram
+//! seen from arm's length at a phone's resolution mostly makes parts large on the glass, and
+//! there the polygons win.
 
 use glam::{Vec2, Vec3};
+use phantogram_assets::model::IMPOSTOR_LEVEL;
 use phantogram_geometry::projection::OffAxisProjection;
+
+/// A part's baked relief-texture impostor, as the chooser weighs it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ImpostorSummary {
+    /// How far a surface point it draws can lie from the true surface, metres.
+    pub error_m: f32,
+    /// Texels along a side of each face's map.
+    pub texels: u32,
+}
 
 /// What the chooser knows of one part. See [`crate::PartSummary::of`].
 #[derive(Clone, Debug, PartialEq)]
@@ -35,6 +56,8 @@ pub struct PartSummary {
     pub facing: Vec3,
     /// Per level, finest (the full mesh, error 0) first: triangles and geometric error, metres.
     pub levels: Vec<(u32, f32)>,
+    /// The part's impostor, where one was baked.
+    pub impostor: Option<ImpostorSummary>,
 }
 
 /// Tuning of [`Chooser`]. The defaults are chosen from first principles, not from the data:
@@ -47,6 +70,11 @@ pub struct ChooseParams {
     /// How much more a part must need triangles than the current holder before the holder is
     /// coarsened for it (and below how much of `visible_px` a part may stay refined).
     pub stickiness: f32,
+    /// What one step of an impostor's ray in one pixel costs, in triangles (see the module
+    /// docs). Measured on this project's machine by `cargo xtask bench detail` (lavapipe); a
+    /// phone GPU's figure is not measured — the budget controller corrects the sum of costs
+    /// to the measured frame time, not this ratio between the two kinds.
+    pub impostor_step_triangles: f32,
 }
 
 impl Default for ChooseParams {
@@ -54,8 +82,24 @@ impl Default for ChooseParams {
         Self {
             visible_px: 0.5,
             stickiness: 1.5,
+            impostor_step_triangles: IMPOSTOR_STEP_TRIANGLES,
         }
     }
+}
+
+/// [`ChooseParams::impostor_step_triangles`]' default: 0.109 measured by `cargo xtask bench
+/// detail` on this project's machine (lavapipe, the turtle made big: every part as its
+/// impostor against every part at full detail, both over the coarsest frame; see
+/// `benchmarks/detail.md`).
+pub const IMPOSTOR_STEP_TRIANGLES: f32 = 0.11;
+
+/// One way to draw a part: its level code (an index into its levels, or [`IMPOSTOR_LEVEL`]),
+/// its cost (triangles, or their equivalent) and its error on the glass (pixels, unweighted).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Candidate {
+    code: u8,
+    cost: u64,
+    error_px: f32,
 }
 
 /// The view a frame is chosen for.
@@ -83,7 +127,7 @@ pub struct Chooser {
 /// The outcome of one [`Chooser::choose`].
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ChoiceStats {
-    /// Triangles drawn per eye.
+    /// Triangles drawn per eye, with each impostor's cost in triangles.
     pub triangles: u64,
     /// The largest weighted error left on screen, pixels.
     pub worst_px: f32,
@@ -91,73 +135,145 @@ pub struct ChoiceStats {
     /// weighted) of a level switched to or from: the size of the visible change switching made.
     pub switched: u32,
     pub switched_px: f32,
+    /// Parts drawn as impostors.
+    pub impostors: u32,
 }
 
 impl Chooser {
-    /// The levels of the last choice, one per part (0 the finest).
+    /// The levels of the last choice, one per part (0 the finest; [`IMPOSTOR_LEVEL`] for an
+    /// impostor).
     pub fn levels(&self) -> &[u8] {
         &self.levels
     }
 
     /// Chooses each part's level for `view` within `budget_triangles` per eye (never fewer than
-    /// every part's coarsest level).
+    /// every part's cheapest option).
     pub fn choose(&mut self, parts: &[PartSummary], view: &ChoiceView, budget_triangles: u64) -> ChoiceStats {
         let n = parts.len();
         let previous = std::mem::take(&mut self.levels);
         let had_previous = previous.len() == n;
         let weight: Vec<f32> = parts.iter().map(|p| importance(p, view)).collect();
-        let coarsest = |p: &PartSummary| p.levels.len().saturating_sub(1);
-        let mut level: Vec<usize> = parts.iter().map(coarsest).collect();
-        let mut triangles: u64 = parts
+        // Each part's options worth having, costliest (finest) first.
+        let chains: Vec<Vec<Candidate>> = parts.iter().map(|p| options(p, view, &self.params)).collect();
+        let mut pos: Vec<usize> = chains.iter().map(|c| c.len().saturating_sub(1)).collect();
+        let mut triangles: u64 = chains
             .iter()
-            .zip(&level)
-            .map(|(p, &l)| u64::from(p.levels.get(l).map_or(0, |t| t.0)))
+            .zip(&pos)
+            .map(|(c, &k)| c.get(k).map_or(0, |o| o.cost))
             .sum();
-        let error_px = |i: usize, l: usize| -> f32 { weight[i] * projected_error_px(&parts[i], l, view) };
-        let stick = |i: usize, l: usize| -> f32 {
-            // A part already at (or finer than) the level it would refine to needs it more.
-            if had_previous && usize::from(previous[i]) < l {
+        let error_px = |i: usize, k: usize| -> f32 { weight[i] * chains[i].get(k).map_or(0.0, |o| o.error_px) };
+        // Where last frame's choice sits in this frame's chain (none: it is no longer worth
+        // having, and nothing holds the part to it).
+        let previous_pos: Vec<Option<usize>> = (0..n)
+            .map(|i| {
+                had_previous
+                    .then(|| chains[i].iter().position(|o| o.code == previous[i]))
+                    .flatten()
+            })
+            .collect();
+        let stick = |i: usize, k: usize| -> f32 {
+            // A part already at (or finer than) the option it would refine to needs it more.
+            if previous_pos[i].is_some_and(|p| p < k) {
                 self.params.stickiness
             } else {
                 1.0
             }
         };
-        // Max-heap on the weighted error of refining part i from level l.
+        // Max-heap on the weighted error of refining part i from its position k.
         let mut heap: std::collections::BinaryHeap<(OrdF32, usize)> = (0..n)
-            .filter(|&i| level[i] > 0)
-            .map(|i| (OrdF32(error_px(i, level[i]) * stick(i, level[i])), i))
+            .filter(|&i| pos[i] > 0)
+            .map(|i| (OrdF32(error_px(i, pos[i]) * stick(i, pos[i])), i))
             .collect();
         while let Some((OrdF32(key), i)) = heap.pop() {
             if key < self.params.visible_px {
                 break;
             }
-            let l = level[i];
-            let cost = u64::from(parts[i].levels[l - 1].0).saturating_sub(u64::from(parts[i].levels[l].0));
-            if triangles + cost > budget_triangles {
+            let k = pos[i];
+            let cost = chains[i][k - 1].cost.saturating_sub(chains[i][k].cost);
+            if triangles.saturating_add(cost) > budget_triangles {
                 // Cheaper refinements of other parts may still fit.
                 continue;
             }
             triangles += cost;
-            level[i] = l - 1;
-            if level[i] > 0 {
-                heap.push((OrdF32(error_px(i, level[i]) * stick(i, level[i])), i));
+            pos[i] = k - 1;
+            if pos[i] > 0 {
+                heap.push((OrdF32(error_px(i, pos[i]) * stick(i, pos[i])), i));
             }
         }
         let mut stats = ChoiceStats {
             triangles,
             ..ChoiceStats::default()
         };
+        let codes: Vec<u8> = (0..n).map(|i| chains[i].get(pos[i]).map_or(0, |o| o.code)).collect();
         for i in 0..n {
-            stats.worst_px = stats.worst_px.max(error_px(i, level[i]));
-            if had_previous && usize::from(previous[i]) != level[i] {
+            stats.worst_px = stats.worst_px.max(error_px(i, pos[i]));
+            if codes[i] == IMPOSTOR_LEVEL {
+                stats.impostors += 1;
+            }
+            if had_previous && previous[i] != codes[i] {
                 stats.switched += 1;
-                let a = projected_error_px(&parts[i], level[i], view);
-                let b = projected_error_px(&parts[i], usize::from(previous[i]), view);
+                let a = code_error_px(&parts[i], codes[i], view);
+                let b = code_error_px(&parts[i], previous[i], view);
                 stats.switched_px = stats.switched_px.max(a.max(b));
             }
         }
-        self.levels = level.into_iter().map(|l| l.min(usize::from(u8::MAX)) as u8).collect();
+        self.levels = codes;
         stats
+    }
+}
+
+/// `part`'s options for `view` that no other beats in both cost and error, costliest first.
+fn options(part: &PartSummary, view: &ChoiceView, params: &ChooseParams) -> Vec<Candidate> {
+    // Level codes stop short of the impostor's (a chain that long is not made).
+    let mut all: Vec<Candidate> = part
+        .levels
+        .iter()
+        .enumerate()
+        .take(usize::from(IMPOSTOR_LEVEL))
+        .map(|(l, &(triangles, _))| Candidate {
+            code: l as u8,
+            cost: u64::from(triangles),
+            error_px: projected_error_px(part, l, view),
+        })
+        .collect();
+    if let Some(imp) = part.impostor {
+        all.push(Candidate {
+            code: IMPOSTOR_LEVEL,
+            cost: impostor_cost(part, &imp, view, params),
+            error_px: projected_px(part, imp.error_m, view),
+        });
+    }
+    // Cheapest first; keep each option that is more exact than every cheaper one kept.
+    all.sort_by(|a, b| a.cost.cmp(&b.cost).then(a.error_px.total_cmp(&b.error_px)));
+    let mut kept: Vec<Candidate> = Vec::with_capacity(all.len());
+    for o in all {
+        if kept.last().is_none_or(|k| o.error_px < k.error_px) {
+            kept.push(o);
+        }
+    }
+    kept.reverse();
+    kept
+}
+
+/// An impostor's cost in triangles: the pixels its box covers in the eye that sees it largest
+/// (the part's bounding sphere's disc), times the ray's steps per pixel (two per texel along
+/// the box, the mean chord about one box side), times a step's cost.
+pub fn impostor_cost(part: &PartSummary, imp: &ImpostorSummary, view: &ChoiceView, params: &ChooseParams) -> u64 {
+    let radius_px = projected_px(part, part.radius_m, view);
+    if !radius_px.is_finite() {
+        return u64::MAX / 4;
+    }
+    let pixels = std::f32::consts::PI * radius_px * radius_px;
+    let steps = 2.0 * imp.texels as f32;
+    (pixels * steps * params.impostor_step_triangles).ceil().min(1e15) as u64 + 12
+}
+
+/// The error of the option `code` stands for, pixels (unweighted).
+fn code_error_px(part: &PartSummary, code: u8, view: &ChoiceView) -> f32 {
+    if code == IMPOSTOR_LEVEL {
+        part.impostor.map_or(0.0, |i| projected_px(part, i.error_m, view))
+    } else {
+        projected_error_px(part, usize::from(code), view)
     }
 }
 
@@ -180,7 +296,12 @@ fn importance(part: &PartSummary, view: &ChoiceView) -> f32 {
 /// Level `l`'s geometric error as seen in pixels by the eye that sees it largest: the error
 /// placed at the part's point nearest that eye, across the eye's line of sight.
 pub fn projected_error_px(part: &PartSummary, l: usize, view: &ChoiceView) -> f32 {
-    let error_m = part.levels.get(l).map_or(0.0, |t| t.1);
+    projected_px(part, part.levels.get(l).map_or(0.0, |t| t.1), view)
+}
+
+/// A length `error_m` at the part's point nearest the eye that sees it largest, across that
+/// eye's line of sight, in pixels.
+pub fn projected_px(part: &PartSummary, error_m: f32, view: &ChoiceView) -> f32 {
     if error_m <= 0.0 {
         return 0.0;
     }
@@ -246,6 +367,7 @@ mod tests {
                     (t, if l == 0 { 0.0 } else { 0.00002 * 4f32.powi(l as i32 - 1) })
                 })
                 .collect(),
+            impostor: None,
         }
     }
 
@@ -338,5 +460,67 @@ mod tests {
             levels: vec![1, 2],
         };
         assert_eq!(loose.choose(&parts, &v, budget).switched, 2);
+    }
+
+    /// A heavy part (a million triangles) with a 64-texel impostor, centred `z` from the glass.
+    fn heavy(z: f32) -> PartSummary {
+        PartSummary {
+            centre_m: Vec3::new(0.0, 0.0, z),
+            radius_m: 0.01,
+            facing: Vec3::Z,
+            levels: vec![(1_000_000, 0.0), (100_000, 0.0004), (10_000, 0.002), (1_000, 0.006)],
+            impostor: Some(ImpostorSummary {
+                error_m: 0.00022,
+                texels: 64,
+            }),
+        }
+    }
+
+    #[test]
+    fn an_impostor_is_drawn_where_it_is_the_cheaper_way_to_an_error() {
+        let (l, r) = eyes_at(Vec3::new(0.0, 0.0, 0.35));
+        let eyes = [&l, &r];
+        let v = view(&eyes);
+        // A metre behind the glass the part covers a few thousand pixels: its impostor costs less
+        // than its second level and shows less error, so within that budget it is drawn.
+        let far = heavy(-1.0);
+        let chain = options(&far, &v, &ChooseParams::default());
+        let imp = chain
+            .iter()
+            .find(|c| c.code == IMPOSTOR_LEVEL)
+            .expect("the impostor is worth having far away");
+        assert!(
+            imp.cost < 100_000 && imp.error_px < projected_error_px(&far, 1, &v),
+            "{chain:?}"
+        );
+        assert!(
+            !chain.iter().any(|c| c.code == 1),
+            "level 1 is beaten in cost and error: {chain:?}"
+        );
+        let mut chooser = Chooser::default();
+        let stats = chooser.choose(std::slice::from_ref(&far), &v, 90_000);
+        assert_eq!(chooser.levels(), &[IMPOSTOR_LEVEL], "{stats:?}");
+        assert_eq!(stats.impostors, 1);
+        assert!(stats.triangles == imp.cost && stats.triangles <= 90_000);
+        // Without its impostor the same budget leaves it at level 2, five times the error.
+        let bare = PartSummary {
+            impostor: None,
+            ..far.clone()
+        };
+        let mut chooser = Chooser::default();
+        chooser.choose(std::slice::from_ref(&bare), &v, 90_000);
+        assert_eq!(chooser.levels(), &[2]);
+        // Unbounded, the full mesh (the impostor's error is visible at this distance).
+        let mut chooser = Chooser::default();
+        chooser.choose(std::slice::from_ref(&far), &v, u64::MAX);
+        assert_eq!(chooser.levels(), &[0]);
+        // At the glass the part is large on screen: every pixel's ray costs more than the
+        // triangles it replaces, and the impostor is not an option.
+        let near = heavy(-0.01);
+        let chain = options(&near, &v, &ChooseParams::default());
+        assert!(!chain.iter().any(|c| c.code == IMPOSTOR_LEVEL), "{chain:?}");
+        let mut chooser = Chooser::default();
+        chooser.choose(std::slice::from_ref(&near), &v, 90_000);
+        assert_ne!(chooser.levels()[0], IMPOSTOR_LEVEL);
     }
 }

@@ -33,7 +33,7 @@ use phantogram_assets::model::{Model, Primitive};
 use phantogram_geometry::projection::OffAxisProjection;
 
 pub use budget::BudgetController;
-pub use choose::{ChoiceStats, ChoiceView, ChooseParams, Chooser, PartSummary};
+pub use choose::{ChoiceStats, ChoiceView, ChooseParams, Chooser, ImpostorSummary, PartSummary};
 
 /// How [`prepare`] splits a scan.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -212,6 +212,7 @@ impl PartSummary {
             radius_m,
             facing,
             levels,
+            impostor: None,
         }
     }
 }
@@ -291,6 +292,19 @@ impl Detail {
         };
         self.last = self.chooser.choose(&self.parts, &view, budget_triangles);
         self.chooser.levels()
+    }
+
+    /// Gives part `index` (the model's primitive) its baked impostor, or takes it away
+    /// (`None`); an index past the parts is ignored.
+    pub fn set_impostor(&mut self, index: usize, impostor: Option<ImpostorSummary>) {
+        if let Some(p) = self.parts.get_mut(index) {
+            p.impostor = impostor;
+        }
+    }
+
+    /// The parts the chooser weighs, one per model primitive.
+    pub fn parts(&self) -> &[PartSummary] {
+        &self.parts
     }
 
     /// What the last [`Detail::choose`] did.

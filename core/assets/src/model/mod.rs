@@ -308,6 +308,11 @@ pub struct Primitive {
     pub lods: Vec<Lod>,
 }
 
+/// The level of detail that draws a primitive as its relief-texture impostor (where the renderer
+/// baked one; the coarsest level where not). Levels below it index the primitive's chain (0 the
+/// full mesh, l its `lods[l − 1]`).
+pub const IMPOSTOR_LEVEL: u8 = u8::MAX;
+
 /// A coarser level of detail of a [`Primitive`]: triangles over the primitive's own vertices.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Lod {
