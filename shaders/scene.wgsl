@@ -75,6 +75,8 @@ override HAS_NORMAL_TEXTURE: bool = true;
 override HAS_OCCLUSION_TEXTURE: bool = true;
 override HAS_EMISSIVE_TEXTURE: bool = true;
 override ALPHA_MASK: bool = true;
+// A pipeline for the draws of a cross-fade between levels (`vs_fade`; render crate, `fades`).
+override FADE: bool = false;
 
 @group(0) @binding(0) var<uniform> eye: Eye;
 @group(0) @binding(1) var shadow_map: texture_depth_2d;
@@ -115,7 +117,22 @@ struct VsOut {
     @location(3) uv: vec4<f32>,
     @location(4) color: vec4<f32>,
     @location(5) material: vec2<f32>,
+    // The draw's cross-fade (see `screen_door_hides`).
+    @location(6) @interpolate(flat) fade: vec2<f32>,
 };
+
+// Screen-door cross-fade between a part's two levels (detail crate, fade.rs): `fade.x` is the
+// fraction of pixels showing the new level, `fade.y` +1 in the new level's draw, −1 in the old
+// one's, 0 in a draw that is not fading. Each pixel has a fixed threshold (interleaved gradient
+// noise, Jimenez 2014: evenly spread, no pattern at a glance), so it changes once, from the old
+// level to the new, as the fraction grows, and the two draws cover every pixel exactly once.
+fn screen_door_hides(pixel: vec2<f32>, fade: vec2<f32>) -> bool {
+    if (fade.y == 0.0) {
+        return false;
+    }
+    let threshold = fract(52.9829189 * fract(dot(floor(pixel), vec2<f32>(0.06711056, 0.00583715))));
+    return (threshold < fade.x) != (fade.y > 0.0);
+}
 
 // Shadow pass: depth only, from the light.
 @vertex
@@ -151,6 +168,10 @@ fn fs_shadow_masked(in: ShadowMaskedOut) {
 
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
+    return vertex_out(v);
+}
+
+fn vertex_out(v: VsIn) -> VsOut {
     var out: VsOut;
     out.clip = eye.view_proj * vec4<f32>(v.position, 1.0);
     out.world = v.position;
@@ -159,6 +180,15 @@ fn vs_main(v: VsIn) -> VsOut {
     out.uv = v.uv;
     out.color = v.color;
     out.material = v.material;
+    out.fade = vec2<f32>(0.0);
+    return out;
+}
+
+// `vs_main` for the draws of a cross-fade: the fade comes per instance (one instance a draw).
+@vertex
+fn vs_fade(v: VsIn, @location(6) fade: vec2<f32>) -> VsOut {
+    var out = vertex_out(v);
+    out.fade = fade;
     return out;
 }
 
@@ -364,7 +394,7 @@ fn alpha_cut(s: Surface) -> bool {
 @fragment
 fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
     let s = material_surface(in, front);
-    if (alpha_cut(s)) {
+    if (alpha_cut(s) || (FADE && screen_door_hides(in.clip.xy, in.fade))) {
         discard;
     }
     var out_alpha = 1.0;
@@ -552,11 +582,14 @@ struct ImpostorVsOut {
     @location(0) world: vec3<f32>,
     // The box face's outward normal.
     @location(1) @interpolate(flat) outward: vec3<f32>,
+    // The draw's cross-fade (`screen_door_hides`).
+    @location(2) @interpolate(flat) fade: vec2<f32>,
 };
 
-// The box as 36 vertices: face f (axis f / 2, + side for even f), two triangles.
+// The box as 36 vertices: face f (axis f / 2, + side for even f), two triangles. The fade comes
+// per instance.
 @vertex
-fn vs_impostor(@builtin(vertex_index) index: u32) -> ImpostorVsOut {
+fn vs_impostor(@builtin(vertex_index) index: u32, @location(6) fade: vec2<f32>) -> ImpostorVsOut {
     let f = index / 6u;
     var corners = array<vec2<f32>, 6>(
         vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
@@ -576,6 +609,7 @@ fn vs_impostor(@builtin(vertex_index) index: u32) -> ImpostorVsOut {
     out.clip = eye.view_proj * vec4<f32>(world, 1.0);
     out.world = world;
     out.outward = outward;
+    out.fade = fade;
     return out;
 }
 
@@ -622,7 +656,7 @@ fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
     let o = eye.eye_pos.xyz;
     let d = normalize(in.world - o);
     // Each ray is cast once, from the face it enters by.
-    if (dot(d, in.outward) >= 0.0) {
+    if (dot(d, in.outward) >= 0.0 || screen_door_hides(in.clip.xy, in.fade)) {
         discard;
     }
     let lo = impostor.lo.xyz;

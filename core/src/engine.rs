@@ -1733,8 +1733,13 @@ impl Engine {
         let input = self.oriented(frame_input(&view, Vec3::Z * -push));
         self.follow_seen_sides(&view, centre, display_t_ns);
         let levels = self.choose_levels(&input);
+        let fades = match self.detail.as_mut() {
+            Some(d) => d.fade(display_t_ns.map(|t| t as f64 * 1e-9)),
+            None => Vec::new(),
+        };
         let input = FrameInput {
             levels: &levels,
+            fades: &fades,
             ..input
         };
         self.stats.eyes_from_camera = matches!(self.session.eye_source(), crate::eyetrack::EyeSource::Camera);
@@ -2464,6 +2469,7 @@ pub fn frame_input(view: &crate::session::FrameView, offset: Vec3) -> FrameInput
         device_to_world: view.device_to_world.unwrap_or(glam::Quat::IDENTITY),
         offset,
         levels: &[],
+        fades: &[],
     }
 }
 

@@ -118,6 +118,7 @@ pub fn render(renderer: &mut crate::render::Renderer, posed: &Posed) -> Option<V
         device_to_world: Quat::IDENTITY,
         offset: Vec3::ZERO,
         levels: &[],
+        fades: &[],
     };
     renderer
         .render_other_model(&posed.model, &input, THUMBNAIL_PX, THUMBNAIL_PX)

@@ -225,6 +225,7 @@ fn gpu_composition_matches_the_cpu_reference() {
         device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
         levels: &[],
+        fades: &[],
     };
     let centre = ((H / 2) * W + W / 2) as usize * 4;
     let to_linear = |c: u8| {
@@ -291,6 +292,7 @@ fn render_over_floor(mut model: Model, shadows: bool, toward_light: Vec3) -> Opt
         device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
         levels: &[],
+        fades: &[],
     };
     Some((renderer.render(&input, Method::Mono, W, H).unwrap(), mono))
 }
@@ -472,6 +474,7 @@ fn environment_light_turns_with_the_device() {
             device_to_world: q,
             offset: Vec3::ZERO,
             levels: &[],
+            fades: &[],
         };
         renderer.render(&input, Method::Mono, W, H).unwrap()
     };
@@ -551,6 +554,7 @@ fn mirror_metal_reflects_the_environment_and_rough_metal_blurs_it() {
             device_to_world: phantogram::glam::Quat::IDENTITY,
             offset: Vec3::ZERO,
             levels: &[],
+            fades: &[],
         };
         let px = renderer.render(&input, Method::Mono, W, H).unwrap();
         luminance_at(&px, &mono, Vec3::new(0.0, 0.0, -0.01))

@@ -12,10 +12,10 @@
 //! The parts and levels of a scan are kept on disk and reused when the same scan is opened again
 //! ([`cache`], [`prepare_cached`]).
 //!
-//! Not here yet: the paper's relief-texture impostors (six orthographic colour, depth and normal
-//! maps per part, relief-mapped per eye), and cross-fades between levels (switches happen only
-//! where both levels' errors are below the visible threshold, or under budget pressure;
-//! [`ChoiceStats::switched_px`] measures them).
+//! A part may also have the paper's relief-texture impostor (baked and drawn by the renderer,
+//! `phantogram_render::impostor`; the engine gives it to [`Detail::set_impostor`]), which the
+//! chooser weighs as one more option. A part that changes level cross-fades from the old one
+//! to the new over a quarter second ([`fade`], [`Detail::fade`]).
 //!
 //! Frames and units: the model's frame is the device frame (metres), as everywhere in the
 //! engine. Threading: [`prepare`] runs on the loader thread (seconds for millions of triangles);
@@ -24,6 +24,7 @@
 pub mod budget;
 pub mod cache;
 pub mod choose;
+pub mod fade;
 pub mod lod;
 pub mod parts;
 pub mod seen;
@@ -223,6 +224,7 @@ pub struct Detail {
     /// One per model primitive (a primitive without levels has one level).
     parts: Vec<PartSummary>,
     chooser: Chooser,
+    fades: fade::Fades,
     budget: BudgetController,
     last: ChoiceStats,
 }
@@ -243,6 +245,7 @@ impl Detail {
         Some(Self {
             parts,
             chooser: Chooser::default(),
+            fades: fade::Fades::default(),
             // The first frames at what a phone draws twice within a frame (the size from which
             // scans are split), not at full detail: the controller takes it from there.
             budget: BudgetController::new(target_frame_s, min, max)
@@ -305,6 +308,12 @@ impl Detail {
     /// The parts the chooser weighs, one per model primitive.
     pub fn parts(&self) -> &[PartSummary] {
         &self.parts
+    }
+
+    /// The cross-fades of the frame the last [`Detail::choose`] chose, shown at display time
+    /// `now_s` (`None`: frames drawn on request, which switch at once); call once a frame.
+    pub fn fade(&mut self, now_s: Option<f64>) -> Vec<phantogram_assets::model::LevelFade> {
+        self.fades.update(self.chooser.levels(), now_s)
     }
 
     /// What the last [`Detail::choose`] did.

@@ -234,7 +234,7 @@ impl crate::Renderer {
                     module,
                     entry_point: Some("vs_impostor"),
                     compilation_options: Default::default(),
-                    buffers: &[],
+                    buffers: &[Some(crate::fade_buffer_layout(&crate::FADE_ATTRIBUTES))],
                 },
                 // Back faces are discarded in the shader by the ray's direction, whatever the
                 // projection's handedness.
@@ -619,15 +619,17 @@ impl crate::Renderer {
         })
     }
 
-    /// Draws impostor `source` into the eye pass (eye bind group set).
-    pub(crate) fn draw_impostor(&self, pass: &mut wgpu::RenderPass<'_>, impostor: &GpuImpostor) {
+    /// Draws `impostor` into the eye pass (eye bind group set) as instance `instance` of the
+    /// cross-fades' buffer (0: not fading).
+    pub(crate) fn draw_impostor(&self, pass: &mut wgpu::RenderPass<'_>, impostor: &GpuImpostor, instance: u32) {
         let Some(pipelines) = self.impostor_pipelines.as_ref() else {
             return;
         };
         pass.set_pipeline(&pipelines.draw);
         pass.set_bind_group(1, &pipelines.empty, &[]);
         pass.set_bind_group(2, &impostor.bind, &[]);
-        pass.draw(0..36, 0..1);
+        pass.set_vertex_buffer(0, self.fade_buffer.slice(..));
+        pass.draw(0..36, instance..instance + 1);
     }
 }
 

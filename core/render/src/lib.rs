@@ -47,6 +47,7 @@ use thiserror::Error;
 use wgpu::util::DeviceExt;
 
 pub use phantogram_assets::appearance::Appearance;
+pub use phantogram_assets::model::LevelFade;
 use phantogram_assets::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
 pub use phantogram_assets::ward;
 use phantogram_geometry::anaglyph::Method;
@@ -339,6 +340,10 @@ pub struct FrameInput<'a> {
     /// chain draws its coarsest; a primitive without an entry (all of them, for an empty slice)
     /// is drawn at full detail.
     pub levels: &'a [u8],
+    /// Primitives cross-fading from another level to theirs in `levels` (at most one entry a
+    /// primitive; `phantogram-detail`'s `fade` makes them): both drawn, each on its share of the
+    /// pixels. Blended primitives switch at once.
+    pub fades: &'a [LevelFade],
 }
 
 impl<'a> FrameInput<'a> {
@@ -430,13 +435,17 @@ impl GpuPrimitive {
     /// Binds the buffers and draws the level `levels` chooses for it (see
     /// [`FrameInput::levels`]), with whatever pipeline and bind groups are set.
     fn draw(&self, pass: &mut wgpu::RenderPass<'_>, levels: &[u8]) {
-        let level = usize::from(levels.get(self.source).copied().unwrap_or(0));
-        let Some(range) = self.levels.get(level).or(self.levels.last()) else {
+        self.draw_at(pass, levels.get(self.source).copied().unwrap_or(0), 0);
+    }
+
+    /// Draws level `level` (past the chain: the coarsest) as instance `instance`.
+    fn draw_at(&self, pass: &mut wgpu::RenderPass<'_>, level: u8, instance: u32) {
+        let Some(range) = self.levels.get(usize::from(level)).or(self.levels.last()) else {
             return;
         };
         pass.set_vertex_buffer(0, self.vertices.slice(..));
         pass.set_index_buffer(self.indices.slice(..), wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(range.clone(), 0, 0..1);
+        pass.draw_indexed(range.clone(), 0, instance..instance + 1);
     }
 }
 
@@ -511,6 +520,9 @@ struct MaterialVariant {
     textures: [bool; 5],
     /// Alpha mask: the shader may discard (which also costs early depth testing).
     mask: bool,
+    /// The pipeline of a cross-fade's draws (`vs_fade`, the per-instance fade, and a
+    /// screen-door discard); made for the materials of primitives with levels of detail.
+    fade: bool,
 }
 
 impl MaterialVariant {
@@ -547,12 +559,21 @@ impl ScenePipelines {
         self.variants.get(variant)
     }
 
-    /// Creates the pipelines of `model`'s materials that do not exist yet.
+    /// Creates the pipelines of `model`'s materials that do not exist yet, with the cross-fade
+    /// variants of those its primitives with levels of detail use.
     fn prepare(&mut self, device: &wgpu::Device, model: &GpuModel) {
-        for m in &model.materials {
-            if !self.variants.contains_key(&m.variant) {
-                let pipeline = self.create(device, &m.variant);
-                self.variants.insert(m.variant, pipeline);
+        let fading = model
+            .primitives
+            .iter()
+            .filter(|p| p.levels.len() > 1)
+            .map(|p| model.materials[p.material].variant)
+            .filter(|v| !v.blend)
+            .map(|v| MaterialVariant { fade: true, ..v });
+        let variants: Vec<MaterialVariant> = model.materials.iter().map(|m| m.variant).chain(fading).collect();
+        for v in variants {
+            if !self.variants.contains_key(&v) {
+                let pipeline = self.create(device, &v);
+                self.variants.insert(v, pipeline);
             }
         }
         let casts_masked = model.materials.iter().any(|m| m.variant.casts_masked_shadow());
@@ -613,14 +634,21 @@ impl ScenePipelines {
             .map(|(name, has)| (*name, flag(has)))
             .collect();
         constants.push(("ALPHA_MASK", flag(v.mask)));
+        constants.push(("FADE", flag(v.fade)));
+        let fade_attributes = FADE_ATTRIBUTES;
+        let plain = [Some(vertex_buffer(&vertex_attributes))];
+        let fading = [
+            Some(vertex_buffer(&vertex_attributes)),
+            Some(fade_buffer_layout(&fade_attributes)),
+        ];
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("scene"),
+            label: Some(if v.fade { "scene (cross-fade)" } else { "scene" }),
             layout: Some(&self.layout),
             vertex: wgpu::VertexState {
                 module: &self.module,
-                entry_point: Some("vs_main"),
+                entry_point: Some(if v.fade { "vs_fade" } else { "vs_main" }),
                 compilation_options: Default::default(),
-                buffers: &[Some(vertex_buffer(&vertex_attributes))],
+                buffers: if v.fade { &fading } else { &plain },
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -654,6 +682,18 @@ impl ScenePipelines {
             multiview_mask: None,
             cache: None,
         })
+    }
+}
+
+/// The per-instance cross-fade (`vs_fade`, `vs_impostor`): fraction shown and side.
+const FADE_ATTRIBUTES: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![6 => Float32x2];
+
+/// The cross-fades' instance buffer: one `[f32; 2]` per draw ([`Renderer::write_fades`]).
+fn fade_buffer_layout(attributes: &[wgpu::VertexAttribute]) -> wgpu::VertexBufferLayout<'_> {
+    wgpu::VertexBufferLayout {
+        array_stride: 8,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes,
     }
 }
 
@@ -730,6 +770,10 @@ pub struct Renderer {
     timer: Option<gpu_timer::GpuTimer>,
     /// Made with the first impostor baked.
     impostor_pipelines: Option<impostor::ImpostorPipelines>,
+    /// The cross-fades' instance data for the frame being drawn (entry 0: no fade; fade k:
+    /// entries 2k + 1, the new level's, and 2k + 2, the old one's), and its size in entries.
+    fade_buffer: wgpu::Buffer,
+    fade_entries: u64,
 }
 
 impl Renderer {
@@ -980,6 +1024,8 @@ impl Renderer {
             lamp: None,
             timer: gpu_timer::GpuTimer::new(&gpu.device, &gpu.queue),
             impostor_pipelines: None,
+            fade_buffer: fade_instance_buffer(&gpu.device, FADE_ENTRIES_AT_FIRST),
+            fade_entries: FADE_ENTRIES_AT_FIRST,
             gpu,
         }
     }
@@ -1433,6 +1479,7 @@ impl Renderer {
             right: rm.map(row),
             params: [self.lighting.exposure, 0.0, 0.0, 0.0],
         };
+        let fading = self.write_fades(input.fades);
         let queue = &self.gpu.queue;
         for (buffer, u) in self.eye_buffers.iter().zip(&uniforms) {
             queue.write_buffer(buffer, 0, bytemuck::bytes_of(u));
@@ -1527,15 +1574,30 @@ impl Renderer {
             // Opaque and masked first; then blended, farthest first, as this eye sees them.
             let eye_at = Vec3::from_slice(&u.eye_pos[..3]);
             let mut blended: Vec<&GpuPrimitive> = Vec::new();
-            let mut impostors_drawn: Vec<usize> = Vec::new();
+            let mut impostors_drawn: Vec<(usize, u32)> = Vec::new();
             for p in &self.model.primitives {
                 if self.model.materials[p.material].variant.blend {
                     blended.push(p);
+                } else if let Some(k) = fading.get(&p.source) {
+                    // Both levels, each on its share of the pixels.
+                    let new = input.levels.get(p.source).copied().unwrap_or(0);
+                    let old = input.fades[*k].from;
+                    let first = 2 * *k as u32 + 1;
+                    for (level, instance) in [(new, first), (old, first + 1)] {
+                        match self.impostor_of(p.source, level) {
+                            Some(imp) if !impostors_drawn.contains(&(p.source, instance)) => {
+                                impostors_drawn.push((p.source, instance));
+                                self.draw_impostor(&mut pass, imp, instance);
+                            }
+                            Some(_) => {}
+                            None => self.draw_fading(&mut pass, p, level, instance),
+                        }
+                    }
                 } else if let Some(imp) = self.impostor_drawn_for(p, input.levels) {
                     // Once for the primitive, however many pieces it was uploaded in.
-                    if !impostors_drawn.contains(&p.source) {
-                        impostors_drawn.push(p.source);
-                        self.draw_impostor(&mut pass, imp);
+                    if !impostors_drawn.contains(&(p.source, 0)) {
+                        impostors_drawn.push((p.source, 0));
+                        self.draw_impostor(&mut pass, imp, 0);
                     }
                 } else {
                     self.draw_primitive(&mut pass, p, input.levels);
@@ -1621,10 +1683,68 @@ impl Renderer {
 
     /// The impostor `levels` draws for `p` in place of its triangles, if any.
     fn impostor_drawn_for(&self, p: &GpuPrimitive, levels: &[u8]) -> Option<&impostor::GpuImpostor> {
-        if levels.get(p.source) != Some(&IMPOSTOR_LEVEL) {
+        self.impostor_of(p.source, levels.get(p.source).copied()?)
+    }
+
+    /// Primitive `source`'s impostor, if `level` is [`IMPOSTOR_LEVEL`] and it has one.
+    fn impostor_of(&self, source: usize, level: u8) -> Option<&impostor::GpuImpostor> {
+        if level != IMPOSTOR_LEVEL {
             return None;
         }
-        self.model.impostors.get(p.source)?.as_ref()
+        self.model.impostors.get(source)?.as_ref()
+    }
+
+    /// Writes this frame's cross-fades into the instance buffer (growing it when needed) and
+    /// returns, by primitive, the index of its fade in `fades`. A fade of a primitive past the
+    /// model, or a second one of a primitive, is ignored.
+    fn write_fades(&mut self, fades: &[LevelFade]) -> std::collections::HashMap<usize, usize> {
+        let mut by_primitive = std::collections::HashMap::new();
+        let mut data: Vec<[f32; 2]> = vec![[0.0, 0.0]; 2 * fades.len() + 1];
+        for (k, f) in fades.iter().enumerate() {
+            let source = f.primitive as usize;
+            if !self.model.primitives.iter().any(|p| p.source == source) || by_primitive.contains_key(&source) {
+                continue;
+            }
+            let shown = if f.shown.is_finite() {
+                f.shown.clamp(0.0, 1.0)
+            } else {
+                1.0
+            };
+            data[2 * k + 1] = [shown, 1.0];
+            data[2 * k + 2] = [shown, -1.0];
+            by_primitive.insert(source, k);
+        }
+        let needed = data.len() as u64;
+        if needed > self.fade_entries {
+            self.fade_entries = needed.next_power_of_two();
+            self.fade_buffer = fade_instance_buffer(&self.gpu.device, self.fade_entries);
+        }
+        self.gpu
+            .queue
+            .write_buffer(&self.fade_buffer, 0, bytemuck::cast_slice(&data));
+        by_primitive
+    }
+
+    /// Draws `p` at `level` as one side of a cross-fade (instance `instance` of the fades'
+    /// buffer).
+    fn draw_fading(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive, level: u8, instance: u32) {
+        let m = &self.model.materials[p.material];
+        let variant = MaterialVariant {
+            fade: true,
+            ..m.variant
+        };
+        let Some(pipeline) = self.scene.get(&variant) else {
+            // Made with the model for every primitive with levels; without it, the new level
+            // alone (a switch without the fade).
+            if instance % 2 == 1 {
+                self.draw_primitive(pass, p, &[level]);
+            }
+            return;
+        };
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(1, &m.bind, &[]);
+        pass.set_vertex_buffer(1, self.fade_buffer.slice(..));
+        p.draw_at(pass, level, instance);
     }
 
     fn draw_primitive(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive, levels: &[u8]) {
@@ -1639,6 +1759,19 @@ impl Renderer {
         pass.set_bind_group(1, &m.bind, &[]);
         p.draw(pass, levels);
     }
+}
+
+/// The cross-fades' instance buffer's first size (entries): 31 fades at once; it grows when a
+/// frame has more.
+const FADE_ENTRIES_AT_FIRST: u64 = 64;
+
+fn fade_instance_buffer(device: &wgpu::Device, entries: u64) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("cross-fades"),
+        size: entries * 8,
+        usage: wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
 
 /// Runs `f` inside a validation error scope, turning what wgpu would otherwise report to its

@@ -208,6 +208,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     blend: m.alpha == AlphaMode::Blend,
                     textures,
                     mask: matches!(m.alpha, AlphaMode::Mask(_)),
+                    fade: false,
                 },
                 _uniform: uniform,
             }

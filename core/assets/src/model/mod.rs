@@ -313,6 +313,20 @@ pub struct Primitive {
 /// full mesh, l its `lods[l − 1]`).
 pub const IMPOSTOR_LEVEL: u8 = u8::MAX;
 
+/// A primitive changing level of detail, drawn at both for a moment: its new level on the
+/// fraction `shown` of the pixels and the level `from` on the rest (a screen-door cross-fade,
+/// the same pixels each frame, so that the new level grows in and nothing pops).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LevelFade {
+    /// The primitive, by index in its model.
+    pub primitive: u32,
+    /// The level faded out (a level as in the levels the renderer is given, or
+    /// [`IMPOSTOR_LEVEL`]).
+    pub from: u8,
+    /// Fraction of pixels at the new level, 0 to 1.
+    pub shown: f32,
+}
+
 /// A coarser level of detail of a [`Primitive`]: triangles over the primitive's own vertices.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Lod {
