@@ -18,7 +18,11 @@
 //!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
 //!    Opaque and masked primitives first, then blended ones back to front (depth test, no depth
 //!    write). Mono renders only the cyclopean eye. Light, materials and textures are shared by
-//!    both eyes; only the small per-eye uniform differs.
+//!    both eyes; only the small per-eye uniform differs. A primitive whose level is
+//!    [`IMPOSTOR_LEVEL`] and that has one baked is drawn as its relief-texture impostor
+//!    ([`impostor`]; it casts the shadow of its polygon level as exact as it is); a primitive in
+//!    [`FrameInput::fades`] is drawn at both its levels, each on its share of the pixels
+//!    (pipelines with `FADE` set and the fade per instance, `vs_fade`).
 //! 3. Composition pass: tone mapping (Khronos PBR Neutral, exposure) of each eye, then the
 //!    anaglyph matrices ([`phantogram_geometry::anaglyph`]) in linear light, into an `Rgba8UnormSrgb` target.
 //!
