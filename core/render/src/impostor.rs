@@ -120,10 +120,10 @@ impl ImpostorBox {
     }
 
     /// Face `face`'s view (0 to 5; face 2a looks from the +a side, 2a+1 from the −a side): mesh
-    /// coordinates → clip space with x = 1 − 2 q[(a+1)%3] from the + side, 2 q[(a+1)%3] − 1
-    /// from the − side, y = 1 − 2 q[(a+2)%3] (so the map's column and row are 1 − q[(a+1)%3]
-    /// or q[(a+1)%3], and q[(a+2)%3], times `texels`) and z the depth from that side, 1 − q[a]
-    /// or q[a].
+    /// coordinates → clip space with x = 1 − 2 q(a+1) from the + side, 2 q(a+1) − 1 from the −
+    /// side, y = 1 − 2 q(a+2) (so the map's column and row are 1 − q(a+1) or q(a+1), and
+    /// q(a+2), times `texels`) and z the depth from that side, 1 − q(a) or q(a); q(i) is the
+    /// box coordinate along axis i mod 3 ([`Self::to_box`]).
     pub fn face_view(&self, face: usize) -> Mat4 {
         let a = (face / 2).min(2);
         let (u, v) = ((a + 1) % 3, (a + 2) % 3);
