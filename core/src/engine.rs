@@ -77,10 +77,12 @@ fn impostors_for(model: &crate::model::Model, has_detail: bool, memory_bytes: u6
     crate::impostors::ImpostorBaker::plan(model, left)
 }
 
-/// The frame time a big scan's level-of-detail budget aims at by default, seconds: 30 frames a
-/// second, both eyes (the relief-texture paper holds at least 10; a phantogram that lags the
-/// hand by more than a frame at 30 Hz no longer looks fixed in the room).
-pub const DEFAULT_FRAME_TARGET_S: f64 = 1.0 / 30.0;
+/// The frame time a big scan's level-of-detail budget aims at by default, seconds: a frame of
+/// 30 a second, both eyes (the relief-texture paper holds at least 10; a phantogram that lags
+/// the hand by more than a frame at 30 Hz no longer looks fixed in the room), less the budget
+/// controller's dead band (4 %, `phantogram_detail::BudgetController`): the controller settles
+/// on its target, and a target at the frame's period itself would miss it every other frame.
+pub const DEFAULT_FRAME_TARGET_S: f64 = 1.0 / 30.0 / 1.04;
 
 /// How a shell starts an engine.
 #[derive(Clone, Debug)]
@@ -576,6 +578,10 @@ impl Engine {
         };
         let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
         let impostors = impostors_for(&model, detail.is_some(), budget.memory_bytes);
+        let mut detail = detail;
+        if let Some(d) = detail.as_mut() {
+            impostors.announce(d);
+        }
         let (appearances, appearance_warning) =
             crate::appearances::AppearanceStore::open(config.library_dir.as_ref().map(|d| d.join("appearances.json")));
         renderer.appearance = appearances.get(&appearance_key(&model_info));
@@ -1343,6 +1349,9 @@ impl Engine {
                     self.detail.is_some(),
                     self.loader.budget().memory_bytes,
                 );
+                if let Some(d) = self.detail.as_mut() {
+                    self.impostors.announce(d);
+                }
                 // The best scan taking over from its preview is the same artifact: what was
                 // seen of it stays seen.
                 let same_artifact = self.model_info.preview
@@ -1782,18 +1791,16 @@ impl Engine {
     }
 
     /// Each part's level of detail for the frame `input` shows (empty: all at full detail).
-    /// Bakes the next few parts' impostors first.
+    /// First bakes a few of the impostors the chooser would draw in this view.
     fn choose_levels(&mut self, input: &FrameInput) -> Vec<u8> {
         let Some(detail) = self.detail.as_mut() else {
             return Vec::new();
         };
-        if self.impostors.pending() > 0 {
-            // A failed bake stops the baking: the parts without impostors keep their polygons,
-            // and the picture is the same.
-            let _ = self.impostors.step(&mut self.renderer, detail);
-            self.baked_this_frame = true;
-        }
         let eyes = input.eyes_drawn(self.method);
+        // A failed bake stops the baking: the parts without impostors keep their polygons, and
+        // the picture is the same.
+        let baked = self.impostors.step(&mut self.renderer, detail, &eyes, input.offset);
+        self.baked_this_frame = baked.is_ok_and(|n| n > 0);
         detail.choose(&eyes, input.offset, None).to_vec()
     }
 
@@ -1809,8 +1816,9 @@ impl Engine {
         }
     }
 
-    /// The big scan's impostors: baked, still to bake (a few each frame), and the GPU memory of
-    /// those baked, bytes ([`crate::impostors`]).
+    /// The big scan's impostors: baked, planned and not baked (each is baked once the chooser
+    /// would draw it, a few a frame), and the GPU memory of those baked, bytes
+    /// ([`crate::impostors`]).
     pub fn impostor_progress(&self) -> (usize, usize, u64) {
         (
             self.impostors.baked(),

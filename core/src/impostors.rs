@@ -1,14 +1,17 @@
 //! Relief-texture impostors for a big scan's parts (issue 22): which parts get one, at what
-//! resolution, and baking them a few per frame.
+//! resolution, and baking those worth drawing, a few per frame.
 //!
-//! Every part with levels of detail gets an impostor ([`phantogram_render::impostor`]); the
-//! chooser ([`phantogram_detail::choose`]) then draws it where it is the cheaper way to an
-//! error. Their GPU memory comes out of the artifact's memory budget: what the model leaves of
-//! it, at most [`IMPOSTOR_MEMORY_BYTES`], shared equally, each face's side a power of two from
-//! [`MIN_TEXELS`] to [`MAX_TEXELS`]; with less than that, no impostors. Baking a scan's hundred
-//! parts at once would stall a frame on a phone (six views of each part's full mesh), so
-//! [`ImpostorBaker::step`] bakes [`BAKED_PER_FRAME`] per frame and hands each to the chooser as
-//! it is made.
+//! Every part with levels of detail is planned an impostor ([`phantogram_render::impostor`]):
+//! their GPU memory comes out of the artifact's memory budget — what the model leaves of it, at
+//! most [`IMPOSTOR_MEMORY_BYTES`], shared equally, each face's side a power of two from
+//! [`MIN_TEXELS`] to [`MAX_TEXELS`]; with less than that, none. The chooser
+//! ([`phantogram_detail::choose`]) knows each planned impostor's error and cost, and an impostor
+//! is baked only once the chooser would draw it
+//! ([`phantogram_detail::Detail::impostors_worth_baking`]): at the glass, from arm's length, a
+//! scan's parts are large on the screen, their polygons are cheaper, and nothing is baked (no
+//! memory, no time); a part small on the screen for its triangles gets its impostor within a few
+//! frames. Baking takes six views of a part's full mesh, so [`ImpostorBaker::step`] bakes at most
+//! [`BAKED_PER_FRAME`] a frame.
 //!
 //! **Threading**: the render thread's, with the renderer. **Panics**: none; a failed bake stops
 //! the baking (the parts keep their polygons).
@@ -16,6 +19,7 @@
 use glam::Vec3;
 use phantogram_assets::model::Model;
 use phantogram_detail::{Detail, ImpostorSummary};
+use phantogram_geometry::projection::OffAxisProjection;
 use phantogram_render::{ImpostorBox, RenderError, Renderer};
 
 /// GPU memory all of a scan's impostors may take together, at most: a tenth of a mid-range
@@ -46,10 +50,11 @@ pub fn texels_for(parts: usize, memory_bytes: u64) -> Option<u32> {
     (texels >= MIN_TEXELS).then_some(texels.min(MAX_TEXELS))
 }
 
-/// The impostors of one installed model still to bake.
+/// The impostors planned for one installed model, and those baked.
 #[derive(Debug, Default)]
 pub struct ImpostorBaker {
-    queue: Vec<(usize, ImpostorBox)>,
+    /// By part (the model's primitive): its box while planned and not yet baked.
+    planned: Vec<Option<ImpostorBox>>,
     baked: usize,
     bytes: u64,
 }
@@ -64,25 +69,31 @@ impl ImpostorBaker {
         let Some(texels) = texels_for(parts.len(), memory_bytes) else {
             return Self::default();
         };
-        let mut queue: Vec<(usize, ImpostorBox)> = parts
-            .into_iter()
-            .filter_map(|i| {
-                let points = model.primitives[i].mesh.vertices.iter().map(|v| Vec3::from(v.position));
-                ImpostorBox::around(points, texels).map(|b| (i, b))
-            })
-            .collect();
-        // Popped from the end: the first parts first.
-        queue.reverse();
+        let mut planned = vec![None; model.primitives.len()];
+        for i in parts {
+            let points = model.primitives[i].mesh.vertices.iter().map(|v| Vec3::from(v.position));
+            planned[i] = ImpostorBox::around(points, texels);
+        }
         Self {
-            queue,
+            planned,
             baked: 0,
             bytes: 0,
         }
     }
 
-    /// Parts left to bake.
+    /// Tells `detail` of every planned impostor (not baked yet), so that the chooser can say
+    /// which are worth baking.
+    pub fn announce(&self, detail: &mut Detail) {
+        for (i, b) in self.planned.iter().enumerate() {
+            if let Some(b) = b {
+                detail.set_impostor(i, Some(summary(b, false)));
+            }
+        }
+    }
+
+    /// Planned impostors not baked yet.
     pub fn pending(&self) -> usize {
-        self.queue.len()
+        self.planned.iter().flatten().count()
     }
 
     /// Impostors baked so far.
@@ -95,33 +106,76 @@ impl ImpostorBaker {
         self.bytes
     }
 
-    /// Bakes the next [`BAKED_PER_FRAME`] parts and gives them to `detail`. On a GPU failure
-    /// nothing more is baked and the error is returned once.
-    pub fn step(&mut self, renderer: &mut Renderer, detail: &mut Detail) -> Result<(), RenderError> {
-        let take = self.queue.len().min(BAKED_PER_FRAME);
-        let batch: Vec<(usize, ImpostorBox)> = self.queue.split_off(self.queue.len() - take);
+    /// Bakes up to [`BAKED_PER_FRAME`] of the impostors the chooser would draw in the view of
+    /// `eyes` (mesh moved by `offset_m`) and marks them baked in `detail`. Returns how many were
+    /// baked. On a GPU failure nothing more is planned and the error is returned once.
+    pub fn step(
+        &mut self,
+        renderer: &mut Renderer,
+        detail: &mut Detail,
+        eyes: &[&OffAxisProjection],
+        offset_m: Vec3,
+    ) -> Result<usize, RenderError> {
+        if self.pending() == 0 {
+            return Ok(0);
+        }
+        let wanted: Vec<usize> = detail
+            .impostors_worth_baking(eyes, offset_m)
+            .into_iter()
+            .filter(|&i| self.planned.get(i).is_some_and(Option::is_some))
+            .take(BAKED_PER_FRAME)
+            .collect();
+        self.bake(renderer, detail, &wanted)
+    }
+
+    /// Bakes every planned impostor at once (the benchmark's measure of what they cost).
+    pub fn bake_all(&mut self, renderer: &mut Renderer, detail: &mut Detail) -> Result<usize, RenderError> {
+        let all: Vec<usize> = (0..self.planned.len()).filter(|&i| self.planned[i].is_some()).collect();
+        self.bake(renderer, detail, &all)
+    }
+
+    fn bake(&mut self, renderer: &mut Renderer, detail: &mut Detail, parts: &[usize]) -> Result<usize, RenderError> {
+        let batch: Vec<(usize, ImpostorBox)> = parts
+            .iter()
+            .filter_map(|&i| self.planned.get_mut(i).and_then(Option::take).map(|b| (i, b)))
+            .collect();
+        if batch.is_empty() {
+            return Ok(0);
+        }
         match renderer.bake_impostors(&batch) {
             Ok(bytes) => {
                 self.bytes += bytes;
+                let mut made = 0;
                 for (i, b) in batch {
                     if renderer.has_impostor(i) {
-                        self.baked += 1;
-                        detail.set_impostor(
-                            i,
-                            Some(ImpostorSummary {
-                                error_m: b.error_m(),
-                                texels: b.texels,
-                            }),
-                        );
+                        made += 1;
+                        detail.set_impostor(i, Some(summary(&b, true)));
+                    } else {
+                        // Skipped by the renderer (a blended material): not an option.
+                        detail.set_impostor(i, None);
                     }
                 }
-                Ok(())
+                self.baked += made;
+                Ok(made)
             }
             Err(e) => {
-                self.queue.clear();
+                for p in &mut self.planned {
+                    *p = None;
+                }
+                for (i, _) in batch {
+                    detail.set_impostor(i, None);
+                }
                 Err(e)
             }
         }
+    }
+}
+
+fn summary(b: &ImpostorBox, baked: bool) -> ImpostorSummary {
+    ImpostorSummary {
+        error_m: b.error_m(),
+        texels: b.texels,
+        baked,
     }
 }
 

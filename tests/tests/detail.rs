@@ -296,7 +296,7 @@ fn big_amphora_file(dir: &std::path::Path) -> std::path::PathBuf {
 }
 
 #[test]
-fn the_engine_bakes_a_big_scans_impostors_a_few_parts_a_frame() {
+fn the_engine_plans_impostors_and_bakes_none_the_chooser_would_not_draw() {
     use phantogram::engine::EngineConfig;
     let dir = phantogram_integration::scratch("detail-engine-impostors");
     let config = EngineConfig {
@@ -307,35 +307,20 @@ fn the_engine_bakes_a_big_scans_impostors_a_few_parts_a_frame() {
         return;
     };
     engine.resume_offscreen(180, 400).unwrap();
-    let (baked, pending, _) = engine.impostor_progress();
-    assert_eq!(baked, 0, "nothing baked before the first frame");
-    let parts = pending;
-    assert!(parts > 10, "{parts} parts planned");
-    engine.draw(None).unwrap();
-    let (baked, pending, bytes) = engine.impostor_progress();
-    assert_eq!(
-        (baked, pending),
-        (phantogram::impostors::BAKED_PER_FRAME, parts - baked)
-    );
-    let per_part = bytes / baked as u64;
-    let mut frames = 1;
-    while engine.impostor_progress().1 > 0 {
+    let (baked, planned, _) = engine.impostor_progress();
+    assert_eq!(baked, 0);
+    assert!(planned > 10, "{planned} parts planned");
+    // At the glass, from arm's length, every part covers thousands of pixels of a phone's
+    // glass: its polygons are the cheaper way to any error, and no impostor is worth its bake
+    // (where one is, it is baked: the renderer's and the chooser's tests).
+    for _ in 0..3 {
         engine.draw(None).unwrap();
-        frames += 1;
-        assert!(frames <= parts, "baking does not end");
     }
-    let (baked, _, bytes) = engine.impostor_progress();
-    assert_eq!(baked, parts);
-    assert_eq!(bytes, per_part * parts as u64);
-    assert!(bytes <= phantogram::impostors::IMPOSTOR_MEMORY_BYTES);
-    // The chooser weighs them: at the glass, from arm's length, the polygons are the cheaper
-    // way to every error (see `phantogram_detail::choose`), and the frame is drawn.
+    let (baked, pending, bytes) = engine.impostor_progress();
+    assert_eq!((baked, pending, bytes), (0, planned, 0));
     let (stats, _) = engine.detail_stats().expect("a big scan");
+    assert_eq!(stats.impostors, 0);
     assert!(stats.triangles > 0);
-    println!(
-        "{parts} parts, {baked} impostors in {frames} frames, {} KiB each; {stats:?}",
-        per_part >> 10
-    );
 }
 
 #[test]
@@ -380,4 +365,48 @@ fn levels_that_do_not_fit_the_memory_budget_are_left_out_with_a_warning() {
         "{:?}",
         tight.info.warnings
     );
+}
+
+#[test]
+fn the_engine_bakes_the_impostors_of_a_scan_small_on_the_glass_a_few_a_frame() {
+    use phantogram::engine::EngineConfig;
+    let dir = phantogram_integration::scratch("detail-engine-small-scan");
+    // The same 650k triangles fitted 3 mm tall: each part covers a few hundred pixels.
+    let config = EngineConfig {
+        model_path: Some(big_amphora_file(&dir)),
+        fit: phantogram::model::DioramaFit {
+            max_height_m: 0.003,
+            ..Default::default()
+        },
+        ..EngineConfig::default()
+    };
+    let Some(mut engine) = phantogram_integration::engine_or_skip(config) else {
+        return;
+    };
+    engine.resume_offscreen(180, 400).unwrap();
+    let (_, planned, _) = engine.impostor_progress();
+    let mut frames = 0;
+    let mut most = 0;
+    while frames < 20 {
+        engine.draw(None).unwrap();
+        frames += 1;
+        let (baked, _, _) = engine.impostor_progress();
+        assert!(
+            baked - most <= phantogram::impostors::BAKED_PER_FRAME,
+            "{baked} after {most}"
+        );
+        most = baked;
+    }
+    let (baked, pending, bytes) = engine.impostor_progress();
+    let (stats, budget) = engine.detail_stats().expect("a big scan");
+    println!(
+        "{planned} planned, {baked} baked ({} KiB), {pending} not; {stats:?}, budget {budget}",
+        bytes >> 10
+    );
+    // Some are worth baking here (the parts farthest from the eyes); whether the chooser then
+    // draws them depends on the budget (lavapipe's frames hold it at the coarsest levels here,
+    // cheaper still): the chooser's own tests.
+    assert!(baked > 0 && baked < planned, "{baked} of {planned} baked");
+    assert_eq!(baked + pending, planned);
+    assert!(bytes > 0);
 }

@@ -37,13 +37,16 @@ use glam::{Vec2, Vec3};
 use phantogram_assets::model::IMPOSTOR_LEVEL;
 use phantogram_geometry::projection::OffAxisProjection;
 
-/// A part's baked relief-texture impostor, as the chooser weighs it.
+/// A part's relief-texture impostor, as the chooser weighs it: planned (its resolution known,
+/// so its error and cost) and, once the renderer has made it, baked. Only baked impostors are
+/// drawn; [`worth_baking`] says which planned ones the chooser would draw.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImpostorSummary {
     /// How far a surface point it draws can lie from the true surface, metres.
     pub error_m: f32,
     /// Texels along a side of each face's map.
     pub texels: u32,
+    pub baked: bool,
 }
 
 /// What the chooser knows of one part. See [`crate::PartSummary::of`].
@@ -56,7 +59,7 @@ pub struct PartSummary {
     pub facing: Vec3,
     /// Per level, finest (the full mesh, error 0) first: triangles and geometric error, metres.
     pub levels: Vec<(u32, f32)>,
-    /// The part's impostor, where one was baked.
+    /// The part's impostor, where one is planned or baked.
     pub impostor: Option<ImpostorSummary>,
 }
 
@@ -154,7 +157,7 @@ impl Chooser {
         let had_previous = previous.len() == n;
         let weight: Vec<f32> = parts.iter().map(|p| importance(p, view)).collect();
         // Each part's options worth having, costliest (finest) first.
-        let chains: Vec<Vec<Candidate>> = parts.iter().map(|p| options(p, view, &self.params)).collect();
+        let chains: Vec<Vec<Candidate>> = parts.iter().map(|p| options(p, view, &self.params, false)).collect();
         let mut pos: Vec<usize> = chains.iter().map(|c| c.len().saturating_sub(1)).collect();
         let mut triangles: u64 = chains
             .iter()
@@ -222,8 +225,18 @@ impl Chooser {
     }
 }
 
-/// `part`'s options for `view` that no other beats in both cost and error, costliest first.
-fn options(part: &PartSummary, view: &ChoiceView, params: &ChooseParams) -> Vec<Candidate> {
+/// Whether `part`'s planned impostor would be one of its options for `view` (no other option
+/// beats it in both cost and error) once baked: the impostors worth making now.
+pub fn worth_baking(part: &PartSummary, view: &ChoiceView, params: &ChooseParams) -> bool {
+    part.impostor.is_some_and(|i| !i.baked)
+        && options(part, view, params, true)
+            .iter()
+            .any(|c| c.code == IMPOSTOR_LEVEL)
+}
+
+/// `part`'s options for `view` that no other beats in both cost and error, costliest first;
+/// its impostor among them if baked (or, with `planned`, if only planned).
+fn options(part: &PartSummary, view: &ChoiceView, params: &ChooseParams, planned: bool) -> Vec<Candidate> {
     // Level codes stop short of the impostor's (a chain that long is not made).
     let mut all: Vec<Candidate> = part
         .levels
@@ -236,7 +249,7 @@ fn options(part: &PartSummary, view: &ChoiceView, params: &ChooseParams) -> Vec<
             error_px: projected_error_px(part, l, view),
         })
         .collect();
-    if let Some(imp) = part.impostor {
+    if let Some(imp) = part.impostor.filter(|i| i.baked || planned) {
         all.push(Candidate {
             code: IMPOSTOR_LEVEL,
             cost: impostor_cost(part, &imp, view, params),
@@ -472,6 +485,7 @@ mod tests {
             impostor: Some(ImpostorSummary {
                 error_m: 0.00022,
                 texels: 64,
+                baked: true,
             }),
         }
     }
@@ -484,7 +498,7 @@ mod tests {
         // A metre behind the glass the part covers a few thousand pixels: its impostor costs less
         // than its second level and shows less error, so within that budget it is drawn.
         let far = heavy(-1.0);
-        let chain = options(&far, &v, &ChooseParams::default());
+        let chain = options(&far, &v, &ChooseParams::default(), false);
         let imp = chain
             .iter()
             .find(|c| c.code == IMPOSTOR_LEVEL)
@@ -517,10 +531,21 @@ mod tests {
         // At the glass the part is large on screen: every pixel's ray costs more than the
         // triangles it replaces, and the impostor is not an option.
         let near = heavy(-0.01);
-        let chain = options(&near, &v, &ChooseParams::default());
+        let chain = options(&near, &v, &ChooseParams::default(), false);
         assert!(!chain.iter().any(|c| c.code == IMPOSTOR_LEVEL), "{chain:?}");
         let mut chooser = Chooser::default();
         chooser.choose(std::slice::from_ref(&near), &v, 90_000);
         assert_ne!(chooser.levels()[0], IMPOSTOR_LEVEL);
+        // Planned but not baked: never drawn, and worth baking only where it would be.
+        let unbaked = |p: &PartSummary| PartSummary {
+            impostor: p.impostor.map(|i| ImpostorSummary { baked: false, ..i }),
+            ..p.clone()
+        };
+        let mut chooser = Chooser::default();
+        chooser.choose(&[unbaked(&far)], &v, 90_000);
+        assert_eq!(chooser.levels(), &[2]);
+        assert!(worth_baking(&unbaked(&far), &v, &ChooseParams::default()));
+        assert!(!worth_baking(&unbaked(&near), &v, &ChooseParams::default()));
+        assert!(!worth_baking(&far, &v, &ChooseParams::default()), "baked already");
     }
 }

@@ -297,12 +297,28 @@ impl Detail {
         self.chooser.levels()
     }
 
-    /// Gives part `index` (the model's primitive) its baked impostor, or takes it away
-    /// (`None`); an index past the parts is ignored.
+    /// Gives part `index` (the model's primitive) its impostor, planned or baked, or takes it
+    /// away (`None`); an index past the parts is ignored.
     pub fn set_impostor(&mut self, index: usize, impostor: Option<ImpostorSummary>) {
         if let Some(p) = self.parts.get_mut(index) {
             p.impostor = impostor;
         }
+    }
+
+    /// The parts whose planned impostors the chooser would draw in the view of `eyes` (see
+    /// [`choose::worth_baking`]), in the parts' order.
+    pub fn impostors_worth_baking(&self, eyes: &[&OffAxisProjection], offset_m: Vec3) -> Vec<usize> {
+        let image_px = eyes.first().map_or(Vec2::ONE, |e| e.image_px());
+        let view = ChoiceView {
+            eyes,
+            offset_m,
+            attention_px: image_px * 0.5,
+            attention_reach_px: image_px.length() * 0.5,
+        };
+        let params = self.chooser.params;
+        (0..self.parts.len())
+            .filter(|&i| choose::worth_baking(&self.parts[i], &view, &params))
+            .collect()
     }
 
     /// The parts the chooser weighs, one per model primitive.
