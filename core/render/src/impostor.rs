@@ -186,6 +186,16 @@ pub(crate) struct GpuImpostor {
     _maps: [wgpu::Texture; 3],
 }
 
+/// Layer `face` of a six-layer map, as a 2D view (a render target, or the raw depth read).
+fn layer_view(t: &wgpu::Texture, face: u32) -> wgpu::TextureView {
+    t.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2),
+        base_array_layer: face,
+        array_layer_count: Some(1),
+        ..Default::default()
+    })
+}
+
 fn array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
@@ -457,15 +467,7 @@ impl crate::Renderer {
         }
         let mut encoder = device.create_command_encoder(&Default::default());
         for face in 0..6u32 {
-            let layer = |t: &wgpu::Texture| {
-                t.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: face,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            };
-            let views = [layer(&maps[0]), layer(&maps[1]), layer(&raw_depth)];
+            let views = [&maps[0], &maps[1], &raw_depth].map(|t| layer_view(t, face));
             let clear = |view, colour| {
                 Some(wgpu::RenderPassColorAttachment {
                     view,
@@ -518,16 +520,8 @@ impl crate::Renderer {
             }
         }
         for face in 0..6u32 {
-            let layer = |t: &wgpu::Texture| {
-                t.create_view(&wgpu::TextureViewDescriptor {
-                    dimension: Some(wgpu::TextureViewDimension::D2),
-                    base_array_layer: face,
-                    array_layer_count: Some(1),
-                    ..Default::default()
-                })
-            };
-            let raw = layer(&raw_depth);
-            let target = layer(&maps[2]);
+            let raw = layer_view(&raw_depth, face);
+            let target = layer_view(&maps[2], face);
             let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("impostor depth (raw)"),
                 layout: &pipelines.dilate_layout,
