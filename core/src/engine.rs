@@ -67,7 +67,7 @@ pub const MAX_SIDE_PX: u32 = 8192;
 #[cfg(feature = "ui")]
 const MIN_SCREEN_PT: f32 = 240.0;
 
-/// The impostors to bake for `model` (none unless it has levels of detail): within what the
+/// The impostors planned for `model` (none unless it has levels of detail): within what the
 /// artifact's memory budget leaves of it.
 fn impostors_for(model: &crate::model::Model, has_detail: bool, memory_bytes: u64) -> crate::impostors::ImpostorBaker {
     if !has_detail {
@@ -296,7 +296,8 @@ pub struct Engine {
     /// A big scan's levels of detail and their per-frame choice ([`phantogram_detail`]); `None`
     /// for a model drawn whole (and for the Diorama).
     detail: Option<phantogram_detail::Detail>,
-    /// The big scan's parts' impostors still to bake, a few per frame ([`crate::impostors`]).
+    /// The big scan's parts' impostors: planned, and baked a few a frame once the chooser would
+    /// draw them ([`crate::impostors`]).
     impostors: crate::impostors::ImpostorBaker,
     /// This frame baked some (its time is not fed to the budget).
     baked_this_frame: bool,
