@@ -94,6 +94,18 @@ pub fn tap_at(e: &mut phantogram::engine::Engine, px: [f32; 2], t_ms: &mut i64) 
     *t_ms += 1000;
 }
 
+/// The default session's view of a phone held still, tilted `tilt_deg` towards the viewer and
+/// with gravity's sideways component `sideways` (of its unit vector, before normalising): the
+/// oblique view the rendering tests draw.
+pub fn held_view(tilt_deg: f32, sideways: f32) -> phantogram::FrameView {
+    let mut s = phantogram::Session::new(phantogram::SessionConfig::default()).expect("the default session");
+    let tilt = tilt_deg.to_radians();
+    let up = phantogram::glam::Vec3::new(sideways, tilt.sin(), tilt.cos()).normalize();
+    s.push(phantogram::sensors::SensorEvent::accelerometer(1, up * 9.81))
+        .expect("a valid event");
+    s.frame().expect("a frame")
+}
+
 /// A scratch folder unique to this process and `name`, emptied first, removed when the returned
 /// guard drops unless the test is failing (see [`Scratch`]).
 pub fn scratch(name: &str) -> Scratch {

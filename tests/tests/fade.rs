@@ -3,10 +3,10 @@
 //! polygons to polygons and impostor to polygons. (When a fade begins and how it grows:
 //! `phantogram_detail::fade`'s tests.)
 
+use phantogram::FrameView;
 use phantogram::glam::Vec3;
 use phantogram::model::{LevelFade, Lod, Model};
 use phantogram::render::{FrameInput, Gpu, IMPOSTOR_LEVEL, ImpostorBox, Renderer};
-use phantogram::{FrameView, Session, SessionConfig};
 
 fn gpu() -> Option<Gpu> {
     phantogram_integration::gpu_or_skip()
@@ -16,12 +16,7 @@ const W: u32 = 360;
 const H: u32 = 800;
 
 fn oblique_view() -> FrameView {
-    let mut s = Session::new(SessionConfig::default()).unwrap();
-    let tilt = 35f32.to_radians();
-    let up = Vec3::new(0.1, tilt.sin(), tilt.cos()).normalize();
-    s.push(phantogram::sensors::SensorEvent::accelerometer(1, up * 9.81))
-        .unwrap();
-    s.frame().unwrap()
+    phantogram_integration::held_view(35.0, 0.1)
 }
 
 /// The amphora with a second level for its first primitive that is plainly different: the

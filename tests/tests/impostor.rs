@@ -11,12 +11,12 @@
 #[path = "support/golden.rs"]
 mod golden;
 
+use phantogram::FrameView;
 use phantogram::anaglyph::Method;
 use phantogram::glam::Vec3;
 use phantogram::model::{DioramaFit, Mesh, Model, Vertex};
 use phantogram::render::{FrameInput, Gpu, IMPOSTOR_LEVEL, ImpostorBox, Renderer};
 use phantogram::screen::Screen;
-use phantogram::{FrameView, Session, SessionConfig};
 
 fn gpu() -> Option<Gpu> {
     phantogram_integration::gpu_or_skip()
@@ -99,12 +99,7 @@ fn scene(unlit: bool) -> Model {
 }
 
 fn oblique_view() -> FrameView {
-    let mut s = Session::new(SessionConfig::default()).unwrap();
-    let tilt = 30f32.to_radians();
-    let up = Vec3::new(0.15, tilt.sin(), tilt.cos()).normalize();
-    s.push(phantogram::sensors::SensorEvent::accelerometer(1, up * 9.81))
-        .unwrap();
-    s.frame().unwrap()
+    phantogram_integration::held_view(30.0, 0.15)
 }
 
 /// Fraction of covered pixels (not background in either frame) of `a` with no pixel of the
