@@ -184,12 +184,11 @@ fn main() {
     // step costs against a triangle (the chooser's `impostor_step_triangles`).
     let budget = phantogram::budget::ResourceBudget::PHONE.memory_bytes;
     let left = budget.saturating_sub(phantogram::budget::model_bytes(&big));
-    let mut baker = phantogram::impostors::ImpostorBaker::plan(&big, left);
+    let mut baker = phantogram::impostors::ImpostorBaker::plan_for(&big, left, &mut detail);
     let planned = baker.pending();
-    baker.announce(&mut detail);
-    let worth = detail
-        .impostors_worth_baking(&input.eyes_drawn(Method::DuboisRedCyan), input.offset)
-        .len();
+    // As the engine learns it: from a choice (unbound here) with the impostors planned.
+    detail.choose_within(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, None, u64::MAX);
+    let worth = detail.impostors_worth_baking().len();
     let start = Instant::now();
     baker.bake_all(&mut renderer, &mut detail).expect("impostors bake");
     // The bakes are queued on the GPU: a frame waits for them.

@@ -67,14 +67,18 @@ pub const MAX_SIDE_PX: u32 = 8192;
 #[cfg(feature = "ui")]
 const MIN_SCREEN_PT: f32 = 240.0;
 
-/// The impostors planned for `model` (none unless it has levels of detail): within what the
-/// artifact's memory budget leaves of it.
-fn impostors_for(model: &crate::model::Model, has_detail: bool, memory_bytes: u64) -> crate::impostors::ImpostorBaker {
-    if !has_detail {
+/// The impostors planned for `model` and announced to its `detail` (none without levels of
+/// detail): within what the artifact's memory budget leaves of it.
+fn impostors_for(
+    model: &crate::model::Model,
+    detail: Option<&mut phantogram_detail::Detail>,
+    memory_bytes: u64,
+) -> crate::impostors::ImpostorBaker {
+    let Some(detail) = detail else {
         return Default::default();
-    }
+    };
     let left = memory_bytes.saturating_sub(crate::budget::model_bytes(model));
-    crate::impostors::ImpostorBaker::plan(model, left)
+    crate::impostors::ImpostorBaker::plan_for(model, left, detail)
 }
 
 /// The frame time a big scan's level-of-detail budget aims at by default, seconds: a frame of
@@ -578,11 +582,8 @@ impl Engine {
             None => None,
         };
         let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
-        let impostors = impostors_for(&model, detail.is_some(), budget.memory_bytes);
         let mut detail = detail;
-        if let Some(d) = detail.as_mut() {
-            impostors.announce(d);
-        }
+        let impostors = impostors_for(&model, detail.as_mut(), budget.memory_bytes);
         let (appearances, appearance_warning) =
             crate::appearances::AppearanceStore::open(config.library_dir.as_ref().map(|d| d.join("appearances.json")));
         renderer.appearance = appearances.get(&appearance_key(&model_info));
@@ -1345,14 +1346,8 @@ impl Engine {
                     d.set_target(self.frame_target_s);
                     d
                 });
-                self.impostors = impostors_for(
-                    &prepared.model,
-                    self.detail.is_some(),
-                    self.loader.budget().memory_bytes,
-                );
-                if let Some(d) = self.detail.as_mut() {
-                    self.impostors.announce(d);
-                }
+                self.impostors =
+                    impostors_for(&prepared.model, self.detail.as_mut(), self.loader.budget().memory_bytes);
                 // The best scan taking over from its preview is the same artifact: what was
                 // seen of it stays seen.
                 let same_artifact = self.model_info.preview
@@ -1792,16 +1787,16 @@ impl Engine {
     }
 
     /// Each part's level of detail for the frame `input` shows (empty: all at full detail).
-    /// First bakes a few of the impostors the chooser would draw in this view.
+    /// First bakes a few of the impostors the last choice would have drawn.
     fn choose_levels(&mut self, input: &FrameInput) -> Vec<u8> {
         let Some(detail) = self.detail.as_mut() else {
             return Vec::new();
         };
-        let eyes = input.eyes_drawn(self.method);
         // A failed bake stops the baking: the parts without impostors keep their polygons, and
         // the picture is the same.
-        let baked = self.impostors.step(&mut self.renderer, detail, &eyes, input.offset);
+        let baked = self.impostors.step(&mut self.renderer, detail);
         self.baked_this_frame = baked.is_ok_and(|n| n > 0);
+        let eyes = input.eyes_drawn(self.method);
         detail.choose(&eyes, input.offset, None).to_vec()
     }
 

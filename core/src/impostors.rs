@@ -19,7 +19,6 @@
 use glam::Vec3;
 use phantogram_assets::model::Model;
 use phantogram_detail::{Detail, ImpostorSummary};
-use phantogram_geometry::projection::OffAxisProjection;
 use phantogram_render::{ImpostorBox, RenderError, Renderer};
 
 /// GPU memory all of a scan's impostors may take together, at most: a tenth of a mid-range
@@ -61,8 +60,17 @@ pub struct ImpostorBaker {
 
 impl ImpostorBaker {
     /// The parts of `model` (primitives with levels of detail) and their boxes, within
+    /// `memory_bytes` of GPU memory, each announced to `detail` as planned (not baked), so that
+    /// the chooser can say which are worth baking.
+    pub fn plan_for(model: &Model, memory_bytes: u64, detail: &mut Detail) -> Self {
+        let baker = Self::plan(model, memory_bytes);
+        baker.announce(detail);
+        baker
+    }
+
+    /// The parts of `model` (primitives with levels of detail) and their boxes, within
     /// `memory_bytes` of GPU memory.
-    pub fn plan(model: &Model, memory_bytes: u64) -> Self {
+    fn plan(model: &Model, memory_bytes: u64) -> Self {
         let parts: Vec<usize> = (0..model.primitives.len())
             .filter(|&i| !model.primitives[i].lods.is_empty() && !model.primitives[i].is_floor)
             .collect();
@@ -83,7 +91,7 @@ impl ImpostorBaker {
 
     /// Tells `detail` of every planned impostor (not baked yet), so that the chooser can say
     /// which are worth baking.
-    pub fn announce(&self, detail: &mut Detail) {
+    fn announce(&self, detail: &mut Detail) {
         for (i, b) in self.planned.iter().enumerate() {
             if let Some(b) = b {
                 detail.set_impostor(i, Some(summary(b, false)));
@@ -106,22 +114,15 @@ impl ImpostorBaker {
         self.bytes
     }
 
-    /// Bakes up to [`BAKED_PER_FRAME`] of the impostors the chooser would draw in the view of
-    /// `eyes` (mesh moved by `offset_m`) and marks them baked in `detail`. Returns how many were
-    /// baked. On a GPU failure nothing more is planned and the error is returned once.
-    pub fn step(
-        &mut self,
-        renderer: &mut Renderer,
-        detail: &mut Detail,
-        eyes: &[&OffAxisProjection],
-        offset_m: Vec3,
-    ) -> Result<usize, RenderError> {
-        if self.pending() == 0 {
-            return Ok(0);
-        }
+    /// Bakes up to [`BAKED_PER_FRAME`] of the impostors the chooser's last choice would have
+    /// drawn ([`Detail::impostors_worth_baking`]: a frame's lag) and marks them baked in
+    /// `detail`. Returns how many were baked. On a GPU failure nothing more is planned and the
+    /// error is returned once.
+    pub fn step(&mut self, renderer: &mut Renderer, detail: &mut Detail) -> Result<usize, RenderError> {
         let wanted: Vec<usize> = detail
-            .impostors_worth_baking(eyes, offset_m)
-            .into_iter()
+            .impostors_worth_baking()
+            .iter()
+            .copied()
             .filter(|&i| self.planned.get(i).is_some_and(Option::is_some))
             .take(BAKED_PER_FRAME)
             .collect();

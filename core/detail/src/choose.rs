@@ -125,6 +125,8 @@ pub struct ChoiceView<'a> {
 pub struct Chooser {
     pub params: ChooseParams,
     levels: Vec<u8>,
+    /// Parts whose planned impostor the last choice would have drawn (see [`worth_baking`]).
+    worth_baking: Vec<usize>,
 }
 
 /// The outcome of one [`Chooser::choose`].
@@ -149,6 +151,12 @@ impl Chooser {
         &self.levels
     }
 
+    /// The parts, in order, whose planned (not yet baked) impostor would have been among their
+    /// options in the last choice: the impostors worth baking.
+    pub fn worth_baking(&self) -> &[usize] {
+        &self.worth_baking
+    }
+
     /// Chooses each part's level for `view` within `budget_triangles` per eye (never fewer than
     /// every part's cheapest option).
     pub fn choose(&mut self, parts: &[PartSummary], view: &ChoiceView, budget_triangles: u64) -> ChoiceStats {
@@ -156,8 +164,24 @@ impl Chooser {
         let previous = std::mem::take(&mut self.levels);
         let had_previous = previous.len() == n;
         let weight: Vec<f32> = parts.iter().map(|p| importance(p, view)).collect();
-        // Each part's options worth having, costliest (finest) first.
-        let chains: Vec<Vec<Candidate>> = parts.iter().map(|p| options(p, view, &self.params, false)).collect();
+        // Each part's options worth having, costliest (finest) first; and, from the same
+        // candidates, the planned impostors that would be among them once baked.
+        let mut worth_baking = Vec::new();
+        let chains: Vec<Vec<Candidate>> = parts
+            .iter()
+            .enumerate()
+            .map(|(i, p)| {
+                let all = candidates(p, view, &self.params);
+                if p.impostor.is_none_or(|imp| imp.baked) {
+                    return front(all);
+                }
+                if front(all.clone()).iter().any(|c| c.code == IMPOSTOR_LEVEL) {
+                    worth_baking.push(i);
+                }
+                front(all.into_iter().filter(|c| c.code != IMPOSTOR_LEVEL).collect())
+            })
+            .collect();
+        self.worth_baking = worth_baking;
         let mut pos: Vec<usize> = chains.iter().map(|c| c.len().saturating_sub(1)).collect();
         let mut triangles: u64 = chains
             .iter()
@@ -226,17 +250,28 @@ impl Chooser {
 }
 
 /// Whether `part`'s planned impostor would be one of its options for `view` (no other option
-/// beats it in both cost and error) once baked: the impostors worth making now.
+/// beats it in both cost and error) once baked: an impostor worth making now. (The chooser
+/// records the same for every part as it chooses: [`Chooser::worth_baking`].)
 pub fn worth_baking(part: &PartSummary, view: &ChoiceView, params: &ChooseParams) -> bool {
     part.impostor.is_some_and(|i| !i.baked)
-        && options(part, view, params, true)
+        && front(candidates(part, view, params))
             .iter()
             .any(|c| c.code == IMPOSTOR_LEVEL)
 }
 
 /// `part`'s options for `view` that no other beats in both cost and error, costliest first;
-/// its impostor among them if baked (or, with `planned`, if only planned).
-fn options(part: &PartSummary, view: &ChoiceView, params: &ChooseParams, planned: bool) -> Vec<Candidate> {
+/// its impostor among them only if baked.
+#[cfg(test)]
+fn options(part: &PartSummary, view: &ChoiceView, params: &ChooseParams) -> Vec<Candidate> {
+    let mut all = candidates(part, view, params);
+    if part.impostor.is_some_and(|i| !i.baked) {
+        all.retain(|c| c.code != IMPOSTOR_LEVEL);
+    }
+    front(all)
+}
+
+/// Every way to draw `part` for `view`: its levels and its impostor (planned or baked).
+fn candidates(part: &PartSummary, view: &ChoiceView, params: &ChooseParams) -> Vec<Candidate> {
     // Level codes stop short of the impostor's (a chain that long is not made).
     let mut all: Vec<Candidate> = part
         .levels
@@ -249,13 +284,18 @@ fn options(part: &PartSummary, view: &ChoiceView, params: &ChooseParams, planned
             error_px: projected_error_px(part, l, view),
         })
         .collect();
-    if let Some(imp) = part.impostor.filter(|i| i.baked || planned) {
+    if let Some(imp) = part.impostor {
         all.push(Candidate {
             code: IMPOSTOR_LEVEL,
             cost: impostor_cost(part, &imp, view, params),
             error_px: projected_px(part, imp.error_m, view),
         });
     }
+    all
+}
+
+/// The candidates no other beats in both cost and error, costliest first.
+fn front(mut all: Vec<Candidate>) -> Vec<Candidate> {
     // Cheapest first; keep each option that is more exact than every cheaper one kept.
     all.sort_by(|a, b| a.cost.cmp(&b.cost).then(a.error_px.total_cmp(&b.error_px)));
     let mut kept: Vec<Candidate> = Vec::with_capacity(all.len());
@@ -471,6 +511,7 @@ mod tests {
                 ..ChooseParams::default()
             },
             levels: vec![1, 2],
+            worth_baking: Vec::new(),
         };
         assert_eq!(loose.choose(&parts, &v, budget).switched, 2);
     }
@@ -498,7 +539,7 @@ mod tests {
         // A metre behind the glass the part covers a few thousand pixels: its impostor costs less
         // than its second level and shows less error, so within that budget it is drawn.
         let far = heavy(-1.0);
-        let chain = options(&far, &v, &ChooseParams::default(), false);
+        let chain = options(&far, &v, &ChooseParams::default());
         let imp = chain
             .iter()
             .find(|c| c.code == IMPOSTOR_LEVEL)
@@ -531,7 +572,7 @@ mod tests {
         // At the glass the part is large on screen: every pixel's ray costs more than the
         // triangles it replaces, and the impostor is not an option.
         let near = heavy(-0.01);
-        let chain = options(&near, &v, &ChooseParams::default(), false);
+        let chain = options(&near, &v, &ChooseParams::default());
         assert!(!chain.iter().any(|c| c.code == IMPOSTOR_LEVEL), "{chain:?}");
         let mut chooser = Chooser::default();
         chooser.choose(std::slice::from_ref(&near), &v, 90_000);
@@ -547,5 +588,9 @@ mod tests {
         assert!(worth_baking(&unbaked(&far), &v, &ChooseParams::default()));
         assert!(!worth_baking(&unbaked(&near), &v, &ChooseParams::default()));
         assert!(!worth_baking(&far, &v, &ChooseParams::default()), "baked already");
+        // The chooser records the same as it chooses.
+        let mut chooser = Chooser::default();
+        chooser.choose(&[unbaked(&near), unbaked(&far), far.clone()], &v, 90_000);
+        assert_eq!(chooser.worth_baking(), &[1]);
     }
 }

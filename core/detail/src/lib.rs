@@ -305,20 +305,10 @@ impl Detail {
         }
     }
 
-    /// The parts whose planned impostors the chooser would draw in the view of `eyes` (see
-    /// [`choose::worth_baking`]), in the parts' order.
-    pub fn impostors_worth_baking(&self, eyes: &[&OffAxisProjection], offset_m: Vec3) -> Vec<usize> {
-        let image_px = eyes.first().map_or(Vec2::ONE, |e| e.image_px());
-        let view = ChoiceView {
-            eyes,
-            offset_m,
-            attention_px: image_px * 0.5,
-            attention_reach_px: image_px.length() * 0.5,
-        };
-        let params = self.chooser.params;
-        (0..self.parts.len())
-            .filter(|&i| choose::worth_baking(&self.parts[i], &view, &params))
-            .collect()
+    /// The parts whose planned impostors the last [`Detail::choose`] would have drawn, in
+    /// order ([`Chooser::worth_baking`]): the impostors worth baking now.
+    pub fn impostors_worth_baking(&self) -> &[usize] {
+        self.chooser.worth_baking()
     }
 
     /// The parts the chooser weighs, one per model primitive.
