@@ -63,7 +63,8 @@ impl Fades {
                 }
             }
         }
-        self.previous = levels.to_vec();
+        self.previous.clear();
+        self.previous.extend_from_slice(levels);
         fades
     }
 }

@@ -210,7 +210,8 @@ fn array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 }
 
 impl crate::Renderer {
-    fn impostor_pipelines(&mut self) -> &ImpostorPipelines {
+    /// Makes the impostors' pipelines if they are not made yet.
+    fn make_impostor_pipelines(&mut self) {
         if self.impostor_pipelines.is_none() {
             let device = &self.gpu.device;
             let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -370,7 +371,6 @@ impl crate::Renderer {
                 face_binds,
             });
         }
-        self.impostor_pipelines.as_ref().expect("made above")
     }
 
     /// Bakes an impostor for each `(primitive, box)` of the model set (primitives by index in the
@@ -381,9 +381,7 @@ impl crate::Renderer {
     /// ([`crate::Renderer::set_model`], [`crate::Renderer::update_vertices`]).
     pub fn bake_impostors(&mut self, boxes: &[(usize, ImpostorBox)]) -> Result<u64, crate::RenderError> {
         let device = self.gpu.device.clone();
-        crate::checked(&device, "the impostors' pipelines", || {
-            self.impostor_pipelines();
-        })?;
+        crate::checked(&device, "the impostors' pipelines", || self.make_impostor_pipelines())?;
         let mut bytes = 0;
         for &(source, bounds) in boxes {
             let blended = self
@@ -456,7 +454,7 @@ impl crate::Renderer {
                 view_formats: &[],
             })
             .create_view(&Default::default());
-        self.impostor_pipelines();
+        // Made by `bake_impostors` before.
         let pipelines = self.impostor_pipelines.as_ref()?;
         for (face, buffer) in pipelines.face_buffers.iter().enumerate() {
             let uniform = crate::EyeUniform {

@@ -1674,7 +1674,10 @@ fn create_compose_pipeline(
 
 impl Renderer {
     /// `levels` with each impostor drawn replaced by the level its shadow is cast with.
-    fn shadow_levels(&self, levels: &[u8]) -> Vec<u8> {
+    fn shadow_levels<'l>(&self, levels: &'l [u8]) -> std::borrow::Cow<'l, [u8]> {
+        if self.model.impostors.is_empty() {
+            return std::borrow::Cow::Borrowed(levels);
+        }
         levels
             .iter()
             .enumerate()
@@ -1682,7 +1685,8 @@ impl Renderer {
                 Some(Some(imp)) if l == IMPOSTOR_LEVEL => imp.shadow_level,
                 _ => l,
             })
-            .collect()
+            .collect::<Vec<u8>>()
+            .into()
     }
 
     /// The impostor `levels` draws for `p` in place of its triangles, if any.
@@ -1703,6 +1707,10 @@ impl Renderer {
     /// model, or a second one of a primitive, is ignored.
     fn write_fades(&mut self, fades: &[LevelFade]) -> std::collections::HashMap<usize, usize> {
         let mut by_primitive = std::collections::HashMap::new();
+        if fades.is_empty() {
+            // Entry 0 (no fade) is zero from the buffer's creation and every write.
+            return by_primitive;
+        }
         let mut data: Vec<[f32; 2]> = vec![[0.0, 0.0]; 2 * fades.len() + 1];
         for (k, f) in fades.iter().enumerate() {
             let source = f.primitive as usize;
