@@ -295,6 +295,35 @@ fn ward_lobe(l: vec3<f32>, v: vec3<f32>, t: vec3<f32>, b: vec3<f32>, n: vec3<f32
     return dot(h, h) / (PI * alpha.x * alpha.y * hn * hn * hn * hn) * exp(-(hx * hx + hy * hy) / (hn * hn));
 }
 
+// The image light of the Ward lobe (unit albedo) towards v, with v and the frame (t, b, n) in the
+// mesh's space: eight reads of the prefiltered level of the shorter roughness, about the mirror
+// directions of half vectors tilted along the longer axis by the nodes of a one-dimensional
+// Gaussian of the remaining slope (ibl/anisotropic.rs, its reference and measurements). Taps
+// below the surface are left out; a round lobe reads the mirror direction eight times.
+fn ward_image_light(v: vec3<f32>, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, alpha: vec2<f32>) -> vec3<f32> {
+    // WARD_TAP_NODES: Φ⁻¹((k + ½)/8) scaled to unit variance.
+    var nodes = array<f32, 8>(-1.66312, -0.96171, -0.52991, -0.17053, 0.17053, 0.52991, 0.96171, 1.66312);
+    let short = min(alpha.x, alpha.y);
+    let long = max(alpha.x, alpha.y);
+    let spread = sqrt(max((long * long - short * short) * 0.5, 0.0));
+    let axis = select(b, t, alpha.x > alpha.y);
+    let lod = clamp(sqrt(short), 0.0, 1.0) * PREFILTERED_MAX_LEVEL;
+    var sum = vec3<f32>(0.0);
+    var kept = 0.0;
+    for (var k = 0u; k < 8u; k = k + 1u) {
+        let h = normalize(n + axis * (nodes[k] * spread));
+        let l = reflect(-v, h);
+        if (dot(l, n) > 0.0) {
+            sum = sum + textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(to_world(l)), lod).rgb;
+            kept = kept + 1.0;
+        }
+    }
+    if (kept == 0.0) {
+        return textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(to_world(reflect(-v, n))), lod).rgb;
+    }
+    return sum / kept;
+}
+
 fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
@@ -454,8 +483,9 @@ fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
     if (look.ward_rho_d.w > 0.5) {
         // Ward: ρd (times the base colour) / π + ρs · lobe along the tangent frame (any frame
         // about n where the mesh has no tangents: the lobe is then isotropic in effect only if
-        // αx = αy). Its image-based light takes the prefiltered map at the GGX roughness of the
-        // same RMS slope, sqrt(sqrt(αx αy)), and the split sum with F0 = 1 for the lobe's albedo.
+        // αx = αy). Its image-based light: the lobe's shape from `ward_image_light`, its albedo
+        // from the split sum with F0 = 1 at the GGX roughness of the same RMS slope,
+        // sqrt(sqrt(αx αy)).
         var tw = t - n * dot(n, t);
         if (dot(tw, tw) < 1e-8) {
             tw = cross(select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9), n);
@@ -469,7 +499,7 @@ fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
         let rough_eq = clamp(sqrt(sqrt(look.ward_alpha.x * look.ward_alpha.y)), 0.045, 1.0);
         let lut_uv = clamp(vec2<f32>(n_dot_v, rough_eq), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
-        let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), rough_eq * PREFILTERED_MAX_LEVEL).rgb;
+        let prefiltered = ward_image_light(v, n, tw, bw, look.ward_alpha.xy);
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * (scale_bias.x + scale_bias.y);
     } else {
         let f0 = mix(vec3<f32>(0.04 * look.tint.w), base, metallic);

@@ -158,3 +158,33 @@ fn a_change_that_cannot_be_saved_is_shown_and_reported() {
     assert!(err.to_string().contains("could not be saved"), "{err}");
     assert_eq!(engine.appearance(), lacquer, "shown all the same");
 }
+
+#[test]
+fn ward_image_light_on_the_shared_rooms() {
+    // The anisotropic read of the image light (ibl/anisotropic.rs) checked where its taps were
+    // not chosen: every shared room, brushed metal's and silk's lobes, against a Monte-Carlo
+    // integral of the lobe over the room. It must beat the round read it replaced on each.
+    use phantogram::ibl::{Environment, accuracy::read_errors};
+    use phantogram::ward::WardLobe;
+    let Some(dir) = phantogram_integration::data_subdir("env") else {
+        eprintln!("PHANTOGRAM_DATA not set: skipping the Ward image-light check on the shared rooms");
+        return;
+    };
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("env folder")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "hdr" || e == "exr"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no environments in {}", dir.display());
+    for path in &files {
+        let env = Environment::load(path).expect("environment");
+        for (name, preset) in [("brushed", WardPreset::BrushedMetal), ("silk", WardPreset::Silk)] {
+            let m = preset.material();
+            let e = read_errors(&env, WardLobe::new(m.alpha_x, m.alpha_y), 80);
+            let file = path.file_name().unwrap_or_default().to_string_lossy();
+            println!("{file:28} {name:8} round {:.3} tapped {:.3}", e.round, e.tapped);
+            assert!(e.tapped < e.round, "{file} {name}: {e:?}");
+        }
+    }
+}

@@ -2024,6 +2024,23 @@ mod tests {
     }
 
     #[test]
+    fn the_shader_taps_a_ward_lobe_where_its_reference_does() {
+        // `ward_image_light` in scene.wgsl holds its own copy of the nodes (WGSL has no shared
+        // constants with Rust); they must be the reference's.
+        let start = SCENE_WGSL
+            .find("var nodes = array<f32, 8>(")
+            .expect("nodes in scene.wgsl");
+        let list = &SCENE_WGSL[start..];
+        let list = &list[list.find('(').expect("open") + 1..list.find(')').expect("close")];
+        let nodes: Vec<f32> = list.split(',').map(|x| x.trim().parse().expect("a number")).collect();
+        let reference = phantogram_assets::ibl::WARD_TAP_NODES;
+        assert_eq!(nodes.len(), reference.len());
+        for (a, b) in nodes.iter().zip(reference) {
+            assert!((a - b).abs() < 1e-4, "{nodes:?} vs {reference:?}");
+        }
+    }
+
+    #[test]
     fn mips_average_colour_in_linear_light() {
         // A 2×1 image, black and white: the 1×1 mip is 50 % linear grey (188 in sRGB), not 128.
         let levels = mip_chain(2, 1, &[0, 0, 0, 255, 255, 255, 255, 255], true);

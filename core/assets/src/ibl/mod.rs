@@ -23,13 +23,18 @@
 //! and return when done.
 //!
 //! Files: [`sh`] (the irradiance's nine coefficients), [`prefilter`] (the specular levels and
-//! the split-sum table); this one holds the environment map itself.
+//! the split-sum table), [`anisotropic`] (a Ward lobe's light read from those levels),
+//! [`accuracy`] (that read against a Monte-Carlo integral); this one holds the environment map
+//! itself.
 
 use glam::Vec3;
 
+pub mod accuracy;
+pub mod anisotropic;
 pub mod prefilter;
 pub mod sh;
 
+pub use anisotropic::{WARD_IMAGE_LIGHT_TAPS, WARD_TAP_NODES, WardImageLight, sample_levels};
 pub use prefilter::{PREFILTER_LEVELS, brdf_lut, prefiltered_levels};
 pub use sh::IrradianceSh;
 

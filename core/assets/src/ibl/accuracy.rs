@@ -1,0 +1,153 @@
+//! How close the renderer's image light of a Ward lobe ([`super::anisotropic`]) comes to the
+//! truth: a Monte-Carlo integral of the lobe over the environment, compared with the tapped read
+//! and with the single round read the renderer made before, over a spread of surface frames and
+//! views. Used by the tests here and by the integration tests over the shared rooms.
+//!
+//! Pure functions; slow (thousands of samples per case), no panics.
+
+use glam::Vec3;
+
+use super::anisotropic::{WardImageLight, sample_levels};
+use super::{Environment, prefiltered_levels};
+use crate::ward::WardLobe;
+
+/// Relative RMS error (luminance) of the two reads, each scaled by the lobe's true directional
+/// albedo so that only the direction-dependent part (what the split sum's table does not hold)
+/// is compared.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ReadErrors {
+    /// One read of the level at the lobe's geometric-mean roughness about the mirror direction.
+    pub round: f32,
+    /// [`WardImageLight`]'s taps.
+    pub tapped: f32,
+}
+
+/// The `i`-th of `n` points of a 2-D low-discrepancy set (Hammersley, centred).
+fn hammersley(i: u32, n: u32) -> (f32, f32) {
+    (
+        (i as f32 + 0.5) / n as f32,
+        (i.reverse_bits() as f64 / 4_294_967_296.0) as f32,
+    )
+}
+
+/// A world-from-surface frame: tangent, bitangent, normal.
+#[derive(Clone, Copy)]
+struct Frame {
+    t: Vec3,
+    b: Vec3,
+    n: Vec3,
+}
+
+impl Frame {
+    fn world(&self, d: Vec3) -> Vec3 {
+        self.t * d.x + self.b * d.y + self.n * d.z
+    }
+}
+
+/// A deterministic spread of frames and views: normals over the sphere, tangents turned about
+/// them by the golden angle, views from 15° to 75° off the normal at every azimuth.
+fn cases(count: usize) -> Vec<(Frame, Vec3)> {
+    (0..count)
+        .map(|i| {
+            let (u1, u2) = hammersley(i as u32, count as u32);
+            let z = 1.0 - 2.0 * u1;
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let phi = std::f32::consts::TAU * u2;
+            let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let helper = if n.z.abs() < 0.9 { Vec3::Z } else { Vec3::X };
+            let t0 = helper.cross(n).normalize();
+            let turn = 2.399_963 * i as f32;
+            let t = (t0 * turn.cos() + n.cross(t0) * turn.sin()).normalize();
+            let b = n.cross(t);
+            let elevation = (15.0 + 60.0 * ((i * 7 % 11) as f32 / 10.0)).to_radians();
+            let azimuth = 1.3 * i as f32;
+            let v = Vec3::new(
+                elevation.sin() * azimuth.cos(),
+                elevation.sin() * azimuth.sin(),
+                elevation.cos(),
+            );
+            (Frame { t, b, n }, v)
+        })
+        .collect()
+}
+
+/// Monte-Carlo radiance reflected by the unit-albedo lobe towards `v`, and the lobe's
+/// directional albedo (the same samples under a white environment).
+fn reference(env: &Environment, lobe: WardLobe, frame: Frame, v: Vec3, samples: u32) -> ([f32; 3], f32) {
+    let mut sum = [0.0f64; 3];
+    let mut albedo = 0.0f64;
+    for i in 0..samples {
+        let (u1, u2) = hammersley(i, samples);
+        if let Some((l, pdf)) = lobe.sample(v, u1, u2) {
+            let w = (lobe.eval(l, v) * l.z / pdf.max(1e-12)) as f64;
+            let c = env.sample(frame.world(l));
+            for ch in 0..3 {
+                sum[ch] += c[ch] as f64 * w;
+            }
+            albedo += w;
+        }
+    }
+    let n = samples as f64;
+    (sum.map(|s| (s / n) as f32), (albedo / n) as f32)
+}
+
+fn luminance(c: [f32; 3]) -> f32 {
+    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
+}
+
+/// Both reads' errors for `lobe` under `env` over `count` frames and views (2048 samples each
+/// for the truth; levels prefiltered at the renderer's 256-texel base width).
+pub fn read_errors(env: &Environment, lobe: WardLobe, count: usize) -> ReadErrors {
+    let levels = prefiltered_levels(env, 256);
+    let light = WardImageLight::for_lobe(lobe);
+    let (mut round, mut tapped, mut norm) = (0.0f64, 0.0f64, 0.0f64);
+    for (frame, v) in cases(count) {
+        let (truth, albedo) = reference(env, lobe, frame, v, 2048);
+        let truth = luminance(truth) as f64;
+        let mirror = Vec3::new(-v.x, -v.y, v.z);
+        let round_read = sample_levels(
+            &levels,
+            frame.world(mirror),
+            (lobe.alpha_x * lobe.alpha_y).sqrt().sqrt(),
+        );
+        let mut tapped_read = 0.0f32;
+        for (l, w) in light.taps(v) {
+            tapped_read += luminance(sample_levels(&levels, frame.world(l), light.level_roughness)) * w;
+        }
+        round += ((luminance(round_read) * albedo) as f64 - truth).powi(2);
+        tapped += ((tapped_read * albedo) as f64 - truth).powi(2);
+        norm += truth * truth;
+    }
+    let norm = norm.max(1e-30);
+    ReadErrors {
+        round: (round / norm).sqrt() as f32,
+        tapped: (tapped / norm).sqrt() as f32,
+    }
+}
+
+/// A dim sky with a small bright sun (2° across) and a thin bright band along half the horizon:
+/// the light whose reflection a brushed surface stretches into a streak.
+pub fn sun_and_band() -> Environment {
+    let (width, height) = (512, 256);
+    let mut env = Environment {
+        width,
+        height,
+        texels: vec![[0.0; 3]; width * height],
+    };
+    let sun = Vec3::new(0.5, 0.3, 0.81).normalize();
+    let sun_cos = 1f32.to_radians().cos();
+    for y in 0..height {
+        for x in 0..width {
+            let d = env.direction(x, y);
+            let mut c = [0.2 + 0.1 * d.z.max(0.0); 3];
+            if d.dot(sun) > sun_cos {
+                c = [200.0; 3];
+            }
+            if d.z.abs() < 0.03 && d.x > 0.0 {
+                c = [8.0; 3];
+            }
+            env.texels[y * width + x] = c;
+        }
+    }
+    env
+}
