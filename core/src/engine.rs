@@ -803,11 +803,18 @@ impl Engine {
         if let Some(q) = device_to_world {
             worker.set_orientation(q);
         }
+        // Where the GPU convolves the specular levels, the worker leaves them to it.
+        worker.set_prefilter_on_gpu(self.renderer.prefilters_on_gpu());
         if let Some(update) = worker.take_update() {
             self.stats.room_light_updates += 1;
             self.stats.room_light_coverage = update.coverage;
             // A failed upload keeps the light there was; the next update tries again.
-            let _ = self.renderer.set_prefiltered_environment(&update.levels, &update.sh);
+            let _ = match &update.specular {
+                crate::room_light::Specular::Base(base) => self.renderer.set_environment_base(base, &update.sh),
+                crate::room_light::Specular::Levels(levels) => {
+                    self.renderer.set_prefiltered_environment(levels, &update.sh)
+                }
+            };
         }
     }
 

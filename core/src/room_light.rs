@@ -1,8 +1,11 @@
 //! The live room light as the engine runs it: camera frames go to a worker thread that blends
 //! them into the room map (`phantogram_roomlight`) with the device's orientation at that moment,
-//! and every [`UPDATE_INTERVAL_NS`] of camera time reduces the map to the image-based light (nine
-//! SH coefficients and the specular levels, tens of milliseconds on the CPU), which the render
-//! thread then only uploads ([`crate::render::Renderer::set_prefiltered_environment`]).
+//! and every [`UPDATE_INTERVAL_NS`] of camera time reduces the map to the image-based light: nine
+//! SH coefficients and the specular levels' level 0, and — unless the render thread said its GPU
+//! convolves them ([`RoomLightWorker::set_prefilter_on_gpu`]) — the rough levels too, tens of
+//! milliseconds on the CPU. The render thread then only uploads
+//! ([`crate::render::Renderer::set_environment_base`], which dispatches the GPU's convolution, or
+//! [`crate::render::Renderer::set_prefiltered_environment`]).
 //!
 //! **Colour and exposure**: a YUV frame (luma with its chroma planes, as the bridges hand it over)
 //! is turned into colour here, on the worker, never on the camera's thread; a luma-only frame
@@ -22,7 +25,7 @@
 use std::sync::{Arc, Condvar, Mutex};
 
 use glam::Quat;
-use phantogram_assets::ibl::{Environment, IrradianceSh, prefiltered_levels};
+use phantogram_assets::ibl::{Environment, IrradianceSh, prefilter_base, prefiltered_levels};
 use phantogram_roomlight::{CaptureFrame, CaptureParams, RoomCapture, world_from_buffer_camera};
 use phantogram_sensing::camera::{CameraPose, Exposure, OwnedFrame};
 
@@ -34,12 +37,20 @@ const EXPOSURES_KEPT: usize = 32;
 
 /// A new image-based light made from the room map.
 pub struct RoomLightUpdate {
-    pub levels: Vec<Environment>,
+    pub specular: Specular,
     pub sh: IrradianceSh,
     /// Share of the sphere the map has seen, 0 to 1.
     pub coverage: f32,
     /// Frames blended so far.
     pub frames: u64,
+}
+
+/// The specular image light of an update, as far as the worker reduced it.
+pub enum Specular {
+    /// Level 0 only ([`prefilter_base`]): the renderer's GPU convolves the rest.
+    Base(Environment),
+    /// Every level ([`prefiltered_levels`]), convolved on the worker.
+    Levels(Vec<Environment>),
 }
 
 /// One camera frame waiting for the worker.
@@ -67,6 +78,8 @@ struct Shared {
     busy: bool,
     /// Off: frames handed over are dropped (the settings' studio light); the map is kept.
     off: bool,
+    /// The renderer convolves the rough specular levels on its GPU: updates carry level 0 only.
+    prefilter_on_gpu: bool,
     stop: bool,
 }
 
@@ -143,6 +156,12 @@ impl RoomLightWorker {
 
     pub fn is_on(&self) -> bool {
         !self.lock().off
+    }
+
+    /// Whether the render thread convolves the rough specular levels on its GPU
+    /// ([`crate::render::Renderer::prefilters_on_gpu`]); until told so, the worker does.
+    pub fn set_prefilter_on_gpu(&self, on_gpu: bool) {
+        self.lock().prefilter_on_gpu = on_gpu;
     }
 
     /// The device's orientation now (device → world), for the frames that follow.
@@ -245,12 +264,17 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
         let added = capture.add(&frame).is_ok();
         let t = image.capture_t_ns;
         let due = added && last_update_t_ns.is_none_or(|last| t.saturating_sub(last) >= UPDATE_INTERVAL_NS || t < last);
+        let on_gpu = lock().prefilter_on_gpu;
         let update = due.then(|| {
             last_update_t_ns = Some(t);
             let env = capture.environment();
             RoomLightUpdate {
                 sh: IrradianceSh::from_environment(&env),
-                levels: prefiltered_levels(&env, base_width),
+                specular: if on_gpu {
+                    Specular::Base(prefilter_base(&env, base_width))
+                } else {
+                    Specular::Levels(prefiltered_levels(&env, base_width))
+                },
                 coverage: capture.coverage(),
                 frames: capture.frames(),
             }
@@ -313,8 +337,17 @@ mod tests {
             assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
             if let Some(u) = worker.take_update() {
                 made += 1;
-                assert_eq!(u.levels.len(), phantogram_assets::ibl::PREFILTER_LEVELS);
+                // The first on the CPU, every level; then the renderer says its GPU convolves
+                // them, and the second carries level 0 alone.
+                match (made, &u.specular) {
+                    (1, Specular::Levels(levels)) => {
+                        assert_eq!(levels.len(), phantogram_assets::ibl::PREFILTER_LEVELS)
+                    }
+                    (2, Specular::Base(base)) => assert_eq!((base.width, base.height), (64, 32)),
+                    _ => panic!("update {made} is not what was asked for"),
+                }
                 assert!(u.coverage > 0.05 && u.sh.irradiance(Vec3::Z)[0] > 0.0);
+                worker.set_prefilter_on_gpu(true);
             }
         }
         // Frames at 0, 0.2, … 1.0 s: an update with the first, then at least 0.5 s later (0.6 s).

@@ -61,6 +61,7 @@ mod gpu;
 mod gpu_timer;
 pub mod impostor;
 mod lighting_tables;
+pub mod prefilter_gpu;
 pub mod surface;
 mod upload;
 
@@ -778,6 +779,8 @@ pub struct Renderer {
     /// entries 2k + 1, the new level's, and 2k + 2, the old one's), and its size in entries.
     fade_buffer: wgpu::Buffer,
     fade_entries: u64,
+    /// The GPU prefilter: `None` until first asked for, then whether the device has one.
+    gpu_prefilter: Option<Option<prefilter_gpu::GpuPrefilter>>,
 }
 
 impl Renderer {
@@ -1030,6 +1033,7 @@ impl Renderer {
             impostor_pipelines: None,
             fade_buffer: fade_instance_buffer(&gpu.device, FADE_ENTRIES_AT_FIRST),
             fade_entries: FADE_ENTRIES_AT_FIRST,
+            gpu_prefilter: None,
             gpu,
         }
     }
@@ -1054,13 +1058,54 @@ impl Renderer {
 
     /// Lights the scene with `env` (world frame) instead of the generated studio.
     ///
-    /// Prefilters the environment for specular light on the CPU (a few tens of milliseconds in
-    /// release builds for the default 256-wide base level); a live room light does that on its
-    /// own thread and hands the result to [`Self::set_prefiltered_environment`].
+    /// Prefilters the environment for specular light on the GPU where the device can
+    /// ([`Self::prefilters_on_gpu`]), else on the CPU (a few tens of milliseconds in release
+    /// builds for the default 256-wide base level); a live room light reduces the environment on
+    /// its own thread and hands the result to [`Self::set_environment_base`] or
+    /// [`Self::set_prefiltered_environment`].
     pub fn set_environment(&mut self, env: &phantogram_assets::ibl::Environment) -> Result<(), RenderError> {
         let sh = phantogram_assets::ibl::IrradianceSh::from_environment(env);
-        let levels = phantogram_assets::ibl::prefiltered_levels(env, PREFILTERED_BASE_WIDTH);
-        self.set_prefiltered_environment(&levels, &sh)
+        let base = phantogram_assets::ibl::prefilter_base(env, PREFILTERED_BASE_WIDTH);
+        self.set_environment_base(&base, &sh)
+    }
+
+    /// Whether this renderer convolves the specular levels on the GPU ([`prefilter_gpu`]); made
+    /// on the first call (a compute pipeline).
+    pub fn prefilters_on_gpu(&mut self) -> bool {
+        let gpu = &self.gpu;
+        self.gpu_prefilter
+            .get_or_insert_with(|| prefilter_gpu::GpuPrefilter::new(gpu))
+            .is_some()
+    }
+
+    /// Lights the scene with an environment given by its level 0 (from
+    /// [`phantogram_assets::ibl::prefilter_base`] at [`PREFILTERED_BASE_WIDTH`]) and irradiance:
+    /// the rough levels are convolved on the GPU where it can, else here on the CPU.
+    pub fn set_environment_base(
+        &mut self,
+        base: &phantogram_assets::ibl::Environment,
+        sh: &phantogram_assets::ibl::IrradianceSh,
+    ) -> Result<(), RenderError> {
+        if self.prefilters_on_gpu()
+            && let Some(Some(prefilter)) = &self.gpu_prefilter
+        {
+            let texture = prefilter.run(&self.gpu, base)?;
+            self.environment_sh = sh.shader_coefficients();
+            let device = self.gpu.device.clone();
+            return checked(&device, "the environment map", || {
+                self.ibl = IblTextures::with_texture(&self.gpu, &texture);
+                self.eye_bind = eye_bind_groups(
+                    &device,
+                    &self.eye_layout,
+                    &self.eye_buffers,
+                    &self.shadow_view,
+                    &self.shadow_sampler,
+                    &self.ibl,
+                );
+            });
+        }
+        let levels = phantogram_assets::ibl::prefiltered_levels(base, PREFILTERED_BASE_WIDTH);
+        self.set_prefiltered_environment(&levels, sh)
     }
 
     /// Lights the scene with `environment`, or the generated studio when `None` (whose reduction
@@ -1086,6 +1131,16 @@ impl Renderer {
         levels: &[phantogram_assets::ibl::Environment],
         sh: &phantogram_assets::ibl::IrradianceSh,
     ) -> Result<(), RenderError> {
+        if levels.is_empty()
+            || levels
+                .iter()
+                .any(|l| l.width == 0 || l.height == 0 || l.texels.len() != l.width * l.height)
+        {
+            return Err(RenderError::Gpu {
+                what: "the environment map",
+                message: "no levels, or a level whose texels do not fill it".into(),
+            });
+        }
         self.environment_sh = sh.shader_coefficients();
         let device = self.gpu.device.clone();
         checked(&device, "the environment map", || {
@@ -1940,6 +1995,7 @@ mod tests {
         }
         assert!(n >= 2, "found {n} shaders in {}", dir.display());
         validate("scene", SCENE_WGSL);
+        validate("prefilter", prefilter_gpu::PREFILTER_WGSL);
         validate("compose", COMPOSE_WGSL);
         validate("impostor_dilate", impostor::IMPOSTOR_DILATE_WGSL);
     }

@@ -63,50 +63,23 @@ pub(super) struct IblTextures {
 impl IblTextures {
     /// Uploads `levels` (from [`phantogram_assets::ibl::prefiltered_levels`], a mip chain) and the BRDF table.
     pub(super) fn new(gpu: &Gpu, levels: &[phantogram_assets::ibl::Environment]) -> Self {
-        let (device, queue) = (&gpu.device, &gpu.queue);
-        let texture = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("prefiltered environment"),
-            size: wgpu::Extent3d {
-                width: levels[0].width as u32,
-                height: levels[0].height as u32,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: levels.len() as u32,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rgba16Float,
-            usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-            view_formats: &[],
-        });
+        let texture = prefiltered_texture(
+            &gpu.device,
+            levels[0].width as u32,
+            levels[0].height as u32,
+            levels.len() as u32,
+            wgpu::TextureUsages::empty(),
+        );
         for (k, level) in levels.iter().enumerate() {
-            let bytes: Vec<u8> = level
-                .texels
-                .iter()
-                .flat_map(|t| [t[0], t[1], t[2], 1.0])
-                // f16 saturates at 65504: clamp so a very bright sun stays finite.
-                .map(|c| half::f16::from_f32(c.min(65_000.0)))
-                .flat_map(|h| h.to_le_bytes())
-                .collect();
-            queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: k as u32,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                &bytes,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(8 * level.width as u32),
-                    rows_per_image: Some(level.height as u32),
-                },
-                wgpu::Extent3d {
-                    width: level.width as u32,
-                    height: level.height as u32,
-                    depth_or_array_layers: 1,
-                },
-            );
+            write_level(&gpu.queue, &texture, k as u32, level);
         }
+        Self::with_texture(gpu, &texture)
+    }
+
+    /// The prefiltered environment `texture` (made by [`prefiltered_texture`] and filled) and the
+    /// BRDF table.
+    pub(super) fn with_texture(gpu: &Gpu, texture: &wgpu::Texture) -> Self {
+        let (device, queue) = (&gpu.device, &gpu.queue);
         let lut = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("split-sum BRDF table"),
             size: wgpu::Extent3d {
@@ -156,4 +129,65 @@ impl IblTextures {
             sampler,
         }
     }
+}
+
+/// An `Rgba16Float` texture for a prefiltered environment of `levels` mip levels, sampled by the
+/// scene shader and written by uploads, plus `extra` uses (the GPU prefilter's storage writes).
+pub(super) fn prefiltered_texture(
+    device: &wgpu::Device,
+    width: u32,
+    height: u32,
+    levels: u32,
+    extra: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("prefiltered environment"),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: levels,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba16Float,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST | extra,
+        view_formats: &[],
+    })
+}
+
+/// Writes `level` into mip `mip` of an `Rgba16Float` texture.
+pub(super) fn write_level(
+    queue: &wgpu::Queue,
+    texture: &wgpu::Texture,
+    mip: u32,
+    level: &phantogram_assets::ibl::Environment,
+) {
+    let bytes: Vec<u8> = level
+        .texels
+        .iter()
+        .flat_map(|t| [t[0], t[1], t[2], 1.0])
+        // f16 saturates at 65504: clamp so a very bright sun stays finite.
+        .map(|c| half::f16::from_f32(c.min(65_000.0)))
+        .flat_map(|h| h.to_le_bytes())
+        .collect();
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: mip,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        &bytes,
+        wgpu::TexelCopyBufferLayout {
+            offset: 0,
+            bytes_per_row: Some(8 * level.width as u32),
+            rows_per_image: Some(level.height as u32),
+        },
+        wgpu::Extent3d {
+            width: level.width as u32,
+            height: level.height as u32,
+            depth_or_array_layers: 1,
+        },
+    );
 }

@@ -35,7 +35,9 @@ pub mod prefilter;
 pub mod sh;
 
 pub use anisotropic::{WARD_IMAGE_LIGHT_TAPS, WARD_TAP_NODES, WardImageLight, sample_levels};
-pub use prefilter::{PREFILTER_LEVELS, brdf_lut, prefiltered_levels};
+pub use prefilter::{
+    PREFILTER_LEVELS, PREFILTER_SAMPLES, brdf_lut, prefilter_base, prefilter_base_width, prefiltered_levels,
+};
 pub use sh::IrradianceSh;
 
 /// Widest environment [`Environment::load`] reads: 4096 × 2048 (128 MiB as RGBA floats while
@@ -188,7 +190,7 @@ impl Environment {
     }
 
     /// Half the resolution, each texel the mean of four (keeps the integral for prefiltering).
-    pub(crate) fn downsampled(&self) -> Self {
+    pub fn downsampled(&self) -> Self {
         let (w, h) = ((self.width / 2).max(2), (self.height / 2).max(1));
         let mut texels = vec![[0.0f32; 3]; w * h];
         for y in 0..h {

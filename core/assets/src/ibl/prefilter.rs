@@ -24,34 +24,53 @@ fn ggx_half_vector(u1: f32, u2: f32, alpha: f32, n: Vec3) -> Vec3 {
     (t * (sin_theta * phi.cos()) + b * (sin_theta * phi.sin()) + n * cos_theta).normalize()
 }
 
-/// The environment convolved with the GGX lobe: level `k` (roughness `k / (LEVELS − 1)`) at
-/// `base_width / 2^k` × `base_width / 2^(k+1)`, so the levels form the first [`PREFILTER_LEVELS`]
-/// levels of a texture mip chain. Level 0 is the environment itself, resampled to
-/// `base_width × base_width / 2`.
-///
-/// `base_width` is rounded up to a power of two of at least `2^PREFILTER_LEVELS` so that every
-/// level has whole texels.
-pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environment> {
-    let base_width = base_width.max(1 << PREFILTER_LEVELS).next_power_of_two();
+/// Width of [`prefiltered_levels`]' sharpest level for a requested `base_width`: a power of two
+/// of at least `2^PREFILTER_LEVELS`, so that every level has whole texels.
+pub fn prefilter_base_width(base_width: usize) -> usize {
+    base_width.max(1 << PREFILTER_LEVELS).next_power_of_two()
+}
+
+/// Level 0 of [`prefiltered_levels`]: the environment resampled to
+/// [`prefilter_base_width`]` × half that` (box-filtered down first where it is at least twice as
+/// wide). Every rougher level is convolved from it and its box-filtered halvings
+/// ([`Environment::downsampled`]), on the CPU here or on the GPU by the renderer.
+pub fn prefilter_base(env: &Environment, base_width: usize) -> Environment {
+    let base_width = prefilter_base_width(base_width);
     // Sample from a source a little coarser than each level, so few samples suffice.
     let mut source = env.clone();
     while source.width >= 2 * base_width && source.width > 8 {
         source = source.downsampled();
     }
-    if source.width != base_width || source.height != base_width / 2 {
-        let mut level0 = Environment {
-            width: base_width,
-            height: base_width / 2,
-            texels: Vec::new(),
-        };
-        level0.texels = (0..level0.height)
-            .flat_map(|y| (0..level0.width).map(move |x| (x, y)))
-            .map(|(x, y)| source.sample(level0.direction(x, y)))
-            .collect();
-        source = level0;
+    if source.width == base_width && source.height == base_width / 2 {
+        return source;
     }
+    let mut level0 = Environment {
+        width: base_width,
+        height: base_width / 2,
+        texels: Vec::new(),
+    };
+    level0.texels = (0..level0.height)
+        .flat_map(|y| (0..level0.width).map(move |x| (x, y)))
+        .map(|(x, y)| source.sample(level0.direction(x, y)))
+        .collect();
+    level0
+}
+
+/// GGX samples per texel of a rough level (Hammersley points; the GPU path uses the same).
+pub const PREFILTER_SAMPLES: u32 = 96;
+
+/// The environment convolved with the GGX lobe: level `k` (roughness `k / (LEVELS − 1)`) at
+/// `base_width / 2^k` × `base_width / 2^(k+1)`, so the levels form the first [`PREFILTER_LEVELS`]
+/// levels of a texture mip chain. Level 0 is [`prefilter_base`]; level `k ≥ 1` reads the
+/// halving of level 0 twice its width (bilinear), [`PREFILTER_SAMPLES`] GGX samples a texel
+/// weighted by n·l.
+///
+/// `base_width` is rounded up as [`prefilter_base_width`] says.
+pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environment> {
+    let base_width = prefilter_base_width(base_width);
+    let mut source = prefilter_base(env, base_width);
     let mut levels = vec![source.clone()];
-    let samples = 96u32;
+    let samples = PREFILTER_SAMPLES;
     for k in 1..PREFILTER_LEVELS {
         let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
         let alpha = roughness * roughness;

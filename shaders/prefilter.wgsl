@@ -1,0 +1,60 @@
+// The specular image light's rough levels on the GPU (core/render/src/prefilter_gpu.rs): one
+// level of the prefiltered environment, roughness² = `alpha`, convolved from the box-filtered
+// halving of level 0 at `source_level` (twice the target's width) with the same 96 Hammersley GGX
+// samples a texel and the same n·l weights as phantogram_assets::ibl::prefiltered_levels on the
+// CPU, so both give the same levels (to f16 and summation order).
+
+struct Params {
+    alpha: f32,
+    source_level: f32,
+    width: u32,
+    height: u32,
+}
+
+@group(0) @binding(0) var source: texture_2d<f32>;
+@group(0) @binding(1) var source_sampler: sampler;
+@group(0) @binding(2) var level_out: texture_storage_2d<rgba16float, write>;
+@group(0) @binding(3) var<uniform> params: Params;
+
+const PI: f32 = 3.14159265358979;
+// PREFILTER_SAMPLES in prefilter.rs.
+const SAMPLES: u32 = 96u;
+
+// Equirectangular coordinates of world direction d (ibl/mod.rs; scene.wgsl's equirect_uv).
+fn equirect_uv(d: vec3<f32>) -> vec2<f32> {
+    let u = fract(atan2(d.y, d.x) / (2.0 * PI) + 1.0);
+    let v = acos(clamp(d.z, -1.0, 1.0)) / PI;
+    return vec2<f32>(u, v);
+}
+
+@compute @workgroup_size(8, 8)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {
+    if (id.x >= params.width || id.y >= params.height) {
+        return;
+    }
+    // The texel's centre direction (Environment::direction).
+    let phi = 2.0 * PI * (f32(id.x) + 0.5) / f32(params.width);
+    let theta = PI * (f32(id.y) + 0.5) / f32(params.height);
+    let n = vec3<f32>(sin(theta) * cos(phi), sin(theta) * sin(phi), cos(theta));
+    let up = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 0.0, 1.0), abs(n.z) < 0.999);
+    let t = normalize(cross(up, n));
+    let b = cross(n, t);
+    let a2 = params.alpha * params.alpha;
+    var acc = vec3<f32>(0.0);
+    var weight = 0.0;
+    for (var i = 0u; i < SAMPLES; i = i + 1u) {
+        let u1 = f32(i) / f32(SAMPLES);
+        let u2 = f32(reverseBits(i)) * 2.3283064365386963e-10;
+        let azimuth = 2.0 * PI * u1;
+        let cos_t = sqrt(max((1.0 - u2) / (1.0 + (a2 - 1.0) * u2), 0.0));
+        let sin_t = sqrt(max(1.0 - cos_t * cos_t, 0.0));
+        let h = normalize(t * (sin_t * cos(azimuth)) + b * (sin_t * sin(azimuth)) + n * cos_t);
+        let l = normalize(h * (2.0 * dot(n, h)) - n);
+        let n_dot_l = dot(n, l);
+        if (n_dot_l > 0.0) {
+            acc = acc + textureSampleLevel(source, source_sampler, equirect_uv(l), params.source_level).rgb * n_dot_l;
+            weight = weight + n_dot_l;
+        }
+    }
+    textureStore(level_out, vec2<i32>(id.xy), vec4<f32>(acc / max(weight, 1e-6), 1.0));
+}
