@@ -29,6 +29,20 @@ pub fn data_subdir(name: &str) -> Option<PathBuf> {
     }
 }
 
+/// The shared HDR environments (`$PHANTOGRAM_DATA/env/*.hdr|exr`), sorted; `None` after printing
+/// that the tests needing them are skipped. Fails the test if the folder holds none.
+pub fn shared_environments() -> Option<Vec<PathBuf>> {
+    let dir = data_subdir("env")?;
+    let mut files: Vec<_> = std::fs::read_dir(&dir)
+        .expect("env folder")
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|e| e == "hdr" || e == "exr"))
+        .collect();
+    files.sort();
+    assert!(!files.is_empty(), "no environments in {}", dir.display());
+    Some(files)
+}
+
 pub use phantogram_testkit::Scratch;
 
 /// An engine on `config`; `None` (the test skips, saying so) where no GPU adapter is found,

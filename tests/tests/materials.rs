@@ -166,17 +166,9 @@ fn ward_image_light_on_the_shared_rooms() {
     // integral of the lobe over the room. It must beat the round read it replaced on each.
     use phantogram::ibl::{Environment, accuracy::read_errors};
     use phantogram::ward::WardLobe;
-    let Some(dir) = phantogram_integration::data_subdir("env") else {
-        eprintln!("PHANTOGRAM_DATA not set: skipping the Ward image-light check on the shared rooms");
+    let Some(files) = phantogram_integration::shared_environments() else {
         return;
     };
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .expect("env folder")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "hdr" || e == "exr"))
-        .collect();
-    files.sort();
-    assert!(!files.is_empty(), "no environments in {}", dir.display());
     for path in &files {
         let env = Environment::load(path).expect("environment");
         for (name, preset) in [("brushed", WardPreset::BrushedMetal), ("silk", WardPreset::Silk)] {

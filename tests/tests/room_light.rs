@@ -20,7 +20,6 @@ use phantogram::anaglyph::Method;
 use phantogram::engine::EngineConfig;
 use phantogram::glam::{Mat3, Quat, Vec3};
 use phantogram::ibl::{Environment, IrradianceSh};
-use phantogram_integration::data_subdir;
 
 #[path = "support/golden.rs"]
 mod golden;
@@ -98,17 +97,9 @@ fn sweep() -> Vec<Quat> {
 
 #[test]
 fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
-    let Some(dir) = data_subdir("env") else {
-        eprintln!("PHANTOGRAM_DATA not set: skipping the room-light reconstruction test");
+    let Some(files) = phantogram_integration::shared_environments() else {
         return;
     };
-    let mut files: Vec<_> = std::fs::read_dir(&dir)
-        .expect("env folder")
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|e| e == "hdr" || e == "exr"))
-        .collect();
-    files.sort();
-    assert!(!files.is_empty(), "no environments in {}", dir.display());
     let camera = SyntheticCamera::phone_front();
     let normals = normals(2000);
     let (mut worst_full, mut worst_80) = ((0.0f32, String::new()), (0.0f32, String::new()));

@@ -1090,19 +1090,7 @@ impl Renderer {
             && let Some(Some(prefilter)) = &self.gpu_prefilter
         {
             let texture = prefilter.run(&self.gpu, base)?;
-            self.environment_sh = sh.shader_coefficients();
-            let device = self.gpu.device.clone();
-            return checked(&device, "the environment map", || {
-                self.ibl = IblTextures::with_texture(&self.gpu, &texture);
-                self.eye_bind = eye_bind_groups(
-                    &device,
-                    &self.eye_layout,
-                    &self.eye_buffers,
-                    &self.shadow_view,
-                    &self.shadow_sampler,
-                    &self.ibl,
-                );
-            });
+            return self.use_ibl(sh, |gpu| IblTextures::with_texture(gpu, &texture));
         }
         let levels = phantogram_assets::ibl::prefiltered_levels(base, PREFILTERED_BASE_WIDTH);
         self.set_prefiltered_environment(&levels, sh)
@@ -1141,10 +1129,20 @@ impl Renderer {
                 message: "no levels, or a level whose texels do not fill it".into(),
             });
         }
+        self.use_ibl(sh, |gpu| IblTextures::new(gpu, levels))
+    }
+
+    /// Lights the scene with the image light `make` builds and the irradiance `sh`, the eyes'
+    /// bind groups made again for it.
+    fn use_ibl(
+        &mut self,
+        sh: &phantogram_assets::ibl::IrradianceSh,
+        make: impl FnOnce(&Gpu) -> IblTextures,
+    ) -> Result<(), RenderError> {
         self.environment_sh = sh.shader_coefficients();
         let device = self.gpu.device.clone();
         checked(&device, "the environment map", || {
-            self.ibl = IblTextures::new(&self.gpu, levels);
+            self.ibl = make(&self.gpu);
             self.eye_bind = eye_bind_groups(
                 &device,
                 &self.eye_layout,
@@ -1940,8 +1938,8 @@ fn float_texture_entry(binding: u32, filterable: bool) -> wgpu::BindGroupLayoutE
     }
 }
 
-fn read_back(device: &wgpu::Device, targets: &Offscreen, width: u32, height: u32) -> Result<Vec<u8>, RenderError> {
-    let slice = targets.readback.slice(..);
+/// Maps `slice` for reading and waits until it is (or the mapping failed).
+fn map_for_reading(device: &wgpu::Device, slice: &wgpu::BufferSlice<'_>) -> Result<(), RenderError> {
     let (tx, rx) = std::sync::mpsc::channel();
     slice.map_async(wgpu::MapMode::Read, move |r| {
         let _ = tx.send(r);
@@ -1951,7 +1949,12 @@ fn read_back(device: &wgpu::Device, targets: &Offscreen, width: u32, height: u32
         .map_err(|e| RenderError::Readback(e.to_string()))?;
     rx.recv()
         .map_err(|e| RenderError::Readback(e.to_string()))?
-        .map_err(|e| RenderError::Readback(e.to_string()))?;
+        .map_err(|e| RenderError::Readback(e.to_string()))
+}
+
+fn read_back(device: &wgpu::Device, targets: &Offscreen, width: u32, height: u32) -> Result<Vec<u8>, RenderError> {
+    let slice = targets.readback.slice(..);
+    map_for_reading(device, &slice)?;
     let row_bytes = (width * 4) as usize;
     let mut pixels = Vec::with_capacity(row_bytes * height as usize);
     {

@@ -274,16 +274,7 @@ impl GpuPrefilter {
             );
             gpu.queue.submit([encoder.finish()]);
             let slice = buffer.slice(..);
-            let (tx, rx) = std::sync::mpsc::channel();
-            slice.map_async(wgpu::MapMode::Read, move |r| {
-                let _ = tx.send(r);
-            });
-            device
-                .poll(wgpu::PollType::wait_indefinitely())
-                .map_err(|e| RenderError::Readback(e.to_string()))?;
-            rx.recv()
-                .map_err(|e| RenderError::Readback(e.to_string()))?
-                .map_err(|e| RenderError::Readback(e.to_string()))?;
+            crate::map_for_reading(device, &slice)?;
             let mut texels = Vec::with_capacity((w * h) as usize);
             {
                 let data = slice
