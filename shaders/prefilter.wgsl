@@ -9,6 +9,9 @@ struct Params {
     source_level: f32,
     width: u32,
     height: u32,
+    // The source was divided by this power of two to fit f16 (a sun brighter than 65504);
+    // multiplied back here, before the result is stored (and clamped as the CPU path's upload).
+    scale: f32,
 }
 
 @group(0) @binding(0) var source: texture_2d<f32>;
@@ -56,5 +59,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {
             weight = weight + n_dot_l;
         }
     }
-    textureStore(level_out, vec2<i32>(id.xy), vec4<f32>(acc / max(weight, 1e-6), 1.0));
+    let radiance = min(acc / max(weight, 1e-6) * params.scale, vec3<f32>(65000.0));
+    textureStore(level_out, vec2<i32>(id.xy), vec4<f32>(radiance, 1.0));
 }

@@ -115,8 +115,8 @@ impl GpuPrefilter {
 
     /// The prefiltered environment of `base` (a level 0 from
     /// [`phantogram_assets::ibl::prefilter_base`]: a power of two at least `2^PREFILTER_LEVELS`
-    /// wide, twice as wide as high): a texture of [`PREFILTER_LEVELS`] mip levels, level 0 a copy
-    /// of `base`, the others convolved on the GPU. Submitted, not waited for.
+    /// wide, twice as wide as high): a texture of [`PREFILTER_LEVELS`] mip levels, level 0
+    /// `base` itself, the others convolved on the GPU. Submitted, not waited for.
     pub fn run(&self, gpu: &Gpu, base: &Environment) -> Result<wgpu::Texture, RenderError> {
         let (w0, h0) = (base.width as u32, base.height as u32);
         if !w0.is_power_of_two()
@@ -145,13 +145,31 @@ impl GpuPrefilter {
             }
             source_mip.push(sources.len() - 1);
         }
+        // The source is f16, which ends at 65504: a brighter sun is divided by a power of two
+        // (exact) so that its energy reaches the rough levels as on the CPU, and multiplied back
+        // in the shader.
+        let peak = base
+            .texels
+            .iter()
+            .flatten()
+            .fold(0.0f32, |m, &c| if c.is_finite() { m.max(c) } else { m });
+        let scale = if peak > 32_768.0 {
+            (peak / 32_768.0).log2().ceil().exp2()
+        } else {
+            1.0
+        };
+        for level in &mut sources {
+            for t in &mut level.texels {
+                *t = t.map(|c| c / scale);
+            }
+        }
         checked(device, "the GPU prefilter", || {
             let source = lighting_tables::prefiltered_texture(
                 device,
                 w0,
                 h0,
                 sources.len() as u32,
-                wgpu::TextureUsages::COPY_SRC,
+                wgpu::TextureUsages::empty(),
             );
             for (m, level) in sources.iter().enumerate() {
                 lighting_tables::write_level(&gpu.queue, &source, m as u32, level);
@@ -164,26 +182,29 @@ impl GpuPrefilter {
                 wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
             );
             let source_view = source.create_view(&Default::default());
+            // Level 0 as given (clamped to f16 as the CPU path's upload clamps it).
+            lighting_tables::write_level(&gpu.queue, &target, 0, base);
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("prefilter"),
             });
-            encoder.copy_texture_to_texture(
-                source.as_image_copy(),
-                target.as_image_copy(),
-                wgpu::Extent3d {
-                    width: w0,
-                    height: h0,
-                    depth_or_array_layers: 1,
-                },
-            );
             let mut keep = Vec::new();
             for (k, &mip) in (1..PREFILTER_LEVELS).zip(&source_mip) {
                 let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
                 let (w, h) = (w0 >> k, h0 >> k);
-                let params: Vec<u8> = [(roughness * roughness).to_bits(), (mip as f32).to_bits(), w, h]
-                    .iter()
-                    .flat_map(|x| x.to_le_bytes())
-                    .collect();
+                // Params in prefilter.wgsl, padded to 32 bytes.
+                let params: Vec<u8> = [
+                    (roughness * roughness).to_bits(),
+                    (mip as f32).to_bits(),
+                    w,
+                    h,
+                    scale.to_bits(),
+                    0,
+                    0,
+                    0,
+                ]
+                .iter()
+                .flat_map(|x| x.to_le_bytes())
+                .collect();
                 let buffer = wgpu::util::DeviceExt::create_buffer_init(
                     device,
                     &wgpu::util::BufferInitDescriptor {
