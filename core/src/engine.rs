@@ -803,9 +803,10 @@ impl Engine {
         if let Some(q) = device_to_world {
             worker.set_orientation(q);
         }
-        // Where the GPU convolves the specular levels, the worker leaves them to it.
-        worker.set_prefilter_on_gpu(self.renderer.prefilters_on_gpu());
         if let Some(update) = worker.take_update() {
+            // Where the GPU convolves the specular levels, the worker leaves them to it from
+            // the next update on (asked here, not at start-up: it makes a compute pipeline).
+            worker.set_prefilter_on_gpu(self.renderer.prefilters_on_gpu());
             self.stats.room_light_updates += 1;
             self.stats.room_light_coverage = update.coverage;
             // A failed upload keeps the light there was; the next update tries again.

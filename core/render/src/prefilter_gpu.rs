@@ -14,7 +14,7 @@
 //! records and submits without waiting; frames submitted after it see the result (queue order).
 //! No panics: validation failures come back as [`RenderError::Gpu`].
 
-use phantogram_assets::ibl::{Environment, PREFILTER_LEVELS};
+use phantogram_assets::ibl::{Environment, PREFILTER_LEVELS, PrefilterSources};
 
 use crate::{Gpu, RenderError, checked, lighting_tables};
 
@@ -130,21 +130,11 @@ impl GpuPrefilter {
             });
         }
         let device = &gpu.device;
-        // The halvings each level reads, as prefiltered_levels picks them: level k reads the
-        // first halving no more than twice its width (and never below 8 texels wide).
-        let mut sources = vec![base.clone()];
-        let mut source_mip = Vec::with_capacity(PREFILTER_LEVELS);
-        for k in 1..PREFILTER_LEVELS {
-            let w = base.width >> k;
-            while sources.last().is_some_and(|s| s.width > 2 * w && s.width > 8) {
-                let next = sources
-                    .last()
-                    .map(Environment::downsampled)
-                    .unwrap_or_else(|| base.clone());
-                sources.push(next);
-            }
-            source_mip.push(sources.len() - 1);
-        }
+        // The halvings each level reads, as prefiltered_levels reads them.
+        let PrefilterSources {
+            halvings: mut sources,
+            read_by,
+        } = PrefilterSources::new(base.clone());
         // The source is f16, which ends at 65504: a brighter sun is divided by a power of two
         // (exact) so that its energy reaches the rough levels as on the CPU, and multiplied back
         // in the shader.
@@ -187,8 +177,7 @@ impl GpuPrefilter {
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("prefilter"),
             });
-            let mut keep = Vec::new();
-            for (k, &mip) in (1..PREFILTER_LEVELS).zip(&source_mip) {
+            for (k, &mip) in read_by.iter().enumerate().skip(1) {
                 let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
                 let (w, h) = (w0 >> k, h0 >> k);
                 // Params in prefilter.wgsl, padded to 32 bytes.
@@ -249,7 +238,6 @@ impl GpuPrefilter {
                     pass.set_bind_group(0, &bind, &[]);
                     pass.dispatch_workgroups(w.div_ceil(8), h.div_ceil(8), 1);
                 }
-                keep.push(buffer);
             }
             gpu.queue.submit([encoder.finish()]);
             target

@@ -36,7 +36,8 @@ pub mod sh;
 
 pub use anisotropic::{WARD_IMAGE_LIGHT_TAPS, WARD_TAP_NODES, WardImageLight, sample_levels};
 pub use prefilter::{
-    PREFILTER_LEVELS, PREFILTER_SAMPLES, brdf_lut, prefilter_base, prefilter_base_width, prefiltered_levels,
+    PREFILTER_LEVELS, PREFILTER_SAMPLES, PrefilterSources, brdf_lut, prefilter_base, prefilter_base_width,
+    prefiltered_levels,
 };
 pub use sh::IrradianceSh;
 

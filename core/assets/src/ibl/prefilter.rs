@@ -59,6 +59,35 @@ pub fn prefilter_base(env: &Environment, base_width: usize) -> Environment {
 /// GGX samples per texel of a rough level (Hammersley points; the GPU path uses the same).
 pub const PREFILTER_SAMPLES: u32 = 96;
 
+/// What the rough levels are convolved from: level 0 and its box-filtered halvings, and which of
+/// them each level reads — the first no more than twice its width (never below 8 texels wide),
+/// so that [`PREFILTER_SAMPLES`] samples suffice. The CPU ([`prefiltered_levels`]) and the
+/// renderer's GPU path read the same ones.
+pub struct PrefilterSources {
+    /// Level 0 ([`prefilter_base`]) first, then each halving ([`Environment::downsampled`]).
+    pub halvings: Vec<Environment>,
+    /// `read_by[k]`: the index in `halvings` level `k` reads (level 0 is `halvings[0]` itself).
+    pub read_by: [usize; PREFILTER_LEVELS],
+}
+
+impl PrefilterSources {
+    /// The sources for level 0 `base` (from [`prefilter_base`]).
+    pub fn new(base: Environment) -> Self {
+        let base_width = base.width;
+        let mut halvings = vec![base];
+        let mut read_by = [0; PREFILTER_LEVELS];
+        for (k, read) in read_by.iter_mut().enumerate().skip(1) {
+            let w = base_width >> k;
+            while let Some(last) = halvings.last().filter(|s| s.width > 2 * w && s.width > 8) {
+                let next = last.downsampled();
+                halvings.push(next);
+            }
+            *read = halvings.len() - 1;
+        }
+        Self { halvings, read_by }
+    }
+}
+
 /// The environment convolved with the GGX lobe: level `k` (roughness `k / (LEVELS − 1)`) at
 /// `base_width / 2^k` × `base_width / 2^(k+1)`, so the levels form the first [`PREFILTER_LEVELS`]
 /// levels of a texture mip chain. Level 0 is [`prefilter_base`]; level `k ≥ 1` reads the
@@ -68,16 +97,14 @@ pub const PREFILTER_SAMPLES: u32 = 96;
 /// `base_width` is rounded up as [`prefilter_base_width`] says.
 pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environment> {
     let base_width = prefilter_base_width(base_width);
-    let mut source = prefilter_base(env, base_width);
-    let mut levels = vec![source.clone()];
+    let sources = PrefilterSources::new(prefilter_base(env, base_width));
+    let mut levels = vec![sources.halvings[0].clone()];
     let samples = PREFILTER_SAMPLES;
     for k in 1..PREFILTER_LEVELS {
         let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
         let alpha = roughness * roughness;
         let (w, h) = (base_width >> k, base_width >> (k + 1));
-        while source.width > 2 * w && source.width > 8 {
-            source = source.downsampled();
-        }
+        let source = &sources.halvings[sources.read_by[k]];
         let grid = Environment {
             width: w,
             height: h,
