@@ -33,6 +33,10 @@ struct Eye {
     lamp_position: vec4<f32>,
     lamp_axis: vec4<f32>,
     lamp_intensity: vec4<f32>,
+    // The lamp's cube shadow, for a lamp among what it shadows (render crate, point_shadow.rs):
+    // near and far (metres), texels along a face, and in w 1 when the lamp's shadows are read
+    // from `shadow_cube` (then `shadow.y` is 0).
+    lamp_shadow: vec4<f32>,
 };
 
 // The visitor's changes over the glTF materials (appearance.rs; render.rs `appearance_uniform`).
@@ -87,6 +91,8 @@ override FADE: bool = false;
 @group(0) @binding(3) var prefiltered_env: texture_2d<f32>;
 @group(0) @binding(4) var brdf_lut: texture_2d<f32>;
 @group(0) @binding(5) var env_sampler: sampler;
+// The lamp's cube shadow: six 90° depth views about the lamp, read along the direction from it.
+@group(0) @binding(6) var shadow_cube: texture_depth_cube;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_texture: texture_2d<f32>;
@@ -234,6 +240,9 @@ fn shadow_pcf(uv: vec2<f32>, depth: f32) -> f32 {
 // moves one and a half texels along the normal, and further at grazing light, which removes acne
 // without the detached shadows (peter-panning) that a large constant bias gives.
 fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
+    if (eye.lamp_shadow.w > 0.5) {
+        return lamp_cube_visibility(world, n, l);
+    }
     if (eye.shadow.y < 0.5) {
         return 1.0;
     }
@@ -255,6 +264,38 @@ fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
         return 1.0;
     }
     return shadow_pcf(uv, min(p.z, 1.0));
+}
+
+// The depth a cube face stores for a point `major` metres along its axis (point_shadow.rs,
+// `cube_depth`; the tests compare the two).
+// BEGIN cube_depth
+fn cube_depth(major: f32, near: f32, far: f32) -> f32 {
+    return far * (major - near) / (major * (far - near));
+}
+// END cube_depth
+
+// Fraction of the lamp's light reaching `world` (1 = lit) from its cube shadow: the same normal
+// offset as `light_visibility`, by a texel at this distance (2 × distance / texels at a face's
+// centre, at most twice that at its corners), then four bilinear comparisons half a texel apart
+// across the face: a tent three texels wide, like the 2-D map's filter.
+fn lamp_cube_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
+    let from_lamp = world - eye.lamp_position.xyz;
+    let texel = 2.0 * length(from_lamp) / eye.lamp_shadow.z;
+    let n_dot_l = clamp(dot(n, l), 0.05, 1.0);
+    let r = from_lamp + n * texel * (1.5 + 2.0 * sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l);
+    let a = abs(r);
+    let major = max(a.x, max(a.y, a.z));
+    // Beyond the far plane only what lies past every caster: compared at the far plane.
+    let depth = min(cube_depth(major, eye.lamp_shadow.x, eye.lamp_shadow.y), 1.0);
+    // Two directions across the face, half a texel long at its distance along the axis.
+    let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), a.x >= max(a.y, a.z));
+    let u = normalize(cross(r, helper)) * (major / eye.lamp_shadow.z);
+    let v = normalize(cross(r, u)) * (major / eye.lamp_shadow.z);
+    let lit = textureSampleCompareLevel(shadow_cube, shadow_sampler, r + u + v, depth)
+        + textureSampleCompareLevel(shadow_cube, shadow_sampler, r + u - v, depth)
+        + textureSampleCompareLevel(shadow_cube, shadow_sampler, r - u + v, depth)
+        + textureSampleCompareLevel(shadow_cube, shadow_sampler, r - u - v, depth);
+    return lit * 0.25;
 }
 
 fn to_world(v: vec3<f32>) -> vec3<f32> {

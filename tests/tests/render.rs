@@ -276,7 +276,17 @@ fn push_floor_marker(mesh: &mut Mesh) {
 }
 
 /// `model` on its floor seen straight on from 30 cm, lit from `toward_light`, in mono.
-fn render_over_floor(mut model: Model, shadows: bool, toward_light: Vec3) -> Option<(Vec<u8>, OffAxisProjection)> {
+fn render_over_floor(model: Model, shadows: bool, toward_light: Vec3) -> Option<(Vec<u8>, OffAxisProjection)> {
+    render_over_floor_lit(model, shadows, toward_light, None)
+}
+
+/// [`render_over_floor`], with `lamp` in place of the directional light if given.
+fn render_over_floor_lit(
+    mut model: Model,
+    shadows: bool,
+    toward_light: Vec3,
+    lamp: Option<phantogram::render::Lamp>,
+) -> Option<(Vec<u8>, OffAxisProjection)> {
     let gpu = gpu()?;
     let screen = Screen::default();
     model.add_floor(&screen, 2.0);
@@ -284,6 +294,7 @@ fn render_over_floor(mut model: Model, shadows: bool, toward_light: Vec3) -> Opt
     let mono = OffAxisProjection::new(&screen, eye, DepthRange::default()).unwrap();
     let mut renderer = Renderer::new(gpu, &model).unwrap();
     renderer.lighting.shadows = shadows;
+    renderer.lamp = lamp;
     let input = FrameInput {
         left: &mono,
         right: &mono,
@@ -320,6 +331,78 @@ fn shadows_fall_where_the_light_says() {
     );
     println!("floor luminance: in the predicted shadow {dark}, at its mirror image {lit}");
     assert!(dark < 0.6 * lit, "shadow {dark} vs lit {lit}");
+}
+
+/// A point lamp standing among what it shadows (inside the casters' bounds, so no single view
+/// holds them): 9 mm above the floor, with a block to its −x (off to +y) and one to its +y (off
+/// to +x) whose tops rise 1 mm above it, each shadow starts on the floor 16 mm out on its side
+/// (the ray over the block's lower inner edge) and runs outwards, fanning away from the axis. There
+/// the floor has only the room's light (as with the lamp dark); at the points mirrored across
+/// the lamp in x and in y, with nothing between, and between the lamp and the blocks, it is lit
+/// as without shadows. The shadows are read from two faces of the cube (−X and +Y), off their
+/// centres on both axes, so a face drawn mirrored any way or in another's place moves a shadow
+/// off its point. Lamps outside the casters' sphere keep the one perspective view
+/// (`a_lamps_shadow_view_holds_...`).
+#[test]
+fn a_lamp_among_its_casters_shadows_every_way() {
+    let scene = |shadows: bool, intensity: f32| {
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::new(-0.012, 0.006, -0.024), 0.003, [0.8, 0.8, 0.8, 1.0]);
+        mesh.push_cube(Vec3::new(0.006, 0.012, -0.024), 0.003, [0.8, 0.8, 0.8, 1.0]);
+        push_floor_marker(&mut mesh);
+        let lamp = phantogram::render::Lamp {
+            position_m: Vec3::new(0.0, 0.0, -0.022),
+            axis: Vec3::NEG_Z,
+            cone_half_angle_rad: None,
+            intensity_rgb: Vec3::splat(intensity),
+        };
+        render_over_floor_lit(
+            Model::from_painted_mesh("lamp among blocks", mesh),
+            shadows,
+            OBLIQUE_LIGHT,
+            Some(lamp),
+        )
+    };
+    let Some((pixels, proj)) = scene(true, 0.004) else {
+        return;
+    };
+    let (without, _) = scene(false, 0.004).expect("a GPU");
+    let (dark_lamp, _) = scene(true, 0.0).expect("a GPU");
+    let floor_z = -0.031;
+    let at = |px: &[u8], (x, y): (f32, f32)| luminance_at(px, &proj, Vec3::new(x, y, floor_z));
+    // Luminance is in 8-bit levels: two and a half are a rounding of each channel.
+    let near = |a: f32, b: f32| (a - b).abs() < 2.5;
+    for (name, (x, y)) in [
+        ("beyond the −x block", (-0.029, 0.018)),
+        ("beyond the +y block", (0.018, 0.029)),
+    ] {
+        let dark = at(&pixels, (x, y));
+        let room_only = at(&dark_lamp, (x, y));
+        println!("{name}: {dark} in the shadow, {room_only} in the room's light alone");
+        assert!(
+            near(dark, room_only),
+            "{name}: the shadow {dark} vs the room's light alone {room_only}"
+        );
+        for mirror in [(-x, y), (x, -y), (-x, -y)] {
+            let lit = at(&pixels, mirror);
+            assert!(
+                lit > room_only + 20.0,
+                "{name}: the lamp lights {mirror:?} ({lit} vs {room_only})"
+            );
+            assert!(
+                near(lit, at(&without, mirror)),
+                "{name}: {mirror:?} is lit as without shadows"
+            );
+        }
+        assert!(
+            near(at(&without, (x, y)), at(&without, (-x, -y))),
+            "{name}: without shadows alike"
+        );
+    }
+    for p in [(-0.018, 0.0), (0.0, 0.018), (0.01, -0.01), (-0.02, -0.02)] {
+        let (with, plain) = (at(&pixels, p), at(&without, p));
+        assert!(near(with, plain), "{p:?}: {with} with shadows, {plain} without");
+    }
 }
 
 #[test]
@@ -776,6 +859,109 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
     );
     // Bilinear weights are quantised (8 fractional bits on lavapipe, as on most GPUs).
     assert!(worst < 0.01, "largest difference {worst}");
+}
+
+/// The lamp cube's depth in `scene.wgsl` (`cube_depth`, cut out of the real shader) is the one
+/// the faces store (`point_shadow::cube_depth`, which the render crate's tests check against
+/// the faces' projection): both run on the same distances and ranges, from a tenth of a
+/// millimetre to the far plane.
+#[test]
+fn the_shaders_cube_depth_is_the_faces() {
+    use phantogram::render::point_shadow::cube_depth;
+    use phantogram::wgpu;
+    use phantogram::wgpu::util::DeviceExt;
+    let Some(gpu) = gpu() else { return };
+    let source = phantogram::render::SCENE_WGSL;
+    let (begin, end) = ("// BEGIN cube_depth", "// END cube_depth");
+    let function = &source[source.find(begin).expect(begin)..source.find(end).expect(end)];
+    let shader = format!(
+        "@group(0) @binding(0) var<storage, read> queries: array<vec4<f32>>;
+@group(0) @binding(1) var<storage, read_write> results: array<f32>;
+{function}
+@compute @workgroup_size(64)
+fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
+    if (id.x < arrayLength(&queries)) {{
+        let q = queries[id.x];
+        results[id.x] = cube_depth(q.x, q.y, q.z);
+    }}
+}}"
+    );
+    let mut queries: Vec<[f32; 4]> = Vec::new();
+    for far in [0.05f32, 0.3, 2.0] {
+        let near = far * 1e-3;
+        for k in 0..=40 {
+            let major = near + (far - near) * (k as f32 / 40.0).powi(3);
+            queries.push([major, near, far, 0.0]);
+        }
+    }
+    let device = &gpu.device;
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("queries"),
+        contents: bytemuck::cast_slice(&queries),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let size = (queries.len() * 4) as u64;
+    let results = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("results"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("cube_depth test"),
+        source: wgpu::ShaderSource::Wgsl(shader.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("cube_depth test"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: input.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: results.as_entire_binding(),
+            },
+        ],
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups((queries.len() as u32).div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(&results, 0, &readback, 0, size);
+    gpu.queue.submit([encoder.finish()]);
+    readback.slice(..).map_async(wgpu::MapMode::Read, |r| r.unwrap());
+    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let bytes = readback.slice(..).get_mapped_range().expect("mapped").to_vec();
+    for (q, b) in queries.iter().zip(bytes.chunks_exact(4)) {
+        let got = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+        let want = cube_depth(q[0], q[1], q[2]);
+        assert!(
+            (got - want).abs() < 1e-5,
+            "major {} near {} far {}: {got} vs {want}",
+            q[0],
+            q[1],
+            q[2]
+        );
+    }
 }
 
 /// `KHR_materials_unlit`: an unlit surface shows its base colour whatever the light does; the

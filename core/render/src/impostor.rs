@@ -356,6 +356,7 @@ impl crate::Renderer {
                         b,
                         &self.shadow_view,
                         &self.shadow_sampler,
+                        &self.point_shadow.cube_view,
                         &self.ibl,
                     )
                 })

@@ -13,7 +13,9 @@
 //! 1. Shadow pass, once for both eyes: depth from the world-fixed light (orthographic over the
 //!    model without its floor, which only receives unless the light is below it), both faces of
 //!    every surface; alpha-masked materials are cut out as in the scene pass
-//!    (their shadows have the holes they have), blended ones cast none.
+//!    (their shadows have the holes they have), blended ones cast none. A [`Lamp`] in its place
+//!    is seen from one perspective view, or, standing among what it shadows, from the six faces
+//!    of a cube ([`point_shadow`]: six passes of 512² texels).
 //! 2. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
 //!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
 //!    Opaque and masked primitives first, then blended ones back to front (depth test, no depth
@@ -61,6 +63,7 @@ mod gpu;
 mod gpu_timer;
 pub mod impostor;
 mod lighting_tables;
+pub mod point_shadow;
 pub mod prefilter_gpu;
 pub mod surface;
 mod upload;
@@ -140,10 +143,14 @@ struct EyeUniform {
     /// The [`Lamp`], if one shines: position (w: 1 when on), axis (w: cos outer), intensity (w:
     /// cos inner).
     lamp: [[f32; 4]; 3],
+    /// The lamp's cube shadow ([`point_shadow`]): near and far (metres), texels a face, and 1 when
+    /// the lamp's shadows are read from it.
+    lamp_shadow: [f32; 4],
 }
 
 /// A lamp in place of the directional light: a point light, or a spot light with a cone, in
-/// mesh coordinates (the device frame, metres), with its shadows from a perspective shadow map.
+/// mesh coordinates (the device frame, metres), with its shadows from a perspective shadow map,
+/// or from a cube of them when it stands among what it shadows ([`point_shadow`]).
 /// The engine places it each frame (held like a torch, or fixed in the room, or where a finger
 /// put it); see `phantogram::lamp`.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -196,8 +203,8 @@ impl Lamp {
 }
 
 /// The perspective shadow view of a lamp over `bounds` (mesh coordinates) and the size of a
-/// texel at the bounds' centre in metres; `None` when the lamp is within the bounds (no single
-/// view sees all it shadows: then it casts none).
+/// texel at the bounds' centre in metres; `None` when the lamp is within the bounds' sphere (no
+/// single view sees all it shadows: the renderer then draws a cube of views, [`point_shadow`]).
 pub fn lamp_view_proj(bounds: &phantogram_geometry::containment::Aabb, lamp: &Lamp) -> Option<(Mat4, f32)> {
     let centre = (bounds.min + bounds.max) * 0.5;
     let radius = (bounds.max - bounds.min).length() * 0.5 + 1e-4;
@@ -759,6 +766,10 @@ pub struct Renderer {
     shadow_pipeline: wgpu::RenderPipeline,
     shadow_bind: wgpu::BindGroup,
     shadow_view: wgpu::TextureView,
+    /// The shadow pass's group 0 (the light's matrix), for the lamp cube's faces.
+    shadow_layout: wgpu::BindGroupLayout,
+    /// The shadows of a lamp among its casters ([`point_shadow`]).
+    point_shadow: point_shadow::PointShadowMap,
     /// The environment's irradiance, as the shader takes it.
     environment_sh: [[f32; 4]; 9],
     targets: Option<Targets>,
@@ -863,6 +874,16 @@ impl Renderer {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                wgpu::BindGroupLayoutEntry {
+                    binding: 6,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Texture {
+                        sample_type: wgpu::TextureSampleType::Depth,
+                        view_dimension: wgpu::TextureViewDimension::Cube,
+                        multisampled: false,
+                    },
+                    count: None,
+                },
             ],
         });
         let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -896,13 +917,23 @@ impl Renderer {
             })
         });
         let ibl = IblTextures::new(&gpu, environment);
-        let eye_bind = eye_bind_groups(device, &eye_layout, &eye_buffers, &shadow_view, &shadow_sampler, &ibl);
         // The shadow pass reads only the light's matrix (the same in both eye blocks) and must
         // not bind the shadow map it writes.
         let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("shadow"),
             entries: &[uniform_entry(0, wgpu::ShaderStages::VERTEX)],
         });
+        // 1×1 a face until a lamp stands among its casters (see `point_shadow`).
+        let point_shadow = point_shadow::PointShadowMap::new(device, &shadow_layout, 1);
+        let eye_bind = eye_bind_groups(
+            device,
+            &eye_layout,
+            &eye_buffers,
+            &shadow_view,
+            &shadow_sampler,
+            &point_shadow.cube_view,
+            &ibl,
+        );
         let shadow_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("shadow"),
             layout: &shadow_layout,
@@ -1023,6 +1054,8 @@ impl Renderer {
             shadow_pipeline,
             shadow_bind,
             shadow_view,
+            shadow_layout,
+            point_shadow,
             environment_sh,
             targets: None,
             side_targets: None,
@@ -1143,15 +1176,21 @@ impl Renderer {
         let device = self.gpu.device.clone();
         checked(&device, "the environment map", || {
             self.ibl = make(&self.gpu);
-            self.eye_bind = eye_bind_groups(
-                &device,
-                &self.eye_layout,
-                &self.eye_buffers,
-                &self.shadow_view,
-                &self.shadow_sampler,
-                &self.ibl,
-            );
+            self.remake_eye_binds();
         })
+    }
+
+    /// The eyes' bind groups made again, after the image light or the lamp's cube changed.
+    fn remake_eye_binds(&mut self) {
+        self.eye_bind = eye_bind_groups(
+            &self.gpu.device,
+            &self.eye_layout,
+            &self.eye_buffers,
+            &self.shadow_view,
+            &self.shadow_sampler,
+            &self.point_shadow.cube_view,
+            &self.ibl,
+        );
     }
 
     /// Replaces the model drawn (keeps pipelines and targets).
@@ -1336,6 +1375,7 @@ impl Renderer {
             sh: self.environment_sh,
             appearance: appearance_uniform(&self.appearance),
             lamp: Lamp::uniform(self.lamp.as_ref()),
+            lamp_shadow: [0.0; 4],
         }
     }
 
@@ -1515,18 +1555,40 @@ impl Renderer {
             None => input.toward_light,
         };
         let (floor_casts, shadow_bounds) = self.model.shadow_casters(toward);
-        // A lamp inside what it would shadow casts none (no single view holds it all).
-        let (shadow, lamp_shadows) = match &lamp {
+        // A lamp among what it shadows (no single view holds it all) is seen from a cube.
+        let (shadow, cube) = match &lamp {
             Some(l) => match lamp_view_proj(&shadow_bounds, l) {
-                Some(s) => (s, true),
-                None => ((Mat4::IDENTITY, 1.0), false),
+                Some(s) => (s, None),
+                None => (
+                    (Mat4::IDENTITY, 1.0),
+                    Some((l.position_m, point_shadow::cube_range_m(&shadow_bounds, l.position_m))),
+                ),
             },
-            None => (light_view_proj(&shadow_bounds, input.toward_light), true),
+            None => (light_view_proj(&shadow_bounds, input.toward_light), None),
         };
+        let cube_pass = self.lighting.shadows && cube.is_some();
+        if cube_pass && self.point_shadow.size < point_shadow::POINT_SHADOW_SIZE {
+            let device = self.gpu.device.clone();
+            checked(&device, "the lamp's shadow cube", || {
+                self.point_shadow =
+                    point_shadow::PointShadowMap::new(&device, &self.shadow_layout, point_shadow::POINT_SHADOW_SIZE);
+                self.remake_eye_binds();
+            })?;
+        }
         let mut uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input, shadow)).collect();
-        if !lamp_shadows {
+        if let Some((lamp_m, (near_m, far_m))) = cube {
             for u in &mut uniforms {
                 u.shadow[1] = 0.0;
+                u.lamp_shadow = [
+                    near_m,
+                    far_m,
+                    self.point_shadow.size as f32,
+                    f32::from(u8::from(cube_pass)),
+                ];
+            }
+            if cube_pass {
+                let faces = point_shadow::cube_face_view_proj(lamp_m, near_m, far_m);
+                self.point_shadow.write_faces(&self.gpu.queue, &faces);
             }
         }
         let (lm, rm) = method.matrices();
@@ -1546,60 +1608,38 @@ impl Renderer {
         // Timed (where the device can) from the first pass's start to the composition's end.
         let timed = self.timer.as_mut().is_some_and(|t| t.start_frame());
         let timer = self.timer.as_ref().filter(|_| timed);
-        let shadow_pass = self.lighting.shadows && lamp_shadows;
+        let shadow_pass = self.lighting.shadows;
         let targets = self.targets.as_ref().expect("the caller sized the targets");
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         if shadow_pass {
-            // Once per frame, for both eyes.
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("shadow"),
-                timestamp_writes: timer.map(|t| t.writes(true, false)),
-                color_attachments: &[],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &self.shadow_view,
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(1.0),
-                        store: wgpu::StoreOp::Store,
-                    }),
-                    stencil_ops: None,
-                }),
-                ..Default::default()
-            });
-            pass.set_pipeline(&self.shadow_pipeline);
-            pass.set_bind_group(0, &self.shadow_bind, &[]);
+            // Once per frame, for both eyes: one view, or the lamp cube's six.
+            let views: Vec<(&wgpu::TextureView, &wgpu::BindGroup)> = if cube.is_some() {
+                self.point_shadow
+                    .face_views
+                    .iter()
+                    .zip(&self.point_shadow.face_binds)
+                    .collect()
+            } else {
+                vec![(&self.shadow_view, &self.shadow_bind)]
+            };
             // Impostors cast the shadow of the polygon level as exact as they are.
             let shadow_levels = self.shadow_levels(input.levels);
-            let input = FrameInput {
-                levels: &shadow_levels,
-                ..*input
-            };
-            let variant = |p: &GpuPrimitive| self.model.materials[p.material].variant;
-            // Solid casters: opaque materials (masked ones follow, blended ones cast none).
-            for p in self.model.primitives.iter().filter(|p| {
-                let v = variant(p);
-                !v.blend && !v.mask && (floor_casts || !p.is_floor)
-            }) {
-                p.draw(&mut pass, input.levels);
-            }
-            let mut masked = self
-                .model
-                .primitives
-                .iter()
-                .filter(|p| variant(p).casts_masked_shadow() && (floor_casts || !p.is_floor))
-                .peekable();
-            if masked.peek().is_some() {
-                // Made with the model (`ScenePipelines::prepare`); a miss would be our bug, and
-                // those surfaces then cast no shadow rather than panic mid-frame.
-                match &self.scene.shadow_masked {
-                    Some(pipeline) => {
-                        pass.set_pipeline(pipeline);
-                        for p in masked {
-                            pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
-                            p.draw(&mut pass, input.levels);
-                        }
-                    }
-                    None => debug_assert!(false, "no shadow pipeline for masked materials"),
-                }
+            for (k, (view, bind)) in views.into_iter().enumerate() {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("shadow"),
+                    timestamp_writes: timer.filter(|_| k == 0).map(|t| t.writes(true, false)),
+                    color_attachments: &[],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(1.0),
+                            store: wgpu::StoreOp::Store,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    ..Default::default()
+                });
+                self.draw_shadow_casters(&mut pass, bind, &shadow_levels, floor_casts);
             }
         }
         for (i, u) in uniforms.iter().enumerate() {
@@ -1726,6 +1766,47 @@ fn create_compose_pipeline(
 }
 
 impl Renderer {
+    /// Draws what casts shadows into a shadow pass whose light matrix `bind` holds: opaque
+    /// materials, then masked ones cut out (blended ones cast none); the floor only when
+    /// `floor_casts`.
+    fn draw_shadow_casters(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        bind: &wgpu::BindGroup,
+        levels: &[u8],
+        floor_casts: bool,
+    ) {
+        pass.set_pipeline(&self.shadow_pipeline);
+        pass.set_bind_group(0, bind, &[]);
+        let variant = |p: &GpuPrimitive| self.model.materials[p.material].variant;
+        for p in self.model.primitives.iter().filter(|p| {
+            let v = variant(p);
+            !v.blend && !v.mask && (floor_casts || !p.is_floor)
+        }) {
+            p.draw(pass, levels);
+        }
+        let mut masked = self
+            .model
+            .primitives
+            .iter()
+            .filter(|p| variant(p).casts_masked_shadow() && (floor_casts || !p.is_floor))
+            .peekable();
+        if masked.peek().is_some() {
+            // Made with the model (`ScenePipelines::prepare`); a miss would be our bug, and
+            // those surfaces then cast no shadow rather than panic mid-frame.
+            match &self.scene.shadow_masked {
+                Some(pipeline) => {
+                    pass.set_pipeline(pipeline);
+                    for p in masked {
+                        pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
+                        p.draw(pass, levels);
+                    }
+                }
+                None => debug_assert!(false, "no shadow pipeline for masked materials"),
+            }
+        }
+    }
+
     /// `levels` with each impostor drawn replaced by the level its shadow is cast with.
     fn shadow_levels<'l>(&self, levels: &'l [u8]) -> std::borrow::Cow<'l, [u8]> {
         if self.model.impostors.is_empty() {
@@ -1872,9 +1953,20 @@ fn eye_bind_groups(
     buffers: &[wgpu::Buffer; 2],
     shadow_view: &wgpu::TextureView,
     shadow_sampler: &wgpu::Sampler,
+    shadow_cube: &wgpu::TextureView,
     ibl: &IblTextures,
 ) -> [wgpu::BindGroup; 2] {
-    [0, 1].map(|i| eye_bind_group(device, layout, &buffers[i], shadow_view, shadow_sampler, ibl))
+    [0, 1].map(|i| {
+        eye_bind_group(
+            device,
+            layout,
+            &buffers[i],
+            shadow_view,
+            shadow_sampler,
+            shadow_cube,
+            ibl,
+        )
+    })
 }
 
 fn eye_bind_group(
@@ -1883,6 +1975,7 @@ fn eye_bind_group(
     buffer: &wgpu::Buffer,
     shadow_view: &wgpu::TextureView,
     shadow_sampler: &wgpu::Sampler,
+    shadow_cube: &wgpu::TextureView,
     ibl: &IblTextures,
 ) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -1912,6 +2005,10 @@ fn eye_bind_group(
             wgpu::BindGroupEntry {
                 binding: 5,
                 resource: wgpu::BindingResource::Sampler(&ibl.sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 6,
+                resource: wgpu::BindingResource::TextureView(shadow_cube),
             },
         ],
     })
