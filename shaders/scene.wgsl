@@ -20,7 +20,8 @@ struct Eye {
     world_from_device: array<vec4<f32>, 3>,
     // Mesh coordinates → shadow-map clip space (orthographic, from the light).
     light_view_proj: mat4x4<f32>,
-    // x: shadow-map texel size in metres; y: 1 if shadows are on.
+    // x: shadow-map texel size in metres; y: 1 if shadows are on; z: the angle one pixel
+    // subtends from the eye, radians (for the Ward map's mip level).
     shadow: vec4<f32>,
     // The environment's irradiance as nine RGB spherical-harmonic terms, pre-multiplied by the
     // cosine-lobe band weights and basis constants (see ibl.rs).
@@ -46,7 +47,8 @@ struct Appearance {
     // x: roughness, y: metalness (negative: the material's own); z: clear coat; w: its roughness.
     params: vec4<f32>,
     // Ward lobe: rgb ρd (times the base colour texture), w: 1 when the Ward lobe replaces the
-    // metallic-roughness one; ρs; αx, αy along the tangent and bitangent.
+    // metallic-roughness one; ρs; αx, αy along the tangent and bitangent, and in z the side of
+    // its texture map's tile in metres (0: no map; `ward_map`).
     ward_rho_d: vec4<f32>,
     ward_rho_s: vec4<f32>,
     ward_alpha: vec4<f32>,
@@ -93,6 +95,11 @@ override FADE: bool = false;
 @group(0) @binding(5) var env_sampler: sampler;
 // The lamp's cube shadow: six 90° depth views about the lamp, read along the direction from it.
 @group(0) @binding(6) var shadow_cube: texture_depth_cube;
+// The Ward material's texture map (assets crate, ward_map.rs): per texel the scales of ρs (r)
+// and of the roughnesses (g), each over 2, the share whose grain runs across the tangent (b),
+// the scale of ρd over 2 (a); tiled along the tangent frame, repeating sampler.
+@group(0) @binding(7) var ward_map: texture_2d<f32>;
+@group(0) @binding(8) var ward_sampler: sampler;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_texture: texture_2d<f32>;
@@ -533,14 +540,31 @@ fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
         }
         tw = normalize(tw);
         let bw = cross(n, tw);
-        let rho_d = base * look.ward_rho_d.rgb;
-        let rho_s = look.ward_rho_s.rgb;
-        let lobe = ward_lobe(l, v, tw, bw, n, look.ward_alpha.xy);
+        var rho_d = base * look.ward_rho_d.rgb;
+        var rho_s = look.ward_rho_s.rgb;
+        var ward_alpha = look.ward_alpha.xy;
+        if (look.ward_alpha.z > 0.0) {
+            // The map, laid out in metres along the tangent frame; its level from the pixel's
+            // footprint there (the mips average it: a far weave is its mean, not noise). Applied
+            // as `WardMap::material_at` does: ρs ≤ 1, ρd ≤ 1 − ρs, αx and αy swapped by the share
+            // across.
+            let tile = look.ward_alpha.z;
+            let at = vec2<f32>(dot(world, tw), dot(world, bw)) / tile;
+            let size = f32(textureDimensions(ward_map).x);
+            let footprint = length(eye.eye_pos.xyz - world) * eye.shadow.z / max(n_dot_v, 0.2);
+            let level = log2(max(footprint / tile * size, 1e-6));
+            let m = textureSampleLevel(ward_map, ward_sampler, at, level);
+            rho_s = min(rho_s * (2.0 * m.r), vec3<f32>(1.0));
+            rho_d = min(rho_d * (2.0 * m.a), vec3<f32>(1.0) - rho_s);
+            ward_alpha = mix(ward_alpha, ward_alpha.yx, m.b) * (2.0 * m.g);
+            ward_alpha = clamp(ward_alpha, vec2<f32>(0.01), vec2<f32>(1.0));
+        }
+        let lobe = ward_lobe(l, v, tw, bw, n, ward_alpha);
         direct = (rho_d / PI + rho_s * lobe) * light_in;
-        let rough_eq = clamp(sqrt(sqrt(look.ward_alpha.x * look.ward_alpha.y)), 0.045, 1.0);
+        let rough_eq = clamp(sqrt(sqrt(ward_alpha.x * ward_alpha.y)), 0.045, 1.0);
         let lut_uv = clamp(vec2<f32>(n_dot_v, rough_eq), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
-        let prefiltered = ward_image_light(v, n, tw, bw, look.ward_alpha.xy);
+        let prefiltered = ward_image_light(v, n, tw, bw, ward_alpha);
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * (scale_bias.x + scale_bias.y);
     } else {
         let f0 = mix(vec3<f32>(0.04 * look.tint.w), base, metallic);

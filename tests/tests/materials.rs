@@ -180,3 +180,126 @@ fn ward_image_light_on_the_shared_rooms() {
         }
     }
 }
+
+/// A Ward preset's texture map as the renderer lays it: silk's plain weave over a flat panel in
+/// the glass, seen straight on at phone resolution. The threads are a millimetre wide along the
+/// surface's tangent frame whatever the screen: along a row, luminance one thread over is
+/// anti-correlated (warp and weft alternate) and two threads over correlated; the map keeps the
+/// preset's brightness on average (its scales average one: the mean of the preset's lobe and
+/// the lobe turned a quarter, as warp and weft are) but not its uniformity. Brushed metal's
+/// grooves run along the tangent: rows differ more from each other than columns do.
+#[test]
+fn a_ward_map_lays_its_threads_a_millimetre_apart_and_keeps_the_albedo() {
+    use phantogram::model::{Mesh, Model};
+    use phantogram::projection::{DepthRange, OffAxisProjection};
+    use phantogram::render::{FrameInput, Renderer};
+    use phantogram::screen::Screen;
+    use phantogram::ward::WardMap;
+    let Some(gpu) = phantogram_integration::gpu_or_skip() else {
+        return;
+    };
+    let screen = Screen::default();
+    let (w, h) = (540u32, 1200u32);
+    let px_per_mm = w as f32 / (screen.width_m() * 1000.0);
+    // A panel 50 mm square whose top face lies in the glass (z = 0), tangent +x, bitangent +y.
+    let mut mesh = Mesh::default();
+    mesh.push_cube(Vec3::new(0.0, 0.0, -0.025), 0.025, [1.0; 4]);
+    let model = Model::from_painted_mesh("panel", mesh);
+    let mut renderer = Renderer::new(gpu, &model).expect("renderer");
+    let eye = OffAxisProjection::new(&screen, Vec3::new(0.0, 0.0, 0.3), DepthRange::default()).expect("projection");
+    let input = FrameInput {
+        left: &eye,
+        right: &eye,
+        mono: &eye,
+        toward_light: Vec3::new(0.3, 0.4, 1.0),
+        device_to_world: Quat::IDENTITY,
+        offset: Vec3::ZERO,
+        levels: &[],
+        fades: &[],
+    };
+    let mut draw = |preset: WardPreset, map: Option<WardMap>, turned: bool| {
+        let mut look = Appearance::preset(preset);
+        if let Some(ward) = look.ward.as_mut() {
+            if let Some(map) = map {
+                ward.map = map;
+            }
+            if turned {
+                (ward.alpha_x, ward.alpha_y) = (ward.alpha_y, ward.alpha_x);
+            }
+        }
+        renderer.appearance = look;
+        let px = renderer.render(&input, Method::Mono, w, h).expect("render");
+        // Luminance of the central 240 × 240 pixels (about 30 mm), rows top to bottom.
+        let (x0, y0, n) = (w / 2 - 120, h / 2 - 120, 240u32);
+        (0..n)
+            .map(|y| {
+                (0..n)
+                    .map(|x| {
+                        let k = (((y0 + y) * w + x0 + x) * 4) as usize;
+                        0.2126 * f64::from(px[k]) + 0.7152 * f64::from(px[k + 1]) + 0.0722 * f64::from(px[k + 2])
+                    })
+                    .collect::<Vec<f64>>()
+            })
+            .collect::<Vec<Vec<f64>>>()
+    };
+    let mean = |img: &[Vec<f64>]| img.iter().flatten().sum::<f64>() / img.iter().map(Vec::len).sum::<usize>() as f64;
+    let spread = |img: &[Vec<f64>]| {
+        let m = mean(img);
+        (img.iter().flatten().map(|v| (v - m).powi(2)).sum::<f64>() / img.iter().map(Vec::len).sum::<usize>() as f64)
+            .sqrt()
+    };
+    // Correlation of each row with itself shifted by `lag` pixels, over all rows.
+    let row_correlation = |img: &[Vec<f64>], lag: usize| {
+        let (mut num, mut den) = (0.0, 0.0);
+        for row in img {
+            let m = row.iter().sum::<f64>() / row.len() as f64;
+            for i in 0..row.len() - lag {
+                num += (row[i] - m) * (row[i + lag] - m);
+            }
+            den += row.iter().map(|v| (v - m).powi(2)).sum::<f64>();
+        }
+        num / den.max(1e-12)
+    };
+    let woven = draw(WardPreset::Silk, None, false);
+    let plain = draw(WardPreset::Silk, Some(WardMap::Uniform), false);
+    let turned = draw(WardPreset::Silk, Some(WardMap::Uniform), true);
+    let (m_woven, m_plain) = (mean(&woven), 0.5 * (mean(&plain) + mean(&turned)));
+    let (s_woven, s_plain) = (spread(&woven), spread(&plain));
+    let thread = px_per_mm.round() as usize;
+    let (one, two) = (row_correlation(&woven, thread), row_correlation(&woven, 2 * thread));
+    println!(
+        "silk: mean {m_woven:.1} with its weave, {m_plain:.1} without (both ways); spread {s_woven:.2} vs {s_plain:.2}; \
+         row correlation at one thread ({thread} px) {one:.2}, at two {two:.2}"
+    );
+    assert!((m_woven - m_plain).abs() < 0.03 * m_plain, "the weave keeps the albedo");
+    // (The plain panel's spread is its shading's gradient.)
+    assert!(s_woven > 2.0 * s_plain.max(0.5), "the weave shows");
+    assert!(one < -0.2 && two > 0.3, "warp and weft alternate every millimetre");
+
+    let brushed = draw(WardPreset::BrushedMetal, None, false);
+    let plain = draw(WardPreset::BrushedMetal, Some(WardMap::Uniform), false);
+    // Grooves along x: a row is one groove (nearly), so the spread of row means is large and
+    // that of column means small (both of the difference from the plain panel, which has its
+    // shading's gradient).
+    let diff: Vec<Vec<f64>> = brushed
+        .iter()
+        .zip(&plain)
+        .map(|(a, b)| a.iter().zip(b).map(|(x, y)| x - y).collect())
+        .collect();
+    let row_means: Vec<f64> = diff.iter().map(|r| r.iter().sum::<f64>() / r.len() as f64).collect();
+    let column_means: Vec<f64> = (0..diff[0].len())
+        .map(|x| diff.iter().map(|r| r[x]).sum::<f64>() / diff.len() as f64)
+        .collect();
+    let deviation = |v: &[f64]| {
+        let m = v.iter().sum::<f64>() / v.len() as f64;
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / v.len() as f64).sqrt()
+    };
+    let (across, along) = (deviation(&row_means), deviation(&column_means));
+    let (m_brushed, m_plain) = (mean(&brushed), mean(&plain));
+    println!("brushed: mean {m_brushed:.1} vs {m_plain:.1}; row means spread {across:.2}, column means {along:.2}");
+    assert!(
+        (m_brushed - m_plain).abs() < 0.05 * m_plain,
+        "the grooves keep the albedo"
+    );
+    assert!(across > 3.0 * along, "the grooves run along the tangent");
+}

@@ -7,7 +7,7 @@
 //! Plain data; [`Appearance::sanitised`] keeps every value in its range whatever a slider, a
 //! file or the FFI says, so the renderer never sees NaN or a material that creates energy.
 
-use crate::ward::{WardMaterial, WardPreset};
+use crate::ward::{WardMap, WardMaterial, WardPreset};
 
 /// Changes over an artifact's glTF materials (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -111,7 +111,12 @@ impl Appearance {
         if let Some(w) = self.ward {
             put(
                 "ward",
-                serde_json::json!({"rho_d": w.rho_d, "rho_s": w.rho_s, "alpha": [w.alpha_x, w.alpha_y]}),
+                serde_json::json!({
+                    "rho_d": w.rho_d,
+                    "rho_s": w.rho_s,
+                    "alpha": [w.alpha_x, w.alpha_y],
+                    "map": w.map.key(),
+                }),
             );
         }
         serde_json::Value::Object(o)
@@ -139,6 +144,12 @@ impl Appearance {
                 rho_s: rgb(w.get("rho_s"))?,
                 alpha_x,
                 alpha_y,
+                // Stores written before maps (or naming one unknown here): the constants.
+                map: w
+                    .get("map")
+                    .and_then(|m| m.as_str())
+                    .and_then(WardMap::from_key)
+                    .unwrap_or_default(),
             })
         });
         Self {
@@ -177,6 +188,7 @@ mod tests {
                 rho_s: [1.0; 3],
                 alpha_x: 5.0,
                 alpha_y: 0.0,
+                map: WardMap::Woven,
             }),
         }
         .sanitised();
@@ -211,5 +223,15 @@ mod tests {
         let got = Appearance::from_json(&junk);
         assert_eq!((got.tint, got.roughness, got.ward), ([1.0; 3], Some(1.0), None));
         assert!(Appearance::from_json(&serde_json::json!(null)).is_default());
+        // A store from before the maps, or naming a map unknown here: the constants.
+        for map in [
+            serde_json::json!(null),
+            serde_json::json!("plaid"),
+            serde_json::json!(3),
+        ] {
+            let old = serde_json::json!({"ward": {"rho_d": [0.1, 0.1, 0.1], "rho_s": [0.7, 0.7, 0.7], "alpha": [0.05, 0.25], "map": map}});
+            let ward = Appearance::from_json(&old).ward.expect("a Ward lobe");
+            assert_eq!((ward.map, ward.alpha_y), (WardMap::Uniform, 0.25));
+        }
     }
 }

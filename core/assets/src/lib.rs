@@ -32,3 +32,4 @@ pub mod model;
 pub mod parallel;
 pub mod progress;
 pub mod ward;
+pub mod ward_map;

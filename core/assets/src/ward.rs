@@ -19,6 +19,8 @@
 
 use glam::Vec3;
 
+pub use crate::ward_map::WardMap;
+
 /// A Ward material: diffuse and specular albedo (linear RGB) and the lobe's two roughnesses.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct WardMaterial {
@@ -28,6 +30,9 @@ pub struct WardMaterial {
     /// [`ALPHA_RANGE`]: the RMS slope of the micro-surface.
     pub alpha_x: f32,
     pub alpha_y: f32,
+    /// How the constants above vary across the surface ([`crate::ward_map`]); [`Self::eval`]
+    /// is the constants alone.
+    pub map: WardMap,
 }
 
 /// The roughnesses a lobe accepts: sharper than 0.01 is a mirror the prefiltered light cannot
@@ -171,14 +176,22 @@ impl WardPreset {
             rho_s,
             alpha_x,
             alpha_y,
+            map: WardMap::Uniform,
         };
+        // Brushed metal and silk are their structure: grooves, a weave (`ward_map`).
         match self {
             Self::Matte => m([0.55, 0.33, 0.22], [0.03; 3], 0.6, 0.6),
             Self::Glazed => m([0.45, 0.52, 0.60], [0.08; 3], 0.05, 0.05),
             Self::Polished => m([0.05, 0.04, 0.02], [0.75, 0.55, 0.35], 0.08, 0.08),
             Self::Patinated => m([0.20, 0.38, 0.30], [0.12, 0.10, 0.08], 0.35, 0.35),
-            Self::BrushedMetal => m([0.10; 3], [0.70, 0.70, 0.72], 0.05, 0.25),
-            Self::Silk => m([0.50, 0.25, 0.30], [0.20, 0.14, 0.15], 0.35, 0.10),
+            Self::BrushedMetal => WardMaterial {
+                map: WardMap::Brushed,
+                ..m([0.10; 3], [0.70, 0.70, 0.72], 0.05, 0.25)
+            },
+            Self::Silk => WardMaterial {
+                map: WardMap::Woven,
+                ..m([0.50, 0.25, 0.30], [0.20, 0.14, 0.15], 0.35, 0.10)
+            },
             Self::Lacquer => m([0.02; 3], [0.10; 3], 0.02, 0.02),
         }
     }
@@ -328,6 +341,7 @@ mod tests {
             rho_s: [0.5, 2.0, 0.1],
             alpha_x: 0.0,
             alpha_y: f32::NAN,
+            map: WardMap::Uniform,
         }
         .conserving();
         assert_eq!(wild.rho_s, [0.5, 1.0, 0.1]);

@@ -349,17 +349,7 @@ impl crate::Renderer {
                 .collect();
             let face_binds = face_buffers
                 .iter()
-                .map(|b| {
-                    crate::eye_bind_group(
-                        device,
-                        &self.eye_layout,
-                        b,
-                        &self.shadow_view,
-                        &self.shadow_sampler,
-                        &self.point_shadow.cube_view,
-                        &self.ibl,
-                    )
-                })
+                .map(|b| crate::eye_bind_group(device, &self.eye_layout, b, &self.eye_views(), &self.ibl))
                 .collect();
             self.impostor_pipelines = Some(ImpostorPipelines {
                 bake,

@@ -56,6 +56,7 @@ pub use phantogram_assets::appearance::Appearance;
 pub use phantogram_assets::model::LevelFade;
 use phantogram_assets::model::{AlphaMode, Material, Model, Sampler, TextureRef, Vertex, Wrap};
 pub use phantogram_assets::ward;
+use phantogram_assets::ward::WardMap;
 use phantogram_geometry::anaglyph::Method;
 use phantogram_geometry::projection::OffAxisProjection;
 
@@ -136,6 +137,7 @@ struct EyeUniform {
     light: [f32; 4],
     world_from_device: [[f32; 4]; 3],
     light_view_proj: [[f32; 4]; 4],
+    /// Texel size (metres) and on/off of the shadow map; the angle a pixel subtends (radians).
     shadow: [f32; 4],
     sh: [[f32; 4]; 9],
     /// The artifact's [`Appearance`], as `Appearance` in `scene.wgsl` lays it out.
@@ -225,7 +227,8 @@ pub fn lamp_view_proj(bounds: &phantogram_geometry::containment::Aabb, lamp: &La
 }
 
 /// `Appearance` in `scene.wgsl`: rgb tint and specular scale; roughness and metalness overrides
-/// (negative: keep), clear coat and its roughness; Ward ρd (w: 1 when on), ρs, and αx, αy.
+/// (negative: keep), clear coat and its roughness; Ward ρd (w: 1 when on), ρs, and αx, αy and
+/// the side of its map's tile in metres (0: no map).
 fn appearance_uniform(a: &Appearance) -> [[f32; 4]; 5] {
     let a = a.sanitised();
     let ward = a.ward.unwrap_or(phantogram_assets::ward::WardPreset::Matte.material());
@@ -240,7 +243,7 @@ fn appearance_uniform(a: &Appearance) -> [[f32; 4]; 5] {
         ],
         [ward.rho_d[0], ward.rho_d[1], ward.rho_d[2], on],
         [ward.rho_s[0], ward.rho_s[1], ward.rho_s[2], 0.0],
-        [ward.alpha_x, ward.alpha_y, 0.0, 0.0],
+        [ward.alpha_x, ward.alpha_y, ward.map.tile_m(), 0.0],
     ]
 }
 
@@ -770,6 +773,10 @@ pub struct Renderer {
     shadow_layout: wgpu::BindGroupLayout,
     /// The shadows of a lamp among its casters ([`point_shadow`]).
     point_shadow: point_shadow::PointShadowMap,
+    /// The texture map of the appearance's Ward material ([`WardMap`]; 1×1 neutral for none),
+    /// and its sampler (repeating, mipmapped).
+    ward_map: (WardMap, wgpu::TextureView),
+    ward_sampler: wgpu::Sampler,
     /// The environment's irradiance, as the shader takes it.
     environment_sh: [[f32; 4]; 9],
     targets: Option<Targets>,
@@ -884,6 +891,13 @@ impl Renderer {
                     },
                     count: None,
                 },
+                filterable_texture_entry(7),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 8,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
             ],
         });
         let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -925,13 +939,27 @@ impl Renderer {
         });
         // 1×1 a face until a lamp stands among its casters (see `point_shadow`).
         let point_shadow = point_shadow::PointShadowMap::new(device, &shadow_layout, 1);
+        let ward_map = (WardMap::Uniform, upload_ward_map(&gpu, WardMap::Uniform));
+        let ward_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("Ward map"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
         let eye_bind = eye_bind_groups(
             device,
             &eye_layout,
             &eye_buffers,
-            &shadow_view,
-            &shadow_sampler,
-            &point_shadow.cube_view,
+            &EyeViews {
+                shadow: &shadow_view,
+                shadow_sampler: &shadow_sampler,
+                shadow_cube: &point_shadow.cube_view,
+                ward_map: &ward_map.1,
+                ward_sampler: &ward_sampler,
+            },
             &ibl,
         );
         let shadow_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -1056,6 +1084,8 @@ impl Renderer {
             shadow_view,
             shadow_layout,
             point_shadow,
+            ward_map,
+            ward_sampler,
             environment_sh,
             targets: None,
             side_targets: None,
@@ -1180,17 +1210,41 @@ impl Renderer {
         })
     }
 
-    /// The eyes' bind groups made again, after the image light or the lamp's cube changed.
+    /// The eyes' bind groups made again, after the image light, the lamp's cube or the Ward
+    /// map changed.
     fn remake_eye_binds(&mut self) {
         self.eye_bind = eye_bind_groups(
             &self.gpu.device,
             &self.eye_layout,
             &self.eye_buffers,
-            &self.shadow_view,
-            &self.shadow_sampler,
-            &self.point_shadow.cube_view,
+            &self.eye_views(),
             &self.ibl,
         );
+    }
+
+    /// What the eyes' bind groups hold besides their uniforms and the image light.
+    fn eye_views(&self) -> EyeViews<'_> {
+        EyeViews {
+            shadow: &self.shadow_view,
+            shadow_sampler: &self.shadow_sampler,
+            shadow_cube: &self.point_shadow.cube_view,
+            ward_map: &self.ward_map.1,
+            ward_sampler: &self.ward_sampler,
+        }
+    }
+
+    /// Uploads the texture map the appearance's Ward material asks for, if it is not the one
+    /// bound (a preset chosen on the material screen: once, not per frame).
+    fn use_ward_map(&mut self) -> Result<(), RenderError> {
+        let wanted = self.appearance.sanitised().ward.map_or(WardMap::Uniform, |w| w.map);
+        if wanted == self.ward_map.0 {
+            return Ok(());
+        }
+        let device = self.gpu.device.clone();
+        checked(&device, "the Ward material's texture map", || {
+            self.ward_map = (wanted, upload_ward_map(&self.gpu, wanted));
+            self.remake_eye_binds();
+        })
     }
 
     /// Replaces the model drawn (keeps pipelines and targets).
@@ -1356,6 +1410,10 @@ impl Renderer {
         // The mesh moves by `offset` (push-back): fold it into the projection.
         let view_proj = proj.view_proj * Mat4::from_translation(input.offset);
         let l = self.lighting;
+        // The angle a pixel subtends (at the screen's centre): the near plane's width over its
+        // distance, 2 / proj[0][0], shared among the target's pixels. For the Ward map's level.
+        let width_px = self.targets.as_ref().map_or(1, |t| t.width).max(1) as f32;
+        let radians_per_px = 2.0 / (proj.proj.x_axis.x.abs().max(1e-6) * width_px);
         EyeUniform {
             view_proj: view_proj.to_cols_array_2d(),
             // Shading happens in mesh coordinates, so the eye moves the other way.
@@ -1371,7 +1429,7 @@ impl Renderer {
                 ]
             },
             light_view_proj: shadow.0.to_cols_array_2d(),
-            shadow: [shadow.1, f32::from(u8::from(l.shadows)), 0.0, 0.0],
+            shadow: [shadow.1, f32::from(u8::from(l.shadows)), radians_per_px, 0.0],
             sh: self.environment_sh,
             appearance: appearance_uniform(&self.appearance),
             lamp: Lamp::uniform(self.lamp.as_ref()),
@@ -1549,6 +1607,7 @@ impl Renderer {
             })?;
             self.compose_pipelines.insert(format, pipeline);
         }
+        self.use_ward_map()?;
         let lamp = self.lamp.filter(Lamp::is_finite);
         let toward = match &lamp {
             Some(l) => l.toward_from((self.model.bounds.min + self.model.bounds.max) * 0.5),
@@ -1947,35 +2006,37 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
     }
 }
 
+/// The eyes' bind group's shadow maps and Ward map (see `Eye`'s bindings in `scene.wgsl`).
+struct EyeViews<'a> {
+    shadow: &'a wgpu::TextureView,
+    shadow_sampler: &'a wgpu::Sampler,
+    shadow_cube: &'a wgpu::TextureView,
+    ward_map: &'a wgpu::TextureView,
+    ward_sampler: &'a wgpu::Sampler,
+}
+
+/// A Ward map's texels as a mipmapped linear texture (the mips average the scales, so a distant
+/// weave shows its mean).
+fn upload_ward_map(gpu: &Gpu, map: WardMap) -> wgpu::TextureView {
+    let (size, texels) = map.texels();
+    upload_texture(gpu, "Ward map", size, size, &texels, false)
+}
+
 fn eye_bind_groups(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     buffers: &[wgpu::Buffer; 2],
-    shadow_view: &wgpu::TextureView,
-    shadow_sampler: &wgpu::Sampler,
-    shadow_cube: &wgpu::TextureView,
+    views: &EyeViews<'_>,
     ibl: &IblTextures,
 ) -> [wgpu::BindGroup; 2] {
-    [0, 1].map(|i| {
-        eye_bind_group(
-            device,
-            layout,
-            &buffers[i],
-            shadow_view,
-            shadow_sampler,
-            shadow_cube,
-            ibl,
-        )
-    })
+    [0, 1].map(|i| eye_bind_group(device, layout, &buffers[i], views, ibl))
 }
 
 fn eye_bind_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     buffer: &wgpu::Buffer,
-    shadow_view: &wgpu::TextureView,
-    shadow_sampler: &wgpu::Sampler,
-    shadow_cube: &wgpu::TextureView,
+    views: &EyeViews<'_>,
     ibl: &IblTextures,
 ) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -1988,11 +2049,11 @@ fn eye_bind_group(
             },
             wgpu::BindGroupEntry {
                 binding: 1,
-                resource: wgpu::BindingResource::TextureView(shadow_view),
+                resource: wgpu::BindingResource::TextureView(views.shadow),
             },
             wgpu::BindGroupEntry {
                 binding: 2,
-                resource: wgpu::BindingResource::Sampler(shadow_sampler),
+                resource: wgpu::BindingResource::Sampler(views.shadow_sampler),
             },
             wgpu::BindGroupEntry {
                 binding: 3,
@@ -2008,7 +2069,15 @@ fn eye_bind_group(
             },
             wgpu::BindGroupEntry {
                 binding: 6,
-                resource: wgpu::BindingResource::TextureView(shadow_cube),
+                resource: wgpu::BindingResource::TextureView(views.shadow_cube),
+            },
+            wgpu::BindGroupEntry {
+                binding: 7,
+                resource: wgpu::BindingResource::TextureView(views.ward_map),
+            },
+            wgpu::BindGroupEntry {
+                binding: 8,
+                resource: wgpu::BindingResource::Sampler(views.ward_sampler),
             },
         ],
     })
