@@ -277,16 +277,17 @@ fn push_floor_marker(mesh: &mut Mesh) {
 
 /// `model` on its floor seen straight on from 30 cm, lit from `toward_light`, in mono.
 fn render_over_floor(model: Model, shadows: bool, toward_light: Vec3) -> Option<(Vec<u8>, OffAxisProjection)> {
-    render_over_floor_lit(model, shadows, toward_light, None)
+    render_over_floor_lit(model, shadows, toward_light, None).map(|(px, proj, _)| (px, proj))
 }
 
-/// [`render_over_floor`], with `lamp` in place of the directional light if given.
+/// [`render_over_floor`], with `lamp` in place of the directional light if given; also the
+/// triangles the shadow passes drew.
 fn render_over_floor_lit(
     mut model: Model,
     shadows: bool,
     toward_light: Vec3,
     lamp: Option<phantogram::render::Lamp>,
-) -> Option<(Vec<u8>, OffAxisProjection)> {
+) -> Option<(Vec<u8>, OffAxisProjection, u64)> {
     let gpu = gpu()?;
     let screen = Screen::default();
     model.add_floor(&screen, 2.0);
@@ -305,7 +306,8 @@ fn render_over_floor_lit(
         levels: &[],
         fades: &[],
     };
-    Some((renderer.render(&input, Method::Mono, W, H).unwrap(), mono))
+    let pixels = renderer.render(&input, Method::Mono, W, H).unwrap();
+    Some((pixels, mono, renderer.shadow_triangles_last_frame()))
 }
 
 fn luminance_at(pixels: &[u8], proj: &OffAxisProjection, p: Vec3) -> f32 {
@@ -341,33 +343,48 @@ fn shadows_fall_where_the_light_says() {
 /// the lamp in x and in y, with nothing between, and between the lamp and the blocks, it is lit
 /// as without shadows. The shadows are read from two faces of the cube (−X and +Y), off their
 /// centres on both axes, so a face drawn mirrored any way or in another's place moves a shadow
-/// off its point. Lamps outside the casters' sphere keep the one perspective view
+/// off its point. Each block and the marker is its own primitive: each face of the cube draws
+/// only those its frustum reaches, so the six passes draw far fewer triangles than six times
+/// the casters. Lamps outside the casters' sphere keep the one perspective view
 /// (`a_lamps_shadow_view_holds_...`).
 #[test]
 fn a_lamp_among_its_casters_shadows_every_way() {
     let scene = |shadows: bool, intensity: f32| {
-        let mut mesh = Mesh::default();
-        mesh.push_cube(Vec3::new(-0.012, 0.006, -0.024), 0.003, [0.8, 0.8, 0.8, 1.0]);
-        mesh.push_cube(Vec3::new(0.006, 0.012, -0.024), 0.003, [0.8, 0.8, 0.8, 1.0]);
-        push_floor_marker(&mut mesh);
+        let mut marker = Mesh::default();
+        push_floor_marker(&mut marker);
+        let mut model = Model::from_painted_mesh("lamp among blocks", marker);
+        for centre in [Vec3::new(-0.012, 0.006, -0.024), Vec3::new(0.006, 0.012, -0.024)] {
+            let mut mesh = Mesh::default();
+            mesh.push_cube(centre, 0.003, [0.8, 0.8, 0.8, 1.0]);
+            model.primitives.push(phantogram::model::Primitive {
+                mesh,
+                material: 0,
+                is_floor: false,
+                lods: Vec::new(),
+            });
+        }
         let lamp = phantogram::render::Lamp {
             position_m: Vec3::new(0.0, 0.0, -0.022),
             axis: Vec3::NEG_Z,
             cone_half_angle_rad: None,
             intensity_rgb: Vec3::splat(intensity),
         };
-        render_over_floor_lit(
-            Model::from_painted_mesh("lamp among blocks", mesh),
-            shadows,
-            OBLIQUE_LIGHT,
-            Some(lamp),
-        )
+        render_over_floor_lit(model, shadows, OBLIQUE_LIGHT, Some(lamp))
     };
-    let Some((pixels, proj)) = scene(true, 0.004) else {
+    let Some((pixels, proj, shadow_triangles)) = scene(true, 0.004) else {
         return;
     };
-    let (without, _) = scene(false, 0.004).expect("a GPU");
-    let (dark_lamp, _) = scene(true, 0.0).expect("a GPU");
+    let (without, _, none) = scene(false, 0.004).expect("a GPU");
+    let (dark_lamp, _, _) = scene(true, 0.0).expect("a GPU");
+    // Three casters of 12 triangles each: the marker in the +Y face's frustum, each block in
+    // two (each touches the diagonal between its face and the next: the −x block reaches
+    // |y| = |x| at (−9, 9) mm from the lamp): five draws, 60 triangles; unculled, 216.
+    println!("shadow passes drew {shadow_triangles} triangles (casters 36, six faces unculled 216)");
+    assert_eq!(none, 0, "no shadow pass without shadows");
+    assert!(
+        (36..=72).contains(&shadow_triangles),
+        "{shadow_triangles} triangles in the cube's passes"
+    );
     let floor_z = -0.031;
     let at = |px: &[u8], (x, y): (f32, f32)| luminance_at(px, &proj, Vec3::new(x, y, floor_z));
     // Luminance is in 8-bit levels: two and a half are a rounding of each channel.

@@ -443,6 +443,9 @@ struct GpuPrimitive {
     source: usize,
     material: usize,
     centre: Vec3,
+    /// This piece's bounds (mesh coordinates), for culling it from the lamp cube's faces;
+    /// `None` for a mesh without vertices.
+    bounds: Option<phantogram_geometry::containment::Aabb>,
     is_floor: bool,
 }
 
@@ -451,6 +454,15 @@ impl GpuPrimitive {
     /// [`FrameInput::levels`]), with whatever pipeline and bind groups are set.
     fn draw(&self, pass: &mut wgpu::RenderPass<'_>, levels: &[u8]) {
         self.draw_at(pass, levels.get(self.source).copied().unwrap_or(0), 0);
+    }
+
+    /// Triangles [`Self::draw`] draws at `levels`.
+    fn triangles_at(&self, levels: &[u8]) -> u64 {
+        let level = usize::from(levels.get(self.source).copied().unwrap_or(0));
+        self.levels
+            .get(level)
+            .or(self.levels.last())
+            .map_or(0, |r| u64::from(r.end - r.start) / 3)
     }
 
     /// Draws level `level` (past the chain: the coarsest) as instance `instance`.
@@ -773,6 +785,8 @@ pub struct Renderer {
     shadow_layout: wgpu::BindGroupLayout,
     /// The shadows of a lamp among its casters ([`point_shadow`]).
     point_shadow: point_shadow::PointShadowMap,
+    /// Triangles the last frame's shadow passes drew (all faces of a lamp's cube together).
+    shadow_triangles: u64,
     /// The texture map of the appearance's Ward material ([`WardMap`]; 1×1 neutral for none),
     /// and its sampler (repeating, mipmapped).
     ward_map: (WardMap, wgpu::TextureView),
@@ -1084,6 +1098,7 @@ impl Renderer {
             shadow_view,
             shadow_layout,
             point_shadow,
+            shadow_triangles: 0,
             ward_map,
             ward_sampler,
             environment_sh,
@@ -1269,10 +1284,13 @@ impl Renderer {
         if !same_shape {
             return self.set_model(model);
         }
-        for (p, g) in drawn.iter().zip(&self.model.primitives) {
+        for (p, g) in drawn.iter().zip(&mut self.model.primitives) {
             self.gpu
                 .queue
                 .write_buffer(&g.vertices, 0, bytemuck::cast_slice(&p.mesh.vertices));
+            // Moved bodies: their bounds (the lamp cube's culling) and centres (blending order).
+            g.bounds = p.mesh.bounds();
+            g.centre = g.bounds.map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5);
         }
         // Baked from the vertices as they were.
         self.model.impostors.clear();
@@ -1635,6 +1653,7 @@ impl Renderer {
             })?;
         }
         let mut uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input, shadow)).collect();
+        let mut faces = None;
         if let Some((lamp_m, (near_m, far_m))) = cube {
             for u in &mut uniforms {
                 u.shadow[1] = 0.0;
@@ -1646,8 +1665,9 @@ impl Renderer {
                 ];
             }
             if cube_pass {
-                let faces = point_shadow::cube_face_view_proj(lamp_m, near_m, far_m);
-                self.point_shadow.write_faces(&self.gpu.queue, &faces);
+                let views = point_shadow::cube_face_view_proj(lamp_m, near_m, far_m);
+                self.point_shadow.write_faces(&self.gpu.queue, &views);
+                faces = Some(views);
             }
         }
         let (lm, rm) = method.matrices();
@@ -1668,22 +1688,26 @@ impl Renderer {
         let timed = self.timer.as_mut().is_some_and(|t| t.start_frame());
         let timer = self.timer.as_ref().filter(|_| timed);
         let shadow_pass = self.lighting.shadows;
+        let mut shadow_triangles = 0;
         let targets = self.targets.as_ref().expect("the caller sized the targets");
         let mut encoder = self.gpu.device.create_command_encoder(&Default::default());
         if shadow_pass {
-            // Once per frame, for both eyes: one view, or the lamp cube's six.
-            let views: Vec<(&wgpu::TextureView, &wgpu::BindGroup)> = if cube.is_some() {
-                self.point_shadow
+            // Once per frame, for both eyes: one view, or the lamp cube's six, each drawing only
+            // what lies in its frustum.
+            let views: Vec<(&wgpu::TextureView, &wgpu::BindGroup, Option<Mat4>)> = match &faces {
+                Some(faces) => self
+                    .point_shadow
                     .face_views
                     .iter()
                     .zip(&self.point_shadow.face_binds)
-                    .collect()
-            } else {
-                vec![(&self.shadow_view, &self.shadow_bind)]
+                    .zip(faces)
+                    .map(|((v, b), m)| (v, b, Some(*m)))
+                    .collect(),
+                None => vec![(&self.shadow_view, &self.shadow_bind, None)],
             };
             // Impostors cast the shadow of the polygon level as exact as they are.
             let shadow_levels = self.shadow_levels(input.levels);
-            for (k, (view, bind)) in views.into_iter().enumerate() {
+            for (k, (view, bind, cull)) in views.into_iter().enumerate() {
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("shadow"),
                     timestamp_writes: timer.filter(|_| k == 0).map(|t| t.writes(true, false)),
@@ -1698,9 +1722,11 @@ impl Renderer {
                     }),
                     ..Default::default()
                 });
-                self.draw_shadow_casters(&mut pass, bind, &shadow_levels, floor_casts);
+                shadow_triangles +=
+                    self.draw_shadow_casters(&mut pass, bind, &shadow_levels, floor_casts, cull.as_ref());
             }
         }
+        self.shadow_triangles = shadow_triangles;
         for (i, u) in uniforms.iter().enumerate() {
             let first = i == 0 && !shadow_pass;
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -1827,28 +1853,36 @@ fn create_compose_pipeline(
 impl Renderer {
     /// Draws what casts shadows into a shadow pass whose light matrix `bind` holds: opaque
     /// materials, then masked ones cut out (blended ones cast none); the floor only when
-    /// `floor_casts`.
+    /// `floor_casts`; with `cull` (that matrix), only pieces whose bounds reach its frustum.
+    /// Returns the triangles drawn.
     fn draw_shadow_casters(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         bind: &wgpu::BindGroup,
         levels: &[u8],
         floor_casts: bool,
-    ) {
+        cull: Option<&Mat4>,
+    ) -> u64 {
         pass.set_pipeline(&self.shadow_pipeline);
         pass.set_bind_group(0, bind, &[]);
         let variant = |p: &GpuPrimitive| self.model.materials[p.material].variant;
+        let seen = |p: &GpuPrimitive| match (cull, &p.bounds) {
+            (Some(m), Some(b)) => !point_shadow::outside_frustum(m, b),
+            _ => true,
+        };
+        let mut triangles = 0;
         for p in self.model.primitives.iter().filter(|p| {
             let v = variant(p);
-            !v.blend && !v.mask && (floor_casts || !p.is_floor)
+            !v.blend && !v.mask && (floor_casts || !p.is_floor) && seen(p)
         }) {
             p.draw(pass, levels);
+            triangles += p.triangles_at(levels);
         }
         let mut masked = self
             .model
             .primitives
             .iter()
-            .filter(|p| variant(p).casts_masked_shadow() && (floor_casts || !p.is_floor))
+            .filter(|p| variant(p).casts_masked_shadow() && (floor_casts || !p.is_floor) && seen(p))
             .peekable();
         if masked.peek().is_some() {
             // Made with the model (`ScenePipelines::prepare`); a miss would be our bug, and
@@ -1859,11 +1893,20 @@ impl Renderer {
                     for p in masked {
                         pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
                         p.draw(pass, levels);
+                        triangles += p.triangles_at(levels);
                     }
                 }
                 None => debug_assert!(false, "no shadow pipeline for masked materials"),
             }
         }
+        triangles
+    }
+
+    /// Triangles the last frame's shadow passes drew: the model's casters once for a light's
+    /// map, for a lamp's cube those each face's frustum reaches (a piece across two faces
+    /// counts twice); 0 without shadows.
+    pub fn shadow_triangles_last_frame(&self) -> u64 {
+        self.shadow_triangles
     }
 
     /// `levels` with each impostor drawn replaced by the level its shadow is cast with.

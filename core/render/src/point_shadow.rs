@@ -70,6 +70,20 @@ pub fn cube_depth(major_m: f32, near_m: f32, far_m: f32) -> f32 {
     far_m * (major_m - near_m) / (major_m * (far_m - near_m))
 }
 
+/// Whether the box `b` lies wholly outside the frustum of `view_proj` (clip space as wgpu's:
+/// −w ≤ x, y ≤ w, 0 ≤ z ≤ w): all eight corners beyond one of its planes. Conservative: a box
+/// beside a corner of the frustum may be kept though nothing of it is inside.
+pub fn outside_frustum(view_proj: &Mat4, b: &phantogram_geometry::containment::Aabb) -> bool {
+    let clip = b.corners().map(|c| *view_proj * c.extend(1.0));
+    let beyond = |test: fn(glam::Vec4) -> bool| clip.iter().all(|c| test(*c));
+    beyond(|c| c.x < -c.w)
+        || beyond(|c| c.x > c.w)
+        || beyond(|c| c.y < -c.w)
+        || beyond(|c| c.y > c.w)
+        || beyond(|c| c.z < 0.0)
+        || beyond(|c| c.z > c.w)
+}
+
 /// The GPU side: the cube texture, a view per face to draw into, and per face a uniform block
 /// holding that face's view-projection where the shadow pass reads the light's
 /// (`Eye::light_view_proj`), so the 2-D map's pipelines draw the faces unchanged.
@@ -211,6 +225,47 @@ mod tests {
                 let major = d.abs().max_element() * distance;
                 assert!((p.z - cube_depth(major, near, far)).abs() < 1e-5, "{d}: depth {}", p.z);
                 assert!((0.0..=1.0).contains(&p.z));
+            }
+        }
+    }
+
+    #[test]
+    fn a_box_is_culled_only_from_faces_it_misses() {
+        use phantogram_geometry::containment::Aabb;
+        let lamp = Vec3::ZERO;
+        let faces = cube_face_view_proj(lamp, 0.001, 1.0);
+        // A small box straight along +x: in the +X face only.
+        let ahead = Aabb::new(Vec3::new(0.3, -0.01, -0.01), Vec3::new(0.32, 0.01, 0.01));
+        let kept: Vec<bool> = faces.iter().map(|m| !outside_frustum(m, &ahead)).collect();
+        assert_eq!(kept, [true, false, false, false, false, false]);
+        // One straddling the +X/+Y edge: in both.
+        let edge = Aabb::new(Vec3::new(0.2, 0.18, -0.01), Vec3::new(0.22, 0.24, 0.01));
+        let kept: Vec<bool> = faces.iter().map(|m| !outside_frustum(m, &edge)).collect();
+        assert_eq!(kept, [true, false, true, false, false, false]);
+        // One around the lamp: in every face.
+        let around = Aabb::new(Vec3::splat(-0.05), Vec3::splat(0.05));
+        assert!(faces.iter().all(|m| !outside_frustum(m, &around)));
+        // Beyond the far plane: in none.
+        let far = Aabb::new(Vec3::new(1.5, -0.01, -0.01), Vec3::new(1.6, 0.01, 0.01));
+        assert!(faces.iter().all(|m| outside_frustum(m, &far)));
+        // A box is never culled from a face that sees one of its points (random boxes, checked
+        // against the lookup rule at their corners and centre).
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 - 0.5
+        };
+        for _ in 0..2000 {
+            let c = Vec3::new(next(), next(), next());
+            let h = Vec3::new(next(), next(), next()).abs() * 0.1;
+            let b = Aabb::new(c - h, c + h);
+            for p in b.corners().into_iter().chain([c]) {
+                let (face, _, _) = lookup(p - lamp);
+                if (p - lamp).abs().max_element() > 0.002 {
+                    assert!(!outside_frustum(&faces[face], &b), "{b:?}: {p} is in face {face}");
+                }
             }
         }
     }

@@ -258,6 +258,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
             material: p.material.min(model.materials.len().saturating_sub(1)),
             // The whole primitive's centre, for the transparent pieces' back-to-front order.
             centre: p.mesh.bounds().map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5),
+            bounds: mesh.bounds(),
             is_floor: p.is_floor,
         }
     };
