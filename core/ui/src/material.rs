@@ -2,7 +2,7 @@
 //! material) or in one of the Ward presets (matte, glazed, polished, patinated, brushed metal,
 //! silk, lacquer), and sliders for its colour tint, roughness, metalness, specular strength and a
 //! clear coat — or, with a Ward preset, for its gloss and its roughness along and across the
-//! grain. Every change is reported at once, so the artifact shows it in the next frame. It takes
+//! grain, and a choice of its surface's texture map (smooth, brushed grooves, woven threads). Every change is reported at once, so the artifact shows it in the next frame. It takes
 //! the lower part of the screen ([`PANEL_FRACTION`]) and scrolls there, so the artifact stays in
 //! view above it.
 //!
@@ -12,7 +12,7 @@
 
 use egui::{Rect, RichText};
 use phantogram_render::Appearance;
-use phantogram_render::ward::WardPreset;
+use phantogram_render::ward::{WardMap, WardPreset};
 
 use crate::menu::CONTROL_HEIGHT_PT;
 
@@ -46,6 +46,24 @@ pub fn preset_key(preset: WardPreset) -> &'static str {
     }
 }
 
+/// The key of a texture map's button: `map-` and its store key (`map-woven`).
+pub fn map_key(map: WardMap) -> &'static str {
+    match map {
+        WardMap::Uniform => "map-uniform",
+        WardMap::Brushed => "map-brushed",
+        WardMap::Woven => "map-woven",
+    }
+}
+
+/// The words a texture map's button shows.
+fn map_label(map: WardMap) -> &'static str {
+    match map {
+        WardMap::Uniform => "Smooth",
+        WardMap::Brushed => "Grooves",
+        WardMap::Woven => "Woven",
+    }
+}
+
 impl MaterialUi {
     pub fn new(appearance: Appearance) -> Self {
         Self {
@@ -57,7 +75,7 @@ impl MaterialUi {
     /// The rectangle (points) of a control drawn last frame: `as-found`, the presets
     /// ([`preset_key`]), the sliders `tint-red`, `tint-green`, `tint-blue`, `roughness`,
     /// `metalness`, `specular`, `clear-coat`, `coat-roughness`, with a Ward preset `gloss`,
-    /// `along`, `across`; and `done`.
+    /// `along`, `across` and the texture maps ([`map_key`]); and `done`.
     pub fn widget_rect(&self, name: &str) -> Option<Rect> {
         self.widget_rects.get(name)
     }
@@ -162,6 +180,22 @@ impl MaterialUi {
                             }
                             self.roughness_slider(ui, "along", "Roughness along the grain", &mut ward.alpha_x);
                             self.roughness_slider(ui, "across", "Roughness across the grain", &mut ward.alpha_y);
+                            // The surface's structure: three buttons in a row, the chosen one lit.
+                            ui.label(RichText::new("Surface").size(16.0));
+                            let third = ((full - 2.0 * ui.spacing().item_spacing.x) / 3.0).max(0.0);
+                            ui.horizontal(|ui| {
+                                for map in WardMap::ALL {
+                                    let r = ui.add_sized(
+                                        [third, CONTROL_HEIGHT_PT],
+                                        egui::Button::new(RichText::new(map_label(map)).size(17.0))
+                                            .selected(ward.map == map),
+                                    );
+                                    self.widget_rects.remember(map_key(map), r.rect);
+                                    if r.clicked() {
+                                        ward.map = map;
+                                    }
+                                }
+                            });
                         }
                         None => {
                             let mut roughness = a.roughness.unwrap_or(0.5);
@@ -262,6 +296,24 @@ mod tests {
         );
         frame(&ctx, &mut s, vec![]);
         assert!(s.widget_rect("along").is_some() && s.widget_rect("gloss").is_some());
+        // Its surface woven, then smooth again: each reported with the rest unchanged.
+        scroll_to(&ctx, &mut s, map_key(WardMap::Woven));
+        let woven = tap(&ctx, &mut s, map_key(WardMap::Woven));
+        let Some(MaterialAction::Changed(w)) = woven.first() else {
+            panic!("the weave was reported: {woven:?}")
+        };
+        assert_eq!(w.ward.map(|w| w.map), Some(WardMap::Woven));
+        assert_eq!(
+            tap(&ctx, &mut s, map_key(WardMap::Uniform)),
+            vec![MaterialAction::Changed(glazed)]
+        );
+        for map in WardMap::ALL {
+            let r = s.widget_rect(map_key(map)).expect("a map button");
+            assert!(
+                r.height() >= CONTROL_HEIGHT_PT - 0.5 && r.width() >= 60.0,
+                "{map:?}: {r:?}"
+            );
+        }
         // Dragging the clear-coat slider to its right end: a full coat, reported in that frame.
         scroll_to(&ctx, &mut s, "clear-coat");
         let r = s.widget_rect("clear-coat").expect("slider");
