@@ -2323,6 +2323,21 @@ impl Screens {
             modifiers: egui::Modifiers::default(),
         };
         let pos = egui::pos2(x_pt, y_pt);
+        // Every finger as egui's touch too: egui scrolls by dragging only once it has seen a
+        // touch screen (`DragScroll::OnTouch`), so without these no panel scrolls under a finger.
+        let touch_phase = match phase {
+            TouchPhase::Down => egui::TouchPhase::Start,
+            TouchPhase::Move => egui::TouchPhase::Move,
+            TouchPhase::Up => egui::TouchPhase::End,
+            TouchPhase::Cancel => egui::TouchPhase::Cancel,
+        };
+        self.events.push(egui::Event::Touch {
+            device_id: egui::TouchDeviceId(0),
+            id: egui::TouchId(u64::from(pointer_id as u32)),
+            phase: touch_phase,
+            pos,
+            force: None,
+        });
         match phase {
             TouchPhase::Down if self.pointer.is_none() => {
                 self.pointer = Some(pointer_id);

@@ -303,3 +303,55 @@ fn a_ward_map_lays_its_threads_a_millimetre_apart_and_keeps_the_albedo() {
     );
     assert!(across > 3.0 * along, "the grooves run along the tangent");
 }
+
+/// A finger scrolls the material screen: its Done button starts below the screen's edge on a
+/// phone-sized surface, a drag up over the panel brings it into view (egui scrolls by dragging
+/// only once it knows the pointer is a touch screen's), and a tap on it closes the screen.
+#[test]
+fn a_finger_drag_scrolls_the_material_screen() {
+    use phantogram::gesture::TouchPhase;
+    let config = EngineConfig {
+        method: Method::Mono,
+        ..EngineConfig::default()
+    };
+    let Some(mut e) = phantogram_integration::engine_or_skip(config) else {
+        return;
+    };
+    let (w, h) = (360u32, 800u32);
+    e.resume_offscreen(w, h).expect("offscreen");
+    let mut t = 0i64;
+    assert!(e.open_menu());
+    for _ in 0..2 {
+        t += 16;
+        e.draw(Some(t * 1_000_000)).expect("draw");
+    }
+    let material = e.control_px("material").expect("the menu's material button");
+    phantogram_integration::tap_at(&mut e, material, &mut t);
+    let done_before = e.control_px("done").expect("the Done button");
+    assert!(done_before[1] > h as f32, "Done starts below the edge: {done_before:?}");
+    // Up from the panel's heading (no control there), 300 px in 20 moves, a frame each.
+    let ms = 1_000_000;
+    let (x, y0) = (w as f32 * 0.5, h as f32 * 0.64);
+    e.touch(TouchPhase::Down, 7, x, y0, t * ms);
+    for k in 1..=20 {
+        let y = y0 - 15.0 * k as f32;
+        e.touch(TouchPhase::Move, 7, x, y, (t + 16 * k) * ms);
+        e.draw(Some((t + 16 * k) * ms)).expect("draw");
+    }
+    e.touch(TouchPhase::Up, 7, x, y0 - 300.0, (t + 336) * ms);
+    for k in 0..60 {
+        e.draw(Some((t + 352 + 16 * k) * ms)).expect("draw");
+    }
+    t += 2000;
+    let done_after = e.control_px("done").expect("the Done button");
+    println!("Done at {done_before:?}, after the drag at {done_after:?}");
+    assert!(
+        done_after[1] < done_before[1] - 250.0,
+        "the drag scrolled the panel: {done_before:?} → {done_after:?}"
+    );
+    // Nothing under the finger changed: still the glTF's own material.
+    assert_eq!(e.appearance(), Appearance::default());
+    assert!(done_after[1] < h as f32 - 10.0, "Done is on the screen: {done_after:?}");
+    phantogram_integration::tap_at(&mut e, done_after, &mut t);
+    assert!(e.control_px("done").is_none(), "Done closed the screen");
+}
