@@ -35,6 +35,26 @@ fn frame(engine: &mut Engine) -> Vec<u8> {
     engine.last_frame().expect("a frame").2.to_vec()
 }
 
+/// A mono engine on a `w × h` offscreen surface with the material screen opened from the menu
+/// by taps, and the sensor clock (ms) after them; `None` without a GPU.
+fn material_screen(w: u32, h: u32) -> Option<(Engine, i64)> {
+    let config = EngineConfig {
+        method: Method::Mono,
+        ..EngineConfig::default()
+    };
+    let mut e = phantogram_integration::engine_or_skip(config)?;
+    e.resume_offscreen(w, h).expect("offscreen");
+    let mut t = 0i64;
+    assert!(e.open_menu());
+    for _ in 0..2 {
+        t += 16;
+        e.draw(Some(t * 1_000_000)).expect("draw");
+    }
+    let material = e.control_px("material").expect("the menu's material button");
+    phantogram_integration::tap_at(&mut e, material, &mut t);
+    Some((e, t))
+}
+
 #[test]
 fn each_preset_matches_its_golden_frame_and_shows_in_the_next_frame() {
     let config = EngineConfig {
@@ -104,23 +124,10 @@ fn a_change_is_remembered_for_its_artifact() {
 
 #[test]
 fn the_material_screen_is_reached_from_the_menu_and_driven_by_taps() {
-    let config = EngineConfig {
-        method: Method::Mono,
-        ..EngineConfig::default()
-    };
-    let Some(mut e) = phantogram_integration::engine_or_skip(config) else {
+    let (w, h) = (360, 800);
+    let Some((mut e, mut t)) = material_screen(w, h) else {
         return;
     };
-    let (w, h) = (360, 800);
-    e.resume_offscreen(w, h).expect("offscreen");
-    let mut t = 0i64;
-    assert!(e.open_menu());
-    for _ in 0..2 {
-        t += 16;
-        e.draw(Some(t * 1_000_000)).expect("draw");
-    }
-    let material = e.control_px("material").expect("the menu's material button");
-    phantogram_integration::tap_at(&mut e, material, &mut t);
     let screen = e.last_frame().expect("frame").2.to_vec();
     if let Ok(dir) = std::env::var("PHANTOGRAM_SAVE_UI") {
         image::save_buffer(
@@ -310,23 +317,10 @@ fn a_ward_map_lays_its_threads_a_millimetre_apart_and_keeps_the_albedo() {
 #[test]
 fn a_finger_drag_scrolls_the_material_screen() {
     use phantogram::gesture::TouchPhase;
-    let config = EngineConfig {
-        method: Method::Mono,
-        ..EngineConfig::default()
-    };
-    let Some(mut e) = phantogram_integration::engine_or_skip(config) else {
+    let (w, h) = (360u32, 800u32);
+    let Some((mut e, mut t)) = material_screen(w, h) else {
         return;
     };
-    let (w, h) = (360u32, 800u32);
-    e.resume_offscreen(w, h).expect("offscreen");
-    let mut t = 0i64;
-    assert!(e.open_menu());
-    for _ in 0..2 {
-        t += 16;
-        e.draw(Some(t * 1_000_000)).expect("draw");
-    }
-    let material = e.control_px("material").expect("the menu's material button");
-    phantogram_integration::tap_at(&mut e, material, &mut t);
     let done_before = e.control_px("done").expect("the Done button");
     assert!(done_before[1] > h as f32, "Done starts below the edge: {done_before:?}");
     // Up from the panel's heading (no control there), 300 px in 20 moves, a frame each.

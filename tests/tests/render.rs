@@ -714,6 +714,89 @@ fn pipelines_that_skip_missing_textures_draw_the_same_picture() {
     assert!(d <= 1, "specialised and general pipelines differ by {d} levels");
 }
 
+/// Runs `shader`'s compute entry point `main` (workgroups of 64) over `queries` and returns its
+/// `results`, `per_query` f32s a query. Its group 0 holds `leading` at bindings 0, 1, …, then
+/// the queries (`array<vec4<f32>>`, read-only storage) and the results (read-write storage).
+fn run_compute(
+    gpu: &Gpu,
+    shader: &str,
+    leading: &[phantogram::wgpu::BindingResource<'_>],
+    queries: &[[f32; 4]],
+    per_query: usize,
+) -> Vec<f32> {
+    use phantogram::wgpu;
+    use phantogram::wgpu::util::DeviceExt;
+    let device = &gpu.device;
+    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: Some("queries"),
+        contents: bytemuck::cast_slice(queries),
+        usage: wgpu::BufferUsages::STORAGE,
+    });
+    let size = (queries.len() * per_query * 4) as u64;
+    let results = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("results"),
+        size,
+        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+        mapped_at_creation: false,
+    });
+    let readback = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size,
+        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("compute test"),
+        source: wgpu::ShaderSource::Wgsl(shader.into()),
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("compute test"),
+        layout: None,
+        module: &module,
+        entry_point: Some("main"),
+        compilation_options: Default::default(),
+        cache: None,
+    });
+    let mut entries: Vec<wgpu::BindGroupEntry> = leading
+        .iter()
+        .enumerate()
+        .map(|(k, r)| wgpu::BindGroupEntry {
+            binding: k as u32,
+            resource: r.clone(),
+        })
+        .collect();
+    let n = leading.len() as u32;
+    entries.push(wgpu::BindGroupEntry {
+        binding: n,
+        resource: input.as_entire_binding(),
+    });
+    entries.push(wgpu::BindGroupEntry {
+        binding: n + 1,
+        resource: results.as_entire_binding(),
+    });
+    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: None,
+        layout: &pipeline.get_bind_group_layout(0),
+        entries: &entries,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    {
+        let mut pass = encoder.begin_compute_pass(&Default::default());
+        pass.set_pipeline(&pipeline);
+        pass.set_bind_group(0, &bind, &[]);
+        pass.dispatch_workgroups((queries.len() as u32).div_ceil(64), 1, 1);
+    }
+    encoder.copy_buffer_to_buffer(&results, 0, &readback, 0, size);
+    gpu.queue.submit([encoder.finish()]);
+    readback.slice(..).map_async(wgpu::MapMode::Read, |r| r.unwrap());
+    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
+    let bytes = readback.slice(..).get_mapped_range().expect("mapped").to_vec();
+    bytes
+        .chunks_exact(4)
+        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        .collect()
+}
+
 /// The shadow filter in `scene.wgsl` (`shadow_pcf`, four gathers) gives the same visibility as
 /// the nine bilinear comparisons it stands for: the function, cut out of the real shader, runs in
 /// a compute pass beside a plain nine-tap reference, on a random depth map at 4096 random lookups
@@ -790,78 +873,20 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
         ..Default::default()
     });
     const N: usize = 4096;
-    let queries: Vec<f32> = (0..N)
-        .flat_map(|_| [0.05 + 0.9 * next(), 0.05 + 0.9 * next(), 0.25 + 0.5 * next(), 0.0])
+    let queries: Vec<[f32; 4]> = (0..N)
+        .map(|_| [0.05 + 0.9 * next(), 0.05 + 0.9 * next(), 0.25 + 0.5 * next(), 0.0])
         .collect();
-    let queries = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("queries"),
-        contents: bytemuck::cast_slice(&queries),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (N * 8) as u64;
-    let results = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("results"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("shadow_pcf test"),
-        source: wgpu::ShaderSource::Wgsl(shader.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("shadow_pcf test"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
     let view = map.create_view(&Default::default());
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&view),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::Sampler(&sampler),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: queries.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 3,
-                resource: results.as_entire_binding(),
-            },
+    let values = run_compute(
+        &gpu,
+        &shader,
+        &[
+            wgpu::BindingResource::TextureView(&view),
+            wgpu::BindingResource::Sampler(&sampler),
         ],
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups((N as u32).div_ceil(64), 1, 1);
-    }
-    encoder.copy_buffer_to_buffer(&results, 0, &readback, 0, size);
-    gpu.queue.submit([encoder.finish()]);
-    readback.slice(..).map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-    let bytes = readback.slice(..).get_mapped_range().expect("mapped").to_vec();
-    let values: Vec<f32> = bytes
-        .chunks_exact(4)
-        .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-        .collect();
+        &queries,
+        2,
+    );
     let (mut worst, mut partial) = (0.0f32, 0);
     for pair in values.chunks_exact(2) {
         worst = worst.max((pair[0] - pair[1]).abs());
@@ -885,8 +910,6 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
 #[test]
 fn the_shaders_cube_depth_is_the_faces() {
     use phantogram::render::point_shadow::cube_depth;
-    use phantogram::wgpu;
-    use phantogram::wgpu::util::DeviceExt;
     let Some(gpu) = gpu() else { return };
     let source = phantogram::render::SCENE_WGSL;
     let (begin, end) = ("// BEGIN cube_depth", "// END cube_depth");
@@ -911,65 +934,8 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
             queries.push([major, near, far, 0.0]);
         }
     }
-    let device = &gpu.device;
-    let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("queries"),
-        contents: bytemuck::cast_slice(&queries),
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let size = (queries.len() * 4) as u64;
-    let results = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("results"),
-        size,
-        usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-        mapped_at_creation: false,
-    });
-    let readback = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("readback"),
-        size,
-        usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("cube_depth test"),
-        source: wgpu::ShaderSource::Wgsl(shader.into()),
-    });
-    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("cube_depth test"),
-        layout: None,
-        module: &module,
-        entry_point: Some("main"),
-        compilation_options: Default::default(),
-        cache: None,
-    });
-    let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: None,
-        layout: &pipeline.get_bind_group_layout(0),
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: input.as_entire_binding(),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: results.as_entire_binding(),
-            },
-        ],
-    });
-    let mut encoder = device.create_command_encoder(&Default::default());
-    {
-        let mut pass = encoder.begin_compute_pass(&Default::default());
-        pass.set_pipeline(&pipeline);
-        pass.set_bind_group(0, &bind, &[]);
-        pass.dispatch_workgroups((queries.len() as u32).div_ceil(64), 1, 1);
-    }
-    encoder.copy_buffer_to_buffer(&results, 0, &readback, 0, size);
-    gpu.queue.submit([encoder.finish()]);
-    readback.slice(..).map_async(wgpu::MapMode::Read, |r| r.unwrap());
-    device.poll(wgpu::PollType::wait_indefinitely()).unwrap();
-    let bytes = readback.slice(..).get_mapped_range().expect("mapped").to_vec();
-    for (q, b) in queries.iter().zip(bytes.chunks_exact(4)) {
-        let got = f32::from_le_bytes([b[0], b[1], b[2], b[3]]);
+    let values = run_compute(&gpu, &shader, &[], &queries, 1);
+    for (q, &got) in queries.iter().zip(&values) {
         let want = cube_depth(q[0], q[1], q[2]);
         assert!(
             (got - want).abs() < 1e-5,

@@ -338,14 +338,7 @@ impl crate::Renderer {
                 cache: None,
             });
             let face_buffers: Vec<wgpu::Buffer> = (0..6)
-                .map(|_| {
-                    device.create_buffer(&wgpu::BufferDescriptor {
-                        label: Some("impostor face"),
-                        size: std::mem::size_of::<crate::EyeUniform>() as u64,
-                        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                        mapped_at_creation: false,
-                    })
-                })
+                .map(|_| crate::eye_block_buffer(device, "impostor face"))
                 .collect();
             let face_binds = face_buffers
                 .iter()

@@ -936,14 +936,7 @@ impl Renderer {
             compare: Some(wgpu::CompareFunction::LessEqual),
             ..Default::default()
         });
-        let eye_buffers = [0, 1].map(|i| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(if i == 0 { "eye left" } else { "eye right" }),
-                size: std::mem::size_of::<EyeUniform>() as u64,
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                mapped_at_creation: false,
-            })
-        });
+        let eye_buffers = ["eye left", "eye right"].map(|label| eye_block_buffer(device, label));
         let ibl = IblTextures::new(&gpu, environment);
         // The shadow pass reads only the light's matrix (the same in both eye blocks) and must
         // not bind the shadow map it writes.
@@ -2047,6 +2040,17 @@ fn uniform_entry(binding: u32, visibility: wgpu::ShaderStages) -> wgpu::BindGrou
         },
         count: None,
     }
+}
+
+/// A uniform buffer for one `Eye` block: an eye's, or a view's that passes draw from (a lamp
+/// cube's face, an impostor's bake), written with `queue.write_buffer`.
+fn eye_block_buffer(device: &wgpu::Device, label: &str) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size: std::mem::size_of::<EyeUniform>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
 }
 
 /// The eyes' bind group's shadow maps and Ward map (see `Eye`'s bindings in `scene.wgsl`).

@@ -130,14 +130,7 @@ impl PointShadowMap {
             })
             .collect();
         let face_buffers: Vec<wgpu::Buffer> = (0..6)
-            .map(|_| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("lamp shadow face"),
-                    size: std::mem::size_of::<crate::EyeUniform>() as u64,
-                    usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            })
+            .map(|_| crate::eye_block_buffer(device, "lamp shadow face"))
             .collect();
         let face_binds = face_buffers
             .iter()
