@@ -787,6 +787,8 @@ pub struct Renderer {
     point_shadow: point_shadow::PointShadowMap,
     /// Triangles the last frame's shadow passes drew (all faces of a lamp's cube together).
     shadow_triangles: u64,
+    /// Why the lamp's cube could not be made, if it could not ([`Renderer::lamp_cube_error`]).
+    lamp_cube_error: Option<RenderError>,
     /// The texture map of the appearance's Ward material ([`WardMap`]; 1×1 neutral for none),
     /// and its sampler (repeating, mipmapped).
     ward_map: (WardMap, wgpu::TextureView),
@@ -1092,6 +1094,7 @@ impl Renderer {
             shadow_layout,
             point_shadow,
             shadow_triangles: 0,
+            lamp_cube_error: None,
             ward_map,
             ward_sampler,
             environment_sh,
@@ -1636,14 +1639,24 @@ impl Renderer {
             },
             None => (light_view_proj(&shadow_bounds, input.toward_light), None),
         };
-        let cube_pass = self.lighting.shadows && cube.is_some();
+        let mut cube_pass = self.lighting.shadows && cube.is_some() && self.lamp_cube_error.is_none();
         if cube_pass && self.point_shadow.size < point_shadow::POINT_SHADOW_SIZE {
             let device = self.gpu.device.clone();
-            checked(&device, "the lamp's shadow cube", || {
-                self.point_shadow =
-                    point_shadow::PointShadowMap::new(&device, &self.shadow_layout, point_shadow::POINT_SHADOW_SIZE);
-                self.remake_eye_binds();
-            })?;
+            let made = checked(&device, "the lamp's shadow cube", || {
+                point_shadow::PointShadowMap::new(&device, &self.shadow_layout, point_shadow::POINT_SHADOW_SIZE)
+            });
+            match made {
+                Ok(map) => {
+                    self.point_shadow = map;
+                    self.remake_eye_binds();
+                }
+                // A device that cannot make it: such a lamp casts no shadow (as before the
+                // cube), the frames go on, and the error is kept for the host to read.
+                Err(e) => {
+                    self.lamp_cube_error = Some(e);
+                    cube_pass = false;
+                }
+            }
         }
         let mut uniforms: Vec<EyeUniform> = eyes.iter().map(|p| self.eye_uniform(p, input, shadow)).collect();
         let mut faces = None;
@@ -1900,6 +1913,12 @@ impl Renderer {
     /// counts twice); 0 without shadows.
     pub fn shadow_triangles_last_frame(&self) -> u64 {
         self.shadow_triangles
+    }
+
+    /// Why the device could not make the cube of shadow views a lamp among its casters needs,
+    /// if it could not: such a lamp then casts no shadow and the frames go on.
+    pub fn lamp_cube_error(&self) -> Option<&RenderError> {
+        self.lamp_cube_error.as_ref()
     }
 
     /// `levels` with each impostor drawn replaced by the level its shadow is cast with.
