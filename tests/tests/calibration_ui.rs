@@ -86,7 +86,7 @@ fn eye_reflection_targets_are_drawn_where_the_geometry_puts_them() {
     });
     overlay.paint(&gpu, &ctx, output, &view, [w, h]);
 
-    let pixels = read_back(&gpu, &texture, w, h);
+    let pixels = phantogram::render::read_texture_level(&gpu, &texture, 0).expect("read back");
     let at = |p: Vec2| {
         assert!(
             p.x >= 0.0 && p.y >= 0.0 && p.x < w as f32 && p.y < h as f32,
@@ -117,40 +117,6 @@ fn eye_reflection_targets_are_drawn_where_the_geometry_puts_them() {
             .save(std::path::Path::new(&dir).join("calibration-eye.png"))
             .expect("saving");
     }
-}
-
-fn read_back(gpu: &Gpu, texture: &wgpu::Texture, w: u32, h: u32) -> Vec<u8> {
-    let row = (w * 4).div_ceil(256) * 256;
-    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
-        label: None,
-        size: u64::from(row * h),
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = gpu.device.create_command_encoder(&Default::default());
-    encoder.copy_texture_to_buffer(
-        texture.as_image_copy(),
-        wgpu::TexelCopyBufferInfo {
-            buffer: &buffer,
-            layout: wgpu::TexelCopyBufferLayout {
-                offset: 0,
-                bytes_per_row: Some(row),
-                rows_per_image: Some(h),
-            },
-        },
-        wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-    );
-    gpu.queue.submit([encoder.finish()]);
-    buffer.slice(..).map_async(wgpu::MapMode::Read, |r| r.expect("mapping"));
-    gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("polling");
-    let data = buffer.slice(..).get_mapped_range().expect("mapped");
-    (0..h)
-        .flat_map(|y| data[(y * row) as usize..(y * row + w * 4) as usize].to_vec())
-        .collect()
 }
 
 /// The phones' path through the engine: a three-finger tap opens the screens over the picture

@@ -2184,6 +2184,66 @@ fn map_for_reading(device: &wgpu::Device, slice: &wgpu::BufferSlice<'_>) -> Resu
         .map_err(|e| RenderError::Readback(e.to_string()))
 }
 
+/// Reads level `mip` of `texture` back, waiting for the GPU: its rows top to bottom, unpadded,
+/// in the texture's own texel bytes. Makes a buffer per call: for tests, tools and benchmarks
+/// (frames are read through [`Offscreen`]'s kept buffer). Needs `COPY_SRC` on the texture and
+/// an uncompressed colour format.
+pub fn read_texture_level(gpu: &Gpu, texture: &wgpu::Texture, mip: u32) -> Result<Vec<u8>, RenderError> {
+    let (w, h) = ((texture.width() >> mip).max(1), (texture.height() >> mip).max(1));
+    let texel = texture
+        .format()
+        .block_copy_size(None)
+        .ok_or(RenderError::Readback(format!(
+            "{:?} has no single texel size",
+            texture.format()
+        )))?;
+    let row = texel * w;
+    let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
+    let device = &gpu.device;
+    let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("texture read-back"),
+        size: u64::from(padded) * u64::from(h),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&Default::default());
+    encoder.copy_texture_to_buffer(
+        wgpu::TexelCopyTextureInfo {
+            texture,
+            mip_level: mip,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(padded),
+                rows_per_image: Some(h),
+            },
+        },
+        wgpu::Extent3d {
+            width: w,
+            height: h,
+            depth_or_array_layers: 1,
+        },
+    );
+    checked(device, "the texture read-back", || gpu.queue.submit([encoder.finish()]))?;
+    let slice = buffer.slice(..);
+    map_for_reading(device, &slice)?;
+    let mut bytes = Vec::with_capacity((row * h) as usize);
+    {
+        let data = slice
+            .get_mapped_range()
+            .map_err(|e| RenderError::Readback(e.to_string()))?;
+        for r in data.chunks(padded as usize).take(h as usize) {
+            bytes.extend_from_slice(&r[..row as usize]);
+        }
+    }
+    buffer.unmap();
+    Ok(bytes)
+}
+
 fn read_back(device: &wgpu::Device, targets: &Offscreen, width: u32, height: u32) -> Result<Vec<u8>, RenderError> {
     let slice = targets.readback.slice(..);
     map_for_reading(device, &slice)?;

@@ -247,56 +247,15 @@ impl GpuPrefilter {
     /// Reads every level of a prefiltered texture back (waits for the GPU): for tests and the
     /// benchmark.
     pub fn read_back(gpu: &Gpu, texture: &wgpu::Texture) -> Result<Vec<Environment>, RenderError> {
-        let device = &gpu.device;
         let mut levels = Vec::new();
         for mip in 0..texture.mip_level_count() {
             let (w, h) = ((texture.width() >> mip).max(1), (texture.height() >> mip).max(1));
-            let row = 8 * w;
-            let padded = row.div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-            let buffer = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("prefilter read-back"),
-                size: (padded * h) as u64,
-                usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-                mapped_at_creation: false,
-            });
-            let mut encoder = device.create_command_encoder(&Default::default());
-            encoder.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture,
-                    mip_level: mip,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &buffer,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: 0,
-                        bytes_per_row: Some(padded),
-                        rows_per_image: Some(h),
-                    },
-                },
-                wgpu::Extent3d {
-                    width: w,
-                    height: h,
-                    depth_or_array_layers: 1,
-                },
-            );
-            gpu.queue.submit([encoder.finish()]);
-            let slice = buffer.slice(..);
-            crate::map_for_reading(device, &slice)?;
-            let mut texels = Vec::with_capacity((w * h) as usize);
-            {
-                let data = slice
-                    .get_mapped_range()
-                    .map_err(|e| RenderError::Readback(e.to_string()))?;
-                for r in data.chunks(padded as usize).take(h as usize) {
-                    for t in r[..row as usize].chunks(8) {
-                        let c = |i: usize| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32();
-                        texels.push([c(0), c(1), c(2)]);
-                    }
-                }
-            }
-            buffer.unmap();
+            // `Rgba16Float`: eight bytes a texel, alpha unused.
+            let bytes = crate::read_texture_level(gpu, texture, mip)?;
+            let texels = bytes
+                .chunks_exact(8)
+                .map(|t| std::array::from_fn(|i| half::f16::from_le_bytes([t[2 * i], t[2 * i + 1]]).to_f32()))
+                .collect();
             levels.push(Environment {
                 width: w as usize,
                 height: h as usize,
