@@ -2186,7 +2186,7 @@ fn map_for_reading(device: &wgpu::Device, slice: &wgpu::BufferSlice<'_>) -> Resu
 
 /// Reads level `mip` of `texture` back, waiting for the GPU: its rows top to bottom, unpadded,
 /// in the texture's own texel bytes. Makes a buffer per call: for tests, tools and benchmarks
-/// (frames are read through [`Offscreen`]'s kept buffer). Needs `COPY_SRC` on the texture and
+/// (frames are read through the offscreen target's kept buffer). Needs `COPY_SRC` on the texture and
 /// an uncompressed colour format.
 pub fn read_texture_level(gpu: &Gpu, texture: &wgpu::Texture, mip: u32) -> Result<Vec<u8>, RenderError> {
     let (w, h) = ((texture.width() >> mip).max(1), (texture.height() >> mip).max(1));
