@@ -58,7 +58,7 @@ fn android_ndk(sdk: Option<&Path>) -> Option<PathBuf> {
 
 /// The face models, copied next to the app's resources (tilt-only without them).
 fn copy_face_models(to: &Path) -> Result<()> {
-    let Some(from) = phantogram::face_models_dir().filter(|d| d.is_dir()) else {
+    let Some(from) = phantogram_sensing::storage::face_models_dir().filter(|d| d.is_dir()) else {
         println!("note: no face models found (run `cargo xtask models`); the app will track tilt only");
         return Ok(());
     };
