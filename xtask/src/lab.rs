@@ -131,7 +131,7 @@ fn bench_orientation() -> Result<()> {
          scored after removing the constant turn between the room and the estimator's north (the circular\n\
          mean of its heading errors over the main rows), so they measure how steady the heading is.\n\
          Phone truth is also the marker body's attitude, 1–2° off the phone's IMU: that is the floor of ~2° every\n\
-         estimator shows there. `phone_inclination_floor_is_the_marker_mounting` (tests/tests/fusion_real.rs)\n\
+         estimator shows there. `phone_inclination_floor_is_the_marker_mounting` (tests/tests/integration/fusion_real.rs)\n\
          scores the phone trials against the truth turned onto the IMU as well.\n\
          `ns/evt`: wall time per sensor event (accelerometer, gyroscope or magnetometer) on the machine\n\
          that ran it (shared, noisy: compare within one run); none for VQF's replayed tracks.\n\n```text\n{table}```\n"

@@ -300,7 +300,7 @@ fn viewer_runs_its_surface_lifecycle_in_a_window() {
     assert!(after("reconfigured ") >= 4, "{line}");
 }
 
-#[path = "../../../tests/tests/support/golden.rs"]
+#[path = "../../../tests/tests/integration/golden.rs"]
 mod golden;
 
 /// The menu as the desktop viewer's window shows it, screenshotted from a virtual X server

@@ -6,7 +6,7 @@
 //! The CPU makes level 0 ([`phantogram_assets::ibl::prefilter_base`], a resampling) and its
 //! box-filtered halvings (cheap); the GPU convolves levels 1… from them with the same samples and
 //! weights as [`phantogram_assets::ibl::prefiltered_levels`], so the two paths agree to the
-//! precision of `f16` (tested in `tests/tests/prefilter_gpu.rs`). This moves the tens of
+//! precision of `f16` (tested in `tests/tests/integration/prefilter_gpu.rs`). This moves the tens of
 //! milliseconds of GGX convolution (66–140 ms on this machine's CPU for a room-light update) off
 //! the CPU; the figure on a phone's GPU is not measured here (no GPU machine was lent).
 //!

@@ -43,7 +43,7 @@
 //! both of its sides stay in the average. The former rule "ignore readings above 8 g" lost the
 //! horizon by 15–21° on held-out BROAD recordings of vigorous motion (inclination RMSE 4.2° and
 //! 7.8° against VQF's 0.54° and 0.61°; issue 15), and on the vigorous-motion set
-//! (`tests/tests/fusion_vigorous.rs`: 10–16 g shaking and jolts, 700 °/s, ±8 g parts) it gave
+//! (`tests/tests/integration/fusion_vigorous.rs`: 10–16 g shaking and jolts, 700 °/s, ±8 g parts) it gave
 //! 13.5° RMSE, 27.8° at worst, and never came back within 1°. Screening instead
 //! (`fusion/screen.rs`, where each choice is measured): readings beyond a sensor's range are
 //! ignored; readings at its range (declared by the platform, or learnt) are reconstructed from

@@ -21,8 +21,7 @@ use phantogram::engine::EngineConfig;
 use phantogram::glam::{Mat3, Quat, Vec3};
 use phantogram::ibl::{Environment, IrradianceSh};
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 use phantogram_lab::synthetic_camera::{Metering, SyntheticCamera};
 
 /// The short frame of the room light's bracket: the highlights just below clipping, down to

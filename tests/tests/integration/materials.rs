@@ -3,8 +3,7 @@
 //! very next frame, an artifact's change is remembered across engines through the library's
 //! `appearances.json`, and the screen itself is reached from the menu and driven by taps.
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 use phantogram::anaglyph::Method;
 use phantogram::appearance::Appearance;

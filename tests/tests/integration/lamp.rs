@@ -3,8 +3,7 @@
 //! the next frame drawn (a tap still opens the menu), and taking the lamp away gives the room's
 //! light back to the pixel.
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 use phantogram::anaglyph::Method;
 use phantogram::engine::EngineConfig;

@@ -12,8 +12,7 @@
 //!   stretch of the recordings);
 //! * golden frames of the Diorama at rest and mid-slide.
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 use phantogram::FrameView;
 use phantogram::diorama::DioramaScene;

@@ -8,8 +8,7 @@
 //! impostor's frame whose colour appears nowhere within one pixel of the same place in the
 //! polygons' frame is a surface point more than a pixel away from where the polygons draw it.
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 use phantogram::FrameView;
 use phantogram::anaglyph::Method;

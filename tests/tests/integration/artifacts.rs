@@ -1,6 +1,6 @@
 //! The artifact library driven through the engine as a shell drives it: a file opened from
 //! bytes is imported, listed, shown and rendered; a damaged file is an on-screen error while the
-//! previous artifact stays; switching a hundred times leaves resident memory flat.
+//! previous artifact stays (switching a hundred times: `tests/tests/memory.rs`).
 
 use std::time::Duration;
 
@@ -13,14 +13,6 @@ use phantogram_testkit::{Scratch, tetrahedron_glb};
 const W: u32 = 180;
 const H: u32 = 400;
 const WAIT: Duration = Duration::from_secs(60);
-
-/// The tests here run one at a time: resident memory is the process's, so the switching test
-/// must not count the others' allocations.
-static SERIAL: std::sync::Mutex<()> = std::sync::Mutex::new(());
-
-fn serial() -> std::sync::MutexGuard<'static, ()> {
-    SERIAL.lock().unwrap_or_else(|p| p.into_inner())
-}
 
 /// An engine on `config` (see [`phantogram_integration::engine_or_skip`]).
 fn start(config: EngineConfig) -> Option<Engine> {
@@ -39,40 +31,8 @@ fn frame(engine: &mut Engine) -> Vec<u8> {
     engine.last_frame().unwrap().2.to_vec()
 }
 
-/// Resident memory of this process, bytes (Linux), after glibc has handed its free pages back.
-///
-/// Without the trim the figure counts what the allocator keeps for reuse: models are allocated on
-/// the loader thread and freed on this one, and how much of that glibc keeps in its per-thread
-/// arenas varies from run to run (one CI run: +40 MiB over 80 switches with nothing leaked; 400
-/// switches here stayed within 177–193 MiB). Trimmed, the same 400 switches stay within
-/// 153–160 MiB, the spread of which artifact happens to be shown, so a leak stands out.
-fn resident_bytes() -> Option<u64> {
-    trim_allocator();
-    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
-    let pages: u64 = statm.split_whitespace().nth(1)?.parse().ok()?;
-    Some(pages * 4096)
-}
-
-/// Returns the free memory of every glibc arena to the system (elsewhere: nothing to do).
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn trim_allocator() {
-    unsafe extern "C" {
-        /// glibc's `int malloc_trim(size_t pad)` (malloc.h).
-        fn malloc_trim(pad: usize) -> i32;
-    }
-    // SAFETY: malloc_trim takes a plain integer and only releases memory the allocator holds
-    // free; it is thread-safe (it locks each arena) and invalidates no live allocation.
-    unsafe {
-        malloc_trim(0);
-    }
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn trim_allocator() {}
-
 #[test]
 fn an_opened_file_is_imported_listed_shown_and_a_damaged_one_keeps_the_previous() {
-    let _serial = serial();
     let dir = Scratch::new("engine-artifacts");
     let Some(mut e) = engine(&dir) else { return };
     e.resume_offscreen(W, H).unwrap();
@@ -151,7 +111,6 @@ fn an_opened_file_is_imported_listed_shown_and_a_damaged_one_keeps_the_previous(
 
 #[test]
 fn a_voyager_folder_is_shown_in_its_thumb_first_then_in_its_best_scan() {
-    let _serial = serial();
     let dir = Scratch::new("engine-preview");
     let turtle = dir.join("bundled/turtle");
     std::fs::create_dir_all(&turtle).unwrap();
@@ -204,60 +163,12 @@ fn a_voyager_folder_is_shown_in_its_thumb_first_then_in_its_best_scan() {
     );
 }
 
-#[test]
-fn a_hundred_switches_leave_resident_memory_flat() {
-    let _serial = serial();
-    let dir = Scratch::new("engine-switches");
-    let Some(mut e) = engine(&dir) else { return };
-    e.resume_offscreen(W, H).unwrap();
-    e.import_artifact("tetra.glb", tetrahedron_glb(0.2, ""));
-    assert!(e.wait_for_artifact(WAIT));
-    // The artifacts loaded from the library (the Diorama is made, not loaded: it has its own
-    // tests in diorama.rs).
-    let ids: Vec<ArtifactId> = e
-        .artifacts()
-        .into_iter()
-        .map(|a| a.id)
-        .filter(|id| id.to_string() != phantogram::diorama::DIORAMA_ID)
-        .collect();
-    assert_eq!(ids.len(), 4);
-    let mut after_warm_up = None;
-    for i in 0..100 {
-        e.select_artifact(ids[i % ids.len()].clone());
-        assert!(e.wait_for_artifact(WAIT), "switch {i}: {:?}", e.loading_status());
-        frame(&mut e);
-        if i == 19 {
-            after_warm_up = resident_bytes();
-        }
-    }
-    let (Some(before), Some(after)) = (after_warm_up, resident_bytes()) else {
-        eprintln!("no /proc/self/statm: resident memory not measured");
-        return;
-    };
-    let growth_mib = (after as f64 - before as f64) / f64::from(1 << 20);
-    eprintln!(
-        "resident after 20 switches {} MiB, after 100 {} MiB",
-        before >> 20,
-        after >> 20
-    );
-    // Each switch allocates a model of 1 to 5 MiB on the loader thread; a leak of a sixteenth
-    // of one per switch is 24+ MiB over 80 (a leaked model per switch: +266 MiB). Measured after
-    // a trim (see resident_bytes) the 20th and 100th switches, which show the same artifact,
-    // differ by under 7 MiB.
-    assert!(
-        growth_mib < 24.0,
-        "resident memory grew {growth_mib:.1} MiB over 80 switches"
-    );
-}
-
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 /// The menu a single tap opens and the status banner, driven by simulated taps: choose an
 /// artifact, see a failure, dismiss it. Each screen is compared with its golden image.
 #[test]
 fn the_menu_and_the_banner_are_driven_by_taps() {
-    let _serial = serial();
     use phantogram::anaglyph::Method;
     let dir = Scratch::new("engine-menu");
     let config = EngineConfig {
@@ -369,7 +280,6 @@ fn the_menu_and_the_banner_are_driven_by_taps() {
 #[test]
 fn a_tap_on_an_annotation_marker_reads_it() {
     use phantogram::gesture::TouchPhase;
-    let _serial = serial();
     let Some(data) = std::env::var_os("PHANTOGRAM_DATA") else {
         eprintln!("PHANTOGRAM_DATA not set: skipping");
         return;
@@ -417,7 +327,6 @@ fn a_tap_on_an_annotation_marker_reads_it() {
 #[test]
 fn settings_are_chosen_by_taps_applied_and_kept() {
     use phantogram::anaglyph::Method;
-    let _serial = serial();
     let dir = Scratch::new("engine-settings");
     let calibration = dir.join("calibration.txt");
     std::fs::write(&calibration, "phantogram-calibration 1\nintroduced 1\n").unwrap();
@@ -502,7 +411,6 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
 /// [`phantogram::engine::TEXT_SCALE_RANGE`]; nonsense is refused.
 #[test]
 fn the_menu_follows_the_system_text_size() {
-    let _serial = serial();
     let dir = Scratch::new("engine-text-scale");
     let Some(mut e) = engine(&dir) else { return };
     let (w, h) = (360, 800);
@@ -539,7 +447,6 @@ fn the_menu_follows_the_system_text_size() {
 /// finger's drag turns the artifact, and the choice is kept for the next start.
 #[test]
 fn with_reduce_motion_a_finger_turns_the_artifact_and_tilting_does_nothing() {
-    let _serial = serial();
     use phantogram::sensors::SensorEvent;
     let dir = Scratch::new("engine-reduce-motion");
     let calibration = dir.join("calibration.txt");

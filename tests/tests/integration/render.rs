@@ -8,8 +8,7 @@
 //! `NAME-difference.png` beside the golden image (git-ignored). `PHANTOGRAM_BLESS=1` rewrites the
 //! golden images from the current output; look at them before committing.
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 use phantogram::anaglyph::Method;
 use phantogram::artifact::default_model;

@@ -304,8 +304,7 @@ fn the_screens_keep_the_phones_layout_on_a_smaller_target() {
     );
 }
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 /// The first run, driven by taps as a new user would: the screens open by themselves, the
 /// glasses check swaps the eyes when the glasses are on the other way round, Start takes the

@@ -3,8 +3,7 @@
 //! place (at most a pixel apart), and the frame matches its golden image. (How loaded models are
 //! turned, sized and placed in surface mode: `phantogram_assets`' model tests.)
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 use phantogram::anaglyph::Method;
 use phantogram::engine::{EngineConfig, Snapshot};

@@ -1,4 +1,5 @@
-//! Golden images, shared by the rendering and screen tests (included with `#[path]`).
+//! Golden images, shared by the rendering and screen tests (and included by the CLI's tests with
+//! `#[path]`).
 //!
 //! Golden images live in `tests/golden/`. On a mismatch the test writes `NAME-actual.png` and
 //! `NAME-difference.png` beside the golden image (git-ignored). `PHANTOGRAM_BLESS=1` rewrites the

@@ -5,8 +5,7 @@
 //! The big scans are made by `phantogram_lab::big_scan` from the built-in amphora (always) and
 //! from the shared sea turtle (with `PHANTOGRAM_DATA`).
 
-#[path = "support/golden.rs"]
-mod golden;
+use crate::golden;
 
 use phantogram::anaglyph::Method;
 use phantogram::detail::{Detail, DetailParams};

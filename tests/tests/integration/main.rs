@@ -1,0 +1,33 @@
+//! The desktop integration tests, as one test binary: each module is what was once a binary of
+//! its own. One binary links the engine's dependencies (wgpu, tract, egui, …) once instead of two
+//! dozen times, and its tests share the cores instead of waiting for each other binary by binary.
+//! `cargo test -p phantogram-integration --test integration render::` runs one module.
+//!
+//! A test that measures the process itself (resident memory) cannot share it: it has its own
+//! binary (`tests/tests/memory.rs`).
+
+mod accessibility;
+mod artifacts;
+mod assets;
+mod calibration_ui;
+mod containment_sweep;
+mod detail;
+mod diorama;
+mod eyetrack;
+mod face;
+mod fade;
+mod fusion_real;
+mod fusion_vigorous;
+mod glasses;
+mod golden;
+mod impostor;
+mod lamp;
+mod materials;
+mod models;
+mod prefilter_gpu;
+mod projection_ground_truth;
+mod render;
+mod room_light;
+mod shared_data;
+mod surface;
+mod viewpoint_and_light;
