@@ -5,7 +5,7 @@
 //! give the environment's irradiance (relative RMS over 2000 normals spread evenly over the
 //! sphere): within 5 % once the sweep has seen the whole sphere, with an exposure bracket whose
 //! exposures the platform reports; at 80 % seen the figures are printed and guarded (the goal
-//! of 5 % there is not reached on every room: see the TODO). Auto-exposure alone, exposures
+//! of 5 % there is reached on eight of the nine rooms: see the TODO). Auto-exposure alone, exposures
 //! estimated, is printed for comparison (up to the unknown overall scale).
 //!
 //! Needs the external data (`PHANTOGRAM_DATA`); without it the test prints a notice and returns.
@@ -136,10 +136,11 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
                     })
                     .expect("frame");
                 if at_80.is_none() && capture.coverage() >= 0.8 {
-                    at_80 = Some((k + 1, IrradianceSh::from_environment(&capture.environment())));
+                    let oracle = IrradianceSh::from_environment(&unseen_as_their_true_mean(&env, &capture));
+                    at_80 = Some((k + 1, IrradianceSh::from_environment(&capture.environment()), oracle));
                 }
             }
-            let (frames_80, sh_80) = at_80.expect("the sweep sees 80 % of the sphere");
+            let (frames_80, sh_80, oracle_80) = at_80.expect("the sweep sees 80 % of the sphere");
             let full = IrradianceSh::from_environment(&capture.environment());
             let error = |got: &IrradianceSh| {
                 let scale = if bracketed {
@@ -150,14 +151,16 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
                 relative_rms(got, &want, scale, &normals)
             };
             let (e80, efull) = (error(&sh_80), error(&full));
+            let oracle = relative_rms(&oracle_80, &want, 1.0, &normals);
             line.push(format!(
-                "{}: {:.1} % at 80 % seen ({frames_80} frames), {:.1} % at {:.0} % seen",
+                "{}: {:.1} % at 80 % seen ({frames_80} frames; unseen as their true mean: {:.1} %), {:.1} % at {:.0} % seen",
                 if bracketed {
                     "bracketed"
                 } else {
                     "auto-exposed (up to scale)"
                 },
                 e80 * 100.0,
+                oracle * 100.0,
                 efull * 100.0,
                 capture.coverage() * 100.0
             ));
@@ -192,16 +195,47 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
         worst_full.0 * 100.0,
         worst_full.1
     );
-    // TODO(issue 20): the goal is 5 % at 80 % seen; filling the unseen fifth (pull-push from the
-    // nearest seen light) reaches it on six of the nine environments, not on rooms whose unseen
-    // floor differs from the lowest walls seen (apartment ~21 %, studio small ~7 %, studio
-    // ~6 %). Until a better prior exists, this guards against regressions only.
+    // TODO(issue 20): the goal is 5 % at 80 % seen. The unseen fifth is the floor, filled with
+    // the mean of what was seen below the horizon (`RoomCapture::environment`): within 3.7 % on
+    // eight of the nine rooms, 8.9 % in the apartment (was 20.6 % with the nearest-seen fill).
+    // What the seen part cannot tell bounds it: the unseen fifth filled with the true mean of
+    // what is there — which knows the floor's light exactly and misses only its layout — is
+    // still 5.6 % off in the apartment (printed as "unseen as their true mean"). So with the
+    // floor seen last, as a visitor's sweep sees it, 5 % there is out of reach for any fill of
+    // one value. This bound (set after measuring 8.9 %) guards against regressions only.
     assert!(
-        worst_80.0 <= 0.25,
+        worst_80.0 <= 0.12,
         "{:.1} % off at 80 % seen in {}",
         worst_80.0 * 100.0,
         worst_80.1
     );
+}
+
+/// `env` with every texel the capture has not seen replaced by the solid-angle-weighted mean of
+/// those texels' true radiance: the best a fill that knows only how much light the unseen part
+/// holds can do (a reference for the capture's own fill, not something a phone could know).
+fn unseen_as_their_true_mean(env: &Environment, capture: &RoomCapture) -> Environment {
+    let (map_w, map_h) = (capture.width(), capture.height());
+    // Both are equirectangular maps with the same convention (column 0 east, row 0 the zenith).
+    let seen = |x: usize, y: usize| capture.seen(x * map_w / env.width, y * map_h / env.height);
+    let (mut sum, mut total) = ([0.0f64; 3], 0.0f64);
+    for y in 0..env.height {
+        let solid_angle = f64::from(((y as f32 + 0.5) / env.height as f32 * std::f32::consts::PI).sin());
+        for x in (0..env.width).filter(|x| !seen(*x, y)) {
+            for (s, v) in sum.iter_mut().zip(env.texels[y * env.width + x]) {
+                *s += f64::from(v) * solid_angle;
+            }
+            total += solid_angle;
+        }
+    }
+    let mean = sum.map(|v| (v / total.max(1e-30)) as f32);
+    let mut filled = env.clone();
+    for y in 0..env.height {
+        for x in (0..env.width).filter(|x| !seen(*x, y)) {
+            filled.texels[y * env.width + x] = mean;
+        }
+    }
+    filled
 }
 
 /// A warm evening room made here: a low orange sun in the west, a dim blue sky, a dark floor.
