@@ -393,8 +393,9 @@ impl RoomCapture {
     /// seen nearest to it, one band of lower wall, and that band is a poor sample of a floor. On
     /// the nine shared rooms swept to 80 % (`room_light.rs`), with the floor unseen, the
     /// irradiance was 0.4–20.6 % off that way (studio small 6.9 %, studio 5.8 %) and is
-    /// 0.6–8.9 % this way, eight rooms within 3.7 %; filling the unseen part with its *true* mean
-    /// would give 0.2–5.6 %, the worst both times the apartment, whose floor is unlike its walls.
+    /// 0.6–8.9 % this way, eight rooms within 3.7 %; the best single value for the unseen part,
+    /// chosen knowing the truth, would give 0.2–5.6 %, the worst both times the apartment, whose
+    /// floor is unlike its walls.
     /// The reach was set at 11.25° before that measurement; 5.6°, 22.5° and 45° give a worst of
     /// 8.4, 12.1 and 10.4 % (the apartment) and at most 4.5, 3.7 and 2.9 % on the other eight.
     ///
