@@ -52,6 +52,7 @@ pub use worker::FaceWorker;
 
 pub mod glasses;
 mod prelu;
+mod reduced;
 mod worker;
 use tract_onnx::prelude::*;
 
@@ -151,7 +152,13 @@ pub struct UprightImage<'a> {
     /// Buffer bytes from an upright pixel to its right-hand and to its lower neighbour.
     step_x: isize,
     step_y: isize,
+    /// The image at half and a quarter of its resolution, each made when a crop first needs it.
+    levels: [std::cell::OnceCell<reduced::Reduced>; REDUCED_LEVELS],
 }
+
+/// How many reduced levels a frame may get ([`reduced`]): a quarter of the resolution takes
+/// BlazeFace's crop of a whole 640 × 480 frame (5 pixels an output pixel) to under two.
+const REDUCED_LEVELS: usize = 2;
 
 impl<'a> UprightImage<'a> {
     pub fn new(frame: CameraFrame<'a>) -> Result<Self, FaceError> {
@@ -206,6 +213,29 @@ impl<'a> UprightImage<'a> {
             intrinsics: i.turned_cw(frame.width, frame.height, turns),
             step_x,
             step_y,
+            levels: Default::default(),
+        })
+    }
+
+    /// 8-bit RGB of upright pixel `(x, y)`, which must be inside the image.
+    fn rgb8(&self, x: u32, y: u32) -> [u8; 3] {
+        let at = self.offset(x as i32, y as i32);
+        let d = self.frame.data;
+        match self.frame.format {
+            PixelFormat::Luma8 => [d[at]; 3],
+            PixelFormat::Rgba8 => [d[at], d[at + 1], d[at + 2]],
+        }
+    }
+
+    /// Reduced level `k` (1: half the resolution, up to [`REDUCED_LEVELS`]), made on first use.
+    fn level(&self, k: usize) -> &reduced::Reduced {
+        let k = k.clamp(1, REDUCED_LEVELS);
+        self.levels[k - 1].get_or_init(|| {
+            if k == 1 {
+                reduced::Reduced::half_of(self.width, self.height, |x, y| self.rgb8(x, y))
+            } else {
+                self.level(k - 1).half()
+            }
         })
     }
 
@@ -350,11 +380,17 @@ impl Roi {
         correct: impl Fn(Vec2, [f32; 3]) -> [f32; 3],
     ) -> Vec<f32> {
         let mut out = vec![0.0f32; 3 * n * n];
-        // The pixel footprint may shrink a lot (a 1000-px face into 192): average a few
-        // samples per output pixel so the crop does not alias. A bilinear sample already
+        // The pixel footprint may shrink a lot (a 1000-px face into 192): sample the reduced
+        // level where an output pixel covers at most two of its pixels, and average a few samples
+        // per output pixel beyond that so the crop does not alias. A bilinear sample already
         // averages over about two source pixels, so ⌈step / 2⌉ of them per axis cover one.
-        let step = self.size / n as f32;
+        let (level, step) = reduced::level_for(self.size / n as f32, REDUCED_LEVELS);
         let taps = ((step * 0.5).ceil() as usize).clamp(1, 3);
+        let reduced = (level > 0).then(|| (image.level(level), 1.0 / (1u32 << level) as f32));
+        let sample = |p: Vec2| match reduced {
+            Some((r, scale)) => r.bilinear(p * scale),
+            None => image.bilinear(p),
+        };
         let (lo, hi) = range;
         // `image_point` is affine in (a, b): its origin and two steps, turned once (not per
         // sample: a sine and cosine per sample cost more than the sampling).
@@ -371,7 +407,7 @@ impl Roi {
                     for tx in 0..taps {
                         let a = (i as f32 + (tx as f32 + 0.5) / taps as f32) / n as f32;
                         let b = (j as f32 + (ty as f32 + 0.5) / taps as f32) / n as f32;
-                        let c = image.bilinear(at(a, b));
+                        let c = sample(at(a, b));
                         for k in 0..3 {
                             acc[k] += c[k];
                         }
