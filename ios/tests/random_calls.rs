@@ -5,6 +5,8 @@
 
 use phantogram_ios::ffi::*;
 
+#[path = "support/engine.rs"]
+mod engine;
 #[path = "support/random_calls.rs"]
 mod random_calls;
 
@@ -31,14 +33,9 @@ impl Random {
 
 #[test]
 fn random_call_sequences_leave_an_engine_that_draws() {
-    let mut engine: *mut PgEngine = std::ptr::null_mut();
-    // SAFETY: null config (defaults) and a valid out pointer.
-    let status = unsafe { pg_engine_create(std::ptr::null(), &mut engine) };
-    if status == PgStatus::Render {
-        eprintln!("no GPU adapter: skipping the random calls");
+    let Some(engine) = engine::created_or_skip("the random calls") else {
         return;
-    }
-    assert_eq!(status, PgStatus::Ok);
+    };
     let mut random = Random(0x9e37_79b9_7f4a_7c15);
     for input in 0..INPUTS {
         let data = random.bytes();

@@ -20,6 +20,9 @@ use std::time::Instant;
 
 use phantogram_ios::ffi::*;
 
+#[path = "support/engine.rs"]
+mod engine;
+
 const CYCLES: usize = 1000;
 /// Cycles before resident memory is first read.
 const WARM_UP: usize = 100;
@@ -42,14 +45,9 @@ fn resident_bytes() -> u64 {
 
 #[test]
 fn foreign_sensor_threads_and_1000_lifecycle_cycles() {
-    let mut engine: *mut PgEngine = std::ptr::null_mut();
-    // SAFETY: null config (defaults) and a valid out pointer.
-    let status = unsafe { pg_engine_create(std::ptr::null(), &mut engine) };
-    if status == PgStatus::Render {
-        eprintln!("no GPU adapter: skipping the stress test");
+    let Some(engine) = engine::created_or_skip("the stress test") else {
         return;
-    }
-    assert_eq!(status, PgStatus::Ok);
+    };
     let handle = Handle(engine);
     let start = Instant::now();
     let stop = Arc::new(AtomicBool::new(false));

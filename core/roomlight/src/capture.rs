@@ -448,7 +448,7 @@ impl RoomCapture {
             let upper = |i: usize| 2 * (i / *w) + 1 < *h;
             let mean_of = |side: &dyn Fn(usize) -> bool| -> Option<[f32; 3]> {
                 let (mut sum, mut total) = ([0.0f32; 3], 0.0f32);
-                for (_, (v, wt)) in rgb.iter().zip(weight.iter()).enumerate().filter(|(i, _)| side(*i)) {
+                for (v, wt) in (0..rgb.len()).filter(|i| side(*i)).map(|i| (rgb[i], weight[i])) {
                     for c in 0..3 {
                         sum[c] += v[c] * wt;
                     }

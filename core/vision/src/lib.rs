@@ -244,16 +244,7 @@ impl<'a> UprightImage<'a> {
         if x < 0 || y < 0 || x >= self.width as i32 || y >= self.height as i32 {
             return [0.0; 3];
         }
-        let at = self.offset(x, y);
-        let d = self.frame.data;
-        match self.frame.format {
-            PixelFormat::Luma8 => [f32::from(d[at]) / 255.0; 3],
-            PixelFormat::Rgba8 => [
-                f32::from(d[at]) / 255.0,
-                f32::from(d[at + 1]) / 255.0,
-                f32::from(d[at + 2]) / 255.0,
-            ],
-        }
+        self.rgb8(x as u32, y as u32).map(|v| f32::from(v) / 255.0)
     }
 
     /// The buffer pixel of upright pixel `(x, y)`: the inverse of the clockwise turn.
