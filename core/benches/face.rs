@@ -1,7 +1,9 @@
 //! `cargo bench -p phantogram --bench face` (or `cargo xtask bench face`): milliseconds per
-//! 640×480 camera frame in detection mode (BlazeFace + FaceMesh + 2 × Iris) and tracking mode
-//! (FaceMesh + 2 × Iris on one frame in `MESH_EVERY`, 2 × Iris alone between), one thread, median
-//! of 30 frames each (and of each kind of tracked frame), measured in the same run.
+//! 640×480 camera frame, one thread, measured in the same run: detection mode (BlazeFace +
+//! FaceMesh + 2 × Iris; median of 30 frames) and tracking mode (FaceMesh + 2 × Iris on one frame
+//! in `NETWORK_EVERY`, the eyes' patches between; the mean over 72 frames, whole cycles of the
+//! schedule, as that is what the tracker takes from the cores; also the worst frame and the
+//! median of each kind). The face sways across the frame by up to 7 pixels a frame.
 //!
 //! Needs the models (`cargo xtask models`; `PHANTOGRAM_MODELS` or the default cache) and a face
 //! photograph: `$PHANTOGRAM_DATA/faces/astronaut.png`, letterboxed into 640×480. Skipped with a
@@ -10,7 +12,9 @@
 use std::sync::Arc;
 use std::time::Instant;
 
-use phantogram::face::{CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, PixelFormat, TrackingMode};
+use phantogram::face::{
+    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, NETWORK_EVERY, PixelFormat, TrackingMode,
+};
 use phantogram::glam::Vec3;
 
 fn median_ms(mut samples: Vec<f64>) -> f64 {
@@ -45,59 +49,83 @@ fn main() {
         }
     };
     let face = image::imageops::resize(&face, 480, 480, image::imageops::FilterType::Triangle);
-    let mut frame_img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
-    image::imageops::overlay(&mut frame_img, &face, 80, 0);
-    let frame = CameraFrame {
+    // The face swaying across the frame, up to 7 pixels a frame (on a still frame the eyes'
+    // patches would settle in one step; a moving one costs what a real tracked frame does).
+    let frames: Vec<image::RgbaImage> = (0..18)
+        .map(|k| {
+            let x = 80.0 + 20.0 * (std::f64::consts::TAU * f64::from(k) / 18.0).sin();
+            let mut img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
+            image::imageops::overlay(&mut img, &face, x.round() as i64, 0);
+            img
+        })
+        .collect();
+    let frame = |k: usize| CameraFrame {
         width: 640,
         height: 480,
         row_stride: 640 * 4,
         format: PixelFormat::Rgba8,
-        data: frame_img.as_raw(),
+        data: frames[k % frames.len()].as_raw(),
         rotation_cw_deg: 0,
         intrinsics: Intrinsics::from_horizontal_fov(640, 480, 60f32.to_radians()),
         capture_t_ns: 0,
         chroma: None,
     };
     let mut tracker = FaceTracker::new(models, CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
-    // Medians per frame kind: (all, FaceMesh run, irises alone).
-    let mut measure = |detect: bool| {
-        let (mut all, mut mesh, mut irises) = (Vec::new(), Vec::new(), Vec::new());
-        for i in 0..33 {
-            if detect {
-                tracker.reset();
-            }
-            let t = Instant::now();
-            let obs = tracker.process(frame).expect("a valid frame");
-            let ms = t.elapsed().as_secs_f64() * 1e3;
-            assert!(
-                obs.eyes_m.is_some(),
-                "the face must be found for the figure to mean anything"
-            );
-            let want = if detect {
-                TrackingMode::Detecting
-            } else {
-                TrackingMode::Tracking
-            };
-            assert_eq!(tracker.last_mode(), want);
-            // The first frames warm caches and allocators.
-            if i >= 3 {
-                all.push(ms);
-                if tracker.followed_irises_only() {
-                    irises.push(ms);
-                } else {
-                    mesh.push(ms);
-                }
-            }
-        }
-        let median = |v: Vec<f64>| if v.is_empty() { f64::NAN } else { median_ms(v) };
-        (median(all), median(mesh), median(irises))
+    let run = |tracker: &mut FaceTracker, k: usize| {
+        let t = Instant::now();
+        let obs = tracker.process(frame(k)).expect("a valid frame");
+        let ms = t.elapsed().as_secs_f64() * 1e3;
+        assert!(
+            obs.eyes_m.is_some(),
+            "the face must be found for the figure to mean anything"
+        );
+        ms
     };
-    let (detection, _, _) = measure(true);
-    let (tracking, with_mesh, irises_only) = measure(false);
-    println!("640×480 frame, one thread: detection mode {detection:.1} ms, tracking mode {tracking:.1} ms");
+    // Detection mode: the tracker forgotten before every frame; the first frames warm caches
+    // and allocators.
+    let mut detection = Vec::new();
+    for k in 0..33 {
+        tracker.reset();
+        let ms = run(&mut tracker, k);
+        assert_eq!(tracker.last_mode(), TrackingMode::Detecting);
+        if k >= 3 {
+            detection.push(ms);
+        }
+    }
+    // Tracking mode: 3 warm-up frames, then 72 (whole cycles for NETWORK_EVERY 1 to 4, 6, 8, 9
+    // or 12), after one detection.
+    tracker.reset();
+    run(&mut tracker, 0);
+    let (mut all, mut by_step) = (Vec::new(), std::collections::BTreeMap::<String, Vec<f64>>::new());
+    for k in 1..4 + 72 {
+        let ms = run(&mut tracker, k);
+        assert_eq!(
+            tracker.last_mode(),
+            TrackingMode::Tracking,
+            "frame {k}: the track was lost"
+        );
+        if k >= 4 {
+            all.push(ms);
+            by_step
+                .entry(format!("{:?}", tracker.last_step()))
+                .or_default()
+                .push(ms);
+        }
+    }
+    let mean = all.iter().sum::<f64>() / all.len() as f64;
+    let worst = all.iter().copied().fold(0.0, f64::max);
+    let detection = median_ms(detection);
     println!(
-        "tracking mode by frame: with FaceMesh {with_mesh:.1} ms, irises alone {irises_only:.1} ms (FaceMesh on one tracked frame in {})",
-        phantogram::face::MESH_EVERY
+        "640×480 frame, one thread: detection mode {detection:.1} ms (median), tracking mode {mean:.2} ms (mean over {} frames; worst {worst:.1} ms)",
+        all.len()
     );
-    println!("tracking / detection = {:.2}", tracking / detection);
+    let kinds: Vec<String> = by_step
+        .into_iter()
+        .map(|(step, v)| format!("{step} {} × {:.2} ms", v.len(), median_ms(v)))
+        .collect();
+    println!(
+        "tracking mode by frame (median): {} (the networks on one tracked frame in {NETWORK_EVERY})",
+        kinds.join(", ")
+    );
+    println!("tracking / detection = {:.2}", mean / detection);
 }

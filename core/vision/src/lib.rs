@@ -10,8 +10,9 @@
 //!
 //! **Tracking**: after a detection, the next frame's face crop comes from the previous frame's
 //! landmarks; the detector runs again only when FaceMesh's face flag says the face is lost.
-//! FaceMesh itself runs on one tracked frame in [`MESH_EVERY`]; between, the irises alone follow
-//! the eyes from the last frame's eye corners while they move together.
+//! The networks run on one tracked frame in [`NETWORK_EVERY`]; between, each eye is followed by
+//! aligning its grey patch from the last network frame ([`eye_patch`]: no network, about a
+//! fifth of a millisecond for both), and the landmarks move with the eyes.
 //!
 //! **Glasses** ([`glasses`]): on colour frames (RGBA, or luma with its chroma planes) the skin
 //! under each eye's lens is compared with the cheek's to name the filters of anaglyph glasses.
@@ -50,6 +51,7 @@ pub use phantogram_sensing::camera::{CameraFrame, CameraPose, Intrinsics, OwnedF
 pub use phantogram_sensing::eyetrack::FaceObservation;
 pub use worker::FaceWorker;
 
+pub mod eye_patch;
 pub mod glasses;
 mod prelu;
 mod reduced;
@@ -700,37 +702,6 @@ impl FaceModels {
         }))
     }
 
-    /// The last frame's face followed by its irises alone (no FaceMesh): each iris crop placed
-    /// from the last frame's eye corners, the landmarks moved with the eyes. `None` when an iris
-    /// moved more than a quarter of its eye's width (the crop would cut it off soon) or the two
-    /// irises moved apart by more than 5 % of the eye distance (the head turned or rolled: the
-    /// corners no longer fit) — FaceMesh then runs.
-    fn follow_irises(&self, image: &UprightImage, last: &FaceFound) -> Result<Option<FaceFound>, FaceError> {
-        let Some([la, lb, ra, rb]) = eye_corners(&last.landmarks) else {
-            return Ok(None);
-        };
-        let Some([(left_eye_px, dl), (right_eye_px, dr)]) =
-            self.irises(image, [la, lb, ra, rb], last.lenses.as_ref())?
-        else {
-            return Ok(None);
-        };
-        let (ml, mr) = (left_eye_px - last.left_eye_px, right_eye_px - last.right_eye_px);
-        let ipd = last.left_eye_px.distance(last.right_eye_px);
-        let eye_width = la.distance(lb).min(ra.distance(rb));
-        if ml.distance(mr) > 0.05 * ipd || ml.length().max(mr.length()) > 0.25 * eye_width {
-            return Ok(None);
-        }
-        let shift = (ml + mr) * 0.5;
-        Ok(Some(FaceFound {
-            left_eye_px,
-            right_eye_px,
-            iris_diameter_px: 0.5 * (dl + dr),
-            confidence: last.confidence,
-            landmarks: last.landmarks.iter().map(|p| *p + shift).collect(),
-            lenses: last.lenses,
-        }))
-    }
-
     /// The face a detection leads to, its confidence the lower of detector score and face flag.
     fn face_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<FaceFound>, FaceError> {
         let [a, b] = [d.keypoints[0], d.keypoints[1]];
@@ -836,6 +807,75 @@ fn eye_corners(landmarks: &[Vec2]) -> Option<[Vec2; 4]> {
     ])
 }
 
+/// `face`'s landmarks carried by the similarity (move, turn in the image, scale) that takes its
+/// eyes to `left_px` and `right_px`: how a face that rolls or comes nearer between FaceMesh runs
+/// keeps its landmarks on it (the next FaceMesh crop and the eye patches' sizes come from them).
+/// Moved only, if the eyes were not apart.
+fn moved_with_the_eyes(face: &FaceFound, left_px: Vec2, right_px: Vec2) -> Vec<Vec2> {
+    let (from, to) = (face.right_eye_px - face.left_eye_px, right_px - left_px);
+    let squared = from.length_squared();
+    // As complex numbers: z ↦ left_px + (to / from)·(z − left).
+    let (a, b) = if squared > 0.0 {
+        (
+            (from.x * to.x + from.y * to.y) / squared,
+            (from.x * to.y - from.y * to.x) / squared,
+        )
+    } else {
+        (1.0, 0.0)
+    };
+    let (a, b) = if a.is_finite() && b.is_finite() {
+        (a, b)
+    } else {
+        (1.0, 0.0)
+    };
+    face.landmarks
+        .iter()
+        .map(|p| {
+            let d = *p - face.left_eye_px;
+            left_px + Vec2::new(a * d.x - b * d.y, b * d.x + a * d.y)
+        })
+        .collect()
+}
+
+/// Each eye's patch (image left, image right) around the irises of `face`, sized by its eye
+/// corners; `None` when either has no texture to follow.
+fn take_patches(image: &UprightImage, face: &FaceFound) -> Option<[eye_patch::EyePatch; 2]> {
+    let [la, lb, ra, rb] = eye_corners(&face.landmarks)?;
+    let left = eye_patch::EyePatch::take(image, face.left_eye_px, la.distance(lb))?;
+    let right = eye_patch::EyePatch::take(image, face.right_eye_px, ra.distance(rb))?;
+    Some([left, right])
+}
+
+/// The last frame's face followed by its eyes' patches (no network): each eye where its patch
+/// aligns, searched from where it was last frame moved by `predicted_px`; the iris size scaled
+/// with the eyes' separation (the face nearer or further), the landmarks moved with the eyes.
+/// `None` — the networks run — when a patch is refused ([`eye_patch`]: no match, or not within
+/// its reach of the prediction) or when the two eyes moved apart by more than 5 % of the eye
+/// distance in one frame (more than a face rolls or nears between frames: a turn of the head,
+/// or a patch that slid).
+fn follow_patches(
+    image: &UprightImage,
+    last: &FaceFound,
+    [left, right]: &[eye_patch::EyePatch; 2],
+    predicted_px: Vec2,
+) -> Option<FaceFound> {
+    let (left_eye_px, _) = left.find(image, last.left_eye_px + predicted_px)?;
+    let (right_eye_px, _) = right.find(image, last.right_eye_px + predicted_px)?;
+    let (ml, mr) = (left_eye_px - last.left_eye_px, right_eye_px - last.right_eye_px);
+    let ipd = last.left_eye_px.distance(last.right_eye_px);
+    if ipd.is_nan() || ipd <= 0.0 || ml.distance(mr) > 0.05 * ipd {
+        return None;
+    }
+    Some(FaceFound {
+        left_eye_px,
+        right_eye_px,
+        iris_diameter_px: last.iris_diameter_px * left_eye_px.distance(right_eye_px) / ipd,
+        confidence: last.confidence,
+        landmarks: moved_with_the_eyes(last, left_eye_px, right_eye_px),
+        lenses: last.lenses,
+    })
+}
+
 /// The next frame's crop from this frame's landmarks (MediaPipe's landmarks-to-ROI).
 fn roi_from_landmarks(landmarks: &[Vec2]) -> Roi {
     Roi::around(landmarks.iter().copied(), landmarks[33], landmarks[263], 1.5)
@@ -879,11 +919,25 @@ impl FaceFound {
     }
 }
 
-/// While tracking, FaceMesh runs on one frame in this many; the irises alone follow the eyes on
-/// the others (FaceMesh costs as much as both irises, `benchmarks/face.md`). At 30 frames/s the
-/// mesh still refreshes the face's outline and its face flag ten times a second, and any frame
-/// whose irises move apart or far runs it at once.
-pub const MESH_EVERY: u32 = 3;
+/// While tracking, the networks (FaceMesh in the last face's region, then both irises) run on
+/// one frame in this many; between, each eye's image patch follows it ([`eye_patch`]: no
+/// network). At 30 frames/s the networks still place the face and measure each eye 7.5 times a
+/// second; a patch that no longer matches (a blink, a turn of the head, a hand) or eyes that
+/// move apart run them at once. The networks are nearly all of a tracked frame's cost, so this
+/// sets the tracker's mean cost; 3, 4 and 5 were measured alike for accuracy
+/// (`benchmarks/face.md`, 2026-12-03).
+pub const NETWORK_EVERY: u32 = 4;
+
+/// What the last tracked frame ran to find the eyes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum TrackedBy {
+    /// BlazeFace, then FaceMesh and the irises (detection mode).
+    Detector,
+    /// FaceMesh in the last face's region, then the irises.
+    FaceMesh,
+    /// No network: each eye's patch aligned ([`eye_patch`]).
+    EyePatches,
+}
 
 /// Whether the last frame ran the detector or followed the face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -899,11 +953,17 @@ pub struct FaceTracker {
     /// The viewer's calibrated interpupillary distance; `None`: distance from the iris.
     pub ipd_m: Option<f32>,
     /// The last frame's face (its landmarks place this frame's crop, its eyes say where glasses
-    /// are looked for before FaceMesh runs), and how many frames in a row its irises alone have
-    /// followed.
+    /// are looked for before FaceMesh runs).
     last_found: Option<FaceFound>,
-    iris_only_frames: u32,
+    /// Each eye's patch (image left, image right) from the last frame that ran the networks, and
+    /// how many frames in a row they have followed the eyes since.
+    eye_patches: Option<[eye_patch::EyePatch; 2]>,
+    patch_frames: u32,
+    /// How far the eyes moved (their mean) between the last two frames, pixels: where this
+    /// frame's search starts (a face sways smoothly: constant velocity over a frame).
+    eye_motion_px: Vec2,
     last_mode: TrackingMode,
+    last_step: TrackedBy,
 }
 
 impl FaceTracker {
@@ -913,8 +973,11 @@ impl FaceTracker {
             pose,
             ipd_m: None,
             last_found: None,
-            iris_only_frames: 0,
+            eye_patches: None,
+            patch_frames: 0,
+            eye_motion_px: Vec2::ZERO,
             last_mode: TrackingMode::Detecting,
+            last_step: TrackedBy::Detector,
         }
     }
 
@@ -923,16 +986,17 @@ impl FaceTracker {
         self.last_mode
     }
 
-    /// Whether the last [`Self::process`] followed the eyes by their irises alone (no FaceMesh;
-    /// see [`MESH_EVERY`]).
-    pub fn followed_irises_only(&self) -> bool {
-        self.last_mode == TrackingMode::Tracking && self.iris_only_frames > 0
+    /// What the last [`Self::process`] ran to find the eyes (see [`NETWORK_EVERY`]).
+    pub fn last_step(&self) -> TrackedBy {
+        self.last_step
     }
 
     /// Forgets the tracked face: the next frame runs the detector.
     pub fn reset(&mut self) {
         self.last_found = None;
-        self.iris_only_frames = 0;
+        self.eye_patches = None;
+        self.patch_frames = 0;
+        self.eye_motion_px = Vec2::ZERO;
     }
 
     /// Finds the viewer's eyes in `frame` (the most confident face if several).
@@ -941,28 +1005,45 @@ impl FaceTracker {
         let mut found = None;
         if let Some(last) = &self.last_found {
             self.last_mode = TrackingMode::Tracking;
-            // FaceMesh on one tracked frame in MESH_EVERY; the irises alone follow the eyes in
-            // between, as long as they move together and stay well inside their crops.
-            if self.iris_only_frames + 1 < MESH_EVERY {
-                found = self.models.follow_irises(&image, last)?;
+            // The networks on one tracked frame in NETWORK_EVERY; the eyes' patches between, as
+            // long as they match and move together.
+            if self.patch_frames + 1 < NETWORK_EVERY {
+                found = (self.eye_patches.as_ref()).and_then(|p| follow_patches(&image, last, p, self.eye_motion_px));
             }
             if found.is_some() {
-                self.iris_only_frames += 1;
+                self.patch_frames += 1;
+                self.last_step = TrackedBy::EyePatches;
             } else {
-                let roi = roi_from_landmarks(&last.landmarks);
+                self.patch_frames = 0;
+                self.last_step = TrackedBy::FaceMesh;
+                // The crop where the face is expected: last frame's, moved on as it was moving.
+                let ahead = |p: Vec2| p + self.eye_motion_px;
+                let landmarks: Vec<Vec2> = last.landmarks.iter().copied().map(ahead).collect();
+                let eyes = [ahead(last.left_eye_px), ahead(last.right_eye_px)];
                 found = self
                     .models
-                    .face_in(&image, &roi, Some([last.left_eye_px, last.right_eye_px]))?;
-                self.iris_only_frames = 0;
+                    .face_in(&image, &roi_from_landmarks(&landmarks), Some(eyes))?;
             }
         }
         if found.is_none() {
             self.last_mode = TrackingMode::Detecting;
-            self.iris_only_frames = 0;
+            self.last_step = TrackedBy::Detector;
+            self.patch_frames = 0;
             if let Some(d) = self.models.detect(&image)?.first() {
                 found = self.models.face_from_detection(&image, d)?;
             }
         }
+        // A frame that ran the networks gives the patches the next frames follow.
+        if self.last_step != TrackedBy::EyePatches {
+            self.eye_patches = found.as_ref().and_then(|f| take_patches(&image, f));
+        }
+        self.eye_motion_px = match (&self.last_found, &found) {
+            (Some(a), Some(b)) if self.last_mode == TrackingMode::Tracking => {
+                let m = (b.left_eye_px - a.left_eye_px + b.right_eye_px - a.right_eye_px) * 0.5;
+                if m.is_finite() { m } else { Vec2::ZERO }
+            }
+            _ => Vec2::ZERO,
+        };
         self.last_found = found.clone();
         let found = found.filter(|f| f.confidence >= MIN_FACE_CONFIDENCE);
         let mut glasses = None;
@@ -1129,6 +1210,34 @@ mod tests {
         // NaN output is skipped, not propagated.
         reg[800 * 16] = f32::NAN;
         assert_eq!(merge_detections(decode_detections(&reg, &scores, &roi)).len(), 1);
+    }
+
+    #[test]
+    fn landmarks_follow_the_eyes_through_a_turn_and_a_change_of_scale() {
+        let face = FaceFound {
+            left_eye_px: Vec2::new(100.0, 100.0),
+            right_eye_px: Vec2::new(160.0, 100.0),
+            iris_diameter_px: 10.0,
+            confidence: 1.0,
+            landmarks: vec![Vec2::new(130.0, 150.0), Vec2::new(90.0, 95.0), Vec2::new(100.0, 100.0)],
+            lenses: None,
+        };
+        // The face turned 10° in the image, 10 % nearer and moved: every landmark is carried by
+        // the same similarity.
+        let (s, c) = 10f32.to_radians().sin_cos();
+        let map = |p: Vec2| {
+            let d = p - Vec2::new(130.0, 100.0);
+            Vec2::new(300.0, 200.0) + 1.1 * Vec2::new(c * d.x - s * d.y, s * d.x + c * d.y)
+        };
+        let moved = moved_with_the_eyes(&face, map(face.left_eye_px), map(face.right_eye_px));
+        for (got, p) in moved.iter().zip(&face.landmarks) {
+            assert!(got.distance(map(*p)) < 1e-3, "{got} vs {}", map(*p));
+        }
+        // Eyes on one point: moved only.
+        let mut flat = face.clone();
+        flat.right_eye_px = flat.left_eye_px;
+        let moved = moved_with_the_eyes(&flat, Vec2::new(110.0, 100.0), Vec2::new(150.0, 90.0));
+        assert!(moved[0].distance(Vec2::new(140.0, 150.0)) < 1e-4, "{}", moved[0]);
     }
 
     #[test]

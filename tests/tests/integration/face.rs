@@ -6,10 +6,12 @@ use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use phantogram::face::{
-    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, OwnedFrame, PixelFormat, TrackingMode, UprightImage,
+    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, NETWORK_EVERY, OwnedFrame, PixelFormat, TrackedBy,
+    TrackingMode, UprightImage,
 };
 use phantogram::glam::{Vec2, Vec3};
 use phantogram_integration::data_subdir;
+use phantogram_lab::drawn_glasses::{draw, style_for};
 
 fn models() -> Option<Arc<FaceModels>> {
     phantogram_integration::face_models()
@@ -293,23 +295,23 @@ fn tracking_follows_the_face_from_its_landmarks_and_gives_metric_device_eyes() {
     }
 }
 
-/// A face moving across the frame, 3 pixels a frame: the tracker follows it with FaceMesh on one
-/// frame in `MESH_EVERY` and the irises alone between, and its eyes stay where a fresh detection
-/// on each frame puts them.
+/// A face moving across the frame, 3 pixels a frame: the tracker follows it with the networks on
+/// one frame in `NETWORK_EVERY` and the eyes' patches between, and its eyes stay where a fresh
+/// detection on each frame puts them.
 #[test]
-fn a_moving_face_is_followed_by_its_irises_between_mesh_frames() {
+fn a_moving_face_is_followed_by_its_eyes_patches_between_network_frames() {
     let Some((models, dir)) = setup() else { return };
     let img = rgba(&dir.join("astronaut.png"));
     let small = image::imageops::resize(&img, 480, 480, image::imageops::FilterType::Triangle);
     let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(Vec3::ZERO));
     let mut fresh = FaceTracker::new(models, CameraPose::front(Vec3::ZERO));
-    let mut followed = 0;
+    let mut steps = Vec::new();
     for k in 0..12u32 {
         let mut canvas = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
         image::imageops::overlay(&mut canvas, &small, 50 + 3 * i64::from(k), 0);
         let k_px = default_intrinsics(&canvas);
         let tracked = tracker.process(frame(&canvas, k_px)).expect("a valid frame");
-        followed += usize::from(tracker.followed_irises_only());
+        steps.push(tracker.last_step());
         fresh.reset();
         let detected = fresh.process(frame(&canvas, k_px)).expect("a valid frame");
         let (Some(a), Some(b)) = (tracked.eyes_m, detected.eyes_m) else {
@@ -328,10 +330,238 @@ fn a_moving_face_is_followed_by_its_irises_between_mesh_frames() {
             );
         }
     }
-    // 12 frames: one detection, then of the 11 tracked frames every MESH_EVERY-th runs FaceMesh
-    // (the detection's own mesh counts as the first).
-    let mesh_every = phantogram::face::MESH_EVERY as usize;
-    assert_eq!(followed, 11 - 11 / mesh_every, "frames followed by the irises alone");
+    // 12 frames: one detection, then of the 11 tracked frames every NETWORK_EVERY-th runs the
+    // networks (the detection counts as the first).
+    let every = NETWORK_EVERY as usize;
+    let want: Vec<TrackedBy> = (0..12)
+        .map(|k| match k {
+            0 => TrackedBy::Detector,
+            k if k % every != 0 => TrackedBy::EyePatches,
+            _ => TrackedBy::FaceMesh,
+        })
+        .collect();
+    assert_eq!(steps, want, "what each frame ran");
+}
+
+/// Frame `k` of a hand-held face: `face` turned by `roll_rad`, scaled by `scale` and moved so
+/// its centre lands at `centre` of a 640 × 480 grey frame (bilinear), and the map from the face
+/// image's pixels to the frame's.
+fn held_face(
+    face: &image::RgbaImage,
+    centre: Vec2,
+    scale: f32,
+    roll_rad: f32,
+) -> (image::RgbaImage, impl Fn(Vec2) -> Vec2) {
+    let (w, h) = (face.width() as f32, face.height() as f32);
+    let mid = Vec2::new(w, h) * 0.5;
+    let (s, c) = roll_rad.sin_cos();
+    let to_frame = move |p: Vec2| {
+        let d = p - mid;
+        centre + scale * Vec2::new(c * d.x - s * d.y, s * d.x + c * d.y)
+    };
+    let mut out = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
+    for (x, y, px) in out.enumerate_pixels_mut() {
+        // The inverse map, sampled at the pixel's centre (pixel centres at half-integers).
+        let d = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - centre) / scale;
+        let p = mid + Vec2::new(c * d.x + s * d.y, -s * d.x + c * d.y) - Vec2::splat(0.5);
+        if p.x < 0.0 || p.y < 0.0 || p.x >= w - 1.0 || p.y >= h - 1.0 {
+            continue;
+        }
+        let (x0, y0) = (p.x.floor() as u32, p.y.floor() as u32);
+        let (fx, fy) = (p.x - x0 as f32, p.y - y0 as f32);
+        let mut acc = [0.0f32; 3];
+        for (dx, dy, wgt) in [
+            (0, 0, (1.0 - fx) * (1.0 - fy)),
+            (1, 0, fx * (1.0 - fy)),
+            (0, 1, (1.0 - fx) * fy),
+            (1, 1, fx * fy),
+        ] {
+            let q = face.get_pixel(x0 + dx, y0 + dy).0;
+            for k in 0..3 {
+                acc[k] += f32::from(q[k]) * wgt;
+            }
+        }
+        *px = image::Rgba([acc[0].round() as u8, acc[1].round() as u8, acc[2].round() as u8, 255]);
+    }
+    (out, to_frame)
+}
+
+/// Faces held in the hand, a second each at 30 frames/s: three photos, three paths each,
+/// moving up to 7–10 pixels a frame, coming 8 % nearer or going 6 % further and rolling up to
+/// ±4°. The tracker's eyes (the networks on one frame in `NETWORK_EVERY`, the eyes' patches
+/// between) stay near the truth — the eyes found once on the face image, carried through each
+/// frame's own warp: within 2 % of the eye distance on nine frames in ten, 4 % on every frame (a
+/// fresh detection on every frame, printed beside it, reaches 2.3 % on this blurry third photo).
+/// A closed eye on one frame stops the patches there.
+#[test]
+fn hand_held_faces_are_followed_between_network_frames_by_their_eyes_patches() {
+    let Some((models, dir)) = setup() else { return };
+    let tau = std::f32::consts::TAU;
+    // (centre amplitude x, y; frequencies x, y, roll (Hz); phase; scale change over the second;
+    // roll amplitude (degrees)).
+    let paths = [
+        (40.0, 15.0, 0.8, 1.3, 0.5, 1.0, 0.08, 3.0f32),
+        (25.0, 30.0, 1.5, 0.7, 0.9, 2.5, -0.06, 4.0),
+        (55.0, 10.0, 0.6, 2.0, 1.2, 4.0, 0.03, 2.0),
+    ];
+    // Errors without and with glasses: (tracked, fresh detection).
+    let mut errors = [(Vec::new(), Vec::new()), (Vec::new(), Vec::new())];
+    let (mut patch_frames, mut frames) = (0, 0);
+    let cases = [
+        ("astronaut.png", None),
+        ("Tom_Cruise_avp_2014_4.jpg", None),
+        ("2008_001009.jpg", None),
+        // Anaglyph glasses drawn on the face (moving with it): the patches see tinted eyes.
+        ("astronaut.png", Some(0)),
+        ("Tom_Cruise_avp_2014_4.jpg", Some(1)),
+    ];
+    for (file, glasses) in cases {
+        // The photo's first face, cropped to four eye distances and scaled to 90 pixels between
+        // the eyes (a viewer half a metre from a phone's front camera).
+        let img = rgba(&dir.join(file));
+        let face = {
+            let k = default_intrinsics(&img);
+            let found = models.find_faces(&UprightImage::new(frame(&img, k)).unwrap()).unwrap();
+            let f = found.first().unwrap_or_else(|| panic!("{file}: no face")).clone();
+            let ipd = f.left_eye_px.distance(f.right_eye_px);
+            let centre = (f.left_eye_px + f.right_eye_px) * 0.5 + Vec2::new(0.0, 0.4 * ipd);
+            let corner = (centre - Vec2::splat(2.0 * ipd)).max(Vec2::ZERO);
+            let end = (centre + Vec2::splat(2.0 * ipd)).min(Vec2::new(img.width() as f32, img.height() as f32));
+            let size = end - corner;
+            let crop = image::imageops::crop_imm(&img, corner.x as u32, corner.y as u32, size.x as u32, size.y as u32)
+                .to_image();
+            let scale = 90.0 / ipd;
+            let (w, h) = ((size.x * scale) as u32, (size.y * scale) as u32);
+            image::imageops::resize(&crop, w, h, image::imageops::FilterType::Triangle)
+        };
+        let (w, h) = face.dimensions();
+        // The truth: the eyes on the face image itself, framed with nothing else.
+        let reference = {
+            let mut canvas = image::RgbaImage::from_pixel(w + 160, h + 160, image::Rgba([40, 40, 40, 255]));
+            image::imageops::overlay(&mut canvas, &face, 80, 80);
+            let k = default_intrinsics(&canvas);
+            let found = models
+                .find_faces(&UprightImage::new(frame(&canvas, k)).unwrap())
+                .unwrap();
+            let f = found.first().unwrap_or_else(|| panic!("{file}: no face")).clone();
+            [f.left_eye_px, f.right_eye_px].map(|p| p - Vec2::splat(80.0))
+        };
+        let face = match glasses {
+            Some(seed) => {
+                let mut with = face.clone();
+                draw(&mut with, w, h, reference[0], reference[1], &style_for(seed));
+                with
+            }
+            None => face,
+        };
+        let (tracked_errors, fresh_errors) = &mut errors[usize::from(glasses.is_some())];
+        for (n, &(ax, ay, fx, fy, fr, phase, grow, roll_deg)) in paths.iter().enumerate() {
+            let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(Vec3::ZERO));
+            let mut fresh = FaceTracker::new(models.clone(), CameraPose::front(Vec3::ZERO));
+            let mut steps = Vec::new();
+            for k in 0..30u32 {
+                let t = k as f32 / 30.0;
+                let centre = Vec2::new(
+                    320.0 + ax * (tau * fx * t).sin(),
+                    240.0 + ay * (tau * fy * t + phase).sin(),
+                );
+                let roll = roll_deg.to_radians() * (tau * fr * t).sin();
+                let (mut canvas, to_frame) = held_face(&face, centre, 1.0 + grow * t, roll);
+                let truth = reference.map(&to_frame);
+                let ipd = truth[0].distance(truth[1]);
+                let closed = n == 0 && k == 20 && glasses.is_none();
+                if closed {
+                    // The image-left eye closed (a patch of skin-like colour over it) on one frame.
+                    for (x, y, px) in canvas.enumerate_pixels_mut() {
+                        if Vec2::new(x as f32, y as f32).distance(truth[0]) < 0.15 * ipd {
+                            *px = image::Rgba([150, 120, 105, 255]);
+                        }
+                    }
+                }
+                let k_px = default_intrinsics(&canvas);
+                // Back to pixels: the device frame's eyes through the camera (pose at the origin).
+                let pose = CameraPose::front(Vec3::ZERO);
+                let to_px = |p: Vec3| {
+                    let c = pose.device_from_camera.inverse() * p;
+                    Vec2::new(k_px.cx_px + k_px.fx_px * c.x / c.z, k_px.cy_px + k_px.fy_px * c.y / c.z)
+                };
+                let error = |eyes: Option<[Vec3; 2]>| -> f32 {
+                    let [a, b] = eyes
+                        .unwrap_or_else(|| panic!("{file}, path {n}, frame {k}: the face was lost"))
+                        .map(to_px);
+                    // Paired with the truth whichever way round the device frame has them.
+                    let e = (a.distance(truth[0]).max(b.distance(truth[1])))
+                        .min(a.distance(truth[1]).max(b.distance(truth[0])));
+                    e / ipd
+                };
+                let tracked = tracker.process(frame(&canvas, k_px)).expect("a valid frame");
+                steps.push(tracker.last_step());
+                fresh.reset();
+                let detected = fresh.process(frame(&canvas, k_px)).expect("a valid frame");
+                if closed {
+                    assert_ne!(
+                        tracker.last_step(),
+                        TrackedBy::EyePatches,
+                        "the closed eye was followed by its patch"
+                    );
+                } else {
+                    tracked_errors.push(error(tracked.eyes_m));
+                    if let Some(eyes) = detected.eyes_m {
+                        fresh_errors.push(error(Some(eyes)));
+                    }
+                }
+            }
+            patch_frames += steps.iter().filter(|s| **s == TrackedBy::EyePatches).count();
+            frames += steps.len();
+            println!("{file}, glasses {glasses:?}, path {n}: {steps:?}");
+        }
+    }
+    let stats = |v: &[f32]| {
+        let mut v = v.to_vec();
+        v.sort_by(f32::total_cmp);
+        (v[v.len() / 2], v[v.len() * 9 / 10], v[v.len() - 1])
+    };
+    let mut figures = Vec::new();
+    for (set, (tracked, fresh)) in ["bare faces", "with glasses"].iter().zip(&errors) {
+        let (t, f) = (stats(tracked), stats(fresh));
+        println!(
+            "hand-held, {set}: eye error / eye distance (median, 90 %, max): tracked {:.2} / {:.2} / {:.2} %, fresh detection on every frame {:.2} / {:.2} / {:.2} %",
+            100.0 * t.0,
+            100.0 * t.1,
+            100.0 * t.2,
+            100.0 * f.0,
+            100.0 * f.1,
+            100.0 * f.2
+        );
+        figures.push((t, f));
+    }
+    println!("{patch_frames} of {frames} frames by the patches");
+    // Following by the patches may add at most half a point (90 %) and one point (max) of the eye
+    // distance to what the networks on every frame give; bare faces also within 2 % and 4 %.
+    // Bounds set after measuring: bare 1.09 vs 1.11 % (90 %), 2.66 vs 2.28 % (max); glasses 2.33
+    // vs 2.11 %, 2.70 vs 2.64 %. The tracker before the patches, bare: 3.8 % and 13.5 % (its
+    // irises alone drifting between FaceMesh runs on the third photo).
+    for (set, (t, f)) in ["bare faces", "with glasses"].iter().zip(&figures) {
+        assert!(
+            t.1 < f.1 + 0.005,
+            "{set}: tracked eyes off by {:.2} % of the eye distance at 90 % (fresh {:.2} %)",
+            100.0 * t.1,
+            100.0 * f.1
+        );
+        assert!(
+            t.2 < f.2 + 0.01,
+            "{set}: tracked eyes off by {:.2} % at most (fresh {:.2} %)",
+            100.0 * t.2,
+            100.0 * f.2
+        );
+    }
+    let (bare, _) = figures[0];
+    assert!(bare.1 < 0.02 && bare.2 < 0.04, "bare faces: {bare:?}");
+    // The patches do carry most frames.
+    assert!(
+        2 * patch_frames >= frames,
+        "{patch_frames} of {frames} frames by the patches"
+    );
 }
 
 #[test]
