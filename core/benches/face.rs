@@ -1,7 +1,7 @@
 //! `cargo bench -p phantogram --bench face` (or `cargo xtask bench face`): milliseconds per
 //! 640×480 camera frame, one thread, measured in the same run: detection mode (BlazeFace +
 //! FaceMesh + 2 × Iris; median of 30 frames) and tracking mode (FaceMesh + 2 × Iris on one frame
-//! in `NETWORK_EVERY`, the eyes' patches between; the mean over 72 frames, whole cycles of the
+//! in `NETWORK_EVERY`, the eyes' patches between; the mean over 60 frames, whole cycles of the
 //! schedule, as that is what the tracker takes from the cores; also the worst frame and the
 //! median of each kind). The face sways across the frame by up to 7 pixels a frame.
 //!
@@ -92,12 +92,12 @@ fn main() {
             detection.push(ms);
         }
     }
-    // Tracking mode: 3 warm-up frames, then 72 (whole cycles for NETWORK_EVERY 1 to 4, 6, 8, 9
-    // or 12), after one detection.
+    // Tracking mode: 3 warm-up frames, then 60 (whole cycles for NETWORK_EVERY 1 to 6, 10 or
+    // 12), after one detection.
     tracker.reset();
     run(&mut tracker, 0);
     let (mut all, mut by_step) = (Vec::new(), std::collections::BTreeMap::<String, Vec<f64>>::new());
-    for k in 1..4 + 72 {
+    for k in 1..4 + 60 {
         let ms = run(&mut tracker, k);
         assert_eq!(
             tracker.last_mode(),

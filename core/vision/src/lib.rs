@@ -921,12 +921,13 @@ impl FaceFound {
 
 /// While tracking, the networks (FaceMesh in the last face's region, then both irises) run on
 /// one frame in this many; between, each eye's image patch follows it ([`eye_patch`]: no
-/// network). At 30 frames/s the networks still place the face and measure each eye 7.5 times a
+/// network). At 30 frames/s the networks still place the face and measure each eye six times a
 /// second; a patch that no longer matches (a blink, a turn of the head, a hand) or eyes that
 /// move apart run them at once. The networks are nearly all of a tracked frame's cost, so this
-/// sets the tracker's mean cost; 3, 4 and 5 were measured alike for accuracy
-/// (`benchmarks/face.md`, 2026-12-03).
-pub const NETWORK_EVERY: u32 = 4;
+/// sets the tracker's mean cost. Every value from 1 (networks on every frame) to 6 gave the same
+/// accuracy on the hand-held test (`benchmarks/face.md`, 2026-12-03); 5 is the smallest that
+/// brings the mean cost to about 4 ms a frame on the bench machine.
+pub const NETWORK_EVERY: u32 = 5;
 
 /// What the last tracked frame ran to find the eyes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
