@@ -147,3 +147,42 @@ pub fn gzip(bytes: &[u8]) -> Vec<u8> {
     enc.write_all(bytes).expect("writing to memory");
     enc.finish().expect("writing to memory")
 }
+
+/// `img` resampled (bilinear, grey 40 outside) into a 640 × 480 frame whose pixel `q` shows `img`
+/// at `centre + R(angle) · (q − (320, 240)) / scale`: `centre` in the middle, enlarged by `scale`,
+/// turned by `angle_rad` (pixel centres at half-integers). The face tests' synthetic camera
+/// frames: a photo moved, scaled and rolled as a hand-held phone would see it.
+pub fn warp_into_frame(
+    img: &image::RgbaImage,
+    centre: phantogram::glam::Vec2,
+    scale: f32,
+    angle_rad: f32,
+) -> image::RgbaImage {
+    use phantogram::glam::Vec2;
+    let (w, h) = img.dimensions();
+    let (s, c) = angle_rad.sin_cos();
+    image::RgbaImage::from_fn(640, 480, |x, y| {
+        let q = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - Vec2::new(320.0, 240.0)) / scale;
+        let p = centre + Vec2::new(c * q.x - s * q.y, s * q.x + c * q.y) - Vec2::splat(0.5);
+        let (x0, y0) = (p.x.floor(), p.y.floor());
+        let (fx, fy) = (p.x - x0, p.y - y0);
+        let mut acc = [0.0f32; 3];
+        for (dx, dy, wt) in [
+            (0, 0, (1.0 - fx) * (1.0 - fy)),
+            (1, 0, fx * (1.0 - fy)),
+            (0, 1, (1.0 - fx) * fy),
+            (1, 1, fx * fy),
+        ] {
+            let (xi, yi) = (x0 as i64 + dx, y0 as i64 + dy);
+            let px = if xi >= 0 && yi >= 0 && xi < w as i64 && yi < h as i64 {
+                img.get_pixel(xi as u32, yi as u32).0
+            } else {
+                [40, 40, 40, 255]
+            };
+            for k in 0..3 {
+                acc[k] += f32::from(px[k]) * wt;
+            }
+        }
+        image::Rgba([acc[0] as u8, acc[1] as u8, acc[2] as u8, 255])
+    })
+}

@@ -10,7 +10,7 @@ use phantogram::face::{
     TrackingMode, UprightImage,
 };
 use phantogram::glam::{Vec2, Vec3};
-use phantogram_integration::data_subdir;
+use phantogram_integration::{data_subdir, warp_into_frame};
 use phantogram_lab::drawn_glasses::{draw, style_for};
 
 fn models() -> Option<Arc<FaceModels>> {
@@ -343,47 +343,22 @@ fn a_moving_face_is_followed_by_its_eyes_patches_between_network_frames() {
     assert_eq!(steps, want, "what each frame ran");
 }
 
-/// Frame `k` of a hand-held face: `face` turned by `roll_rad`, scaled by `scale` and moved so
-/// its centre lands at `centre` of a 640 × 480 grey frame (bilinear), and the map from the face
-/// image's pixels to the frame's.
+/// A hand-held face: `face` turned by `roll_rad` in the image, scaled by `scale` and moved so its
+/// centre lands at `centre` of a 640 × 480 grey frame, and the map from the face image's pixels to
+/// the frame's.
 fn held_face(
     face: &image::RgbaImage,
     centre: Vec2,
     scale: f32,
     roll_rad: f32,
 ) -> (image::RgbaImage, impl Fn(Vec2) -> Vec2) {
-    let (w, h) = (face.width() as f32, face.height() as f32);
-    let mid = Vec2::new(w, h) * 0.5;
+    let mid = Vec2::new(face.width() as f32, face.height() as f32) * 0.5;
     let (s, c) = roll_rad.sin_cos();
-    let to_frame = move |p: Vec2| {
-        let d = p - mid;
-        centre + scale * Vec2::new(c * d.x - s * d.y, s * d.x + c * d.y)
-    };
-    let mut out = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
-    for (x, y, px) in out.enumerate_pixels_mut() {
-        // The inverse map, sampled at the pixel's centre (pixel centres at half-integers).
-        let d = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - centre) / scale;
-        let p = mid + Vec2::new(c * d.x + s * d.y, -s * d.x + c * d.y) - Vec2::splat(0.5);
-        if p.x < 0.0 || p.y < 0.0 || p.x >= w - 1.0 || p.y >= h - 1.0 {
-            continue;
-        }
-        let (x0, y0) = (p.x.floor() as u32, p.y.floor() as u32);
-        let (fx, fy) = (p.x - x0 as f32, p.y - y0 as f32);
-        let mut acc = [0.0f32; 3];
-        for (dx, dy, wgt) in [
-            (0, 0, (1.0 - fx) * (1.0 - fy)),
-            (1, 0, fx * (1.0 - fy)),
-            (0, 1, (1.0 - fx) * fy),
-            (1, 1, fx * fy),
-        ] {
-            let q = face.get_pixel(x0 + dx, y0 + dy).0;
-            for k in 0..3 {
-                acc[k] += f32::from(q[k]) * wgt;
-            }
-        }
-        *px = image::Rgba([acc[0].round() as u8, acc[1].round() as u8, acc[2].round() as u8, 255]);
-    }
-    (out, to_frame)
+    let turn = move |d: Vec2, s: f32| Vec2::new(c * d.x - s * d.y, s * d.x + c * d.y);
+    let to_frame = move |p: Vec2| centre + scale * turn(p - mid, s);
+    // The face's point at the frame's middle, for the warp (which turns frame → face by −roll).
+    let at_middle = mid + turn(Vec2::new(320.0, 240.0) - centre, -s) / scale;
+    (warp_into_frame(face, at_middle, scale, -roll_rad), to_frame)
 }
 
 /// Faces held in the hand, a second each at 30 frames/s: three photos, three paths each,
@@ -539,8 +514,9 @@ fn hand_held_faces_are_followed_between_network_frames_by_their_eyes_patches() {
     println!("{patch_frames} of {frames} frames by the patches");
     // Following by the patches may add at most half a point (90 %) and one point (max) of the eye
     // distance to what the networks on every frame give; bare faces also within 2 % and 4 %.
-    // Bounds set after measuring (NETWORK_EVERY 1 to 6): bare 1.18–1.55 vs 1.11 % (90 %),
-    // 1.66–2.69 vs 2.28 % (max); glasses 2.20–2.44 vs 2.11 %, 2.70–3.23 vs 2.64 %. The tracker before the patches, bare: 3.8 % and 13.5 % (its
+    // Bounds set after measuring (NETWORK_EVERY 1 to 6, benchmarks/face.md): bare 1.2–1.6 vs
+    // 1.1–1.2 % (90 %), 1.7–2.7 vs 2.2–2.3 % (max); glasses 2.2–2.4 vs 2.1–2.2 %, 2.7–3.3 vs
+    // 2.6–2.9 %. The tracker before the patches, bare: 3.8 % and 13.5 % (its
     // irises alone drifting between FaceMesh runs on the third photo).
     for (set, (t, f)) in ["bare faces", "with glasses"].iter().zip(&figures) {
         assert!(

@@ -12,7 +12,7 @@ use std::sync::Arc;
 use phantogram::face::glasses;
 use phantogram::face::{CameraFrame, FaceFound, FaceModels, Intrinsics, PixelFormat, UprightImage};
 use phantogram::glam::Vec2;
-use phantogram_integration::data_subdir;
+use phantogram_integration::{data_subdir, warp_into_frame};
 use phantogram_lab::drawn_glasses::{draw, style_for};
 
 fn models() -> Option<Arc<FaceModels>> {
@@ -49,38 +49,6 @@ const PHOTOS: [&str; 6] = [
     "2008_002470.jpg",
     "2008_007676.jpg",
 ];
-
-/// `img` resampled (bilinear, grey outside) into a 640 × 480 frame whose pixel `q` shows `img`
-/// at `centre + R(angle) · (q − (320, 240)) / scale`: `centre` in the middle, enlarged by `scale`,
-/// turned by `angle_rad`.
-fn warp(img: &image::RgbaImage, centre: Vec2, scale: f32, angle_rad: f32) -> image::RgbaImage {
-    let (w, h) = img.dimensions();
-    let (s, c) = angle_rad.sin_cos();
-    image::RgbaImage::from_fn(640, 480, |x, y| {
-        let q = (Vec2::new(x as f32 + 0.5, y as f32 + 0.5) - Vec2::new(320.0, 240.0)) / scale;
-        let p = centre + Vec2::new(c * q.x - s * q.y, s * q.x + c * q.y) - Vec2::splat(0.5);
-        let (x0, y0) = (p.x.floor(), p.y.floor());
-        let (fx, fy) = (p.x - x0, p.y - y0);
-        let mut acc = [0.0f32; 3];
-        for (dx, dy, wt) in [
-            (0, 0, (1.0 - fx) * (1.0 - fy)),
-            (1, 0, fx * (1.0 - fy)),
-            (0, 1, (1.0 - fx) * fy),
-            (1, 1, fx * fy),
-        ] {
-            let (xi, yi) = (x0 as i64 + dx, y0 as i64 + dy);
-            let px = if xi >= 0 && yi >= 0 && xi < w as i64 && yi < h as i64 {
-                img.get_pixel(xi as u32, yi as u32).0
-            } else {
-                [40, 40, 40, 255]
-            };
-            for k in 0..3 {
-                acc[k] += f32::from(px[k]) * wt;
-            }
-        }
-        image::Rgba([acc[0] as u8, acc[1] as u8, acc[2] as u8, 255])
-    })
-}
 
 struct Outcome {
     case: String,
@@ -191,7 +159,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
             // Upright, and turned by 20° one way or the other (alternating between faces).
             let turn = if seed % 8 < 4 { 20.0 } else { -20.0 };
             for angle_deg in [0.0f32, turn] {
-                let selfie = warp(&img, mid, 120.0 / ipd_px, angle_deg.to_radians());
+                let selfie = warp_into_frame(&img, mid, 120.0 / ipd_px, angle_deg.to_radians());
                 // The reference: the face in the middle of the enlarged, clean frame.
                 let clean_selfie: Vec<FaceFound> = faces(&models, &selfie)
                     .into_iter()
@@ -204,7 +172,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
                         // The tracker's own noise, for scale: the same bare face moved by
                         // (0.5, 0.3) pixels.
                         let shift = Vec2::new(0.5, 0.3);
-                        let moved = warp(&img, mid - shift * ipd_px / 120.0, 120.0 / ipd_px, 0.0);
+                        let moved = warp_into_frame(&img, mid - shift * ipd_px / 120.0, 120.0 / ipd_px, 0.0);
                         let ipd = g.left_eye_px.distance(g.right_eye_px);
                         if let Some(m) = faces(&models, &moved)
                             .into_iter()
