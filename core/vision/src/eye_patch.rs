@@ -1,8 +1,9 @@
 //! Following an eye between iris-network runs by aligning its image patch (no network).
 //!
-//! Two iris runs are most of a tracked frame's cost (`benchmarks/face.md`: ≈ 8 of 12 ms), yet
-//! from one frame to the next at 30 frames/s an eye mostly just moves across the image with the
-//! head. So when the iris network has placed an eye, the grey patch around it becomes a
+//! The networks are nearly all of a tracked frame's cost (`benchmarks/face.md`: FaceMesh and two
+//! irises ≈ 18 ms here), yet from one frame to the next at 30 frames/s an eye mostly just moves
+//! across the image with the head. So when the iris network has placed an eye, the grey patch
+//! around it becomes a
 //! template ([`EyePatch::take`]: about 1.6 × 1 eye widths, 24 × 16 samples), and on the next
 //! frames the same patch is found again ([`EyePatch::find`]) by Lucas–Kanade alignment in its
 //! inverse-compositional form (Baker & Matthews 2004): translation only, on zero-mean,
@@ -27,6 +28,7 @@
 //!
 //! Coordinates: upright image pixels, centres at half-integers (as `UprightImage::bilinear`).
 //!
+//! **Threading**: an [`EyePatch`] is plain data (`Send`, `Sync`); the tracker keeps one per eye.
 //! **Panics**: none; NaN positions or sizes give `None`.
 
 use glam::Vec2;
@@ -45,8 +47,9 @@ pub const MAX_ITERATIONS: usize = 12;
 /// Settled: the last update moved the patch by less than this, in template samples.
 const SETTLED_SAMPLES: f32 = 0.01;
 /// The lowest correlation (zero-mean, normalised) of an accepted match. Sensor noise and a few
-/// per cent of scale or a few degrees of roll between frames leave it above 0.95 (see the unit
-/// tests); a blink or a different patch falls well under.
+/// per cent of scale between frames leave it above 0.95 (unit tests), the hand-held test's
+/// frames (moving, rolling, nearing) at 0.998 or more; a closed eye or a different patch falls
+/// under.
 pub const MIN_CORRELATION: f32 = 0.9;
 
 /// An eye's grey patch from the frame where the iris network last placed it, centred on the
