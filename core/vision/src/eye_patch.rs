@@ -29,6 +29,7 @@
 //! Coordinates: upright image pixels, centres at half-integers (as `UprightImage::bilinear`).
 //!
 //! **Threading**: an [`EyePatch`] is plain data (`Send`, `Sync`); the tracker keeps one per eye.
+//!
 //! **Panics**: none; NaN positions or sizes give `None`.
 
 use glam::Vec2;
