@@ -392,25 +392,32 @@ impl Roi {
             self.image_point(1.0, 0.0, flip) - origin,
             self.image_point(0.0, 1.0, flip) - origin,
         );
-        let at = |a: f32, b: f32| origin + du * a + dv * b;
+        // One output pixel is `du / n` and `dv / n` in the image, a tap a `taps`-th of that; the
+        // offsets of the taps from a pixel's corner are the same for every pixel.
+        let (pixel_u, pixel_v) = (du / n as f32, dv / n as f32);
+        let tap_offsets: Vec<Vec2> = (0..taps * taps)
+            .map(|t| {
+                let (tx, ty) = ((t % taps) as f32 + 0.5, (t / taps) as f32 + 0.5);
+                (pixel_u * tx + pixel_v * ty) / taps as f32
+            })
+            .collect();
+        let norm = 1.0 / (taps * taps) as f32;
+        let plane = n * n;
         for j in 0..n {
+            let row = origin + pixel_v * j as f32;
             for i in 0..n {
+                let corner = row + pixel_u * i as f32;
                 let mut acc = [0.0f32; 3];
-                for ty in 0..taps {
-                    for tx in 0..taps {
-                        let a = (i as f32 + (tx as f32 + 0.5) / taps as f32) / n as f32;
-                        let b = (j as f32 + (ty as f32 + 0.5) / taps as f32) / n as f32;
-                        let c = sample(at(a, b));
-                        for k in 0..3 {
-                            acc[k] += c[k];
-                        }
+                for offset in &tap_offsets {
+                    let c = sample(corner + *offset);
+                    for k in 0..3 {
+                        acc[k] += c[k];
                     }
                 }
-                let norm = 1.0 / (taps * taps) as f32;
-                let centre = at((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
+                let centre = corner + (pixel_u + pixel_v) * 0.5;
                 let c = correct(centre, acc.map(|v| v * norm));
                 for k in 0..3 {
-                    out[k * n * n + j * n + i] = lo + (hi - lo) * c[k];
+                    out[k * plane + j * n + i] = lo + (hi - lo) * c[k];
                 }
             }
         }
