@@ -932,8 +932,9 @@ impl FaceFound {
 /// second; a patch that no longer matches (a blink, a turn of the head, a hand) or eyes that
 /// move apart run them at once. The networks are nearly all of a tracked frame's cost, so this
 /// sets the tracker's mean cost. Every value from 1 (networks on every frame) to 6 gave the same
-/// accuracy on the hand-held test (`benchmarks/face.md`, 2026-12-03); 5 is the smallest that
-/// brings the mean cost to about 4 ms a frame on the bench machine.
+/// accuracy on the hand-held test (`benchmarks/face.md`, 2026-12-03); 5 was chosen as the
+/// smallest that brought the mean cost to about 4 ms a frame on a busy run of the bench here
+/// (2.9 ms on a quiet one, where 4 would also do).
 pub const NETWORK_EVERY: u32 = 5;
 
 /// What the last tracked frame ran to find the eyes.
