@@ -393,7 +393,7 @@ fn hand_held_faces_are_followed_between_network_frames_by_their_eyes_patches() {
     ];
     for (file, glasses) in cases {
         // The photo's first face, cropped to four eye distances and scaled to 90 pixels between
-        // the eyes (a viewer half a metre from a phone's front camera).
+        // the eyes (a viewer about 40 cm from a 60° front camera at 640 × 480).
         let img = rgba(&dir.join(file));
         let face = {
             let k = default_intrinsics(&img);
