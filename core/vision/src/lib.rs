@@ -246,7 +246,12 @@ impl<'a> UprightImage<'a> {
 
     /// 8-bit RGB of upright pixel `(x, y)`, which must be inside the image.
     fn rgb8(&self, x: u32, y: u32) -> [u8; 3] {
-        let at = self.offset(x as i32, y as i32);
+        self.rgb8_at(self.offset(x as i32, y as i32))
+    }
+
+    /// 8-bit RGB of the pixel at buffer offset `at`, which must be a pixel's offset.
+    #[inline]
+    fn rgb8_at(&self, at: usize) -> [u8; 3] {
         let d = self.frame.data;
         match self.frame.format {
             PixelFormat::Luma8 => [d[at]; 3],
@@ -262,16 +267,8 @@ impl<'a> UprightImage<'a> {
                 reduced::Reduced::half_of(self.width, self.height, |y| {
                     // Upright row y starts at its buffer offset and steps `step_x` a pixel
                     // (both in the buffer: checked by `new`).
-                    let start = self.offset(0, y as i32) as isize;
-                    let (step, d) = (self.step_x, self.frame.data);
-                    let format = self.frame.format;
-                    move |x: u32| {
-                        let at = (start + x as isize * step) as usize;
-                        match format {
-                            PixelFormat::Luma8 => [d[at]; 3],
-                            PixelFormat::Rgba8 => [d[at], d[at + 1], d[at + 2]],
-                        }
-                    }
+                    let (start, step) = (self.offset(0, y as i32) as isize, self.step_x);
+                    move |x: u32| self.rgb8_at((start + x as isize * step) as usize)
                 })
             } else {
                 self.level(k - 1).half()
