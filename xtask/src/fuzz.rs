@@ -14,6 +14,10 @@
 //!   repository). The corpus grows across runs; findings go to `target/fuzz/artifacts/TARGET`.
 //! * Runs on the stable toolchain without a sanitizer (`--sanitizer none`): safe Rust needs none
 //!   to find panics, hangs and runaway memory. Needs `cargo install cargo-fuzz --locked`.
+//! * Scratch files (the targets that write each input to a file for the code under test to
+//!   open) go to `/dev/shm` where it is a folder, as `TMPDIR` of the run: they are thrown away
+//!   after each input, and on a RAM-backed folder no input waits on the disk (`import` ran 1644
+//!   executions a second with them on this machine's disk, 2087 on `/dev/shm`, 45 s each).
 //! * `--record` puts each target's row into `benchmarks/fuzz.md` (replacing that target's older
 //!   row, keeping the others').
 
@@ -33,6 +37,15 @@ const TARGETS: [(&str, usize, bool); 6] = [
     ("environment", 1 << 20, false),
     ("c_abi", 4 << 10, true),
 ];
+
+/// A RAM-backed folder for the targets' scratch files, where this system has one we may write.
+fn ram_backed_scratch() -> Option<&'static Path> {
+    let shm = Path::new("/dev/shm");
+    let probe = shm.join(format!("phantogram-xtask-{}", std::process::id()));
+    let writable = std::fs::create_dir(&probe).is_ok();
+    let _ = std::fs::remove_dir(&probe);
+    writable.then_some(shm)
+}
 
 /// What one run did, from libFuzzer's final statistics.
 struct Outcome {
@@ -101,6 +114,9 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .arg("-print_final_stats=1")
             .arg(format!("-artifact_prefix={}/", artifacts.display()))
             .current_dir(&root);
+        if let Some(ram) = ram_backed_scratch() {
+            command.env("TMPDIR", ram);
+        }
         let output = command
             .output()
             .with_context(|| format!("running cargo fuzz for {target}"))?;
