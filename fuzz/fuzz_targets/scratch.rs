@@ -4,11 +4,14 @@
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
-/// `$TMPDIR/phantogram-fuzz-<target>-<pid>`, made once.
+/// `<scratch>/phantogram-fuzz-<target>-<pid>`, made once: `<scratch>` is
+/// `$PHANTOGRAM_FUZZ_SCRATCH` (the folder `cargo xtask fuzz` makes for a run), else the
+/// temporary folder.
 pub fn dir(target: &str) -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
-        let dir = std::env::temp_dir().join(format!("phantogram-fuzz-{target}-{}", std::process::id()));
+        let root = std::env::var_os("PHANTOGRAM_FUZZ_SCRATCH").map_or_else(std::env::temp_dir, PathBuf::from);
+        let dir = root.join(format!("phantogram-fuzz-{target}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         std::fs::create_dir_all(&dir).expect("scratch folder");
         dir
