@@ -2,8 +2,9 @@
 //! frame (the glass is the plane `z = 0`, the rectangle centred on the origin) and the display
 //! rotation that decides which device axes the displayed image's right and up point along.
 //!
-//! Invariants: a [`Screen`] always has a positive, finite size; its `right_device`/`up_device`
-//! axes are unit vectors in the glass plane with `right × up = +z`.
+//! Invariants: a [`Screen`] always has a size a display can have, [`Screen::MIN_SIDE_M`] to
+//! [`Screen::MAX_SIDE_M`] a side; its `right_device`/`up_device` axes are unit vectors in the
+//! glass plane with `right × up = +z`.
 
 use glam::{Vec2, Vec3};
 use thiserror::Error;
@@ -64,6 +65,16 @@ pub enum ScreenError {
     EmptyPanel { width_px: u32, height_px: u32 },
     #[error("pixel density must be positive and finite, got xdpi {xdpi}, ydpi {ydpi}")]
     BadDensity { xdpi: f32, ydpi: f32 },
+    #[error(
+        "a display of {width_m} m × {height_m} m (xdpi {xdpi}, ydpi {ydpi}) is outside what any screen measures \
+         (1 mm to 100 m a side): the pixel density is wrong"
+    )]
+    ImplausibleSize {
+        width_m: f32,
+        height_m: f32,
+        xdpi: f32,
+        ydpi: f32,
+    },
 }
 
 /// The screen rectangle in the device frame plus the display's pixel grid.
@@ -83,6 +94,16 @@ pub struct ScreenCorners {
 }
 
 impl Screen {
+    /// The smallest side a display has: below a watch's centimetres by a factor of ten.
+    pub const MIN_SIDE_M: f32 = 1e-3;
+    /// The largest side a display has: beyond a stadium's video wall.
+    pub const MAX_SIDE_M: f32 = 100.0;
+
+    /// The screen of `panel`, shown at `rotation`. Refused: no pixels, a density that is not a
+    /// positive number, or one that makes a side shorter than [`Self::MIN_SIDE_M`] or longer than
+    /// [`Self::MAX_SIDE_M`] — a density a platform or a caller got wrong, which would put the
+    /// eyes, the projection and the Diorama's tray at scales no display has (a 10⁻²⁷ m by
+    /// 10¹⁷ m tray, from random display calls, held one physics step for over 45 s).
     pub fn new(panel: PanelSpec, rotation: DisplayRotation) -> Result<Self, ScreenError> {
         if panel.width_px == 0 || panel.height_px == 0 {
             return Err(ScreenError::EmptyPanel {
@@ -97,7 +118,18 @@ impl Screen {
                 ydpi: panel.ydpi,
             });
         }
-        Ok(Self { panel, rotation })
+        let screen = Self { panel, rotation };
+        let (width_m, height_m) = (screen.panel_width_m(), screen.panel_height_m());
+        let plausible = |side_m: f32| (Self::MIN_SIDE_M..=Self::MAX_SIDE_M).contains(&side_m);
+        if !plausible(width_m) || !plausible(height_m) {
+            return Err(ScreenError::ImplausibleSize {
+                width_m,
+                height_m,
+                xdpi: panel.xdpi,
+                ydpi: panel.ydpi,
+            });
+        }
+        Ok(screen)
     }
 
     pub fn panel(&self) -> PanelSpec {
@@ -284,6 +316,40 @@ mod tests {
             assert!(lr.distance(Vec2::new(s.width_px() as f32, s.height_px() as f32)) < 1e-3);
             let px = Vec2::new(123.5, 456.5);
             assert!(s.pixel_of_glass_point(s.glass_point_of_pixel(px)).distance(px) < 1e-3);
+        }
+    }
+
+    #[test]
+    fn every_kind_of_display_is_a_screen_and_wrong_densities_are_not() {
+        let panel = |width_px, height_px, xdpi, ydpi| PanelSpec {
+            width_px,
+            height_px,
+            xdpi,
+            ydpi,
+        };
+        for (what, p) in [
+            ("a watch (41 mm)", panel(352, 430, 326.0, 326.0)),
+            ("a phone", PanelSpec::TYPICAL_PHONE),
+            ("a 100-inch 4K television", panel(3840, 2160, 44.0, 44.0)),
+            ("a 4-pixel test surface at 100 dpi (1 mm)", panel(4, 4, 100.0, 100.0)),
+        ] {
+            assert!(Screen::new(p, DisplayRotation::Deg0).is_ok(), "{what}");
+        }
+        // The display calls the C ABI's fuzzing made before its Diorama step hung: 10^-27 m wide,
+        // 10^17 m tall.
+        for (what, p) in [
+            ("1 px at 1.4e25 dpi", panel(1, 1000, 1.4e25, 400.0)),
+            ("1000 px at 9.4e-20 dpi", panel(1080, 1000, 400.0, 9.4e-20)),
+            ("a 4-pixel panel at 420 dpi (0.24 mm)", panel(4, 4, 420.0, 420.0)),
+            ("a 4-billion-pixel panel at 1 dpi", panel(u32::MAX, 1000, 1.0, 400.0)),
+        ] {
+            assert!(
+                matches!(
+                    Screen::new(p, DisplayRotation::Deg0),
+                    Err(ScreenError::ImplausibleSize { .. })
+                ),
+                "{what}"
+            );
         }
     }
 

@@ -446,3 +446,49 @@ fn a_finger_drags_a_body_and_a_double_tap_resets_the_diorama() {
         "the double tap put it back"
     );
 }
+
+/// A display density no screen has is refused through the engine, and the Diorama keeps the
+/// screen it had. Found by fuzzing the C ABI: after random display calls the tray was 10⁻²⁷ m wide
+/// and 10¹⁷ m tall, and one physics step (rapier's continuous collision detection on bodies at
+/// 10¹⁷ m, where a float's step is kilometres) ran for over 45 s.
+#[test]
+fn a_display_no_screen_has_is_refused_and_the_diorama_goes_on() {
+    use phantogram::engine::{EngineConfig, ErrorKind};
+    use phantogram::screen::{DisplayRotation, PanelSpec};
+    let Some(mut engine) = phantogram_integration::engine_or_skip(EngineConfig {
+        artifact: Some("builtin:diorama".parse().unwrap()),
+        ..EngineConfig::default()
+    }) else {
+        return;
+    };
+    engine.resume_offscreen(180, 400).unwrap();
+    let screen = engine.session().config().screen;
+    for (width_px, height_px, xdpi, ydpi) in [(1, 1000, 1.4e25f32, 400.0f32), (1080, 1000, 400.0, 9.4e-20)] {
+        let panel = PanelSpec {
+            width_px,
+            height_px,
+            xdpi,
+            ydpi,
+        };
+        let refused = engine.set_display(panel, DisplayRotation::Deg0);
+        assert_eq!(
+            refused.map_err(|e| e.kind()),
+            Err(ErrorKind::InvalidArgument),
+            "{panel:?}"
+        );
+        assert_eq!(engine.session().config().screen, screen, "the screen is kept");
+    }
+    let ms = 1_000_000;
+    for k in 0..20 {
+        engine
+            .inbox()
+            .push(SensorEvent::accelerometer(k * 50 * ms, Vec3::Z * 9.81))
+            .unwrap();
+        engine.draw(Some(k * 50 * ms)).unwrap();
+    }
+    let half = screen.half_extent_device_m();
+    for pose in engine.diorama().unwrap().world().stepped_poses() {
+        let p = pose.translation_m;
+        assert!(p.x.abs() <= half.x && p.y.abs() <= half.y, "a body left the tray: {p}");
+    }
+}
