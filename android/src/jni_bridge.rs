@@ -648,6 +648,8 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSurfaceDestroyed<'
 }
 
 /// Display metrics or rotation changed (`DisplayMetrics`, `Display.getRotation()`).
+/// `IllegalArgumentException` (the screen kept as it was) for no pixels, a density that is not
+/// positive, or one that makes a side shorter than 1 mm or longer than 100 m.
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeSetDisplay<'local>(

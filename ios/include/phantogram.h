@@ -275,7 +275,9 @@ enum PgStatus pg_resize(const struct PgEngine *engine, uint32_t width, uint32_t 
 // `engine` is a live handle (or null, reported).
 enum PgStatus pg_suspend(const struct PgEngine *engine);
 
-// The panel or the interface orientation changed.
+// The panel or the interface orientation changed. `PG_STATUS_INVALID_ARGUMENT` (the screen
+// kept as it was) for no pixels, a density that is not positive, or one that makes a side
+// shorter than 1 mm or longer than 100 m.
 //
 // # Safety
 // `engine` is a live handle (or null, reported).

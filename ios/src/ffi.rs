@@ -669,7 +669,9 @@ pub unsafe extern "C" fn pg_suspend(engine: *const PgEngine) -> PgStatus {
     })
 }
 
-/// The panel or the interface orientation changed.
+/// The panel or the interface orientation changed. `PG_STATUS_INVALID_ARGUMENT` (the screen
+/// kept as it was) for no pixels, a density that is not positive, or one that makes a side
+/// shorter than 1 mm or longer than 100 m.
 ///
 /// # Safety
 /// `engine` is a live handle (or null, reported).
