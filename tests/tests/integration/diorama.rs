@@ -371,22 +371,23 @@ fn the_diorama_at_rest_and_mid_slide_matches_its_golden_frames() {
     golden::check("diorama-sliding", w, h, &sliding, 3, 0.003);
 }
 
-/// The finger in the Diorama through the engine, as a shell sends touches: a drag on a body
-/// carries it across the tray; a double tap puts everything back.
-#[test]
-fn a_finger_drags_a_body_and_a_double_tap_resets_the_diorama() {
-    use phantogram::engine::EngineConfig;
-    use phantogram::gesture::TouchPhase;
-    let Some(mut engine) = phantogram_integration::engine_or_skip(EngineConfig {
+/// The offscreen target [`diorama_engine`] draws into, pixels.
+const OFFSCREEN_PX: (u32, u32) = (180, 400);
+
+/// An engine showing the Diorama offscreen ([`OFFSCREEN_PX`]); `None` (skipped) without a GPU
+/// adapter.
+fn diorama_engine() -> Option<phantogram::engine::Engine> {
+    let mut engine = phantogram_integration::engine_or_skip(phantogram::engine::EngineConfig {
         artifact: Some("builtin:diorama".parse().unwrap()),
-        ..EngineConfig::default()
-    }) else {
-        return;
-    };
-    let (w, h) = (180u32, 400u32);
-    engine.resume_offscreen(w, h).unwrap();
+        ..phantogram::engine::EngineConfig::default()
+    })?;
+    engine.resume_offscreen(OFFSCREEN_PX.0, OFFSCREEN_PX.1).unwrap();
+    Some(engine)
+}
+
+/// One second lying flat, a frame every 50 ms: the bodies settle where they start.
+fn lie_flat(engine: &mut phantogram::engine::Engine) {
     let ms = 1_000_000;
-    // Lying flat: the bodies settle where they start.
     for k in 0..20 {
         engine
             .inbox()
@@ -394,6 +395,19 @@ fn a_finger_drags_a_body_and_a_double_tap_resets_the_diorama() {
             .unwrap();
         engine.draw(Some(k * 50 * ms)).unwrap();
     }
+}
+
+/// The finger in the Diorama through the engine, as a shell sends touches: a drag on a body
+/// carries it across the tray; a double tap puts everything back.
+#[test]
+fn a_finger_drags_a_body_and_a_double_tap_resets_the_diorama() {
+    use phantogram::gesture::TouchPhase;
+    let Some(mut engine) = diorama_engine() else {
+        return;
+    };
+    let w = OFFSCREEN_PX.0;
+    let ms = 1_000_000;
+    lie_flat(&mut engine);
     let world = engine.diorama().unwrap().world();
     let before = world.stepped_poses().to_vec();
     // The body nearest the screen's centre, and where it is drawn.
@@ -453,15 +467,11 @@ fn a_finger_drags_a_body_and_a_double_tap_resets_the_diorama() {
 /// 10¹⁷ m, where a float's step is kilometres) ran for over 45 s.
 #[test]
 fn a_display_no_screen_has_is_refused_and_the_diorama_goes_on() {
-    use phantogram::engine::{EngineConfig, ErrorKind};
+    use phantogram::engine::ErrorKind;
     use phantogram::screen::{DisplayRotation, PanelSpec};
-    let Some(mut engine) = phantogram_integration::engine_or_skip(EngineConfig {
-        artifact: Some("builtin:diorama".parse().unwrap()),
-        ..EngineConfig::default()
-    }) else {
+    let Some(mut engine) = diorama_engine() else {
         return;
     };
-    engine.resume_offscreen(180, 400).unwrap();
     let screen = engine.session().config().screen;
     for (width_px, height_px, xdpi, ydpi) in [(1, 1000, 1.4e25f32, 400.0f32), (1080, 1000, 400.0, 9.4e-20)] {
         let panel = PanelSpec {
@@ -478,14 +488,7 @@ fn a_display_no_screen_has_is_refused_and_the_diorama_goes_on() {
         );
         assert_eq!(engine.session().config().screen, screen, "the screen is kept");
     }
-    let ms = 1_000_000;
-    for k in 0..20 {
-        engine
-            .inbox()
-            .push(SensorEvent::accelerometer(k * 50 * ms, Vec3::Z * 9.81))
-            .unwrap();
-        engine.draw(Some(k * 50 * ms)).unwrap();
-    }
+    lie_flat(&mut engine);
     let half = screen.half_extent_device_m();
     for pose in engine.diorama().unwrap().world().stepped_poses() {
         let p = pose.translation_m;
