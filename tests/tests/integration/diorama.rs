@@ -332,17 +332,12 @@ fn tilt_events(tilt_deg: f32, roll_deg: f32, until_s: f32) -> Vec<SensorEvent> {
 
 #[test]
 fn the_diorama_at_rest_and_mid_slide_matches_its_golden_frames() {
-    use phantogram::engine::{Engine, EngineConfig};
-    let config = EngineConfig {
-        artifact: Some("builtin:diorama".parse().unwrap()),
-        ..EngineConfig::default()
-    };
-    let Some(mut engine) = phantogram_integration::engine_or_skip(config) else {
+    use phantogram::engine::Engine;
+    let Some(mut engine) = diorama_engine() else {
         return;
     };
     assert!(engine.diorama().is_some(), "the Diorama is on screen");
-    let (w, h) = (180, 400);
-    engine.resume_offscreen(w, h).unwrap();
+    let (w, h) = OFFSCREEN_PX;
     let events = tilt_events(35.0, -30.0, 3.0);
     let inbox = engine.inbox();
     let mut next = 0;
