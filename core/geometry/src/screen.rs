@@ -67,7 +67,9 @@ pub enum ScreenError {
     BadDensity { xdpi: f32, ydpi: f32 },
     #[error(
         "a display of {width_m} m × {height_m} m (xdpi {xdpi}, ydpi {ydpi}) is outside what any screen measures \
-         (1 mm to 100 m a side): the pixel density is wrong"
+         ({min} m to {max} m a side): the pixel density is wrong",
+        min = Screen::MIN_SIDE_M,
+        max = Screen::MAX_SIDE_M
     )]
     ImplausibleSize {
         width_m: f32,
