@@ -254,7 +254,9 @@ fn java_accessibility_constants_are_the_cores() {
 /// Random call sequences through every native method (`android/tests/java/RandomCalls.java`):
 /// only documented exceptions, no panic, no JNI error, no crash, and `-Xcheck:jni` silent.
 /// `PHANTOGRAM_JNI_CALLS` sets the calls per seed (default 400; a long run: a few hundred
-/// thousand), `PHANTOGRAM_JNI_SEEDS` the number of seeds (default 3).
+/// thousand), `PHANTOGRAM_JNI_SEEDS` the number of seeds (default 3). Then the same driver once
+/// more with its choices drawn from 4 KiB of bytes, as the `jni` fuzz target draws them from
+/// libFuzzer's (`RandomCalls.fuzz`): the calls run until the bytes are used up, and end.
 #[test]
 fn random_jni_call_sequences_end_only_in_documented_exceptions() {
     let home = java_home();
@@ -274,15 +276,24 @@ fn random_jni_call_sequences_end_only_in_documented_exceptions() {
     };
     let (calls, seeds) = (number("PHANTOGRAM_JNI_CALLS", 400), number("PHANTOGRAM_JNI_SEEDS", 3));
     let dir = compile_driver(&home, "RandomCalls", "phantogram-jvm-random");
-    for seed in 1..=seeds {
-        let library = dir.join(format!("library-{seed}"));
+    let stream = dir.join("stream");
+    // Bytes of no pattern a call could be tuned to: a multiplicative hash of the position.
+    let bytes: Vec<u8> = (0u32..4096)
+        .map(|i| (i.wrapping_mul(2_654_435_761) >> 24) as u8)
+        .collect();
+    std::fs::write(&stream, bytes).expect("writing the byte stream");
+    let runs = (1..=seeds)
+        .map(|seed| seed.to_string())
+        .chain([format!("bytes:{}", stream.display())]);
+    for (i, seed) in runs.enumerate() {
+        let library = dir.join(format!("library-{i}"));
         let output = Command::new(tool(&home, "java"))
             .arg("-Xcheck:jni")
             .arg("-cp")
             .arg(&dir)
             .arg("RandomCalls")
             .arg(bridge_library())
-            .arg(seed.to_string())
+            .arg(&seed)
             .arg(calls.to_string())
             .arg(&library)
             .output()
@@ -296,6 +307,16 @@ fn random_jni_call_sequences_end_only_in_documented_exceptions() {
             !stderr.contains("WARNING in native method"),
             "seed {seed}: JNI misuse reported:\n{stderr}"
         );
+        if seed.starts_with("bytes:") {
+            // Many calls from the bytes, not one that swallowed them all (nor none).
+            let made: u64 = stdout
+                .split(" bytes: ")
+                .nth(1)
+                .and_then(|rest| rest.split(' ').next())
+                .and_then(|n| n.parse().ok())
+                .unwrap_or(0);
+            assert!(made >= 50, "only {made} calls from 4096 bytes:\n{stdout}");
+        }
     }
     let _ = std::fs::remove_dir_all(&dir);
 }

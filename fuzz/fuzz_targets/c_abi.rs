@@ -8,6 +8,8 @@ use std::sync::OnceLock;
 use libfuzzer_sys::fuzz_target;
 use phantogram_ios::ffi::*;
 
+#[path = "physics_panics.rs"]
+mod physics_panics;
 #[path = "../../ios/tests/support/random_calls.rs"]
 mod random_calls;
 
@@ -23,7 +25,7 @@ fn engine() -> *const PgEngine {
     static ENGINE: OnceLock<Handle> = OnceLock::new();
     ENGINE
         .get_or_init(|| {
-            tolerate_physics_panics();
+            physics_panics::tolerate();
             let mut engine = std::ptr::null_mut();
             // SAFETY: null config (defaults), valid out pointer.
             let status = unsafe { pg_engine_create(std::ptr::null(), &mut engine) };
@@ -31,26 +33,6 @@ fn engine() -> *const PgEngine {
             Handle(engine)
         })
         .0
-}
-
-/// libFuzzer's panic hook aborts on every panic, even one the code catches. The Diorama catches a
-/// panic inside rapier/parry (parry's EPA indexes out of bounds on some degenerate contacts;
-/// `Diorama::faults` counts them) and rebuilds its world, by design: such a panic is let through
-/// here, so that the run goes on to find what is not handled. Every other panic still aborts, and
-/// so does a physics panic that escapes the Diorama: the call then returns `PgStatus::Panic`,
-/// which `random_calls` rejects with a panic of its own.
-fn tolerate_physics_panics() {
-    let libfuzzer_hook = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        let in_physics = info
-            .location()
-            .is_some_and(|l| l.file().contains("/parry3d-") || l.file().contains("/rapier3d-"));
-        if in_physics {
-            eprintln!("tolerated (the Diorama recovers): {info}");
-        } else {
-            libfuzzer_hook(info);
-        }
-    }));
 }
 
 fuzz_target!(|data: &[u8]| {

@@ -19,6 +19,7 @@ pub fn dir(target: &str) -> &'static Path {
 }
 
 /// Writes `bytes` to `dir/name` and returns the path.
+#[allow(dead_code)] // `jni` keeps only its compiled classes there.
 pub fn write(dir: &Path, name: &str, bytes: &[u8]) -> PathBuf {
     let path = dir.join(name);
     std::fs::write(&path, bytes).expect("scratch write");

@@ -4,7 +4,10 @@
 //! * Targets: `gltf` (models and Voyager scenes), `import` (every sensor-log importer), `replay`
 //!   (a log through a session), `calibration`, `environment` (HDR/EXR through the guards) and
 //!   `c_abi` (random call sequences through the C ABI; it links the whole engine and needs a
-//!   GPU adapter such as lavapipe). All of them when none is named.
+//!   GPU adapter such as lavapipe), `jni` (the same through the JNI bridge, driven by
+//!   `android/tests/java/RandomCalls.java` in a JVM inside the fuzzer's process; also needs a
+//!   JDK, and leaves `SIGSEGV`, `SIGBUS`, `SIGFPE` and `SIGILL` to the JVM). All of them when
+//!   none is named.
 //! * Limits: resident memory 1 GiB (`-rss_limit_mb=1024`: an input that takes more is a
 //!   finding), 10 s per input (`-timeout=10`: an input that runs longer is a finding), each
 //!   target for `--seconds` (default 30).
@@ -30,14 +33,15 @@ use anyhow::{Context, Result, bail};
 
 use crate::workspace_root;
 
-/// (name, the longest input it is given, needs the `ffi` feature).
-const TARGETS: [(&str, usize, bool); 6] = [
-    ("gltf", 1 << 20, false),
-    ("import", 64 << 10, false),
-    ("replay", 64 << 10, false),
-    ("calibration", 4 << 10, false),
-    ("environment", 1 << 20, false),
-    ("c_abi", 4 << 10, true),
+/// (name, the longest input it is given, the cargo feature it needs).
+const TARGETS: [(&str, usize, Option<&str>); 7] = [
+    ("gltf", 1 << 20, None),
+    ("import", 64 << 10, None),
+    ("replay", 64 << 10, None),
+    ("calibration", 4 << 10, None),
+    ("environment", 1 << 20, None),
+    ("c_abi", 4 << 10, Some("ffi")),
+    ("jni", 4 << 10, Some("java")),
 ];
 
 /// A new folder for one run's scratch files: on `/dev/shm` (RAM-backed) where this system lets
@@ -97,7 +101,7 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
     }
     let root = workspace_root();
     let mut outcomes = Vec::new();
-    for (target, max_len, ffi) in chosen {
+    for (target, max_len, feature) in chosen {
         let corpus = root.join("target/fuzz/corpus").join(target);
         let artifacts = root.join("target/fuzz/artifacts").join(target);
         std::fs::create_dir_all(&corpus).with_context(|| format!("creating {}", corpus.display()))?;
@@ -106,8 +110,8 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
         println!("fuzzing {target} for {seconds} s (corpus {})", corpus.display());
         let mut command = Command::new("cargo");
         command.args(["fuzz", "run", "--sanitizer", "none", "--release"]);
-        if ffi {
-            command.args(["--features", "ffi"]);
+        if let Some(feature) = feature {
+            command.args(["--features", feature]);
         }
         command
             .arg(target)
@@ -120,6 +124,11 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .arg("-print_final_stats=1")
             .arg(format!("-artifact_prefix={}/", artifacts.display()))
             .current_dir(&root);
+        if target == "jni" {
+            // The JVM in that process uses these signals itself (null checks, safepoints) and
+            // reports its own crashes.
+            command.args(["-handle_segv=0", "-handle_bus=0", "-handle_fpe=0", "-handle_ill=0"]);
+        }
         let scratch = scratch_folder(target)?;
         command.env("PHANTOGRAM_FUZZ_SCRATCH", &scratch);
         let output = command.output();
@@ -362,6 +371,23 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             calls.extend(0.02f64.to_le_bytes());
             calls.extend([14, 0xff, 0xff, 15]);
             put("lifecycle", &calls)?;
+        }
+        "jni" => {
+            // The driver draws every choice from the bytes (`RandomCalls.BytesRandom`): a few
+            // streams of pseudo-random bytes give it a start across all the methods.
+            for (seed, len) in [(1u64, 256usize), (2, 1024), (3, 4096)] {
+                let mut x = seed.wrapping_mul(0x9e37_79b9_7f4a_7c15);
+                let bytes: Vec<u8> = (0..len)
+                    .map(|_| {
+                        // xorshift64
+                        x ^= x << 13;
+                        x ^= x >> 7;
+                        x ^= x << 17;
+                        (x >> 24) as u8
+                    })
+                    .collect();
+                put(&format!("stream-{seed}"), &bytes)?;
+            }
         }
         _ => {}
     }

@@ -13,7 +13,14 @@ import org.phantogram.NativeBridge;
  * undefined behaviour, as with any C handle), descriptors are never open ones (the library would
  * own and close it, and the JVM's own files are open), and nativeDestroy ends the run.
  *
- * Usage: RandomCalls LIBRARY SEED CALLS LIBRARY_DIR
+ * Usage: RandomCalls LIBRARY SEED CALLS LIBRARY_DIR, or RandomCalls LIBRARY bytes:FILE 0 LIBRARY_DIR
+ * to make the calls fuzz() makes from a file's bytes (as the fuzz target does, checked by the
+ * JVM test).
+ *
+ * The same calls are libFuzzer's JNI target (fuzz/fuzz_targets/jni.rs, in the fuzzer's own
+ * process): start() makes the live engine once, fuzz() draws its calls from the fuzzer's bytes
+ * instead of a seeded Random, and nativeMethods() names each native method with its JNI
+ * descriptor for RegisterNatives.
  */
 public final class RandomCalls {
     private static Random random;
@@ -175,30 +182,120 @@ public final class RandomCalls {
         }
     }
 
-    public static void main(String[] args) throws Exception {
-        NativeBridge.load(args[0]);
-        long seed = Long.parseLong(args[1]);
-        long total = Long.parseLong(args[2]);
-        String libraryDir = args[3];
-        random = new Random(seed);
+    /**
+     * One call on the live engine h (now and then on handle 0 instead); an undocumented exception
+     * (a Rust panic, a JNI failure, any other throwable) becomes an AssertionError naming the
+     * calls before it.
+     */
+    private static void checkedCall(long h, String libraryDir, String where) {
+        long handle = random.nextInt(30) == 0 ? 0 : h;
+        calls++;
+        try {
+            call(handle, libraryDir);
+        } catch (IllegalArgumentException | IllegalStateException | UnsupportedOperationException e) {
+            thrown++;
+        } catch (RuntimeException e) {
+            String m = String.valueOf(e.getMessage());
+            // A panic or a JNI failure is a bug; a load or GPU failure is documented.
+            if (e.getClass() != RuntimeException.class || m.startsWith("Rust panic") || m.startsWith("Rust error")) {
+                throw new AssertionError(where + ": " + e + "\nthe calls before it: " + String.join("; ", recent), e);
+            }
+            thrown++;
+        }
+    }
+
+    /** The live engine every call drives, shown offscreen (what a shell does first). */
+    public static long start(String libraryDir) {
         long h = NativeBridge.nativeCreate(null, null, 1080, 2400, 420f, 420f, 0, "dubois", null, libraryDir, null, null);
         NativeBridge.nativeResumeOffscreen(h, 90, 200);
-        for (long i = 0; i < total; i++) {
-            long handle = random.nextInt(30) == 0 ? 0 : h;
-            calls++;
-            try {
-                call(handle, libraryDir);
-            } catch (IllegalArgumentException | IllegalStateException | UnsupportedOperationException e) {
-                thrown++;
-            } catch (RuntimeException e) {
-                String m = String.valueOf(e.getMessage());
-                // A panic or a JNI failure is a bug; a load or GPU failure is documented.
-                if (e.getClass() != RuntimeException.class || m.startsWith("Rust panic") || m.startsWith("Rust error")) {
-                    throw new AssertionError("call " + i + " (seed " + seed + "): " + e + "\nthe calls before it: "
-                            + String.join("; ", recent), e);
-                }
-                thrown++;
+        return h;
+    }
+
+    /** libFuzzer's input: calls on h drawn from its bytes until they run out. */
+    public static void fuzz(long h, byte[] data, String libraryDir) {
+        BytesRandom bytes = new BytesRandom(data);
+        random = bytes;
+        recent.clear();
+        while (bytes.remaining() > 0) {
+            checkedCall(h, libraryDir, "fuzz input call " + calls);
+        }
+    }
+
+    /**
+     * "name descriptor" of each native method of NativeBridge, e.g. "nativeDestroy (J)V": what
+     * RegisterNatives needs, read from the class itself so that it cannot drift from it.
+     */
+    public static String[] nativeMethods() {
+        java.util.ArrayList<String> found = new java.util.ArrayList<>();
+        for (java.lang.reflect.Method m : NativeBridge.class.getDeclaredMethods()) {
+            if (!java.lang.reflect.Modifier.isNative(m.getModifiers())) continue;
+            StringBuilder d = new StringBuilder("(");
+            for (Class<?> p : m.getParameterTypes()) d.append(descriptor(p));
+            d.append(')').append(descriptor(m.getReturnType()));
+            found.add(m.getName() + " " + d);
+        }
+        return found.toArray(new String[0]);
+    }
+
+    private static String descriptor(Class<?> c) {
+        if (c.isArray()) return "[" + descriptor(c.getComponentType());
+        if (c == void.class) return "V";
+        if (c == boolean.class) return "Z";
+        if (c == byte.class) return "B";
+        if (c == char.class) return "C";
+        if (c == short.class) return "S";
+        if (c == int.class) return "I";
+        if (c == long.class) return "J";
+        if (c == float.class) return "F";
+        if (c == double.class) return "D";
+        return "L" + c.getName().replace('.', '/') + ";";
+    }
+
+    /**
+     * A Random whose bits are the fuzzer's bytes, in order (a draw of n bits takes ceil(n / 8)
+     * bytes), then zeros: every draw of nextInt(bound) then ends (zero is always in range), so a
+     * call that starts near the end still finishes.
+     */
+    static final class BytesRandom extends Random {
+        private final byte[] data;
+        private int at = 0;
+
+        BytesRandom(byte[] data) {
+            this.data = data;
+        }
+
+        int remaining() {
+            return data.length - at;
+        }
+
+        @Override
+        protected int next(int bits) {
+            int v = 0;
+            for (int i = 0; i < (bits + 7) / 8; i++) {
+                v = (v << 8) | (at < data.length ? data[at++] & 0xff : 0);
             }
+            return bits == 32 ? v : v & ((1 << bits) - 1);
+        }
+    }
+
+    public static void main(String[] args) throws Exception {
+        NativeBridge.load(args[0]);
+        String libraryDir = args[3];
+        if (args[1].startsWith("bytes:")) {
+            byte[] data = java.nio.file.Files.readAllBytes(java.nio.file.Paths.get(args[1].substring(6)));
+            long h = start(libraryDir);
+            fuzz(h, data, libraryDir);
+            NativeBridge.nativeDestroy(h);
+            System.out.println("calls from " + data.length + " bytes: " + calls + " calls, " + thrown + " documented exceptions");
+            System.out.println("done");
+            return;
+        }
+        long seed = Long.parseLong(args[1]);
+        long total = Long.parseLong(args[2]);
+        random = new Random(seed);
+        long h = start(libraryDir);
+        for (long i = 0; i < total; i++) {
+            checkedCall(h, libraryDir, "call " + i + " (seed " + seed + ")");
         }
         NativeBridge.nativeDestroy(h);
         System.out.println("random calls: seed " + seed + ", " + calls + " calls, " + thrown + " documented exceptions");
