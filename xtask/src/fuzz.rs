@@ -153,16 +153,29 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
                     .ok()
             })
         };
-        let finding = (!output.status.success()).then(|| {
-            log.lines()
-                .find(|l| l.contains("Test unit written to") || l.contains("panicked at"))
-                .unwrap_or("the run failed; see its log")
-                .trim()
-                .to_owned()
-        });
+        // `-Xcheck:jni` (the jni target's JVM) reports misuse it can go on from — a JNI call
+        // without the exception check it needs, more local references than the frame's
+        // capacity — as a warning on the JVM's output,
+        // not as a crash: a finding all the same, though no single input is saved for it.
+        let jvm_output = String::from_utf8_lossy(&output.stdout);
+        let jni_warning = [&*jvm_output, &*log]
+            .into_iter()
+            .flat_map(str::lines)
+            .find(|l| l.contains("WARNING in native method") || l.contains("WARNING: JNI local refs"));
+        let finding = if !output.status.success() {
+            Some(
+                log.lines()
+                    .find(|l| l.contains("Test unit written to") || l.contains("panicked at"))
+                    .unwrap_or("the run failed; see its log")
+                    .trim()
+                    .to_owned(),
+            )
+        } else {
+            jni_warning.map(|l| format!("-Xcheck:jni: {}", l.trim()))
+        };
         if let Some(f) = &finding {
             // The whole log, for the one that failed.
-            eprintln!("{log}");
+            eprintln!("{jvm_output}{log}");
             eprintln!("{target}: FINDING: {f}");
         }
         let Some(executions) = stat("number_of_executed_units") else {
