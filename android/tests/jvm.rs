@@ -316,14 +316,15 @@ fn random_jni_call_sequences_end_only_in_documented_exceptions() {
             panic!("seed {seed}: JNI misuse reported: {warning}\n{stdout}");
         }
         if seed.starts_with("bytes:") {
-            // Many calls from the bytes, not one that swallowed them all (nor none).
+            // Many calls from the bytes, not one that swallowed them all (nor none): 60 with
+            // today's driver; one call takes 8 to ~2100 bytes (an import's up to 2 KiB).
             let made: u64 = stdout
                 .split(" bytes: ")
                 .nth(1)
                 .and_then(|rest| rest.split(' ').next())
                 .and_then(|n| n.parse().ok())
                 .unwrap_or(0);
-            assert!(made >= 50, "only {made} calls from 4096 bytes:\n{stdout}");
+            assert!(made >= 10, "only {made} calls from 4096 bytes:\n{stdout}");
         }
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -68,7 +68,10 @@ public final class RandomCalls {
             case 2: {
                 StringBuilder s = new StringBuilder();
                 int n = random.nextInt(40);
-                for (int i = 0; i < n; i++) s.append((char) random.nextInt(0x3000));
+                // Any UTF-16 unit half the time, unpaired surrogates included (a document's
+                // display name can hold them; the bridge reads Java's modified UTF-8).
+                boolean any = random.nextBoolean();
+                for (int i = 0; i < n; i++) s.append((char) random.nextInt(any ? 0x10000 : 0x3000));
                 return s.toString();
             }
             default: return typical.length == 0 ? "x" : typical[random.nextInt(typical.length)];
