@@ -137,6 +137,11 @@ fn driver() -> &'static Driver {
             .option("-Xrs")
             .option("-Xmx128m")
             .option("-Xcheck:jni")
+            // PHANTOGRAM_JNI_TRACE=1: each call an input makes, with its time, on stderr.
+            .option(format!(
+                "-Dphantogram.trace={}",
+                std::env::var_os("PHANTOGRAM_JNI_TRACE").is_some()
+            ))
             .build()
             .expect("JVM options");
         let vm = JavaVM::with_libjvm(args, || Ok(home.join("lib/server/libjvm.so"))).expect("starting the JVM");

@@ -24,6 +24,23 @@ import org.phantogram.NativeBridge;
  */
 public final class RandomCalls {
     private static Random random;
+    /** -Dphantogram.trace=true: each call and its time on stderr (to see what an input does). */
+    private static final boolean TRACE = Boolean.getBoolean("phantogram.trace");
+    /**
+     * What a fuzz input may still spend on rendering: a frame costs 1, a snapshot or a second
+     * engine 8, and each input starts with 24; a call over the budget is skipped. The engine
+     * persists between inputs, so no state is out of reach, and an input stays well inside
+     * libFuzzer's 10-s timeout: with three fuzzers on two cores a frame took up to 0.23 s and a
+     * snapshot at the full panel (after the surface is gone) up to 2.6 s, and the inputs with
+     * five of those timed out. Unlimited in the seeded runs.
+     */
+    private static long renderBudget = Long.MAX_VALUE;
+
+    private static boolean spend(long cost) {
+        if (renderBudget < cost) return false;
+        renderBudget -= cost;
+        return true;
+    }
     private static long calls = 0;
     private static long thrown = 0;
     /** The last calls made, for the report of a failure. */
@@ -139,7 +156,7 @@ public final class RandomCalls {
             }
             case 10: NativeBridge.nativeSetAnaglyph(h, anyString("dubois", "mono", "half-color", "sepia")); break;
             case 11: NativeBridge.nativeSetSensorRanges(h, anyFloat(), anyFloat()); break;
-            case 12: NativeBridge.nativeDrawFrame(h, random.nextBoolean() ? -1 : anyTime()); break;
+            case 12: if (spend(1)) NativeBridge.nativeDrawFrame(h, random.nextBoolean() ? -1 : anyTime()); break;
             case 13: NativeBridge.nativeReadFrame(h); break;
             case 14: NativeBridge.nativeStats(h); break;
             case 15: NativeBridge.nativeCalibrationWarning(h); break;
@@ -153,7 +170,7 @@ public final class RandomCalls {
             case 22: NativeBridge.nativeOpenMenu(h); break;
             case 23: NativeBridge.nativeTakeShellRequest(h); break;
             case 24: NativeBridge.nativeLoadingState(h); break;
-            case 25: NativeBridge.nativeSnapshotPng(h, anyInt(2)); break;
+            case 25: if (spend(8)) NativeBridge.nativeSnapshotPng(h, anyInt(2)); break;
             case 26: NativeBridge.nativeAccessibilityNodes(h); break;
             case 27: NativeBridge.nativeAccessibilityGeneration(h); break;
             case 28: {
@@ -174,7 +191,7 @@ public final class RandomCalls {
             }
             case 31: {
                 // Rarely: another engine with random settings, destroyed at once.
-                if (random.nextInt(20) != 0) break;
+                if (random.nextInt(20) != 0 || !spend(8)) break;
                 long other = NativeBridge.nativeCreate(anyString("/nonexistent.glb"), null, anyInt(1440), anyInt(3200), anyFloat(),
                         anyFloat(), anyInt(4), anyString("dubois", "mono"), null, random.nextBoolean() ? null : libraryDir, null,
                         anyString("builtin:medal"));
@@ -193,6 +210,7 @@ public final class RandomCalls {
     private static void checkedCall(long h, String libraryDir, String where) {
         long handle = random.nextInt(30) == 0 ? 0 : h;
         calls++;
+        long started = System.nanoTime();
         try {
             call(handle, libraryDir);
         } catch (IllegalArgumentException | IllegalStateException | UnsupportedOperationException e) {
@@ -204,6 +222,10 @@ public final class RandomCalls {
                 throw new AssertionError(where + ": " + e + "\nthe calls before it: " + String.join("; ", recent), e);
             }
             thrown++;
+        } finally {
+            if (TRACE) {
+                System.err.println(where + ": " + recent.peekLast() + ", " + (System.nanoTime() - started) / 1_000_000 + " ms");
+            }
         }
     }
 
@@ -219,6 +241,7 @@ public final class RandomCalls {
         BytesRandom bytes = new BytesRandom(data);
         random = bytes;
         recent.clear();
+        renderBudget = 24;
         while (bytes.remaining() > 0) {
             checkedCall(h, libraryDir, "fuzz input call " + calls);
         }
