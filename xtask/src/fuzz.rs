@@ -57,6 +57,17 @@ fn scratch_folder(target: &str) -> Result<PathBuf> {
     Ok(tmp)
 }
 
+/// Whether the jni target will find a JDK where it looks (`fuzz/fuzz_targets/jni.rs`:
+/// `$JAVA_HOME`, Debian's OpenJDK 17, the `javac` on the PATH).
+fn jdk_found() -> bool {
+    std::env::var_os("JAVA_HOME")
+        .map(PathBuf::from)
+        .into_iter()
+        .chain([PathBuf::from("/usr/lib/jvm/java-17-openjdk-amd64")])
+        .any(|home| home.join("bin/javac").is_file())
+        || Command::new("javac").arg("-version").output().is_ok_and(|o| o.status.success())
+}
+
 /// What one run did, from libFuzzer's final statistics.
 struct Outcome {
     target: &'static str,
@@ -98,6 +109,13 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
     let version = Command::new("cargo").args(["fuzz", "--version"]).output();
     if !version.is_ok_and(|o| o.status.success()) {
         bail!("cargo-fuzz is not installed: `cargo install cargo-fuzz --locked` (about a minute)");
+    }
+    // The jni target starts a JVM; without a JDK it could only fail, which is not a finding.
+    if chosen.iter().any(|t| t.0 == "jni") && !jdk_found() {
+        bail!(
+            "the jni target needs a JDK (javac and libjvm): set JAVA_HOME, or install one \
+             (Debian: openjdk-17-jdk-headless)"
+        );
     }
     let root = workspace_root();
     let mut outcomes = Vec::new();
