@@ -179,10 +179,9 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
                     .ok()
             })
         };
-        // `-Xcheck:jni` (the jni target's JVM) reports misuse it can go on from — a JNI call
-        // without the exception check it needs, more local references than the frame's
-        // capacity — as a warning on the JVM's output,
-        // not as a crash: a finding all the same, though no single input is saved for it.
+        // `-Xcheck:jni` (the jni target's JVM) reports misuse it can go on from — such as a JNI
+        // call made with an exception pending — as a warning on the JVM's standard output, not
+        // as a crash: a finding all the same, though no single input is saved for it.
         let jvm_output = String::from_utf8_lossy(&output.stdout);
         let jni_warning = [&*jvm_output, &*log]
             .into_iter()
