@@ -48,10 +48,10 @@ fn bridge_library() -> PathBuf {
     panic!("libphantogram_android.so not found next to {}", exe.display());
 }
 
-/// The first misuse `-Xcheck:jni` reported, if any. It reports what it can go on from (a JNI call
-/// with an exception pending, one without the exception check it needs, more local references
-/// than the frame's capacity) as warnings on the JVM's standard **output**, not its error stream
-/// (this test looked only at the latter until 2026-12-03, so it could not fail).
+/// The first misuse `-Xcheck:jni` reported, if any. It reports what it can go on from (such as a
+/// JNI call made with an exception pending, checked to be caught here) as warnings on the JVM's
+/// standard **output**, not its error stream (this test looked only at the latter until
+/// 2026-12-03, so it could not fail).
 fn jni_misuse<'a>(stdout: &'a str, stderr: &'a str) -> Option<&'a str> {
     stdout
         .lines()
