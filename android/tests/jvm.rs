@@ -12,6 +12,9 @@ use std::path::{Path, PathBuf};
 use std::process::Command;
 
 use phantogram::engine::{Engine, EngineConfig};
+
+#[path = "support/jdk.rs"]
+mod jdk;
 use phantogram::sensors::{SensorEvent, SensorKind};
 
 const WIDTH: u32 = 108;
@@ -22,17 +25,8 @@ fn workspace() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-fn java_home() -> Option<PathBuf> {
-    std::env::var_os("JAVA_HOME")
-        .map(PathBuf::from)
-        .into_iter()
-        .chain([PathBuf::from("/usr/lib/jvm/java-17-openjdk-amd64")])
-        .find(|home| home.join("bin/javac").is_file())
-}
-
-fn tool(home: &Option<PathBuf>, name: &str) -> PathBuf {
-    home.as_ref()
-        .map_or_else(|| PathBuf::from(name), |h| h.join("bin").join(name))
+fn tool(home: &Path, name: &str) -> PathBuf {
+    home.join("bin").join(name)
 }
 
 /// The host build of the bridge: the cdylib cargo built for this test run.
@@ -69,17 +63,10 @@ fn skip(reason: &str) -> bool {
 
 /// Compiles `NativeBridge.java` (the app's own) and the driver `android/tests/java/NAME.java`
 /// into a fresh folder `PREFIX-<pid>` in the temporary folder, returned.
-fn compile_driver(home: &Option<PathBuf>, name: &str, prefix: &str) -> PathBuf {
+fn compile_driver(home: &Path, name: &str, prefix: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("{prefix}-{}", std::process::id()));
     std::fs::create_dir_all(&dir).expect("temp folder");
-    let status = Command::new(tool(home, "javac"))
-        .arg("-d")
-        .arg(&dir)
-        .arg(workspace().join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
-        .arg(workspace().join(format!("android/tests/java/{name}.java")))
-        .status()
-        .expect("running javac");
-    assert!(status.success(), "javac failed");
+    jdk::compile_driver(&workspace(), home, name, &dir);
     dir
 }
 
@@ -132,11 +119,10 @@ fn reference_frame(events: &[SensorEvent]) -> Option<Vec<u8>> {
 
 #[test]
 fn jni_bridge_replays_a_log_on_the_desktop_jvm() {
-    let home = java_home();
-    if home.is_none() && Command::new("javac").arg("-version").output().is_err() {
+    let Some(home) = jdk::java_homes().next() else {
         skip("no JDK found");
         return;
-    }
+    };
     let log = workspace().join("assets/logs/tilt-sweep.pglog");
     let events = log_events(&log);
     assert!(events.len() > 1000, "the default log has motion events");
@@ -268,11 +254,10 @@ fn java_accessibility_constants_are_the_cores() {
 /// libFuzzer's (`RandomCalls.fuzz`): the calls run until the bytes are used up, and end.
 #[test]
 fn random_jni_call_sequences_end_only_in_documented_exceptions() {
-    let home = java_home();
-    if home.is_none() && Command::new("javac").arg("-version").output().is_err() {
+    let Some(home) = jdk::java_homes().next() else {
         skip("no JDK found");
         return;
-    }
+    };
     if let Err(e) = Engine::new(EngineConfig::default()) {
         skip(&format!("no GPU engine ({e})"));
         return;

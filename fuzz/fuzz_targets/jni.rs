@@ -20,8 +20,7 @@
 #![no_main]
 
 use std::ffi::c_void;
-use std::path::{Path, PathBuf};
-use std::process::Command;
+use std::path::Path;
 use std::sync::OnceLock;
 
 use jni::objects::{JClass, JObjectArray, JString, JValue};
@@ -32,29 +31,12 @@ use jni::{InitArgsBuilder, JNIVersion, JavaVM, NativeMethod, jni_sig, jni_str};
 use libfuzzer_sys::fuzz_target;
 use phantogram_android::jni_bridge::*;
 
+#[path = "../../android/tests/support/jdk.rs"]
+mod jdk;
 #[path = "physics_panics.rs"]
 mod physics_panics;
 #[path = "scratch.rs"]
 mod scratch;
-
-/// The JDK: `$JAVA_HOME`, Debian's OpenJDK 17, or the home of the `javac` on the PATH.
-fn java_home() -> PathBuf {
-    let on_path = || {
-        let out = Command::new("sh")
-            .args(["-c", "readlink -f \"$(command -v javac)\""])
-            .output()
-            .ok()?;
-        let javac = PathBuf::from(String::from_utf8_lossy(&out.stdout).trim());
-        Some(javac.parent()?.parent()?.to_path_buf())
-    };
-    std::env::var_os("JAVA_HOME")
-        .map(PathBuf::from)
-        .into_iter()
-        .chain([PathBuf::from("/usr/lib/jvm/java-17-openjdk-amd64")])
-        .chain(on_path())
-        .find(|home| home.join("bin/javac").is_file() && home.join("lib/server/libjvm.so").is_file())
-        .expect("no JDK found: set JAVA_HOME")
-}
 
 /// The bridge's native methods, by name: `RegisterNatives` binds them to the class's declarations.
 fn native_functions() -> Vec<(&'static str, *mut c_void)> {
@@ -99,19 +81,6 @@ fn native_functions() -> Vec<(&'static str, *mut c_void)> {
     ]
 }
 
-/// Compiles `NativeBridge.java` (the app's own) and the driver into `dir`.
-fn compile_driver(home: &Path, dir: &Path) {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
-    let status = Command::new(home.join("bin/javac"))
-        .arg("-d")
-        .arg(dir)
-        .arg(root.join("android/phantogram/src/main/java/org/phantogram/NativeBridge.java"))
-        .arg(root.join("android/tests/java/RandomCalls.java"))
-        .status()
-        .expect("running javac");
-    assert!(status.success(), "javac failed");
-}
-
 /// What every input drives: the JVM (the `JavaVM` singleton), the driver class, the live engine's
 /// handle and the folder imports go to.
 struct Driver {
@@ -124,12 +93,15 @@ fn driver() -> &'static Driver {
     static DRIVER: OnceLock<Driver> = OnceLock::new();
     DRIVER.get_or_init(|| {
         physics_panics::tolerate();
-        let home = java_home();
+        let home = jdk::java_homes()
+            .find(|home| home.join("lib/server/libjvm.so").is_file())
+            .expect("no JDK found: set JAVA_HOME");
         let scratch = scratch::dir("jni");
         let classes = scratch.join("classes");
         let library = scratch.join("library");
         std::fs::create_dir_all(&library).expect("library folder");
-        compile_driver(&home, &classes);
+        let workspace = Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+        jdk::compile_driver(&workspace, &home, "RandomCalls", &classes);
         let args = InitArgsBuilder::new()
             .version(JNIVersion::V1_8)
             .option(format!("-Djava.class.path={}", classes.display()))

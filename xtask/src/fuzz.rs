@@ -33,6 +33,9 @@ use anyhow::{Context, Result, bail};
 
 use crate::workspace_root;
 
+#[path = "../../android/tests/support/jdk.rs"]
+mod jdk;
+
 /// (name, the longest input it is given, the cargo feature it needs).
 const TARGETS: [(&str, usize, Option<&str>); 7] = [
     ("gltf", 1 << 20, None),
@@ -55,20 +58,6 @@ fn scratch_folder(target: &str) -> Result<PathBuf> {
     let tmp = std::env::temp_dir().join(name);
     std::fs::create_dir_all(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
     Ok(tmp)
-}
-
-/// Whether the jni target will find a JDK where it looks (`fuzz/fuzz_targets/jni.rs`:
-/// `$JAVA_HOME`, Debian's OpenJDK 17, the `javac` on the PATH).
-fn jdk_found() -> bool {
-    std::env::var_os("JAVA_HOME")
-        .map(PathBuf::from)
-        .into_iter()
-        .chain([PathBuf::from("/usr/lib/jvm/java-17-openjdk-amd64")])
-        .any(|home| home.join("bin/javac").is_file())
-        || Command::new("javac")
-            .arg("-version")
-            .output()
-            .is_ok_and(|o| o.status.success())
 }
 
 /// What one run did, from libFuzzer's final statistics.
@@ -106,10 +95,12 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             },
         }
     }
+    // Where the jni target looks for a JDK (it starts a JVM).
+    let jdk_found = jdk::java_homes().next().is_some();
     if chosen.is_empty() {
         chosen = TARGETS.to_vec();
         // All targets: the ones this machine can run (named, jni without a JDK is an error).
-        if !jdk_found() {
+        if !jdk_found {
             eprintln!("no JDK found (set JAVA_HOME): the jni target is left out");
             chosen.retain(|t| t.0 != "jni");
         }
@@ -118,8 +109,8 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
     if !version.is_ok_and(|o| o.status.success()) {
         bail!("cargo-fuzz is not installed: `cargo install cargo-fuzz --locked` (about a minute)");
     }
-    // The jni target starts a JVM; without a JDK it could only fail, which is not a finding.
-    if chosen.iter().any(|t| t.0 == "jni") && !jdk_found() {
+    // Without a JDK the jni target could only fail, which is not a finding.
+    if chosen.iter().any(|t| t.0 == "jni") && !jdk_found {
         bail!(
             "the jni target needs a JDK (javac and libjvm): set JAVA_HOME, or install one \
              (Debian: openjdk-17-jdk-headless)"
