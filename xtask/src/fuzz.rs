@@ -1,5 +1,5 @@
-//! `cargo xtask fuzz [TARGET…] [--seconds N] [--record]`: the cargo-fuzz targets in `fuzz/`, each
-//! seeded and run with the project's limits, and a table of what each run did.
+//! `cargo xtask fuzz [TARGET…] [--seconds N] [--runs N] [--record]`: the cargo-fuzz targets in
+//! `fuzz/`, each seeded and run with the project's limits, and a table of what each run did.
 //!
 //! * Targets: `gltf` (models and Voyager scenes), `import` (every sensor-log importer), `replay`
 //!   (a log through a session), `calibration`, `environment` (HDR/EXR through the guards) and
@@ -10,7 +10,9 @@
 //!   none is named.
 //! * Limits: resident memory 1 GiB (`-rss_limit_mb=1024`: an input that takes more is a
 //!   finding), 10 s per input (`-timeout=10`: an input that runs longer is a finding), each
-//!   target for `--seconds` (default 30).
+//!   target for `--seconds` (default 30), or until it has made `--runs` executions if that comes
+//!   first (issue 17's long runs: `--runs 10000000 --seconds 14400`, 10⁷ executions or 4 h). The
+//!   table gives the seconds the run took.
 //! * Seeds: small inputs written here (valid files and the hostile cases that were once bugs),
 //!   plus, when `PHANTOGRAM_DATA` is set, the shared models, recordings and environments,
 //!   copied into the corpus folder under `target/fuzz/corpus/TARGET` (never into the
@@ -73,6 +75,7 @@ struct Outcome {
 
 pub fn fuzz(args: &[&str]) -> Result<()> {
     let mut seconds = 30u64;
+    let mut runs: Option<u64> = None;
     let mut record = false;
     let mut chosen = Vec::new();
     let mut rest = args.iter();
@@ -84,6 +87,14 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
                     .and_then(|s| s.parse().ok())
                     .filter(|&s| s > 0)
                     .context("--seconds needs a whole number of seconds, at least 1")?;
+            }
+            "--runs" => {
+                runs = Some(
+                    rest.next()
+                        .and_then(|s| s.parse().ok())
+                        .filter(|&n| n > 0)
+                        .context("--runs needs a whole number of executions, at least 1")?,
+                );
             }
             "--record" => record = true,
             name => match TARGETS.iter().find(|t| t.0 == name) {
@@ -124,7 +135,13 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
         std::fs::create_dir_all(&corpus).with_context(|| format!("creating {}", corpus.display()))?;
         std::fs::create_dir_all(&artifacts).with_context(|| format!("creating {}", artifacts.display()))?;
         seed(target, &corpus, max_len)?;
-        println!("fuzzing {target} for {seconds} s (corpus {})", corpus.display());
+        match runs {
+            Some(n) => println!(
+                "fuzzing {target} for {n} executions or {seconds} s (corpus {})",
+                corpus.display()
+            ),
+            None => println!("fuzzing {target} for {seconds} s (corpus {})", corpus.display()),
+        }
         let mut command = Command::new("cargo");
         command.args(["fuzz", "run", "--sanitizer", "none", "--release"]);
         if let Some(feature) = feature {
@@ -141,6 +158,9 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .arg("-print_final_stats=1")
             .arg(format!("-artifact_prefix={}/", artifacts.display()))
             .current_dir(&root);
+        if let Some(runs) = runs {
+            command.arg(format!("-runs={runs}"));
+        }
         if target == "jni" {
             // The JVM in that process uses these signals itself (null checks, safepoints) and
             // reports its own crashes.
@@ -148,7 +168,9 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
         }
         let scratch = scratch_folder(target)?;
         command.env("PHANTOGRAM_FUZZ_SCRATCH", &scratch);
+        let started = std::time::Instant::now();
         let output = command.output();
+        let wall_s = started.elapsed().as_secs();
         let _ = std::fs::remove_dir_all(&scratch);
         let output = output.with_context(|| format!("running cargo fuzz for {target}"))?;
         let log = String::from_utf8_lossy(&output.stderr);
@@ -197,9 +219,24 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
         let Some(executions) = stat("number_of_executed_units") else {
             bail!("{target}: no statistics from libFuzzer (did it build?):\n{log}");
         };
+        // libFuzzer's own `Done N runs in S second(s)`; else the wall time, build included.
+        let took_s = log
+            .lines()
+            .rev()
+            .find_map(|l| {
+                l.strip_prefix("Done ")?
+                    .split(" runs in ")
+                    .nth(1)?
+                    .split(' ')
+                    .next()?
+                    .parse()
+                    .ok()
+            })
+            .unwrap_or(wall_s)
+            .max(1);
         outcomes.push(Outcome {
             target,
-            seconds,
+            seconds: took_s,
             executions,
             coverage: field("cov: ").unwrap_or(0),
             corpus: field("corp: ").unwrap_or(0),
