@@ -35,7 +35,15 @@ fn engine() -> *const PgEngine {
         .0
 }
 
+#[path = "heap_limit.rs"]
+mod heap_limit;
+
+/// Counts the Rust heap: one input may not grow it by more than 1 GiB (`heap_limit`).
+#[global_allocator]
+static ALLOCATOR: heap_limit::Counting = heap_limit::Counting;
+
 fuzz_target!(|data: &[u8]| {
+    heap_limit::input_begins();
     // SAFETY: the engine lives for the whole process.
     unsafe { random_calls::run(engine(), data) }
 });

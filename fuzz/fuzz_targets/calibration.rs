@@ -8,7 +8,15 @@ mod scratch;
 use libfuzzer_sys::fuzz_target;
 use phantogram_sensing::calibration::Calibration;
 
+#[path = "heap_limit.rs"]
+mod heap_limit;
+
+/// Counts the Rust heap: one input may not grow it by more than 1 GiB (`heap_limit`).
+#[global_allocator]
+static ALLOCATOR: heap_limit::Counting = heap_limit::Counting;
+
 fuzz_target!(|data: &[u8]| {
+    heap_limit::input_begins();
     if let Ok(text) = std::str::from_utf8(data)
         && let Ok(c) = Calibration::from_text(text)
     {

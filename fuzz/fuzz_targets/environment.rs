@@ -9,7 +9,15 @@ mod scratch;
 use libfuzzer_sys::fuzz_target;
 use phantogram_assets::ibl::Environment;
 
+#[path = "heap_limit.rs"]
+mod heap_limit;
+
+/// Counts the Rust heap: one input may not grow it by more than 1 GiB (`heap_limit`).
+#[global_allocator]
+static ALLOCATOR: heap_limit::Counting = heap_limit::Counting;
+
 fuzz_target!(|data: &[u8]| {
+    heap_limit::input_begins();
     let path = scratch::write(scratch::dir("environment"), "environment", data);
     if let Ok(env) = Environment::load(&path) {
         assert!(env.texels.iter().flatten().all(|c| c.is_finite() && *c >= 0.0));

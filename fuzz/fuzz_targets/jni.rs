@@ -178,7 +178,15 @@ fn driver() -> &'static Driver {
     })
 }
 
+#[path = "heap_limit.rs"]
+mod heap_limit;
+
+/// Counts the Rust heap: one input may not grow it by more than 1 GiB (`heap_limit`).
+#[global_allocator]
+static ALLOCATOR: heap_limit::Counting = heap_limit::Counting;
+
 fuzz_target!(|data: &[u8]| {
+    heap_limit::input_begins();
     let driver = driver();
     let vm = JavaVM::singleton().expect("the JVM");
     let outcome = vm.attach_current_thread(|env| -> jni::errors::Result<()> {

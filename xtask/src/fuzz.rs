@@ -8,8 +8,11 @@
 //!   `android/tests/java/RandomCalls.java` in a JVM inside the fuzzer's process; also needs a
 //!   JDK, and leaves `SIGSEGV`, `SIGBUS`, `SIGFPE` and `SIGILL` to the JVM). All of them when
 //!   none is named.
-//! * Limits: resident memory 1 GiB (`-rss_limit_mb=1024`: an input that takes more is a
-//!   finding), 10 s per input (`-timeout=10`: an input that runs longer is a finding), each
+//! * Limits: 1 GiB of Rust heap per input (counted by each target's allocator,
+//!   `fuzz/fuzz_targets/heap_limit.rs`: an input that grows the heap by more is a finding),
+//!   resident memory 2 GiB plus twice the corpus on disk as a backstop (`-rss_limit_mb`: the
+//!   process also holds libFuzzer's copy of the corpus, which grows during a run, and memory
+//!   that is not Rust heap, such as lavapipe's and the JVM's), 10 s per input (`-timeout=10`: an input that runs longer is a finding), each
 //!   target for `--seconds` (default 30), or until it has made `--runs` executions if that comes
 //!   first (issue 17's long runs: `--runs 10000000 --seconds 14400`, 10⁷ executions or 4 h). The
 //!   table gives the seconds the run took.
@@ -60,6 +63,19 @@ fn scratch_folder(target: &str) -> Result<PathBuf> {
     let tmp = std::env::temp_dir().join(name);
     std::fs::create_dir_all(&tmp).with_context(|| format!("creating {}", tmp.display()))?;
     Ok(tmp)
+}
+
+/// The size of the files directly in `dir`, MiB (rounded up).
+fn folder_mb(dir: &Path) -> u64 {
+    let bytes: u64 = std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .filter_map(|e| e.metadata().ok())
+        .filter(|m| m.is_file())
+        .map(|m| m.len())
+        .sum();
+    bytes.div_ceil(1 << 20)
 }
 
 /// What one run did, from libFuzzer's final statistics.
@@ -152,7 +168,7 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .arg(&corpus)
             .arg("--")
             .arg(format!("-max_total_time={seconds}"))
-            .arg("-rss_limit_mb=1024")
+            .arg(format!("-rss_limit_mb={}", 2048 + 2 * folder_mb(&corpus)))
             .arg("-timeout=10")
             .arg(format!("-max_len={max_len}"))
             .arg("-print_final_stats=1")
@@ -268,7 +284,7 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
         let text = format!(
             "# Fuzzing\n\nEach row is the newest `cargo xtask fuzz TARGET --seconds N --record` of its target \
              (`PHANTOGRAM_DATA` set for the seeds; the corpus under `target/fuzz` kept from earlier runs): \
-             stable Rust, no sanitizer, 1 GiB RSS limit, 10 s per input, on this project's shared 2-core \
+             stable Rust, no sanitizer, 1 GiB of heap per input, 10 s per input, on this project's shared 2-core \
              machine. Coverage is libFuzzer's `cov:` (edges reached); corpus, the inputs kept; findings, \
              the inputs that panicked, hung or ran out of memory (each fixed and kept as a regression \
              test).\n\n{TABLE_HEAD}{}{notes}",
