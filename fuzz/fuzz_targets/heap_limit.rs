@@ -12,8 +12,8 @@
 //! fuzz` keeps `-rss_limit_mb` as a backstop above the corpus (for memory that is not Rust heap:
 //! lavapipe's, the JVM's).
 //!
-//! Shared by the targets with `#[path]`; each declares `#[global_allocator] static ALLOCATOR:
-//! heap_limit::Counting = heap_limit::Counting;` and calls [`input_begins`] first thing.
+//! Shared by the targets with `#[path]`: including the module installs its allocator as the
+//! target's global one; each target calls [`input_begins`] first thing.
 //! Threads: the count is process-wide (atomics), so allocations on the engine's own threads
 //! during an input count towards it too.
 
@@ -42,7 +42,10 @@ pub fn input_begins() {
 }
 
 /// The system allocator, counting.
-pub struct Counting;
+struct Counting;
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
 
 impl Counting {
     fn grew(size: usize) {

@@ -10,12 +10,9 @@ mod scratch;
 use libfuzzer_sys::fuzz_target;
 use phantogram_lab::sensorlog::import::import;
 
+/// Counts the Rust heap (its own global allocator): one input may not grow it by more than 1 GiB.
 #[path = "heap_limit.rs"]
 mod heap_limit;
-
-/// Counts the Rust heap: one input may not grow it by more than 1 GiB (`heap_limit`).
-#[global_allocator]
-static ALLOCATOR: heap_limit::Counting = heap_limit::Counting;
 
 fuzz_target!(|data: &[u8]| {
     heap_limit::input_begins();

@@ -12,10 +12,10 @@
 //!   `fuzz/fuzz_targets/heap_limit.rs`: an input that grows the heap by more is a finding),
 //!   resident memory 2 GiB plus twice the corpus on disk as a backstop (`-rss_limit_mb`: the
 //!   process also holds libFuzzer's copy of the corpus, which grows during a run, and memory
-//!   that is not Rust heap, such as lavapipe's and the JVM's), 10 s per input (`-timeout=10`: an input that runs longer is a finding), each
-//!   target for `--seconds` (default 30), or until it has made `--runs` executions if that comes
-//!   first (issue 17's long runs: `--runs 10000000 --seconds 14400`, 10⁷ executions or 4 h). The
-//!   table gives the seconds the run took.
+//!   that is not Rust heap, such as lavapipe's and the JVM's), 10 s per input (`-timeout=10`: an
+//!   input that runs longer is a finding), each target for `--seconds` (default 30), or until it
+//!   has made `--runs` executions if that comes first (issue 17's long runs: `--runs 10000000
+//!   --seconds 14400`, 10⁷ executions or 4 h). The table gives the seconds the run took.
 //! * Seeds: small inputs written here (valid files and the hostile cases that were once bugs),
 //!   plus, when `PHANTOGRAM_DATA` is set, the shared models, recordings and environments,
 //!   copied into the corpus folder under `target/fuzz/corpus/TARGET` (never into the

@@ -35,8 +35,8 @@ use crate::tone::linear_from_srgb8;
 
 /// How far from what was seen a hole is filled from its neighbourhood, degrees; beyond, from the
 /// band seen nearest to it on its side of the horizon ([`RoomCapture::environment`]). A few
-/// texels of the map's default 1.4°, and well under the 60–70° a phone camera sees at once: the gaps between
-/// overlapping frames are filled locally, a region no frame has looked at is not.
+/// texels of the map's default 1.4°, and well under the 60–70° a phone camera sees at once: the
+/// gaps between overlapping frames are filled locally, a region no frame has looked at is not.
 pub const LOCAL_FILL_DEG: f32 = 11.25;
 
 /// How the room map is kept.
