@@ -1,23 +1,31 @@
-//! Switching artifacts a hundred times through the engine leaves resident memory flat.
+//! Switching artifacts a hundred times through the engine leaks neither memory nor GPU memory.
 //!
-//! A test binary of its own: resident memory is the process's, so nothing else may run beside
-//! it (the other engine tests are in `tests/tests/integration`).
+//! A test binary of its own: it counts the whole process's memory, so nothing else may run
+//! beside it (the other engine tests are in `tests/tests/integration`).
 //!
-//! What is compared: the *lowest* footprint seen over switches 20–39 against the lowest over
+//! What is compared: the *lowest* of each figure over switches 20–39 against the lowest over
 //! switches 80–99, each window showing every artifact five times and sampled after every frame.
-//! One sample is not enough: within one artifact the heap swings by 15–35 MiB from frame to frame
-//! (the frame-budget controller changes the level of detail, impostors come and go), so which
-//! state the last frame happened to be in decided the old single-sample test — CI failed it at
-//! +32 MiB at the 100th switch with nothing leaked, where this machine measured ±5 MiB. A leak
-//! raises every sample, the lowest included; a swing raises only some.
+//! A leak raises every sample, the lowest included; a swing raises only some.
 //!
-//! Two figures, two bounds. The live heap (what the allocator has handed out and not had back)
-//! is the sharp one: the same to 0.1 MiB in every run here, so 4 MiB is a leak of 70 KiB per
-//! switch. Resident memory also sees what bypasses the allocator, but keeps what fragmentation
-//! pins: with Mesa's sixteen rendering threads (`LP_NUM_THREADS=16`, as on a larger CI machine)
-//! one run in twenty here kept 20 MiB more at the end with the live heap unchanged, so its bound
-//! is 32 MiB, half a model per switch.
+//! Three figures, three bounds:
+//! * **Rust heap** (counted by this binary's global allocator, [`Counting`]): every model, scene
+//!   and frame the engine makes on the CPU. Exact and the same from frame to frame (2.6 MiB after
+//!   every frame here), so its bound is sharp: 2 MiB over 60 switches, 35 KiB a switch.
+//! * **GPU memory** in use by wgpu's live buffers and textures (its allocator's report; on
+//!   lavapipe that memory is malloc'd by Mesa): the same to a few KiB for each artifact, so 1 MiB.
+//! * **Resident memory**, a backstop for what neither counts (a C library's own heap, memory a
+//!   driver maps itself). It is not sharp: it holds what Mesa's software driver keeps for
+//!   itself, which steps by ~21 MiB and stays up or down for dozens of switches depending on the
+//!   machine's load, and what fragmentation pins. A loaded CI run failed the previous version of
+//!   this test, which bounded glibc's in-use heap at 4 MiB: +21.2 MiB between the windows. That
+//!   step is Mesa's, not a leak of ours: reproduced here with busy loops beside the test, the
+//!   tetrahedron's frames sat at 88 MiB of glibc heap where they sit at 109 MiB unloaded, with
+//!   the Rust heap and the GPU memory the same to 0.01 MiB. Six runs here (three beside three busy loops, three with Mesa's sixteen
+//!   rendering threads as on a larger machine): +3 to +26 MiB. Its bound is 48 MiB, below a
+//!   leaked model a switch (60+ MiB).
 
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
 use phantogram::engine::{Engine, EngineConfig};
@@ -32,6 +40,55 @@ const SWITCHES: usize = 100;
 const FRAMES_PER_SWITCH: usize = 3;
 const EARLY: std::ops::Range<usize> = 20..40;
 const LATE: std::ops::Range<usize> = 80..100;
+const MAX_RUST_HEAP_GROWTH_MIB: f64 = 2.0;
+const MAX_GPU_GROWTH_MIB: f64 = 1.0;
+const MAX_RESIDENT_GROWTH_MIB: f64 = 48.0;
+
+/// The system allocator, counting the bytes it has handed out and not had back.
+struct Counting;
+
+static RUST_HEAP_BYTES: AtomicU64 = AtomicU64::new(0);
+
+#[global_allocator]
+static ALLOCATOR: Counting = Counting;
+
+// SAFETY: every call is forwarded unchanged to `System`, which upholds GlobalAlloc's contract;
+// the counting only adds atomic arithmetic (it neither allocates nor panics).
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: the caller's layout, as GlobalAlloc::alloc requires.
+        let p = unsafe { System.alloc(layout) };
+        if !p.is_null() {
+            RUST_HEAP_BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
+        // SAFETY: as alloc.
+        let p = unsafe { System.alloc_zeroed(layout) };
+        if !p.is_null() {
+            RUST_HEAP_BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
+        }
+        p
+    }
+
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: `ptr` was allocated by this allocator (so by System) with `layout`.
+        unsafe { System.dealloc(ptr, layout) };
+        RUST_HEAP_BYTES.fetch_sub(layout.size() as u64, Ordering::Relaxed);
+    }
+
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        // SAFETY: `ptr` was allocated by this allocator with `layout`, as realloc requires.
+        let p = unsafe { System.realloc(ptr, layout, new_size) };
+        if !p.is_null() {
+            RUST_HEAP_BYTES.fetch_add(new_size as u64, Ordering::Relaxed);
+            RUST_HEAP_BYTES.fetch_sub(layout.size() as u64, Ordering::Relaxed);
+        }
+        p
+    }
+}
 
 fn engine(library: &Scratch) -> Option<Engine> {
     phantogram_integration::engine_or_skip(EngineConfig {
@@ -43,19 +100,24 @@ fn engine(library: &Scratch) -> Option<Engine> {
 /// One sample of the process's memory, bytes.
 #[derive(Clone, Copy, Debug)]
 struct Footprint {
+    rust_heap: u64,
+    /// `None` where the backend's allocator gives no report.
+    gpu: Option<u64>,
     /// Resident memory after glibc has handed its free pages back (see [`trim_allocator`]).
     resident: u64,
-    /// Bytes the C allocator has handed out and not had back: Rust's heap and Mesa's (lavapipe
-    /// keeps GPU memory there). Free of the allocator's retention and fragmentation, so a heap
-    /// leak shows in it sharply; `None` off glibc.
-    live_heap: Option<u64>,
 }
 
-fn footprint() -> Option<Footprint> {
+fn footprint(e: &Engine) -> Option<Footprint> {
     trim_allocator();
     Some(Footprint {
+        rust_heap: RUST_HEAP_BYTES.load(Ordering::Relaxed),
+        gpu: e
+            .renderer()
+            .gpu()
+            .device
+            .generate_allocator_report()
+            .map(|r| r.total_allocated_bytes),
         resident: phantogram_testkit::resident_bytes()?,
-        live_heap: live_heap_bytes(),
     })
 }
 
@@ -81,43 +143,6 @@ fn trim_allocator() {
 #[cfg(not(all(target_os = "linux", target_env = "gnu")))]
 fn trim_allocator() {}
 
-/// glibc's in-use bytes over all arenas (`uordblks`) plus its directly mapped blocks (`hblkhd`).
-///
-/// Through `mallinfo`, not `mallinfo2`: the latter is glibc 2.33+ and would keep this test from
-/// linking on older distributions; `mallinfo`'s `int` fields hold up to 2 GiB, ten times what
-/// this test allocates (a figure beyond that would wrap, and fail the test loudly).
-#[cfg(all(target_os = "linux", target_env = "gnu"))]
-fn live_heap_bytes() -> Option<u64> {
-    /// glibc's `struct mallinfo` (malloc.h): ten `int`s.
-    #[repr(C)]
-    struct MallInfo {
-        arena: i32,
-        ordblks: i32,
-        smblks: i32,
-        hblks: i32,
-        hblkhd: i32,
-        usmblks: i32,
-        fsmblks: i32,
-        uordblks: i32,
-        fordblks: i32,
-        keepcost: i32,
-    }
-    unsafe extern "C" {
-        fn mallinfo() -> MallInfo;
-    }
-    // SAFETY: mallinfo takes nothing and returns a plain struct by value (its layout above is
-    // malloc.h's); it reads the arenas under their locks.
-    let info = unsafe { mallinfo() };
-    let in_use = u64::try_from(info.uordblks).ok()?;
-    let mapped = u64::try_from(info.hblkhd).ok()?;
-    Some(in_use + mapped)
-}
-
-#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
-fn live_heap_bytes() -> Option<u64> {
-    None
-}
-
 fn mib(bytes: u64) -> f64 {
     bytes as f64 / f64::from(1 << 20)
 }
@@ -136,7 +161,7 @@ fn lowest(
 }
 
 #[test]
-fn a_hundred_switches_leave_resident_memory_flat() {
+fn a_hundred_switches_leak_neither_memory_nor_gpu_memory() {
     let dir = Scratch::new("engine-switches");
     let Some(mut e) = engine(&dir) else { return };
     e.resume_offscreen(W, H).unwrap();
@@ -161,39 +186,39 @@ fn a_hundred_switches_leave_resident_memory_flat() {
         }
         for _ in 0..FRAMES_PER_SWITCH {
             drawn_frame(&mut e);
-            let Some(f) = footprint() else {
-                eprintln!("no /proc/self/statm: resident memory not measured");
+            let Some(f) = footprint(&e) else {
+                eprintln!("no /proc/self/statm: memory not measured");
                 return;
             };
             samples.push((i, f));
         }
     }
-    let growth_mib = |field: fn(&Footprint) -> Option<u64>| -> Option<(f64, f64, f64)> {
-        let early = lowest(&samples, &EARLY, field)?;
-        let late = lowest(&samples, &LATE, field)?;
-        Some((mib(early), mib(late), mib(late) - mib(early)))
+    // Early, late and growth of one figure, MiB; `None` where it was never measured.
+    let growth = |name: &str, field: fn(&Footprint) -> Option<u64>| -> Option<f64> {
+        let early = mib(lowest(&samples, &EARLY, field)?);
+        let late = mib(lowest(&samples, &LATE, field)?);
+        eprintln!("lowest {name} over switches {EARLY:?}: {early:.2} MiB, over {LATE:?}: {late:.2} MiB");
+        Some(late - early)
     };
-    let Some((early, late, resident_growth)) = growth_mib(|f| Some(f.resident)) else {
-        panic!("no samples in the windows");
-    };
-    eprintln!("lowest resident over switches {EARLY:?}: {early:.1} MiB, over {LATE:?}: {late:.1} MiB");
-    let heap = growth_mib(|f| f.live_heap);
-    if let Some((early, late, _)) = heap {
-        eprintln!("lowest live heap: {early:.1} MiB, then {late:.1} MiB");
-    }
-    // Each switch allocates a model of 1 to 5 MiB on the loader thread: a leaked model per switch
-    // is 60+ MiB over the 60 switches between the windows, a sixteenth of the smallest 4+ MiB.
-    // Measured here (2026-12-03, 25 runs with 2, 4 and 16 Mesa threads): live heap the same to
-    // 0.1 MiB; resident within 5 MiB, once +20 MiB (see the module's docs). A leak of 100 KiB
-    // per switch injected into Engine::install fails it: live heap +5.9 MiB (resident +6.2).
+    let rust_heap = growth("Rust heap", |f| Some(f.rust_heap)).expect("samples in both windows");
+    let gpu = growth("GPU memory", |f| f.gpu);
+    let resident = growth("resident memory", |f| Some(f.resident)).expect("samples in both windows");
+    // Each switch allocates a model of 1 to 5 MiB: a leaked model per switch is 60+ MiB over
+    // the 60 switches between the windows. A leak of 100 KiB a switch injected into
+    // Engine::install fails the Rust heap's bound (+5.9 MiB); a 100 KiB buffer a switch kept
+    // alive there fails the GPU memory's.
     assert!(
-        resident_growth < 32.0,
-        "resident memory grew {resident_growth:.1} MiB over 60 switches ({early:.1} → {late:.1})"
+        rust_heap < MAX_RUST_HEAP_GROWTH_MIB,
+        "the Rust heap grew {rust_heap:.2} MiB over 60 switches"
     );
-    if let Some((early, late, heap_growth)) = heap {
+    if let Some(gpu) = gpu {
         assert!(
-            heap_growth < 4.0,
-            "the live heap grew {heap_growth:.1} MiB over 60 switches ({early:.1} → {late:.1})"
+            gpu < MAX_GPU_GROWTH_MIB,
+            "GPU memory grew {gpu:.2} MiB over 60 switches"
         );
     }
+    assert!(
+        resident < MAX_RESIDENT_GROWTH_MIB,
+        "resident memory grew {resident:.1} MiB over 60 switches"
+    );
 }
