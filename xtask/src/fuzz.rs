@@ -1,4 +1,4 @@
-//! `cargo xtask fuzz [TARGET…] [--seconds N] [--runs N] [--record]`: the cargo-fuzz targets in
+//! `cargo xtask fuzz [TARGET…] [--seconds N] [--runs N] [--workers N] [--record]`: the cargo-fuzz targets in
 //! `fuzz/`, each seeded and run with the project's limits, and a table of what each run did.
 //!
 //! * Targets: `gltf` (models and Voyager scenes), `import` (every sensor-log importer), `replay`
@@ -16,6 +16,12 @@
 //!   input that runs longer is a finding), each target for `--seconds` (default 30), or until it
 //!   has made `--runs` executions if that comes first (issue 17's long runs: `--runs 10000000
 //!   --seconds 14400`, 10⁷ executions or 4 h). The table gives the seconds the run took.
+//! * `--workers N` (default 1): N fuzzing processes at once, in libFuzzer's fork mode
+//!   (`-fork=N`): a parent hands each worker a sample of the corpus for up to 300 s at a time,
+//!   merges what it found and counts the executions of all of them; a timeout, an out-of-memory or
+//!   a crash in any worker stops the run as a finding (`-ignore_timeouts=0 -ignore_ooms=0`: fork
+//!   mode's defaults would go on). Each worker holds only its sample of the corpus, not all of it.
+//!   Peak memory is not reported in this mode (the workers' logs go with their temporary folder).
 //! * Seeds: small inputs written here (valid files and the hostile cases that were once bugs),
 //!   plus, when `PHANTOGRAM_DATA` is set, the shared models, recordings and environments,
 //!   copied into the corpus folder under `target/fuzz/corpus/TARGET` (never into the
@@ -65,6 +71,17 @@ fn scratch_folder(target: &str) -> Result<PathBuf> {
     Ok(tmp)
 }
 
+/// The files directly in `dir` (none if it cannot be read).
+fn folder_files(dir: &Path) -> Vec<PathBuf> {
+    std::fs::read_dir(dir)
+        .into_iter()
+        .flatten()
+        .flatten()
+        .map(|e| e.path())
+        .filter(|p| p.is_file())
+        .collect()
+}
+
 /// The size of the files directly in `dir`, MiB (rounded up).
 fn folder_mb(dir: &Path) -> u64 {
     let bytes: u64 = std::fs::read_dir(dir)
@@ -85,13 +102,15 @@ struct Outcome {
     executions: u64,
     coverage: u64,
     corpus: u64,
-    peak_rss_mb: u64,
+    /// `None` in fork mode (`--workers` above 1), whose parent does not report it.
+    peak_rss_mb: Option<u64>,
     finding: Option<String>,
 }
 
 pub fn fuzz(args: &[&str]) -> Result<()> {
     let mut seconds = 30u64;
     let mut runs: Option<u64> = None;
+    let mut workers = 1u32;
     let mut record = false;
     let mut chosen = Vec::new();
     let mut rest = args.iter();
@@ -111,6 +130,13 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
                         .filter(|&n| n > 0)
                         .context("--runs needs a whole number of executions, at least 1")?,
                 );
+            }
+            "--workers" => {
+                workers = rest
+                    .next()
+                    .and_then(|s| s.parse().ok())
+                    .filter(|&n| n > 0)
+                    .context("--workers needs a whole number of processes, at least 1")?;
             }
             "--record" => record = true,
             name => match TARGETS.iter().find(|t| t.0 == name) {
@@ -177,11 +203,20 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
         if let Some(runs) = runs {
             command.arg(format!("-runs={runs}"));
         }
+        if workers > 1 {
+            command.args([
+                &format!("-fork={workers}"),
+                "-ignore_timeouts=0",
+                "-ignore_ooms=0",
+                "-ignore_crashes=0",
+            ]);
+        }
         if target == "jni" {
             // The JVM in that process uses these signals itself (null checks, safepoints) and
             // reports its own crashes.
             command.args(["-handle_segv=0", "-handle_bus=0", "-handle_fpe=0", "-handle_ill=0"]);
         }
+        let run_began = std::time::SystemTime::now();
         let scratch = scratch_folder(target)?;
         command.env("PHANTOGRAM_FUZZ_SCRATCH", &scratch);
         let started = std::time::Instant::now();
@@ -216,6 +251,18 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .into_iter()
             .flat_map(str::lines)
             .find(|l| l.contains("WARNING in native method") || l.contains("WARNING: JNI local refs"));
+        // Every input libFuzzer saved is a finding, whatever the exit status: fork mode's parent
+        // drops an input of the corpus that crashes while it merges the corpus (saving it) and
+        // goes on.
+        // (By time, not name: an input saved by an earlier run is saved again under its name.)
+        let saved: Vec<PathBuf> = folder_files(&artifacts)
+            .into_iter()
+            .filter(|p| {
+                std::fs::metadata(p)
+                    .and_then(|m| m.modified())
+                    .is_ok_and(|t| t >= run_began)
+            })
+            .collect();
         let finding = if !output.status.success() {
             Some(
                 log.lines()
@@ -224,6 +271,8 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
                     .trim()
                     .to_owned(),
             )
+        } else if let Some(first) = saved.first() {
+            Some(format!("{} input(s) saved, e.g. {}", saved.len(), first.display()))
         } else {
             jni_warning.map(|l| format!("-Xcheck:jni: {}", l.trim()))
         };
@@ -232,31 +281,23 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             eprintln!("{jvm_output}{log}");
             eprintln!("{target}: FINDING: {f}");
         }
-        let Some(executions) = stat("number_of_executed_units") else {
+        let executions = if workers > 1 {
+            fork_executions(&log)
+        } else {
+            stat("number_of_executed_units")
+        };
+        let Some(executions) = executions else {
             bail!("{target}: no statistics from libFuzzer (did it build?):\n{log}");
         };
-        // libFuzzer's own `Done N runs in S second(s)`; else the wall time, build included.
-        let took_s = log
-            .lines()
-            .rev()
-            .find_map(|l| {
-                l.strip_prefix("Done ")?
-                    .split(" runs in ")
-                    .nth(1)?
-                    .split(' ')
-                    .next()?
-                    .parse()
-                    .ok()
-            })
-            .unwrap_or(wall_s)
-            .max(1);
+        // libFuzzer's own count of seconds; else the wall time, build included.
+        let took_s = libfuzzer_seconds(&log).unwrap_or(wall_s).max(1);
         outcomes.push(Outcome {
             target,
             seconds: took_s,
             executions,
             coverage: field("cov: ").unwrap_or(0),
             corpus: field("corp: ").unwrap_or(0),
-            peak_rss_mb: stat("peak_rss_mb").unwrap_or(0),
+            peak_rss_mb: if workers > 1 { None } else { stat("peak_rss_mb") },
             finding,
         });
     }
@@ -282,12 +323,13 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .map(|l| format!("{l}\n"))
             .collect();
         let text = format!(
-            "# Fuzzing\n\nEach row is the newest `cargo xtask fuzz TARGET --seconds N --record` of its target \
-             (`PHANTOGRAM_DATA` set for the seeds; the corpus under `target/fuzz` kept from earlier runs): \
-             stable Rust, no sanitizer, 1 GiB of heap per input, 10 s per input, on this project's shared 2-core \
-             machine. Coverage is libFuzzer's `cov:` (edges reached); corpus, the inputs kept; findings, \
-             the inputs that panicked, hung or ran out of memory (each fixed and kept as a regression \
-             test).\n\n{TABLE_HEAD}{}{notes}",
+            "# Fuzzing\n\nEach row is the newest `cargo xtask fuzz TARGET --seconds N [--runs N] \
+             [--workers N] --record` of its target (`PHANTOGRAM_DATA` set for the seeds; the corpus \
+             under `target/fuzz` kept from earlier runs): stable Rust, no sanitizer, 1 GiB of heap per \
+             input, 10 s per input, on this project's shared 2-core machine (peak RSS `-`: a run with \
+             `--workers`, libFuzzer's fork mode, which does not report it). Coverage is libFuzzer's \
+             `cov:` (edges reached); corpus, the inputs kept; findings, the inputs that panicked, hung \
+             or ran out of memory (each fixed and kept as a regression test).\n\n{TABLE_HEAD}{}{notes}",
             kept.concat()
         );
         std::fs::write(&path, text).with_context(|| format!("writing {}", path.display()))?;
@@ -302,6 +344,26 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
         bail!("findings in: {} (inputs under target/fuzz/artifacts)", found.join(", "));
     }
     Ok(())
+}
+
+/// The executions of all workers in fork mode, whose parent prints no final statistics: the last
+/// of its progress lines `#N: cov: C ft: F corp: K exec/s: … time: Ts …`.
+fn fork_executions(log: &str) -> Option<u64> {
+    log.lines()
+        .rev()
+        .find_map(|l| l.strip_prefix('#')?.split(": cov: ").next()?.parse().ok())
+}
+
+/// The seconds libFuzzer says the run took: `Done N runs in S second(s)`, or in fork mode
+/// `INFO: exiting: CODE time: Ss`.
+fn libfuzzer_seconds(log: &str) -> Option<u64> {
+    log.lines().rev().find_map(|l| {
+        let after = match l.strip_prefix("Done ") {
+            Some(done) => done.split(" runs in ").nth(1)?,
+            None => l.strip_prefix("INFO: exiting: ")?.split(" time: ").nth(1)?,
+        };
+        after.split(|c: char| !c.is_ascii_digit()).next()?.parse().ok()
+    })
 }
 
 const TABLE_HEAD: &str = "| target | date | seconds | executions | exec/s | coverage (edges) | corpus | peak RSS (MB) | findings |\n|---|---|---:|---:|---:|---:|---:|---:|---|\n";
@@ -321,7 +383,7 @@ fn row(o: &Outcome) -> String {
         o.executions / o.seconds.max(1),
         o.coverage,
         o.corpus,
-        o.peak_rss_mb,
+        o.peak_rss_mb.map_or("-".to_owned(), |mb| mb.to_string()),
         o.finding.as_deref().unwrap_or("0")
     )
 }
@@ -518,4 +580,30 @@ fn glb(json: &[u8], bin: &[u8]) -> Vec<u8> {
     out.extend(b"BIN\0");
     out.extend(&bin);
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_single_process_run_is_read_from_its_final_lines() {
+        // As libFuzzer 0.4.13 prints them (the per-unit progress lines have no ": cov:").
+        let log = "#4096\tpulse  cov: 1811 ft: 9000 corp: 2003/40Mb exec/s: 1474 rss: 65Mb\n\
+                   Done 10000000 runs in 6784 second(s)\n\
+                   stat::number_of_executed_units: 10000000\n";
+        assert_eq!(libfuzzer_seconds(log), Some(6784));
+        assert_eq!(fork_executions(log), None);
+    }
+
+    #[test]
+    fn a_fork_mode_run_counts_every_workers_executions() {
+        let log = "INFO: -fork=2: 1360 seed inputs, starting to fuzz in /tmp/x\n\
+                   #1491: cov: 2425 ft: 7014 corp: 1367 exec/s: 745 oom/timeout/crash: 0/0/0 time: 26s job: 1 dft_time: 0\n\
+                   #27756: cov: 3086 ft: 9100 corp: 1749 exec/s: 816 oom/timeout/crash: 0/0/0 time: 33s job: 4 dft_time: 0\n\
+                   INFO: fuzzed for 33 seconds, wrapping up soon\n\
+                   INFO: exiting: 0 time: 34s\n";
+        assert_eq!(fork_executions(log), Some(27756));
+        assert_eq!(libfuzzer_seconds(log), Some(34));
+    }
 }
