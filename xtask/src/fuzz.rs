@@ -107,6 +107,14 @@ struct Outcome {
     finding: Option<String>,
 }
 
+/// A flag's value: a whole number, at least 1, of `what`.
+fn count<T: std::str::FromStr + PartialOrd + From<u8>>(value: Option<&&str>, flag: &str, what: &str) -> Result<T> {
+    value
+        .and_then(|s| s.parse().ok())
+        .filter(|n| *n >= T::from(1))
+        .with_context(|| format!("{flag} needs a whole number of {what}, at least 1"))
+}
+
 pub fn fuzz(args: &[&str]) -> Result<()> {
     let mut seconds = 30u64;
     let mut runs: Option<u64> = None;
@@ -116,28 +124,9 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
     let mut rest = args.iter();
     while let Some(&arg) = rest.next() {
         match arg {
-            "--seconds" => {
-                seconds = rest
-                    .next()
-                    .and_then(|s| s.parse().ok())
-                    .filter(|&s| s > 0)
-                    .context("--seconds needs a whole number of seconds, at least 1")?;
-            }
-            "--runs" => {
-                runs = Some(
-                    rest.next()
-                        .and_then(|s| s.parse().ok())
-                        .filter(|&n| n > 0)
-                        .context("--runs needs a whole number of executions, at least 1")?,
-                );
-            }
-            "--workers" => {
-                workers = rest
-                    .next()
-                    .and_then(|s| s.parse().ok())
-                    .filter(|&n| n > 0)
-                    .context("--workers needs a whole number of processes, at least 1")?;
-            }
+            "--seconds" => seconds = count(rest.next(), "--seconds", "seconds")?,
+            "--runs" => runs = Some(count(rest.next(), "--runs", "executions")?),
+            "--workers" => workers = count(rest.next(), "--workers", "processes")?,
             "--record" => record = true,
             name => match TARGETS.iter().find(|t| t.0 == name) {
                 Some(t) => chosen.push(*t),
