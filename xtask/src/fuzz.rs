@@ -1,5 +1,6 @@
-//! `cargo xtask fuzz [TARGET…] [--seconds N] [--runs N] [--workers N] [--record]`: the cargo-fuzz targets in
-//! `fuzz/`, each seeded and run with the project's limits, and a table of what each run did.
+//! `cargo xtask fuzz [TARGET…] [--seconds N] [--runs N] [--workers N] [--record]`: the
+//! cargo-fuzz targets in `fuzz/`, each seeded and run with the project's limits, and a table of
+//! what each run did.
 //!
 //! * Targets: `gltf` (models and Voyager scenes), `import` (every sensor-log importer), `replay`
 //!   (a log through a session), `calibration`, `environment` (HDR/EXR through the guards) and
@@ -242,8 +243,8 @@ pub fn fuzz(args: &[&str]) -> Result<()> {
             .find(|l| l.contains("WARNING in native method") || l.contains("WARNING: JNI local refs"));
         // Every input libFuzzer saved is a finding, whatever the exit status: fork mode's parent
         // drops an input of the corpus that crashes while it merges the corpus (saving it) and
-        // goes on.
-        // (By time, not name: an input saved by an earlier run is saved again under its name.)
+        // goes on. Told by time, not name: an input an earlier run saved is saved again under the
+        // same name.
         let saved: Vec<PathBuf> = folder_files(&artifacts)
             .into_iter()
             .filter(|p| {
