@@ -8,7 +8,7 @@
 //! A leak raises every sample, the lowest included; a swing raises only some.
 //!
 //! Three figures, three bounds:
-//! * **Rust heap** (counted by this binary's global allocator, [`Counting`]): every model, scene
+//! * **Rust heap** (counted by this binary's global allocator, `phantogram_testkit::heap`): every model, scene
 //!   and frame the engine makes on the CPU. Exact and the same from frame to frame (2.6 MiB after
 //!   every frame here), so its bound is sharp: 2 MiB over 60 switches, 35 KiB a switch.
 //! * **GPU memory** in use by wgpu's live buffers and textures (its allocator's report; on
@@ -24,13 +24,12 @@
 //!   rendering threads as on a larger machine): +3 to +26 MiB. Its bound is 48 MiB, below a
 //!   leaked model a switch (60+ MiB).
 
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Duration;
 
 use phantogram::engine::{Engine, EngineConfig};
 use phantogram::library::ArtifactId;
 use phantogram_integration::drawn_frame;
+use phantogram_testkit::heap::CountingAllocator;
 use phantogram_testkit::{Scratch, tetrahedron_glb};
 
 const W: u32 = 180;
@@ -44,51 +43,9 @@ const MAX_RUST_HEAP_GROWTH_MIB: f64 = 2.0;
 const MAX_GPU_GROWTH_MIB: f64 = 1.0;
 const MAX_RESIDENT_GROWTH_MIB: f64 = 48.0;
 
-/// The system allocator, counting the bytes it has handed out and not had back.
-struct Counting;
-
-static RUST_HEAP_BYTES: AtomicU64 = AtomicU64::new(0);
-
+/// Every allocation of this binary counted (`phantogram_testkit::heap`).
 #[global_allocator]
-static ALLOCATOR: Counting = Counting;
-
-// SAFETY: every call is forwarded unchanged to `System`, which upholds GlobalAlloc's contract;
-// the counting only adds atomic arithmetic (it neither allocates nor panics).
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: the caller's layout, as GlobalAlloc::alloc requires.
-        let p = unsafe { System.alloc(layout) };
-        if !p.is_null() {
-            RUST_HEAP_BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
-        }
-        p
-    }
-
-    unsafe fn alloc_zeroed(&self, layout: Layout) -> *mut u8 {
-        // SAFETY: as alloc.
-        let p = unsafe { System.alloc_zeroed(layout) };
-        if !p.is_null() {
-            RUST_HEAP_BYTES.fetch_add(layout.size() as u64, Ordering::Relaxed);
-        }
-        p
-    }
-
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        // SAFETY: `ptr` was allocated by this allocator (so by System) with `layout`.
-        unsafe { System.dealloc(ptr, layout) };
-        RUST_HEAP_BYTES.fetch_sub(layout.size() as u64, Ordering::Relaxed);
-    }
-
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        // SAFETY: `ptr` was allocated by this allocator with `layout`, as realloc requires.
-        let p = unsafe { System.realloc(ptr, layout, new_size) };
-        if !p.is_null() {
-            RUST_HEAP_BYTES.fetch_add(new_size as u64, Ordering::Relaxed);
-            RUST_HEAP_BYTES.fetch_sub(layout.size() as u64, Ordering::Relaxed);
-        }
-        p
-    }
-}
+static ALLOCATOR: CountingAllocator = CountingAllocator;
 
 fn engine(library: &Scratch) -> Option<Engine> {
     phantogram_integration::engine_or_skip(EngineConfig {
@@ -110,7 +67,7 @@ struct Footprint {
 fn footprint(e: &Engine) -> Option<Footprint> {
     trim_allocator();
     Some(Footprint {
-        rust_heap: RUST_HEAP_BYTES.load(Ordering::Relaxed),
+        rust_heap: phantogram_testkit::heap::live_bytes() as u64,
         gpu: e
             .renderer()
             .gpu()

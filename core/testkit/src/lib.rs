@@ -1,4 +1,5 @@
-//! Scratch folders, a small valid GLB and the process's resident memory for tests: the crates' unit tests, the CLI tests and the workspace's
+//! Scratch folders, a small valid GLB, the process's resident memory and a counting allocator
+//! ([`heap`]) for tests: the crates' unit tests, the CLI tests and the workspace's
 //! integration tests share this one piece, as a dev-dependency only: no library writes temporary
 //! files.
 //!
@@ -7,6 +8,8 @@
 //! says where, a passing one leaves nothing in the temporary folder.
 
 use std::path::{Path, PathBuf};
+
+pub mod heap;
 
 pub struct Scratch(PathBuf);
 
