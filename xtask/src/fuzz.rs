@@ -85,12 +85,9 @@ fn folder_files(dir: &Path) -> Vec<PathBuf> {
 
 /// The size of the files directly in `dir`, MiB (rounded up).
 fn folder_mb(dir: &Path) -> u64 {
-    let bytes: u64 = std::fs::read_dir(dir)
-        .into_iter()
-        .flatten()
-        .flatten()
-        .filter_map(|e| e.metadata().ok())
-        .filter(|m| m.is_file())
+    let bytes: u64 = folder_files(dir)
+        .iter()
+        .filter_map(|p| std::fs::metadata(p).ok())
         .map(|m| m.len())
         .sum();
     bytes.div_ceil(1 << 20)
