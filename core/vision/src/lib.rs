@@ -8,8 +8,11 @@
 //! is calibrated, from the IPD with the pinhole model (more precise: ±1 mm over 63 mm instead of
 //! ±0.5 over 11.7).
 //!
-//! **Tracking**: after a detection, the next frame's face crop comes from the previous frame's
-//! landmarks; the detector runs again only when FaceMesh's face flag says the face is lost.
+//! **Tracking**: the frame that finds a face runs BlazeFace and FaceMesh only; the next frame runs
+//! the irises in the crops those landmarks place (moved as the eyes' patches moved), and gives
+//! the first eyes — so no frame runs all four networks ([`FaceTracker`]). After that, the next
+//! frame's face crop comes from the previous frame's landmarks; the detector runs again only when
+//! FaceMesh's face flag says the face is lost.
 //! The networks run on one tracked frame in [`NETWORK_EVERY`]; between, each eye is followed by
 //! aligning its grey patch from the last network frame ([`eye_patch`]: no network, about a
 //! fifth of a millisecond for both), and the landmarks move with the eyes.
@@ -504,6 +507,14 @@ pub struct FaceFound {
     pub lenses: Option<glasses::Lenses>,
 }
 
+/// FaceMesh's answer for one face: its 468 landmarks (pixels of the upright image) and its
+/// confidence (the face flag, or the lower of it and the detector's score).
+#[derive(Clone, Debug, PartialEq)]
+struct Mesh {
+    landmarks: Vec<Vec2>,
+    confidence: f32,
+}
+
 /// One face-detector hit: box and the six keypoints, pixels.
 #[derive(Clone, Debug, PartialEq)]
 struct Detection {
@@ -726,11 +737,30 @@ impl FaceModels {
         roi: &Roi,
         eyes_hint: Option<[Vec2; 2]>,
     ) -> Result<Option<FaceFound>, FaceError> {
+        match self.mesh_in(image, roi, eyes_hint)? {
+            Some(mesh) => self.eyes_in(image, mesh),
+            None => Ok(None),
+        }
+    }
+
+    /// FaceMesh for the face in `roi` (its crop's tint undone where glasses are seen around
+    /// `eyes_hint`): the landmarks and the face flag, or `None` if not a face.
+    fn mesh_in(
+        &self,
+        image: &UprightImage,
+        roi: &Roi,
+        eyes_hint: Option<[Vec2; 2]>,
+    ) -> Result<Option<Mesh>, FaceError> {
         let hinted = eyes_hint.and_then(|[l, r]| glasses::find_at(image, l, r));
-        let Some((landmarks, flag)) = self.mesh(image, roi, hinted.as_ref())? else {
-            return Ok(None);
-        };
-        let Some([la, lb, ra, rb]) = eye_corners(&landmarks) else {
+        Ok(self
+            .mesh(image, roi, hinted.as_ref())?
+            .map(|(landmarks, confidence)| Mesh { landmarks, confidence }))
+    }
+
+    /// The irises in the crops that `mesh`'s eye corners place in `image` (glasses looked for
+    /// there first): the face, or `None` unless both are found.
+    fn eyes_in(&self, image: &UprightImage, mesh: Mesh) -> Result<Option<FaceFound>, FaceError> {
+        let Some([la, lb, ra, rb]) = eye_corners(&mesh.landmarks) else {
             return Ok(None);
         };
         // Glasses, looked for around the eyes' corners' midpoints (the irises are not known yet).
@@ -743,20 +773,29 @@ impl FaceModels {
             left_eye_px,
             right_eye_px,
             iris_diameter_px: 0.5 * (dl + dr),
-            confidence: flag,
-            landmarks,
+            confidence: mesh.confidence,
+            landmarks: mesh.landmarks,
             lenses,
         }))
     }
 
-    /// The face a detection leads to, its confidence the lower of detector score and face flag.
-    fn face_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<FaceFound>, FaceError> {
+    /// FaceMesh for the face a detection leads to, its confidence the lower of detector score
+    /// and face flag.
+    fn mesh_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<Mesh>, FaceError> {
         let [a, b] = [d.keypoints[0], d.keypoints[1]];
         let eyes = if a.x <= b.x { [a, b] } else { [b, a] };
-        Ok(self.face_in(image, &roi_from_detection(d), Some(eyes))?.map(|mut f| {
-            f.confidence = f.confidence.min(d.score);
-            f
+        Ok(self.mesh_in(image, &roi_from_detection(d), Some(eyes))?.map(|mut m| {
+            m.confidence = m.confidence.min(d.score);
+            m
         }))
+    }
+
+    /// The face a detection leads to (FaceMesh, then the irises).
+    fn face_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<FaceFound>, FaceError> {
+        match self.mesh_from_detection(image, d)? {
+            Some(mesh) => self.eyes_in(image, mesh),
+            None => Ok(None),
+        }
     }
 
     /// Every face in a still image (detection on every call; no tracking).
@@ -977,11 +1016,15 @@ impl FaceFound {
 /// (2.9 ms on a quiet one, where 4 would also do).
 pub const NETWORK_EVERY: u32 = 5;
 
-/// What the last tracked frame ran to find the eyes.
+/// What the last frame ran to find the eyes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum TrackedBy {
-    /// BlazeFace, then FaceMesh and the irises (detection mode).
+    /// BlazeFace, then FaceMesh on the face it found (detection mode). The irises run on the
+    /// next frame ([`TrackedBy::Irises`]), so this frame reports no eyes.
     Detector,
+    /// The frame after a detection: the irises in the crops that the detection's FaceMesh
+    /// landmarks place, giving the first eyes of the track.
+    Irises,
     /// FaceMesh in the last face's region, then the irises.
     FaceMesh,
     /// No network: each eye's patch aligned ([`eye_patch`]).
@@ -996,6 +1039,14 @@ pub enum TrackingMode {
 }
 
 /// Detect, then track: the stateful per-camera tracker.
+///
+/// The frame that finds a face (BlazeFace, then FaceMesh) reports **no eyes**: its irises run on
+/// the next frame, in the crops its landmarks place. So no one frame runs all four networks,
+/// and the frame that finds a face costs about half of what it would (`benchmarks/face.md`); the
+/// first eyes of a track come one camera frame later (33 ms at 30 frames/s). A face that moves
+/// by a few pixels between the two frames stays well inside the iris crops (2.3 eye widths
+/// across). Run the same frame twice after [`FaceTracker::reset`] for the eyes of one still
+/// image (the second run gives exactly what the four networks on that image give).
 pub struct FaceTracker {
     models: Arc<FaceModels>,
     pub pose: CameraPose,
@@ -1004,6 +1055,9 @@ pub struct FaceTracker {
     /// The last frame's face (its landmarks place this frame's crop, its eyes say where glasses
     /// are looked for before FaceMesh runs).
     last_found: Option<FaceFound>,
+    /// FaceMesh's face on a frame that ran the detector, and its eyes' patches: this frame's
+    /// irises are looked for in the crops its eye corners place, moved as the patches moved.
+    detected: Option<Detected>,
     /// Each eye's patch (image left, image right) from the last frame that ran the networks, and
     /// how many frames in a row they have followed the eyes since.
     eye_patches: Option<[eye_patch::EyePatch; 2]>,
@@ -1022,6 +1076,7 @@ impl FaceTracker {
             pose,
             ipd_m: None,
             last_found: None,
+            detected: None,
             eye_patches: None,
             patch_frames: 0,
             eye_motion_px: Vec2::ZERO,
@@ -1043,16 +1098,25 @@ impl FaceTracker {
     /// Forgets the tracked face: the next frame runs the detector.
     pub fn reset(&mut self) {
         self.last_found = None;
+        self.detected = None;
         self.eye_patches = None;
         self.patch_frames = 0;
         self.eye_motion_px = Vec2::ZERO;
     }
 
-    /// Finds the viewer's eyes in `frame` (the most confident face if several).
+    /// Finds the viewer's eyes in `frame` (the most confident face if several). The frame that
+    /// finds a face reports none: its eyes come with the next frame (see [`FaceTracker`]).
     pub fn process(&mut self, frame: CameraFrame) -> Result<FaceObservation, FaceError> {
         let image = UprightImage::new(frame)?;
         let mut found = None;
-        if let Some(last) = &self.last_found {
+        if let Some(detected) = self.detected.take() {
+            // The frame after a detection: its irises only. If they are not found, this frame
+            // has no eyes and the next one detects again (never all four networks on one frame).
+            self.last_mode = TrackingMode::Tracking;
+            self.last_step = TrackedBy::Irises;
+            self.patch_frames = 0;
+            found = self.models.eyes_in(&image, detected.moved_to(&image))?;
+        } else if let Some(last) = &self.last_found {
             self.last_mode = TrackingMode::Tracking;
             // The networks on one tracked frame in NETWORK_EVERY; the eyes' patches between, as
             // long as they match and move together.
@@ -1073,14 +1137,11 @@ impl FaceTracker {
                     .models
                     .face_in(&image, &roi_from_landmarks(&landmarks), Some(eyes))?;
             }
-        }
-        if found.is_none() {
-            self.last_mode = TrackingMode::Detecting;
-            self.last_step = TrackedBy::Detector;
-            self.patch_frames = 0;
-            if let Some(d) = self.models.detect(&image)?.first() {
-                found = self.models.face_from_detection(&image, d)?;
+            if found.is_none() {
+                self.detect(&image)?;
             }
+        } else {
+            self.detect(&image)?;
         }
         // A frame that ran the networks gives the patches the next frames follow.
         if self.last_step != TrackedBy::EyePatches {
@@ -1114,6 +1175,64 @@ impl FaceTracker {
             eyes_m,
             glasses,
         })
+    }
+
+    /// BlazeFace over the whole frame, then FaceMesh on the most confident face: kept for the
+    /// next frame's irises.
+    fn detect(&mut self, image: &UprightImage) -> Result<(), FaceError> {
+        self.last_mode = TrackingMode::Detecting;
+        self.last_step = TrackedBy::Detector;
+        self.patch_frames = 0;
+        self.detected = match self.models.detect(image)?.first() {
+            Some(d) => self
+                .models
+                .mesh_from_detection(image, d)?
+                .map(|mesh| Detected::new(image, mesh)),
+            None => None,
+        };
+        Ok(())
+    }
+}
+
+/// A face found by the detector (and FaceMesh) on one frame, whose irises run on the next.
+struct Detected {
+    mesh: Mesh,
+    /// Each eye's patch (image left, image right) around its corners' midpoint, to see how far
+    /// the face moved by the next frame: the iris network's answer depends on where its crop
+    /// sits, so the crops are placed where the eyes are then, not where they were (on the
+    /// hand-held test a face moving 7–10 pixels a frame put the first eyes up to 4 % of the eye
+    /// distance off without this).
+    patches: Option<[eye_patch::EyePatch; 2]>,
+}
+
+impl Detected {
+    fn new(image: &UprightImage, mesh: Mesh) -> Self {
+        let patches = eye_corners(&mesh.landmarks).and_then(|[la, lb, ra, rb]| {
+            let left = eye_patch::EyePatch::take(image, (la + lb) * 0.5, la.distance(lb))?;
+            let right = eye_patch::EyePatch::take(image, (ra + rb) * 0.5, ra.distance(rb))?;
+            Some([left, right])
+        });
+        Self { mesh, patches }
+    }
+
+    /// The face's landmarks moved on to `image` as both eyes' patches moved (together: by more
+    /// than 5 % of the eye distance apart is not a face moving, and leaves them where they were).
+    fn moved_to(self, image: &UprightImage) -> Mesh {
+        let Self { mut mesh, patches } = self;
+        let moved = patches
+            .zip(eye_corners(&mesh.landmarks))
+            .and_then(|([pl, pr], [la, lb, ra, rb])| {
+                let (l, r) = ((la + lb) * 0.5, (ra + rb) * 0.5);
+                let (ml, mr) = (pl.find(image, l)?.0 - l, pr.find(image, r)?.0 - r);
+                let apart = l.distance(r);
+                (ml.distance(mr) <= 0.05 * apart).then_some((ml + mr) * 0.5)
+            });
+        if let Some(m) = moved.filter(|m| m.is_finite()) {
+            for p in &mut mesh.landmarks {
+                *p += m;
+            }
+        }
+        mesh
     }
 }
 
