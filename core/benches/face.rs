@@ -88,7 +88,11 @@ fn main() {
         assert_eq!(tracker.last_step(), TrackedBy::Detector);
         assert!(!eyes, "the frame that finds the face reports no eyes");
         let (eyes_ms, eyes) = run(&mut tracker, k + 1);
-        assert_eq!(tracker.last_step(), TrackedBy::Irises);
+        assert_eq!(
+            tracker.last_step(),
+            TrackedBy::Irises,
+            "frame {k}: the eyes patches were refused"
+        );
         assert!(eyes, "the face must be found for the figure to mean anything");
         if k >= 3 {
             detection.push(found_ms);

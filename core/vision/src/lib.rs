@@ -1023,7 +1023,10 @@ pub enum TrackedBy {
     /// next frame ([`TrackedBy::Irises`]), so this frame reports no eyes.
     Detector,
     /// The frame after a detection: the irises in the crops that the detection's FaceMesh
-    /// landmarks place, giving the first eyes of the track.
+    /// landmarks place (moved as the eyes' patches moved), giving the first eyes of the track.
+    /// When the patches are not found again there (the face moved further than they reach, or
+    /// frames were dropped between), that frame runs FaceMesh and the irises instead
+    /// ([`TrackedBy::FaceMesh`]), whose face flag says whether the face is still there.
     Irises,
     /// FaceMesh in the last face's region, then the irises.
     FaceMesh,
@@ -1113,9 +1116,20 @@ impl FaceTracker {
             // The frame after a detection: its irises only. If they are not found, this frame
             // has no eyes and the next one detects again (never all four networks on one frame).
             self.last_mode = TrackingMode::Tracking;
-            self.last_step = TrackedBy::Irises;
             self.patch_frames = 0;
-            found = self.models.eyes_in(&image, detected.moved_to(&image))?;
+            found = match detected.moved_to(&image) {
+                Ok(mesh) => {
+                    self.last_step = TrackedBy::Irises;
+                    self.models.eyes_in(&image, mesh)?
+                }
+                // The eyes were not found again by their patches (the face moved too far, or
+                // frames were dropped in between): FaceMesh checks that a face is still there.
+                Err(mesh) => {
+                    self.last_step = TrackedBy::FaceMesh;
+                    self.models
+                        .face_in(&image, &roi_from_landmarks(&mesh.landmarks), None)?
+                }
+            };
         } else if let Some(last) = &self.last_found {
             self.last_mode = TrackingMode::Tracking;
             // The networks on one tracked frame in NETWORK_EVERY; the eyes' patches between, as
@@ -1215,24 +1229,41 @@ impl Detected {
         Self { mesh, patches }
     }
 
-    /// The face's landmarks moved on to `image` as both eyes' patches moved (together: by more
-    /// than 5 % of the eye distance apart is not a face moving, and leaves them where they were).
-    fn moved_to(self, image: &UprightImage) -> Mesh {
+    /// The face's landmarks moved on to `image` as both eyes' patches moved, or, as they were
+    /// (`Err`), when the patches are not found again or the two moved apart by more than 5 % of
+    /// the eye distance (not a face moving).
+    ///
+    /// With no motion known yet to start from, each search starts where the eyes were and, if
+    /// refused there, from points around it a quarter of the eye width apart, out to half an eye
+    /// width (an alignment settles only from near the patch's place: from the one start, a face
+    /// moving 7 pixels a frame with eyes 19 pixels wide was refused one frame in four).
+    fn moved_to(self, image: &UprightImage) -> Result<Mesh, Mesh> {
         let Self { mut mesh, patches } = self;
         let moved = patches
             .zip(eye_corners(&mesh.landmarks))
             .and_then(|([pl, pr], [la, lb, ra, rb])| {
                 let (l, r) = ((la + lb) * 0.5, (ra + rb) * 0.5);
-                let (ml, mr) = (pl.find(image, l)?.0 - l, pr.find(image, r)?.0 - r);
+                let step = 0.125 * (la.distance(lb) + ra.distance(rb));
                 let apart = l.distance(r);
-                (ml.distance(mr) <= 0.05 * apart).then_some((ml + mr) * 0.5)
+                let mut starts: Vec<Vec2> = (-2..=2)
+                    .flat_map(|i| (-2..=2).map(move |j| Vec2::new(i as f32, j as f32)))
+                    .collect();
+                starts.sort_by(|a, b| a.length_squared().total_cmp(&b.length_squared()));
+                starts.into_iter().find_map(|d| {
+                    let from = d * step;
+                    let (ml, mr) = (pl.find(image, l + from)?.0 - l, pr.find(image, r + from)?.0 - r);
+                    (ml.distance(mr) <= 0.05 * apart).then_some((ml + mr) * 0.5)
+                })
             });
-        if let Some(m) = moved.filter(|m| m.is_finite()) {
-            for p in &mut mesh.landmarks {
-                *p += m;
+        match moved.filter(|m| m.is_finite()) {
+            Some(m) => {
+                for p in &mut mesh.landmarks {
+                    *p += m;
+                }
+                Ok(mesh)
             }
+            None => Err(mesh),
         }
-        mesh
     }
 }
 

@@ -363,6 +363,49 @@ fn a_moving_face_is_followed_by_its_eyes_patches_between_network_frames() {
     assert_eq!(steps, want, "what each frame ran");
 }
 
+/// The frame after a detection runs the irises where that detection's landmarks, moved with the
+/// eyes' patches, put them; a face that jumped further than the patches reach (a dropped frame,
+/// a quick turn) is not looked for there but found by FaceMesh, and its eyes are still right.
+/// (40 px here, a sixth of the face; FaceMesh, like the tracked frames' FaceMesh, finds it up to
+/// about 50 px and misplaces it at 70.) 12 px, over half an eye's width, is still followed by the
+/// patches (searched from several starts: from where the eyes were only, they are refused).
+#[test]
+fn a_face_that_jumps_after_its_detection_is_found_again_by_facemesh() {
+    let Some((models, dir)) = setup() else { return };
+    let img = rgba(&dir.join("astronaut.png"));
+    let small = image::imageops::resize(&img, 480, 480, image::imageops::FilterType::Triangle);
+    let at = |x: i64| {
+        let mut canvas = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
+        image::imageops::overlay(&mut canvas, &small, x, 0);
+        canvas
+    };
+    let mut fresh = FaceTracker::new(models.clone(), CameraPose::front(Vec3::ZERO));
+    for (jump_px, step) in [
+        (4, TrackedBy::Irises),
+        (12, TrackedBy::Irises),
+        (40, TrackedBy::FaceMesh),
+    ] {
+        let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(Vec3::ZERO));
+        let (first, second) = (at(60), at(60 + jump_px));
+        let k_px = default_intrinsics(&first);
+        assert_eq!(tracker.process(frame(&first, k_px)).unwrap().eyes_m, None);
+        let eyes = tracker.process(frame(&second, k_px)).unwrap().eyes_m;
+        assert_eq!(tracker.last_step(), step, "a jump of {jump_px} px");
+        let want = fresh_eyes(&mut fresh, frame(&second, k_px)).eyes_m.expect("the face");
+        let got = eyes.unwrap_or_else(|| panic!("a jump of {jump_px} px: no eyes"));
+        let ipd = want[0].distance(want[1]);
+        for i in 0..2 {
+            let (p, q) = (got[i] / got[i].z, want[i] / want[i].z);
+            assert!(
+                p.distance(q) * want[i].z < 0.03 * ipd,
+                "a jump of {jump_px} px, eye {i}: {} vs {}",
+                got[i],
+                want[i]
+            );
+        }
+    }
+}
+
 /// A hand-held face: `face` turned by `roll_rad` in the image, scaled by `scale` and moved so its
 /// centre lands at `centre` of a 640 × 480 grey frame, and the map from the face image's pixels to
 /// the frame's.
