@@ -74,6 +74,22 @@ fn fresh_eyes(tracker: &mut FaceTracker, f: CameraFrame) -> FaceObservation {
     tracker.process(f).expect("a valid frame")
 }
 
+/// The tracked eyes `got` within 3 % of the eye distance of `want` (a fresh detection's), compared
+/// across the image: the distance along the axis differs by the iris size's noise, the same for
+/// both.
+fn assert_same_eyes(got: [Vec3; 2], want: [Vec3; 2], what: &str) {
+    let ipd = want[0].distance(want[1]);
+    for i in 0..2 {
+        let (p, q) = (got[i] / got[i].z, want[i] / want[i].z);
+        assert!(
+            p.distance(q) * want[i].z < 0.03 * ipd,
+            "{what}, eye {i}: tracked {} vs detected {}",
+            got[i],
+            want[i]
+        );
+    }
+}
+
 /// `(file, [(left, top, width, height)])` from dlib's imglab XML, for the files present.
 fn labelled_boxes(dir: &Path) -> Vec<(PathBuf, Vec<[f32; 4]>)> {
     let mut out = Vec::new();
@@ -336,18 +352,7 @@ fn a_moving_face_is_followed_by_its_eyes_patches_between_network_frames() {
         let (Some(a), Some(b)) = (tracked.eyes_m, detected.eyes_m) else {
             panic!("frame {k}: the face was lost");
         };
-        let ipd = b[0].distance(b[1]);
-        for i in 0..2 {
-            // Compared across the image (the distance along the axis differs by the iris size's
-            // noise, the same for both).
-            let (p, q) = (a[i] / a[i].z, b[i] / b[i].z);
-            assert!(
-                p.distance(q) * b[i].z < 0.03 * ipd,
-                "frame {k}, eye {i}: tracked {} vs detected {}",
-                a[i],
-                b[i]
-            );
-        }
+        assert_same_eyes(a, b, &format!("frame {k}"));
     }
     // 12 frames: one detection, its irises on the next frame, then every NETWORK_EVERY-th frame
     // from there runs the networks (the irises' frame counts as the first).
@@ -393,16 +398,7 @@ fn a_face_that_jumps_after_its_detection_is_found_again_by_facemesh() {
         assert_eq!(tracker.last_step(), step, "a jump of {jump_px} px");
         let want = fresh_eyes(&mut fresh, frame(&second, k_px)).eyes_m.expect("the face");
         let got = eyes.unwrap_or_else(|| panic!("a jump of {jump_px} px: no eyes"));
-        let ipd = want[0].distance(want[1]);
-        for i in 0..2 {
-            let (p, q) = (got[i] / got[i].z, want[i] / want[i].z);
-            assert!(
-                p.distance(q) * want[i].z < 0.03 * ipd,
-                "a jump of {jump_px} px, eye {i}: {} vs {}",
-                got[i],
-                want[i]
-            );
-        }
+        assert_same_eyes(got, want, &format!("a jump of {jump_px} px"));
     }
 }
 
