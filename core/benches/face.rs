@@ -91,7 +91,7 @@ fn main() {
         assert_eq!(
             tracker.last_step(),
             TrackedBy::Irises,
-            "frame {k}: the eyes patches were refused"
+            "frame {k}: the eyes' patches were refused"
         );
         assert!(eyes, "the face must be found for the figure to mean anything");
         if k >= 3 {

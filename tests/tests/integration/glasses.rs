@@ -62,7 +62,8 @@ struct Outcome {
     glasses_right: bool,
 }
 
-/// Draws four styles over each face of `img` (clean faces `clean`) and compares.
+/// Draws four styles over each face of `img` (clean faces `clean`; `img` is the photo enlarged
+/// `enlarged` times) and compares.
 fn try_styles(
     models: &FaceModels,
     case: &str,
