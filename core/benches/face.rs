@@ -2,10 +2,10 @@
 //! 640×480 camera frame, one thread, measured in the same run: detection mode (the frame that
 //! finds the face: BlazeFace + FaceMesh; median of 30), the frame after it that gives the first
 //! eyes (2 × Iris; median of 30; the two together are the whole cost of finding a face) and
-//! tracking mode (FaceMesh + 2 × Iris on one frame in `NETWORK_EVERY`, the eyes' patches between;
-//! the mean over 60 frames, whole cycles of the schedule, as that is what the tracker takes from
-//! the cores; also the worst frame and the median of each kind). The face sways across the frame
-//! by up to 7 pixels a frame.
+//! tracking mode (once in `NETWORK_EVERY` frames FaceMesh on one and 2 × Iris on the next, the
+//! eyes' patches between; the mean over 60 frames, whole cycles of the schedule, as that is what
+//! the tracker takes from the cores; also the worst frame and the median of each kind). The face
+//! sways across the frame by up to 7 pixels a frame.
 //!
 //! Needs the models (`cargo xtask models`; `PHANTOGRAM_MODELS` or the default cache) and a face
 //! photograph: `$PHANTOGRAM_DATA/faces/astronaut.png`, letterboxed into 640×480. Skipped with a
@@ -131,7 +131,7 @@ fn main() {
         .map(|(step, v)| format!("{step} {} × {:.2} ms", v.len(), median_ms(v)))
         .collect();
     println!(
-        "tracking mode by frame (median): {} (the networks on one tracked frame in {NETWORK_EVERY})",
+        "tracking mode by frame (median): {} (the networks once in {NETWORK_EVERY} tracked frames, over two of them)",
         kinds.join(", ")
     );
     println!("tracking / detection = {:.2}", mean / detection);

@@ -13,9 +13,10 @@
 //! the first eyes — so no frame runs all four networks ([`FaceTracker`]). After that, the next
 //! frame's face crop comes from the previous frame's landmarks; the detector runs again only when
 //! FaceMesh's face flag says the face is lost.
-//! The networks run on one tracked frame in [`NETWORK_EVERY`]; between, each eye is followed by
-//! aligning its grey patch from the last network frame ([`eye_patch`]: no network, about a
-//! fifth of a millisecond for both), and the landmarks move with the eyes.
+//! The networks run once in [`NETWORK_EVERY`] tracked frames, FaceMesh on one and the irises on
+//! the next; between, each eye is followed by aligning its grey patch from the last irises
+//! ([`eye_patch`]: no network, about a fifth of a millisecond for both), and the landmarks move
+//! with the eyes.
 //!
 //! **Glasses** ([`glasses`]): on colour frames (RGBA, or luma with its chroma planes) the skin
 //! under each eye's lens is compared with the cheek's to name the filters of anaglyph glasses.
@@ -1005,12 +1006,14 @@ impl FaceFound {
     }
 }
 
-/// While tracking, the networks (FaceMesh in the last face's region, then both irises) run on
-/// one frame in this many; between, each eye's image patch follows it ([`eye_patch`]: no
-/// network). At 30 frames/s the networks still place the face and measure each eye six times a
-/// second; a patch that no longer matches (a blink, a turn of the head, a hand) or eyes that
-/// move apart run them at once. The networks are nearly all of a tracked frame's cost, so this
-/// sets the tracker's mean cost. Every value from 1 (networks on every frame) to 6 gave the same
+/// While tracking, the networks (FaceMesh in the last face's region, then both irises) run once
+/// in this many frames, spread over two of them: FaceMesh on the first ([`TrackedBy::Landmarks`],
+/// the eyes still followed by their patches), the irises on the next ([`TrackedBy::Irises`]), so
+/// that no frame runs more than two networks; on the other frames each eye's image patch follows
+/// it ([`eye_patch`]: no network). At 30 frames/s the networks still place the face and measure
+/// each eye six times a second; a patch that no longer matches (a blink, a turn of the head, a
+/// hand) or eyes that move apart run FaceMesh and the irises at once. The networks are nearly
+/// all of a tracked frame's cost, so this sets the tracker's mean cost. Every value from 1 (networks on every frame) to 6 gave the same
 /// accuracy on the hand-held test (`benchmarks/face.md`, 2026-12-03); 5 was chosen as the
 /// smallest that brought the mean cost to about 4 ms a frame on a busy run of the bench here
 /// (2.9 ms on a quiet one, where 4 would also do).
@@ -1022,14 +1025,19 @@ pub enum TrackedBy {
     /// BlazeFace, then FaceMesh on the face it found (detection mode). The irises run on the
     /// next frame ([`TrackedBy::Irises`]), so this frame reports no eyes.
     Detector,
-    /// The frame after a detection: the irises in the crops that the detection's FaceMesh
-    /// landmarks place (moved as the eyes' patches moved), giving the first eyes of the track.
+    /// The frame after a detection or a [`TrackedBy::Landmarks`] frame: the irises in the crops
+    /// that its FaceMesh landmarks place (moved as the eyes' patches moved), giving the first
+    /// eyes of a track or the eyes' regular measurement.
     /// When the patches are not found again there (the face moved further than they reach, or
     /// frames were dropped between), that frame runs FaceMesh and the irises instead
     /// ([`TrackedBy::FaceMesh`]), whose face flag says whether the face is still there.
     Irises,
-    /// FaceMesh in the last face's region, then the irises.
+    /// FaceMesh in the last face's region, then the irises: when the eyes' patches lost them.
     FaceMesh,
+    /// The scheduled network frame ([`NETWORK_EVERY`]), first half: FaceMesh in the last face's
+    /// region for fresh landmarks, the eyes still followed by their patches; the irises run on
+    /// the next frame ([`TrackedBy::Irises`]).
+    Landmarks,
     /// No network: each eye's patch aligned ([`eye_patch`]).
     EyePatches,
 }
@@ -1132,19 +1140,39 @@ impl FaceTracker {
             };
         } else if let Some(last) = &self.last_found {
             self.last_mode = TrackingMode::Tracking;
-            // The networks on one tracked frame in NETWORK_EVERY; the eyes' patches between, as
-            // long as they match and move together.
-            if self.patch_frames + 1 < NETWORK_EVERY {
-                found = (self.eye_patches.as_ref()).and_then(|p| follow_patches(&image, last, p, self.eye_motion_px));
-            }
-            if found.is_some() {
+            // The eyes' patches on every frame, as long as they match and move together; once
+            // in NETWORK_EVERY frames the networks, spread over two: FaceMesh here (the eyes
+            // still by their patches), the irises on the next frame, as after a detection.
+            let ahead = |p: Vec2| p + self.eye_motion_px;
+            let followed =
+                (self.eye_patches.as_ref()).and_then(|p| follow_patches(&image, last, p, self.eye_motion_px));
+            if let Some(f) = followed {
                 self.patch_frames += 1;
-                self.last_step = TrackedBy::EyePatches;
+                if self.patch_frames + 1 < NETWORK_EVERY {
+                    self.last_step = TrackedBy::EyePatches;
+                    found = Some(f);
+                } else {
+                    self.last_step = TrackedBy::Landmarks;
+                    let landmarks: Vec<Vec2> = last.landmarks.iter().copied().map(ahead).collect();
+                    let eyes = [f.left_eye_px, f.right_eye_px];
+                    if let Some(mesh) = self
+                        .models
+                        .mesh_in(&image, &roi_from_landmarks(&landmarks), Some(eyes))?
+                    {
+                        found = Some(FaceFound {
+                            landmarks: mesh.landmarks.clone(),
+                            confidence: mesh.confidence,
+                            ..f
+                        });
+                        self.detected = Some(Detected::new(&image, mesh));
+                    }
+                }
             } else {
+                // The patches lost the eyes (a blink, a turn, a hand): FaceMesh and the irises
+                // at once, in the crop where the face is expected (last frame's, moved on as it
+                // was moving).
                 self.patch_frames = 0;
                 self.last_step = TrackedBy::FaceMesh;
-                // The crop where the face is expected: last frame's, moved on as it was moving.
-                let ahead = |p: Vec2| p + self.eye_motion_px;
                 let landmarks: Vec<Vec2> = last.landmarks.iter().copied().map(ahead).collect();
                 let eyes = [ahead(last.left_eye_px), ahead(last.right_eye_px)];
                 found = self
@@ -1157,8 +1185,8 @@ impl FaceTracker {
         } else {
             self.detect(&image)?;
         }
-        // A frame that ran the networks gives the patches the next frames follow.
-        if self.last_step != TrackedBy::EyePatches {
+        // A frame whose eyes came from the irises gives the patches the next frames follow.
+        if !matches!(self.last_step, TrackedBy::EyePatches | TrackedBy::Landmarks) {
             self.eye_patches = found.as_ref().and_then(|f| take_patches(&image, f));
         }
         self.eye_motion_px = match (&self.last_found, &found) {
