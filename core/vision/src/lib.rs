@@ -924,13 +924,28 @@ fn moved_with_the_eyes(face: &FaceFound, left_px: Vec2, right_px: Vec2) -> Vec<V
         .collect()
 }
 
-/// Each eye's patch (image left, image right) around the irises of `face`, sized by its eye
-/// corners; `None` when either has no texture to follow.
-fn take_patches(image: &UprightImage, face: &FaceFound) -> Option<[eye_patch::EyePatch; 2]> {
-    let [la, lb, ra, rb] = eye_corners(&face.landmarks)?;
-    let left = eye_patch::EyePatch::take(image, face.left_eye_px, la.distance(lb))?;
-    let right = eye_patch::EyePatch::take(image, face.right_eye_px, ra.distance(rb))?;
+/// Each eye's patch (image left, image right) around `centres`, sized by the eye corners of
+/// `landmarks`; `None` when either has no texture to follow.
+fn take_patches(
+    image: &UprightImage,
+    landmarks: &[Vec2],
+    [left, right]: [Vec2; 2],
+) -> Option<[eye_patch::EyePatch; 2]> {
+    let [la, lb, ra, rb] = eye_corners(landmarks)?;
+    let left = eye_patch::EyePatch::take(image, left, la.distance(lb))?;
+    let right = eye_patch::EyePatch::take(image, right, ra.distance(rb))?;
     Some([left, right])
+}
+
+/// The largest difference between the two eyes' motions over one frame, as a share of the eye
+/// distance, that is still one face moving (rolling, nearing): more is a turn of the head or a
+/// patch that slid.
+const MAX_EYE_MOTION_DIFFERENCE: f32 = 0.05;
+
+/// Whether the two eyes' motions `ml` and `mr` (pixels) are one face's, its eyes
+/// `eye_distance_px` apart ([`MAX_EYE_MOTION_DIFFERENCE`]).
+fn moved_together(ml: Vec2, mr: Vec2, eye_distance_px: f32) -> bool {
+    eye_distance_px > 0.0 && ml.distance(mr) <= MAX_EYE_MOTION_DIFFERENCE * eye_distance_px
 }
 
 /// The last frame's face followed by its eyes' patches (no network): each eye where its patch
@@ -950,7 +965,7 @@ fn follow_patches(
     let (right_eye_px, _) = right.find(image, last.right_eye_px + predicted_px)?;
     let (ml, mr) = (left_eye_px - last.left_eye_px, right_eye_px - last.right_eye_px);
     let ipd = last.left_eye_px.distance(last.right_eye_px);
-    if ipd.is_nan() || ipd <= 0.0 || ml.distance(mr) > 0.05 * ipd {
+    if !moved_together(ml, mr, ipd) {
         return None;
     }
     Some(FaceFound {
@@ -1143,7 +1158,9 @@ impl FaceTracker {
             // The eyes' patches on every frame, as long as they match and move together; once
             // in NETWORK_EVERY frames the networks, spread over two: FaceMesh here (the eyes
             // still by their patches), the irises on the next frame, as after a detection.
+            // Where the face is expected: last frame's, moved on as it was moving.
             let ahead = |p: Vec2| p + self.eye_motion_px;
+            let expected_roi = || roi_from_landmarks(&last.landmarks.iter().copied().map(ahead).collect::<Vec<_>>());
             let followed =
                 (self.eye_patches.as_ref()).and_then(|p| follow_patches(&image, last, p, self.eye_motion_px));
             if let Some(f) = followed {
@@ -1153,12 +1170,8 @@ impl FaceTracker {
                     found = Some(f);
                 } else {
                     self.last_step = TrackedBy::Landmarks;
-                    let landmarks: Vec<Vec2> = last.landmarks.iter().copied().map(ahead).collect();
                     let eyes = [f.left_eye_px, f.right_eye_px];
-                    if let Some(mesh) = self
-                        .models
-                        .mesh_in(&image, &roi_from_landmarks(&landmarks), Some(eyes))?
-                    {
+                    if let Some(mesh) = self.models.mesh_in(&image, &expected_roi(), Some(eyes))? {
                         found = Some(FaceFound {
                             landmarks: mesh.landmarks.clone(),
                             confidence: mesh.confidence,
@@ -1169,15 +1182,11 @@ impl FaceTracker {
                 }
             } else {
                 // The patches lost the eyes (a blink, a turn, a hand): FaceMesh and the irises
-                // at once, in the crop where the face is expected (last frame's, moved on as it
-                // was moving).
+                // at once.
                 self.patch_frames = 0;
                 self.last_step = TrackedBy::FaceMesh;
-                let landmarks: Vec<Vec2> = last.landmarks.iter().copied().map(ahead).collect();
                 let eyes = [ahead(last.left_eye_px), ahead(last.right_eye_px)];
-                found = self
-                    .models
-                    .face_in(&image, &roi_from_landmarks(&landmarks), Some(eyes))?;
+                found = self.models.face_in(&image, &expected_roi(), Some(eyes))?;
             }
             if found.is_none() {
                 self.detect(&image)?;
@@ -1187,7 +1196,9 @@ impl FaceTracker {
         }
         // A frame whose eyes came from the irises gives the patches the next frames follow.
         if !matches!(self.last_step, TrackedBy::EyePatches | TrackedBy::Landmarks) {
-            self.eye_patches = found.as_ref().and_then(|f| take_patches(&image, f));
+            self.eye_patches = found
+                .as_ref()
+                .and_then(|f| take_patches(&image, &f.landmarks, [f.left_eye_px, f.right_eye_px]));
         }
         self.eye_motion_px = match (&self.last_found, &found) {
             (Some(a), Some(b)) if self.last_mode == TrackingMode::Tracking => {
@@ -1249,17 +1260,14 @@ struct Detected {
 
 impl Detected {
     fn new(image: &UprightImage, mesh: Mesh) -> Self {
-        let patches = eye_corners(&mesh.landmarks).and_then(|[la, lb, ra, rb]| {
-            let left = eye_patch::EyePatch::take(image, (la + lb) * 0.5, la.distance(lb))?;
-            let right = eye_patch::EyePatch::take(image, (ra + rb) * 0.5, ra.distance(rb))?;
-            Some([left, right])
-        });
+        let patches = eye_corners(&mesh.landmarks)
+            .and_then(|[la, lb, ra, rb]| take_patches(image, &mesh.landmarks, [(la + lb) * 0.5, (ra + rb) * 0.5]));
         Self { mesh, patches }
     }
 
     /// The face's landmarks moved on to `image` as both eyes' patches moved, or, as they were
-    /// (`Err`), when the patches are not found again or the two moved apart by more than 5 % of
-    /// the eye distance (not a face moving).
+    /// (`Err`), when the patches are not found again or did not move together
+    /// ([`moved_together`]).
     ///
     /// With no motion known yet to start from, each search starts where the eyes were and, if
     /// refused there, from points around it a quarter of the eye width apart, out to half an eye
@@ -1280,7 +1288,7 @@ impl Detected {
                 starts.into_iter().find_map(|d| {
                     let from = d * step;
                     let (ml, mr) = (pl.find(image, l + from)?.0 - l, pr.find(image, r + from)?.0 - r);
-                    (ml.distance(mr) <= 0.05 * apart).then_some((ml + mr) * 0.5)
+                    moved_together(ml, mr, apart).then_some((ml + mr) * 0.5)
                 })
             });
         match moved.filter(|m| m.is_finite()) {
