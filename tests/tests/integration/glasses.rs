@@ -3,9 +3,11 @@
 //! wide, the three kinds of glasses either way round, full and partly transparent lenses,
 //! cardboard and plastic rims, reflections), with the clean photo's result as the reference, on
 //! the photos as they are, at selfie scale (each face cropped and enlarged to a 120-pixel eye
-//! distance in a 640 × 480 frame, as a phone's front camera sees a viewer at arm's length) and
-//! at selfie scale turned by 20° (either way). Needs `$PHANTOGRAM_DATA/faces` and `$PHANTOGRAM_MODELS`;
-//! skipped with a notice without them.
+//! distance in a 640 × 480 frame, as a phone's front camera sees a viewer at arm's length), at
+//! selfie scale turned by 20° (either way), and on the photos with the lenses off the eyes as real
+//! glasses sit (the tracker takes the lens centres as a second fix of each eye, so lenses drawn
+//! exactly on the eyes alone would flatter it). Needs `$PHANTOGRAM_DATA/faces` and
+//! `$PHANTOGRAM_MODELS`; skipped with a notice without them.
 
 use std::sync::Arc;
 
