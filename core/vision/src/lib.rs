@@ -534,8 +534,9 @@ const DETECTOR_MIN_SCORE: f32 = 0.5;
 const DETECTOR_NMS_IOU: f32 = 0.3;
 const FACE_FLAG_MIN: f32 = 0.5;
 /// A face is reported only at this confidence (the lower of detector score and FaceMesh's face
-/// flag; the flag alone with glasses on, see `mesh_from_detection`). Stricter than MediaPipe's 0.5 because a false face moves the viewpoint: on the test
-/// photographs every real face scored ≥ 0.82 and two dog faces 0.69 and 0.71.
+/// flag; the flag alone with glasses on, see `mesh_from_detection`). Stricter than MediaPipe's
+/// 0.5 because a false face moves the viewpoint: on the test photographs every real face scored
+/// ≥ 0.82 and two dog faces 0.69 and 0.71.
 pub const MIN_FACE_CONFIDENCE: f32 = 0.75;
 /// FaceMesh landmarks at the eye corners (outer, inner) of the eye on the image's left, and
 /// (inner, outer) of the one on the right, as MediaPipe's iris graph uses them.

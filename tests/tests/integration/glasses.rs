@@ -383,3 +383,46 @@ fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
         (glasses::Filter::Red, glasses::Filter::Cyan, false)
     );
 }
+
+/// A face with glasses, found by the tracker's whole-frame detector, gets its eyes on the very
+/// next frame as a bare face does: the astronaut at the face bench's size (eyes 40 px apart in a
+/// 640 × 480 frame) with the glasses test's first style, whose tinted eyes the detector scores
+/// under `MIN_FACE_CONFIDENCE` (FaceMesh, on the crop with the tint undone, is sure of it). The
+/// eyes are the still photo's (`find_faces`) within 3 % of the eye distance.
+#[test]
+fn a_tracked_face_with_glasses_has_eyes_on_the_frame_after_its_detection() {
+    use phantogram::face::{CameraPose, FaceTracker, TrackedBy};
+    let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
+        return;
+    };
+    let photo = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
+    let face = image::imageops::resize(&photo, 480, 480, image::imageops::FilterType::Triangle);
+    let mut img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
+    image::imageops::overlay(&mut img, &face, 80, 0);
+    let clean = faces(&models, &img);
+    let f = clean.first().expect("the astronaut's face");
+    let (w, h) = img.dimensions();
+    draw(&mut img, w, h, f.left_eye_px, f.right_eye_px, &style_for(0));
+    let still = faces(&models, &img);
+    let g = still.first().expect("the face with glasses, as a still photo");
+    assert!(g.lenses.is_some(), "glasses seen on the still photo");
+    let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(phantogram::glam::Vec3::ZERO));
+    let first = tracker.process(frame(&img)).expect("a valid frame");
+    assert_eq!(tracker.last_step(), TrackedBy::Detector);
+    assert!(first.eyes_m.is_none(), "the frame that finds the face has no eyes yet");
+    let second = tracker.process(frame(&img)).expect("a valid frame");
+    assert_eq!(tracker.last_step(), TrackedBy::Irises);
+    let [a, b] = second.eyes_m.expect("eyes on the frame after the detection");
+    assert!(second.glasses.is_some(), "glasses reported");
+    // Back to pixels: the eyes project where the still photo has them.
+    let k = frame(&img).intrinsics;
+    let (pose, ipd) = (tracker.pose, g.left_eye_px.distance(g.right_eye_px));
+    let project = |p: phantogram::glam::Vec3| {
+        let c = pose.device_from_camera.inverse() * (p - pose.position_m);
+        Vec2::new(k.fx_px * c.x / c.z + k.cx_px, k.fy_px * c.y / c.z + k.cy_px)
+    };
+    let (pa, pb) = (project(a), project(b));
+    let (l, r) = if pa.x <= pb.x { (pa, pb) } else { (pb, pa) };
+    let error = l.distance(g.left_eye_px).max(r.distance(g.right_eye_px)) / ipd;
+    assert!(error < 0.03, "tracked eyes {l} {r} against the still photo's: {error}");
+}
