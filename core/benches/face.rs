@@ -16,8 +16,7 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use phantogram::face::{
-    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, NETWORK_EVERY, PixelFormat, TrackedBy, TrackingMode,
-    UprightImage,
+    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, NETWORK_EVERY, TrackedBy, TrackingMode, UprightImage,
 };
 use phantogram::glam::Vec3;
 
@@ -84,17 +83,12 @@ fn main() {
 /// A still RGBA image as a camera frame.
 fn still(img: &image::RgbaImage) -> CameraFrame<'_> {
     let (w, h) = img.dimensions();
-    CameraFrame {
-        width: w,
-        height: h,
-        row_stride: 4 * w as usize,
-        format: PixelFormat::Rgba8,
-        data: img.as_raw(),
-        rotation_cw_deg: 0,
-        intrinsics: Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
-        capture_t_ns: 0,
-        chroma: None,
-    }
+    CameraFrame::upright_rgba(
+        w,
+        h,
+        img.as_raw(),
+        Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
+    )
 }
 
 /// Detection and tracking modes for `face` (480 × 480) swaying across a 640 × 480 frame, printed.

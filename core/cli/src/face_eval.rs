@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use crate::output::outln;
-use phantogram::face::{CameraFrame, FaceModels, Intrinsics, PixelFormat, UprightImage};
+use phantogram::face::{CameraFrame, FaceModels, Intrinsics, UprightImage};
 
 pub struct EvalFaceArgs<'a> {
     pub images: &'a [PathBuf],
@@ -52,17 +52,7 @@ pub fn eval_face_command(args: EvalFaceArgs) -> Result<()> {
             }
             None => Intrinsics::from_horizontal_fov(w, h, args.hfov_deg.to_radians()),
         };
-        let frame = CameraFrame {
-            width: w,
-            height: h,
-            row_stride: 4 * w as usize,
-            format: PixelFormat::Rgba8,
-            data: image.as_raw(),
-            rotation_cw_deg: 0,
-            intrinsics,
-            capture_t_ns: 0,
-            chroma: None,
-        };
+        let frame = CameraFrame::upright_rgba(w, h, image.as_raw(), intrinsics);
         let upright = UprightImage::new(frame)?;
         let faces = models.find_faces(&upright)?;
         if args.json {

@@ -29,17 +29,7 @@ fn rgba(path: &Path) -> image::RgbaImage {
 }
 
 fn frame(img: &image::RgbaImage, intrinsics: Intrinsics) -> CameraFrame<'_> {
-    CameraFrame {
-        width: img.width(),
-        height: img.height(),
-        row_stride: 4 * img.width() as usize,
-        format: PixelFormat::Rgba8,
-        data: img.as_raw(),
-        rotation_cw_deg: 0,
-        intrinsics,
-        capture_t_ns: 0,
-        chroma: None,
-    }
+    CameraFrame::upright_rgba(img.width(), img.height(), img.as_raw(), intrinsics)
 }
 
 /// [`frame`] as the owned frame a worker or an engine takes, captured at `capture_t_ns`.

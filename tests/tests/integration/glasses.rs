@@ -23,17 +23,12 @@ fn models() -> Option<Arc<FaceModels>> {
 
 fn frame(img: &image::RgbaImage) -> CameraFrame<'_> {
     let (w, h) = img.dimensions();
-    CameraFrame {
-        width: w,
-        height: h,
-        row_stride: 4 * w as usize,
-        format: PixelFormat::Rgba8,
-        data: img.as_raw(),
-        rotation_cw_deg: 0,
-        intrinsics: Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
-        capture_t_ns: 0,
-        chroma: None,
-    }
+    CameraFrame::upright_rgba(
+        w,
+        h,
+        img.as_raw(),
+        Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
+    )
 }
 
 fn faces(models: &FaceModels, img: &image::RgbaImage) -> Vec<FaceFound> {

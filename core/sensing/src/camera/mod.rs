@@ -121,6 +121,24 @@ pub struct ChromaView<'a> {
     pub pixel_stride: usize,
 }
 
+impl<'a> CameraFrame<'a> {
+    /// An upright image of packed RGBA rows (a still photograph, a test frame): no turn, no
+    /// chroma planes, captured at 0. `data` is not checked here; consumers check the size.
+    pub fn upright_rgba(width: u32, height: u32, data: &'a [u8], intrinsics: Intrinsics) -> Self {
+        Self {
+            width,
+            height,
+            row_stride: 4 * width as usize,
+            format: PixelFormat::Rgba8,
+            data,
+            rotation_cw_deg: 0,
+            intrinsics,
+            capture_t_ns: 0,
+            chroma: None,
+        }
+    }
+}
+
 impl CameraFrame<'_> {
     /// The sRGB colour of buffer pixel `(x, y)` (as delivered, before the turn): from RGBA, or
     /// from luma and chroma; `None` for a luma-only frame or a pixel outside the frame.
