@@ -5,8 +5,10 @@
 //! tracking mode (once in `NETWORK_EVERY` frames FaceMesh on one and 2 × Iris on the next, the
 //! eyes' patches between; the mean over 60 frames, whole cycles of the schedule, as that is what
 //! the tracker takes from the cores; also the worst frame and the median of each kind). The face
-//! sways across the frame by up to 7 pixels a frame. All of it twice: the bare face, then the same
-//! face with red/cyan glasses drawn on (`phantogram_lab::drawn_glasses`).
+//! sways across the frame by up to 7 pixels a frame. All of it three times: the bare face, the same
+//! face with red/cyan glasses drawn on (`phantogram_lab::drawn_glasses`), and that face as the YUV
+//! 4:2:0 frames the phones hand over (the networks read luma, the glasses' colour comes from the
+//! chroma planes).
 //!
 //! Needs the models (`cargo xtask models`; `PHANTOGRAM_MODELS` or the default cache) and a face
 //! photograph: `$PHANTOGRAM_DATA/faces/astronaut.png`, letterboxed into 640×480. Skipped with a
@@ -16,7 +18,8 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use phantogram::face::{
-    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, NETWORK_EVERY, TrackedBy, TrackingMode, UprightImage,
+    CameraFrame, CameraPose, FaceModels, FaceTracker, Intrinsics, NETWORK_EVERY, OwnedFrame, TrackedBy, TrackingMode,
+    UprightImage,
 };
 use phantogram::glam::Vec3;
 
@@ -75,8 +78,16 @@ fn main() {
     let mut with_glasses = face.clone();
     let style = phantogram_lab::drawn_glasses::style_for(0);
     phantogram_lab::drawn_glasses::draw(&mut with_glasses, 480, 480, eyes.0, eyes.1, &style);
-    for (name, face) in [("bare face", &face), ("red/cyan glasses", &with_glasses)] {
-        measure(&models, name, face);
+    for (name, face, yuv) in [
+        ("bare face", &face, false),
+        ("red/cyan glasses", &with_glasses, false),
+        (
+            "red/cyan glasses, YUV 4:2:0 as the phones hand it over",
+            &with_glasses,
+            true,
+        ),
+    ] {
+        measure(&models, name, face, yuv);
     }
 }
 
@@ -91,19 +102,37 @@ fn still(img: &image::RgbaImage) -> CameraFrame<'_> {
     )
 }
 
-/// Detection and tracking modes for `face` (480 × 480) swaying across a 640 × 480 frame, printed.
-fn measure(models: &Arc<FaceModels>, name: &str, face: &image::RgbaImage) {
+/// Detection and tracking modes for `face` (480 × 480) swaying across a 640 × 480 frame, printed;
+/// `yuv`: the frames as luma and chroma planes (`phantogram_lab::synthetic_camera::as_yuv420`).
+fn measure(models: &Arc<FaceModels>, name: &str, face: &image::RgbaImage, yuv: bool) {
     // The face swaying across the frame, up to 7 pixels a frame (on a still frame the eyes'
     // patches would settle in one step; a moving one costs what a real tracked frame does).
-    let frames: Vec<image::RgbaImage> = (0..18)
+    let frames: Vec<OwnedFrame> = (0..18)
         .map(|k| {
             let x = 80.0 + 20.0 * (std::f64::consts::TAU * f64::from(k) / 18.0).sin();
             let mut img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
             image::imageops::overlay(&mut img, face, x.round() as i64, 0);
-            img
+            let f = still(&img);
+            let owned = OwnedFrame {
+                width: f.width,
+                height: f.height,
+                row_stride: f.row_stride,
+                format: f.format,
+                data: img.as_raw().clone(),
+                rotation_cw_deg: 0,
+                intrinsics: f.intrinsics,
+                capture_t_ns: 0,
+                chroma: None,
+                exposure: None,
+            };
+            if yuv {
+                phantogram_lab::synthetic_camera::as_yuv420(&owned)
+            } else {
+                owned
+            }
         })
         .collect();
-    let frame = |k: usize| still(&frames[k % frames.len()]);
+    let frame = |k: usize| frames[k % frames.len()].as_frame();
     let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(Vec3::new(0.0, 0.07, 0.0)));
     let run = |tracker: &mut FaceTracker, k: usize| {
         let t = Instant::now();

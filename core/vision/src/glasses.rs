@@ -241,15 +241,16 @@ impl Lenses {
         dot > 0.0 && dot * dot >= 0.49 * here2 * shift2 && here2 >= 0.25 * shift2
     }
 
-    /// `rgb` (sRGB-coded, [0, 1]) at image position `p` with a lens's tint undone when `p` is
-    /// under a lens: near an eye (within 0.45 × 0.35 eye distances), and coloured as that lens
-    /// colours skin (its colour relative to the cheek shifted the lens's way, at least half as
-    /// far: `through_lens`).
-    pub fn untint_at(&self, p: Vec2, rgb: [f32; 3]) -> [f32; 3] {
+    /// A crop's sample `sample` (sRGB-coded, [0, 1]) at image position `p` with a lens's tint
+    /// undone when `p` is under a lens: near an eye (within 0.45 × 0.35 eye distances), and
+    /// coloured as that lens colours skin (its colour relative to the cheek shifted the lens's
+    /// way, at least half as far: `through_lens`). How: `untinted_sample`. A grey sample (a
+    /// YUV frame's crops are read from luma) is judged by the colour of the frame's pixel there.
+    pub fn untint_at(&self, image: &UprightImage, p: Vec2, sample: [f32; 3]) -> [f32; 3] {
         let [l, r] = self.eyes_px;
         let ipd = l.distance(r);
         if ipd.is_nan() || ipd <= 0.0 {
-            return rgb;
+            return sample;
         }
         let across = (r - l) / ipd;
         for i in 0..2 {
@@ -258,13 +259,50 @@ impl Lenses {
             if a * a + b * b > 1.0 {
                 continue;
             }
-            if self.through_lens(i, rgb.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8)) {
-                return untint_colour(rgb, self.transmission[i]);
+            let colour = if image.samples_grey() {
+                image.colour_at(p)
+            } else {
+                Some(sample.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8))
+            };
+            if colour.is_some_and(|c| self.through_lens(i, c)) {
+                return untinted_sample(image, p, sample, self.transmission[i]);
             }
-            return rgb;
+            return sample;
         }
-        rgb
+        sample
     }
+
+    /// A crop's sample at `p` with the tint of lens `i` (0: image left) undone, whatever colour
+    /// it has: for the iris network's crop, which lies all under the lens.
+    pub fn untint_all_at(&self, image: &UprightImage, i: usize, p: Vec2, sample: [f32; 3]) -> [f32; 3] {
+        match self.transmission.get(i) {
+            Some(t) => untinted_sample(image, p, sample, *t),
+            None => sample,
+        }
+    }
+}
+
+/// A crop's sample (sRGB-coded, [0, 1]) at image position `p` seen through a lens of
+/// `transmission`, as it would be without: a colour sample by [`untint_colour`]; a grey one (a
+/// YUV frame's crop, read from luma so that the networks get what they get without glasses)
+/// scaled by how much brighter undoing the tint makes the colour of the frame's pixel at `p`
+/// (Rec. 601 luma of the sRGB codes, as the frame's luma is made), since per-channel gains on
+/// grey would paint it with the lens's opposite colour.
+fn untinted_sample(image: &UprightImage, p: Vec2, sample: [f32; 3], transmission: [f32; 3]) -> [f32; 3] {
+    if !image.samples_grey() {
+        return untint_colour(sample, transmission);
+    }
+    let Some(rgb) = image.colour_at(p) else {
+        return sample;
+    };
+    let luma = |c: [f32; 3]| 0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2];
+    let seen = rgb.map(|c| f32::from(c) / 255.0);
+    let (before, after) = (luma(seen), luma(untint_colour(seen, transmission)));
+    // Black under the lens: nothing to scale.
+    if before < 1.0 / 255.0 {
+        return sample;
+    }
+    sample.map(|v| (v * after / before).min(1.0))
 }
 
 impl Lenses {
@@ -440,16 +478,6 @@ pub fn untint_colour(rgb: [f32; 3], transmission: [f32; 3]) -> [f32; 3] {
         let gain = (top / transmission[k].max(1e-4)).min(MAX_GAIN);
         from_linear_fast(to_linear_fast(rgb[k]) * gain)
     })
-}
-
-/// Undoes a lens's tint in a network's input crop (`n × n`, NCHW, values in [0, 1] sRGB-coded;
-/// all of it under the lens), pixel by pixel as [`untint_colour`].
-pub fn untint(tensor: &mut [f32], n: usize, transmission: [f32; 3]) {
-    let (r, rest) = tensor.split_at_mut(n * n);
-    let (g, b) = rest.split_at_mut(n * n);
-    for ((r, g), b) in r.iter_mut().zip(g.iter_mut()).zip(b.iter_mut().take(n * n)) {
-        [*r, *g, *b] = untint_colour([*r, *g, *b], transmission);
-    }
 }
 
 #[cfg(test)]

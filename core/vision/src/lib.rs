@@ -309,7 +309,13 @@ impl<'a> UprightImage<'a> {
         by as usize * self.frame.row_stride + bx as usize * self.frame.format.bytes_per_pixel()
     }
 
-    /// Whether the frame has colour (RGBA, or luma with its chroma planes).
+    /// Whether crops read from this frame are grey: a luma frame's are (its chroma, if any, is
+    /// read only where colour is asked for, [`Self::colour_at`]).
+    pub fn samples_grey(&self) -> bool {
+        self.frame.format == PixelFormat::Luma8
+    }
+
+    /// Whether colour can be read: an RGBA frame, or luma with its chroma planes.
     pub fn has_colour(&self) -> bool {
         self.frame.format == PixelFormat::Rgba8 || self.frame.chroma.is_some()
     }
@@ -510,14 +516,30 @@ pub struct FaceFound {
     pub lenses: Option<glasses::Lenses>,
 }
 
-/// FaceMesh's answer for one face: its 468 landmarks (pixels of the upright image) and its
-/// confidence (the face flag, or the lower of it and the detector's score).
+/// FaceMesh's answer for one face: its 468 landmarks (pixels of the upright image), its face
+/// flag, and the detector's score when a detection led to it.
 #[derive(Clone, Debug, PartialEq)]
 struct Mesh {
     landmarks: Vec<Vec2>,
-    confidence: f32,
+    flag: f32,
+    detector_score: Option<f32>,
     /// Glasses were seen where the eyes were expected, and their tint undone in the crop.
     through_glasses: bool,
+}
+
+impl Mesh {
+    /// How sure the face is: the face flag, capped by the detector's score — unless glasses were
+    /// seen on it (`glasses_seen`, or before FaceMesh ran): the detector scored the face with the
+    /// lenses' tint on its eyes (the red/cyan glasses of the face bench drop it under
+    /// [`MIN_FACE_CONFIDENCE`] on a face that FaceMesh, on its crop with the tint undone, flags
+    /// at 1), and a pair of anaglyph filters right where a face's eyes are is itself evidence of
+    /// a face.
+    fn confidence(&self, glasses_seen: bool) -> f32 {
+        match self.detector_score {
+            Some(score) if !(glasses_seen || self.through_glasses) => self.flag.min(score),
+            _ => self.flag,
+        }
+    }
 }
 
 /// One face-detector hit: box and the six keypoints, pixels.
@@ -534,7 +556,7 @@ const DETECTOR_MIN_SCORE: f32 = 0.5;
 const DETECTOR_NMS_IOU: f32 = 0.3;
 const FACE_FLAG_MIN: f32 = 0.5;
 /// A face is reported only at this confidence (the lower of detector score and FaceMesh's face
-/// flag; the flag alone with glasses on, see `mesh_from_detection`). Stricter than MediaPipe's
+/// flag; the flag alone with glasses on, see `Mesh::confidence`). Stricter than MediaPipe's
 /// 0.5 because a false face moves the viewpoint: on the test photographs every real face scored
 /// ≥ 0.82 and two dog faces 0.69 and 0.71.
 pub const MIN_FACE_CONFIDENCE: f32 = 0.75;
@@ -666,7 +688,7 @@ impl FaceModels {
         lenses: Option<&glasses::Lenses>,
     ) -> Result<Option<(Vec<Vec2>, f32)>, FaceError> {
         let crop = match lenses {
-            Some(l) => roi.tensor_with(image, 192, (0.0, 1.0), false, |p, c| l.untint_at(p, c)),
+            Some(l) => roi.tensor_with(image, 192, (0.0, 1.0), false, |p, c| l.untint_at(image, p, c)),
             None => roi.tensor(image, 192, (0.0, 1.0), false),
         };
         let out = Self::run(&self.mesh, crop, 192)?;
@@ -686,23 +708,24 @@ impl FaceModels {
     }
 
     /// Iris in the eye between the two corner landmarks: centre and diameter, pixels. Under a
-    /// lens of `transmission`, the crop's tint is undone first.
+    /// lens (`lens`: the glasses and which of their lenses, 0 for the image-left one), the crop's
+    /// tint is undone first.
     fn iris(
         &self,
         image: &UprightImage,
         from: Vec2,
         to: Vec2,
         flip: bool,
-        transmission: Option<[f32; 3]>,
+        lens: Option<(&glasses::Lenses, usize)>,
     ) -> Result<Option<(Vec2, f32)>, FaceError> {
         let roi = Roi::around([from, to].into_iter(), from, to, 2.3);
         if roi.size.is_nan() || roi.size <= 1.0 {
             return Ok(None);
         }
-        let mut crop = roi.tensor(image, 64, (0.0, 1.0), flip);
-        if let Some(t) = transmission {
-            glasses::untint(&mut crop, 64, t);
-        }
+        let crop = match lens {
+            Some((l, i)) => roi.tensor_with(image, 64, (0.0, 1.0), flip, |p, c| l.untint_all_at(image, i, p, c)),
+            None => roi.tensor(image, 64, (0.0, 1.0), flip),
+        };
         let out = Self::run(&self.iris, crop, 64)?;
         let [_, iris, ..] = out.as_slice() else {
             return Err(FaceError::Inference("iris: expected two outputs".into()));
@@ -729,9 +752,8 @@ impl FaceModels {
         [la, lb, ra, rb]: [Vec2; 4],
         lenses: Option<&glasses::Lenses>,
     ) -> Result<Option<[(Vec2, f32); 2]>, FaceError> {
-        let t = lenses.map(|l| l.transmission);
-        let left = self.iris(image, la, lb, false, t.map(|t| t[0]))?;
-        let right = self.iris(image, ra, rb, true, t.map(|t| t[1]))?;
+        let left = self.iris(image, la, lb, false, lenses.map(|l| (l, 0)))?;
+        let right = self.iris(image, ra, rb, true, lenses.map(|l| (l, 1)))?;
         Ok(left.zip(right).map(|(l, r)| [l, r]))
     }
 
@@ -758,13 +780,12 @@ impl FaceModels {
         eyes_hint: Option<[Vec2; 2]>,
     ) -> Result<Option<Mesh>, FaceError> {
         let hinted = eyes_hint.and_then(|[l, r]| glasses::find_at(image, l, r));
-        Ok(self
-            .mesh(image, roi, hinted.as_ref())?
-            .map(|(landmarks, confidence)| Mesh {
-                landmarks,
-                confidence,
-                through_glasses: hinted.is_some(),
-            }))
+        Ok(self.mesh(image, roi, hinted.as_ref())?.map(|(landmarks, flag)| Mesh {
+            landmarks,
+            flag,
+            detector_score: None,
+            through_glasses: hinted.is_some(),
+        }))
     }
 
     /// The irises in the crops that `mesh`'s eye corners place in `image` (glasses looked for
@@ -788,26 +809,20 @@ impl FaceModels {
             left_eye_px,
             right_eye_px,
             iris_diameter_px: 0.5 * (dl + dr),
-            confidence: mesh.confidence,
+            confidence: mesh.confidence(lenses.is_some()),
             landmarks: mesh.landmarks,
             lenses,
         }))
     }
 
-    /// FaceMesh for the face a detection leads to, its confidence the lower of detector score
-    /// and face flag — or the face flag alone with glasses on: the detector scored the face
-    /// with the lenses' tint on its eyes (the red/cyan glasses of the face bench drop it under
-    /// [`MIN_FACE_CONFIDENCE`] on a face that FaceMesh, on its crop with the tint undone, flags at
-    /// 1), and a pair of anaglyph filters right where the detector put the eyes is itself
-    /// evidence of a face.
+    /// FaceMesh for the face a detection leads to, keeping the detector's score
+    /// ([`Mesh::confidence`]).
     fn mesh_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<Mesh>, FaceError> {
         let [a, b] = [d.keypoints[0], d.keypoints[1]];
         let eyes = if a.x <= b.x { [a, b] } else { [b, a] };
-        Ok(self.mesh_in(image, &roi_from_detection(d), Some(eyes))?.map(|mut m| {
-            if !m.through_glasses {
-                m.confidence = m.confidence.min(d.score);
-            }
-            m
+        Ok(self.mesh_in(image, &roi_from_detection(d), Some(eyes))?.map(|m| Mesh {
+            detector_score: Some(d.score),
+            ..m
         }))
     }
 
@@ -1194,7 +1209,7 @@ impl FaceTracker {
                     if let Some(mesh) = self.models.mesh_in(&image, &expected_roi(), Some(eyes))? {
                         found = Some(FaceFound {
                             landmarks: mesh.landmarks.clone(),
-                            confidence: mesh.confidence,
+                            confidence: mesh.confidence(f.lenses.is_some()),
                             ..f
                         });
                         self.detected = Some(Detected::new(&image, mesh));

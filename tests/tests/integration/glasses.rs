@@ -421,3 +421,76 @@ fn a_tracked_face_with_glasses_has_eyes_on_the_frame_after_its_detection() {
     let error = l.distance(g.left_eye_px).max(r.distance(g.right_eye_px)) / ipd;
     assert!(error < 0.03, "tracked eyes {l} {r} against the still photo's: {error}");
 }
+
+/// Phones hand over YUV frames, whose crops the networks read in grey (luma); the glasses are
+/// named from the chroma planes. With glasses on, the eyes found through YUV are as close to the
+/// bare face's as those found through RGBA (the glasses test's first eight styles over the
+/// astronaut, tracked for two frames as a camera streams).
+#[test]
+fn a_face_with_glasses_in_a_yuv_frame_keeps_its_eyes_as_in_rgba() {
+    use phantogram::face::{CameraPose, FaceTracker, OwnedFrame};
+    let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
+        return;
+    };
+    let photo = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
+    let (w, h) = photo.dimensions();
+    let owned = |img: &image::RgbaImage| OwnedFrame {
+        width: w,
+        height: h,
+        row_stride: 4 * w as usize,
+        format: PixelFormat::Rgba8,
+        data: img.as_raw().clone(),
+        rotation_cw_deg: 0,
+        intrinsics: Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
+        capture_t_ns: 0,
+        chroma: None,
+        exposure: None,
+    };
+    // The tracker's eyes (image left, image right), in pixels, and whether it saw glasses.
+    let eyes = |frame: &OwnedFrame| {
+        let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(phantogram::glam::Vec3::ZERO));
+        tracker.process(frame.as_frame()).expect("a valid frame");
+        let o = tracker.process(frame.as_frame()).expect("a valid frame");
+        let (k, pose) = (frame.intrinsics, tracker.pose);
+        let project = |p: phantogram::glam::Vec3| {
+            let c = pose.device_from_camera.inverse() * (p - pose.position_m);
+            Vec2::new(k.fx_px * c.x / c.z + k.cx_px, k.fy_px * c.y / c.z + k.cy_px)
+        };
+        let [a, b] = o.eyes_m.expect("eyes").map(project);
+        (if a.x <= b.x { [a, b] } else { [b, a] }, o.glasses.is_some())
+    };
+    let bare = owned(&photo);
+    let (clean, _) = eyes(&bare);
+    let ipd = clean[0].distance(clean[1]);
+    let off = |e: [Vec2; 2]| e[0].distance(clean[0]).max(e[1].distance(clean[1])) / ipd;
+    let (bare_yuv, _) = eyes(&phantogram_lab::synthetic_camera::as_yuv420(&bare));
+    println!(
+        "bare face: YUV eyes off the RGBA ones by {:.2} %",
+        100.0 * off(bare_yuv)
+    );
+    let (mut through_rgba, mut through_yuv) = (Vec::new(), Vec::new());
+    for seed in 0..8 {
+        let mut img = photo.clone();
+        draw(&mut img, w, h, clean[0], clean[1], &style_for(seed));
+        let rgba = owned(&img);
+        let ((a, ga), (b, gb)) = (eyes(&rgba), eyes(&phantogram_lab::synthetic_camera::as_yuv420(&rgba)));
+        assert!(ga && gb, "style {seed}: glasses seen through RGBA {ga}, YUV {gb}");
+        println!(
+            "style {seed}: eyes off the bare face's by {:.2} % through RGBA, {:.2} % through YUV",
+            100.0 * off(a),
+            100.0 * off(b)
+        );
+        through_rgba.push(off(a));
+        through_yuv.push(off(b));
+    }
+    let worst = |v: &[f32]| v.iter().copied().fold(0.0f32, f32::max);
+    let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
+    assert!(
+        worst(&through_yuv) <= worst(&through_rgba) + 0.01 && mean(&through_yuv) <= mean(&through_rgba) + 0.005,
+        "through YUV: mean {:.2} %, worst {:.2} %; through RGBA: mean {:.2} %, worst {:.2} %",
+        100.0 * mean(&through_yuv),
+        100.0 * worst(&through_yuv),
+        100.0 * mean(&through_rgba),
+        100.0 * worst(&through_rgba)
+    );
+}
