@@ -511,8 +511,9 @@ pub struct FaceFound {
     /// The 468 FaceMesh landmarks (x, y, pixels).
     pub landmarks: Vec<Vec2>,
     /// Anaglyph glasses on the face, when the frame has colour and they are there
-    /// ([`glasses`]): the eyes were then found in crops with the lenses' tint undone, and the
-    /// distance comes from the eye distance, not the (tinted, smaller-looking) iris.
+    /// ([`glasses`]): the eyes were then found in crops with the lenses' tint undone and fused
+    /// with the lens centres ([`glasses::with_lens_centres`]), and the distance comes from the eye
+    /// distance, not the (tinted, smaller-looking) iris.
     pub lenses: Option<glasses::Lenses>,
 }
 
