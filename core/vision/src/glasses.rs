@@ -226,13 +226,13 @@ impl Lenses {
 }
 
 impl Lenses {
-    /// Whether linear colour `lin` near eye `i` (0: image left) is seen through that eye's lens:
-    /// its colour relative to that side's cheek is shifted the lens's way (cosine 0.7 or more)
-    /// and at least half as far as the lens shifts skin. So a rim and what lies beyond the lens
-    /// are not taken for it.
+    /// Whether the colour `rgb` (8-bit sRGB codes) near eye `i` (0: image left) is seen through
+    /// that eye's lens: in linear light, its colour relative to that side's cheek is shifted the
+    /// lens's way (cosine 0.7 or more) and at least half as far as the lens shifts skin. So a rim
+    /// and what lies beyond the lens are not taken for it.
     ///
-    /// Takes the 8-bit sRGB codes: reads the logarithms from a table, as it runs on every pixel
-    /// of the crops' eye regions. Cosine and lengths compared squared (no roots).
+    /// Codes, so that the logarithms come from a table: it runs on every pixel of the crops' eye
+    /// regions. Cosine and lengths compared squared (no roots).
     fn through_lens(&self, i: usize, rgb: [u8; 3]) -> bool {
         let l = Vec3::from(rgb.map(ln_linear)) - self.ln_cheek[i];
         let here = l - Vec3::splat(l.element_sum() / 3.0);
