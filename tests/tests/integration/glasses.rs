@@ -82,8 +82,9 @@ fn try_styles(
         for _ in 0..4 {
             let mut style = style_for(*seed);
             if off_centre {
-                style.spacing_ipd = [0.92, 1.08][(*seed / 2 % 2) as usize];
-                style.drop_ipd = [-0.04, 0.04][(*seed / 4 % 2) as usize];
+                // Each kind of glasses (`seed % 4`) both ways, spaced wide and narrow.
+                style.spacing_ipd = [0.92, 1.08][(*seed / 4 % 2) as usize];
+                style.drop_ipd = [-0.04, 0.04][(*seed / 8 % 2) as usize];
             }
             *seed += 1;
             let mut with = img.clone();
