@@ -91,15 +91,15 @@ fn main() {
     }
 }
 
+/// The bench camera's intrinsics: 60° across.
+fn intrinsics(w: u32, h: u32) -> Intrinsics {
+    Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians())
+}
+
 /// A still RGBA image as a camera frame.
 fn still(img: &image::RgbaImage) -> CameraFrame<'_> {
     let (w, h) = img.dimensions();
-    CameraFrame::upright_rgba(
-        w,
-        h,
-        img.as_raw(),
-        Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
-    )
+    CameraFrame::upright_rgba(w, h, img.as_raw(), intrinsics(w, h))
 }
 
 /// Detection and tracking modes for `face` (480 × 480) swaying across a 640 × 480 frame, printed;
@@ -112,19 +112,7 @@ fn measure(models: &Arc<FaceModels>, name: &str, face: &image::RgbaImage, yuv: b
             let x = 80.0 + 20.0 * (std::f64::consts::TAU * f64::from(k) / 18.0).sin();
             let mut img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
             image::imageops::overlay(&mut img, face, x.round() as i64, 0);
-            let f = still(&img);
-            let owned = OwnedFrame {
-                width: f.width,
-                height: f.height,
-                row_stride: f.row_stride,
-                format: f.format,
-                data: img.as_raw().clone(),
-                rotation_cw_deg: 0,
-                intrinsics: f.intrinsics,
-                capture_t_ns: 0,
-                chroma: None,
-                exposure: None,
-            };
+            let owned = OwnedFrame::upright_rgba(640, 480, img.into_raw(), intrinsics(640, 480), 0);
             if yuv {
                 phantogram_lab::synthetic_camera::as_yuv420(&owned)
             } else {

@@ -34,19 +34,13 @@ fn frame(img: &image::RgbaImage, intrinsics: Intrinsics) -> CameraFrame<'_> {
 
 /// [`frame`] as the owned frame a worker or an engine takes, captured at `capture_t_ns`.
 fn owned_frame(img: &image::RgbaImage, intrinsics: Intrinsics, capture_t_ns: i64) -> OwnedFrame {
-    let f = frame(img, intrinsics);
-    OwnedFrame {
-        width: f.width,
-        height: f.height,
-        row_stride: f.row_stride,
-        format: f.format,
-        data: f.data.to_vec(),
-        rotation_cw_deg: f.rotation_cw_deg,
-        intrinsics: f.intrinsics,
+    OwnedFrame::upright_rgba(
+        img.width(),
+        img.height(),
+        img.as_raw().clone(),
+        intrinsics,
         capture_t_ns,
-        chroma: None,
-        exposure: None,
-    }
+    )
 }
 
 fn default_intrinsics(img: &image::RgbaImage) -> Intrinsics {

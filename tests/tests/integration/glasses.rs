@@ -344,18 +344,13 @@ fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
     let style = style_for(0);
     assert_eq!(style.filters, (glasses::Filter::Cyan, glasses::Filter::Red));
     draw(&mut with, w, h, f.left_eye_px, f.right_eye_px, &style);
-    let rgba = phantogram::face::OwnedFrame {
-        width: w,
-        height: h,
-        row_stride: 4 * w as usize,
-        format: PixelFormat::Rgba8,
-        data: with.into_raw(),
-        rotation_cw_deg: 0,
-        intrinsics: Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
-        capture_t_ns: 5_000_000,
-        chroma: None,
-        exposure: None,
-    };
+    let rgba = phantogram::face::OwnedFrame::upright_rgba(
+        w,
+        h,
+        with.into_raw(),
+        Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
+        5_000_000,
+    );
     let yuv = phantogram_lab::synthetic_camera::as_yuv420(&rgba);
     assert_eq!(yuv.format, PixelFormat::Luma8);
     // Twice, as a camera streams: the frame that finds the face, then the one with its eyes.
@@ -435,17 +430,14 @@ fn a_face_with_glasses_in_a_yuv_frame_keeps_its_eyes_as_in_rgba() {
     };
     let photo = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
     let (w, h) = photo.dimensions();
-    let owned = |img: &image::RgbaImage| OwnedFrame {
-        width: w,
-        height: h,
-        row_stride: 4 * w as usize,
-        format: PixelFormat::Rgba8,
-        data: img.as_raw().clone(),
-        rotation_cw_deg: 0,
-        intrinsics: Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
-        capture_t_ns: 0,
-        chroma: None,
-        exposure: None,
+    let owned = |img: &image::RgbaImage| {
+        OwnedFrame::upright_rgba(
+            w,
+            h,
+            img.as_raw().clone(),
+            Intrinsics::from_horizontal_fov(w, h, 60f32.to_radians()),
+            0,
+        )
     };
     // The tracker's eyes (image left, image right), in pixels, and whether it saw glasses.
     let eyes = |frame: &OwnedFrame| {

@@ -277,6 +277,23 @@ pub struct OwnedFrame {
 }
 
 impl OwnedFrame {
+    /// An upright image of packed RGBA rows, owned (a still photograph, a test frame): no turn,
+    /// no chroma planes, no exposure reported ([`CameraFrame::upright_rgba`], borrowed).
+    pub fn upright_rgba(width: u32, height: u32, data: Vec<u8>, intrinsics: Intrinsics, capture_t_ns: i64) -> Self {
+        Self {
+            width,
+            height,
+            row_stride: 4 * width as usize,
+            format: PixelFormat::Rgba8,
+            data,
+            rotation_cw_deg: 0,
+            intrinsics,
+            capture_t_ns,
+            chroma: None,
+            exposure: None,
+        }
+    }
+
     /// A luma plane (Android's YUV_420_888 plane 0, iOS's bi-planar plane 0) as the bridges
     /// receive it, copied.
     #[allow(clippy::too_many_arguments)]
