@@ -259,15 +259,19 @@ impl Lenses {
             if a * a + b * b > 1.0 {
                 continue;
             }
-            let colour = if image.samples_grey() {
-                image.colour_at(p)
-            } else {
-                Some(sample.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8))
-            };
-            if colour.is_some_and(|c| self.through_lens(i, c)) {
-                return untinted_sample(image, p, sample, self.transmission[i]);
+            let t = self.transmission[i];
+            if image.samples_grey() {
+                return match image.colour_at(p) {
+                    Some(rgb) if self.through_lens(i, rgb) => brightened(sample, rgb, t),
+                    _ => sample,
+                };
             }
-            return sample;
+            let code = sample.map(|c| (c.clamp(0.0, 1.0) * 255.0 + 0.5) as u8);
+            return if self.through_lens(i, code) {
+                untint_colour(sample, t)
+            } else {
+                sample
+            };
         }
         sample
     }
@@ -292,9 +296,15 @@ fn untinted_sample(image: &UprightImage, p: Vec2, sample: [f32; 3], transmission
     if !image.samples_grey() {
         return untint_colour(sample, transmission);
     }
-    let Some(rgb) = image.colour_at(p) else {
-        return sample;
-    };
+    match image.colour_at(p) {
+        Some(rgb) => brightened(sample, rgb, transmission),
+        None => sample,
+    }
+}
+
+/// A grey crop sample scaled as undoing the tint of `transmission` brightens `rgb`, the frame's
+/// colour (8-bit sRGB codes) where it was taken ([`untinted_sample`]).
+fn brightened(sample: [f32; 3], rgb: [u8; 3], transmission: [f32; 3]) -> [f32; 3] {
     let luma = |c: [f32; 3]| 0.299 * c[0] + 0.587 * c[1] + 0.114 * c[2];
     let seen = rgb.map(|c| f32::from(c) / 255.0);
     let (before, after) = (luma(seen), luma(untint_colour(seen, transmission)));

@@ -1064,10 +1064,11 @@ impl FaceFound {
 /// it ([`eye_patch`]: no network). At 30 frames/s the networks still place the face and measure
 /// each eye six times a second; a patch that no longer matches (a blink, a turn of the head, a
 /// hand) or eyes that move apart run FaceMesh and the irises at once. The networks are nearly
-/// all of a tracked frame's cost, so this sets the tracker's mean cost. Every value from 1 (networks on every frame) to 6 gave the same
-/// accuracy on the hand-held test (`benchmarks/face.md`, 2026-12-03); 5 was chosen as the
-/// smallest that brought the mean cost to about 4 ms a frame on a busy run of the bench here
-/// (2.9 ms on a quiet one, where 4 would also do).
+/// all of a tracked frame's cost, so this sets the tracker's mean cost. Every value from 1
+/// (networks on every frame) to 6 gave the same accuracy on the hand-held test
+/// (`benchmarks/face.md`, 2026-12-03); 5 was chosen as the smallest that brought the mean cost
+/// to about 4 ms a frame on a busy run of the bench here (2.9 ms on a quiet one, where 4 would
+/// also do).
 pub const NETWORK_EVERY: u32 = 5;
 
 /// What the last frame ran to find the eyes.
