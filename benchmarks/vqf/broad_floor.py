@@ -32,6 +32,20 @@ def load(path):
         return np.genfromtxt(f, delimiter=",")
 
 
+def trial(path):
+    """One BROAD trial's columns: accelerometer, gyroscope, magnetometer, truth quaternion
+    (sensor -> earth, w x y z), the movement flag, and where the truth is known."""
+    d = load(path)
+    acc, gyr, mag, truth, moving = d[:, 1:4], d[:, 4:7], d[:, 7:10], d[:, 10:14], d[:, 14] == 1
+    return acc, gyr, mag, truth, moving, np.all(np.isfinite(truth), 1)
+
+
+def moving_average(x, n):
+    """Each column of x averaged over n samples, centred."""
+    window = np.ones(n) / n
+    return np.stack([np.convolve(x[:, i], window, "same") for i in range(x.shape[1])], 1)
+
+
 def qmul(a, b):
     w1, x1, y1, z1 = a.T
     w2, x2, y2, z2 = b.T
@@ -67,11 +81,8 @@ def main():
         sys.exit(__doc__)
     print(f"{'trial':44} {'rest':>6} {'oracle':>6} | VQF inclination RMSE, estimate shifted by s samples")
     for path in paths:
-        d = load(path)
-        acc, gyr, mag, truth, moving = d[:, 1:4], d[:, 4:7], d[:, 7:10], d[:, 10:14], d[:, 14] == 1
-        known = np.all(np.isfinite(truth), 1)
-        window = np.ones(143) / 143
-        mean = np.stack([np.convolve(acc[:, i], window, "same") for i in range(3)], 1)
+        acc, gyr, mag, truth, moving, known = trial(path)
+        mean = moving_average(acc, 143)
         rest = (np.linalg.norm(gyr, axis=1) < 0.03) & (np.linalg.norm(acc - mean, axis=1) < 0.15) & known
         a, g = acc[rest], gravity_in_sensor(truth[rest])
         floor, oracle = angle_rms_deg(a, g), angle_rms_deg(a - (a - g).mean(0), g)

@@ -23,7 +23,7 @@ import numpy as np
 from vqf import VQF
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from broad_floor import RATE_HZ, conj, gravity_in_sensor, load, qmul  # noqa: E402
+from broad_floor import RATE_HZ, conj, gravity_in_sensor, moving_average, qmul, trial  # noqa: E402
 
 
 def skew(w):
@@ -45,12 +45,9 @@ def main():
     print(f"{'trial':44} {'r (cm, sensor frame)':>22} {'explained':>9} | VQF inclination RMSE: raw -> lever arm out")
     before, after = [], []
     for path in paths:
-        d = load(path)
-        acc, gyr, mag, truth, moving = d[:, 1:4], d[:, 4:7], d[:, 7:10], d[:, 10:14], d[:, 14] == 1
-        known = np.all(np.isfinite(truth), 1)
+        acc, gyr, mag, truth, moving, known = trial(path)
         # The rate smoothed over 9 samples (31 ms) before differentiating it.
-        window = np.ones(9) / 9
-        rate = np.stack([np.convolve(gyr[:, i], window, "same") for i in range(3)], 1)
+        rate = moving_average(gyr, 9)
         spin = np.gradient(rate, axis=0) * RATE_HZ
         lever = skew(rate) @ skew(rate) + skew(spin)
         rows = moving & known
