@@ -34,7 +34,8 @@
 
 use glam::Vec2;
 
-use crate::{REDUCED_LEVELS, UprightImage, reduced};
+use crate::upright::REDUCED_LEVELS;
+use crate::{UprightImage, reduced};
 
 /// Template samples across and down the eye.
 const COLUMNS: usize = 24;
