@@ -52,6 +52,8 @@ struct Outcome {
     ipd_px: f32,
     /// The face's eye distance in the photograph as it was taken (before any enlarging).
     photo_ipd_px: f32,
+    /// The lenses were drawn with a reflection across them.
+    reflection: bool,
     /// `None`: the face was lost with the glasses on.
     eye_error: Option<f32>,
     distance_error: Option<f32>,
@@ -101,6 +103,7 @@ fn try_styles(
                     case: format!("{case} {style:?}"),
                     ipd_px,
                     photo_ipd_px: ipd_px / enlarged,
+                    reflection: style.reflection > 0.0,
                     eye_error: None,
                     distance_error: None,
                     iris_distance_error: None,
@@ -113,6 +116,7 @@ fn try_styles(
                     ),
                     ipd_px,
                     photo_ipd_px: ipd_px / enlarged,
+                    reflection: style.reflection > 0.0,
                     eye_error: Some(
                         g.left_eye_px
                             .distance(f.left_eye_px)
@@ -250,14 +254,18 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
             percentile(iris.clone(), 0.5),
             percentile(iris.clone(), 1.0),
         );
-        // By the detail the photograph holds: a phone's front camera at arm's length puts its
-        // viewer's eyes about 100 px apart; the shared photos' small faces, 13–35 px.
-        for (part, large) in [("eyes ≥ 40 px apart in the photo", true), ("eyes < 40 px apart", false)] {
-            let errors: Vec<f32> = found
-                .iter()
-                .filter(|o| (o.photo_ipd_px >= 40.0) == large)
-                .filter_map(|o| o.eye_error)
-                .collect();
+        // By the detail the photograph holds (a phone's front camera at arm's length puts its
+        // viewer's eyes about 100 px apart; the shared photos' small faces, 13–35 px), and by
+        // whether a reflection lies across the lenses.
+        type Part = (&'static str, fn(&Outcome) -> bool);
+        let parts: [Part; 4] = [
+            ("eyes ≥ 40 px apart in the photo", |o| o.photo_ipd_px >= 40.0),
+            ("eyes < 40 px apart", |o| o.photo_ipd_px < 40.0),
+            ("lenses without a reflection", |o| !o.reflection),
+            ("lenses with a reflection", |o| o.reflection),
+        ];
+        for (part, within) in parts {
+            let errors: Vec<f32> = found.iter().filter(|o| within(o)).filter_map(|o| o.eye_error).collect();
             if !errors.is_empty() {
                 println!(
                     "  {part}: {} faces, eye error median {:.3}, 90 % {:.3}, max {:.3}",
