@@ -536,7 +536,10 @@ mod tests {
             }
         }
         let stopped = untint_colour([0.8, 0.02, 0.02], [0.9, 0.0, 0.0]);
-        assert!(stopped.iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c)), "{stopped:?}");
+        assert!(
+            stopped.iter().all(|c| c.is_finite() && (0.0..=1.0).contains(c)),
+            "{stopped:?}"
+        );
     }
 
     use crate::{CameraFrame, Intrinsics, PixelFormat};
