@@ -148,8 +148,10 @@ pub fn style_for(seed: u32) -> GlassesStyle {
         LensShape::RoundedRect(0.3),
         LensShape::RoundedRect(0.1),
     ];
-    let pick =
-        |n: u32, salt: u32| ((seed.wrapping_mul(2_654_435_761).wrapping_add(salt.wrapping_mul(40_503))) >> 7) % n;
+    // Each property from its own hash of the seed, so that every combination occurs: a
+    // multiplicative hash's neighbouring bits (as this used before) tied properties together —
+    // width and aspect took 6 of their 9 pairs, and a thin dark rim always came with a reflection.
+    let pick = |n: u32, salt: u32| mix(mix(seed) ^ salt.wrapping_mul(0x9E37_79B9)) % n;
     let cardboard = pick(2, 3) == 0;
     GlassesStyle {
         filters: pairs[(seed % 4) as usize],
@@ -169,9 +171,62 @@ pub fn style_for(seed: u32) -> GlassesStyle {
     }
 }
 
+/// A 32-bit integer hash with good avalanche (Chris Wellons' "lowbias32"): every input bit
+/// flips each output bit with probability close to a half.
+fn mix(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^ (x >> 16)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Over 320 styles (the glasses test's), every pair of properties takes every combination of
+    /// its values, each within half of its even share.
+    #[test]
+    fn styles_cover_every_combination_of_two_properties() {
+        // A property: its name, its value's index, how many values it takes.
+        type Property = (&'static str, fn(&GlassesStyle) -> u32, u32);
+        let styles: Vec<GlassesStyle> = (0..320).map(style_for).collect();
+        let props: [Property; 6] = [
+            (
+                "shape",
+                |s| match s.shape {
+                    LensShape::Ellipse => 0,
+                    LensShape::RoundedRect(r) => 1 + (r < 0.2) as u32,
+                },
+                3,
+            ),
+            ("width", |s| ((s.width_ipd - 0.6) * 10.0).round() as u32, 3),
+            ("aspect", |s| ((s.aspect - 0.6) * 10.0).round() as u32, 3),
+            ("opacity", |s| ((1.0 - s.opacity) / 0.15).round() as u32, 3),
+            (
+                "rim",
+                |s| if s.rim_ipd > 0.05 { 2 } else { (s.rim_ipd > 0.0) as u32 },
+                3,
+            ),
+            ("reflection", |s| (s.reflection > 0.0) as u32, 2),
+        ];
+        for (i, (a, fa, na)) in props.iter().enumerate() {
+            for (b, fb, nb) in &props[i + 1..] {
+                let mut counts = vec![0u32; (na * nb) as usize];
+                for s in &styles {
+                    counts[(fa(s) * nb + fb(s)) as usize] += 1;
+                }
+                let share = styles.len() as f32 / (na * nb) as f32;
+                // The rim's three values are not even (cardboard half, plastic and none a quarter).
+                let least = if *a == "rim" || *b == "rim" { 0.25 } else { 0.5 } * share;
+                assert!(
+                    counts.iter().all(|&c| c as f32 >= least),
+                    "{a} × {b}: {counts:?} (even share {share})"
+                );
+            }
+        }
+    }
 
     #[test]
     fn a_lens_filters_what_is_under_it_and_nothing_else() {
