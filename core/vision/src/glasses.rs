@@ -26,6 +26,7 @@ use phantogram_geometry::srgb::{code_to_linear as linear, from_linear_fast, to_l
 pub use phantogram_sensing::glasses::{Filter, GlassesSeen};
 use std::sync::LazyLock;
 
+use crate::rim::Rim;
 use crate::{FaceFound, UprightImage};
 
 /// The weakest colour shift (natural-log units, both eyes) taken for a lens: a lens that passes
@@ -327,6 +328,13 @@ impl Lenses {
     /// cells' own centroid. `None` for a lens that covers under a twentieth of the window or whose
     /// window runs off the image.
     pub fn centres(&self, image: &UprightImage) -> [Option<Vec2>; 2] {
+        self.outlines(image).map(|o| o.map(|o| o.centre))
+    }
+
+    /// Each lens's outline (image left, image right): the convex hull of the largest group of
+    /// cells seen through it and that hull's centroid, as [`Lenses::centres`] finds them (one read
+    /// of the window serves both the centres and the rims, [`crate::rim`]).
+    pub fn outlines(&self, image: &UprightImage) -> [Option<LensOutline>; 2] {
         const CELLS: (usize, usize) = (60, 50);
         let [l, r] = self.eyes_px;
         let ipd = l.distance(r);
@@ -362,9 +370,38 @@ impl Lenses {
             if points.len() * 20 < lens.len() {
                 return None;
             }
-            Some(to_image(hull_centroid(&points)))
+            let hull = convex_hull(&points);
+            Some(LensOutline {
+                centre: to_image(centroid_of_hull(&hull, &points)),
+                hull_px: hull.into_iter().map(to_image).collect(),
+            })
         })
     }
+}
+
+impl Lenses {
+    /// The dark rims around the lenses whose `outlines` were found ([`crate::rim`]).
+    pub fn rims(&self, image: &UprightImage, outlines: &[Option<LensOutline>; 2]) -> [Option<Rim>; 2] {
+        [0, 1].map(|i| Rim::around(image, self, i, outlines[i].as_ref()?))
+    }
+
+    /// The distance between the eyes the lenses were found at, pixels.
+    pub fn eye_distance_px(&self) -> f32 {
+        self.eyes_px[0].distance(self.eyes_px[1])
+    }
+
+    /// The cheek's colour beside lens `i` (0: image left), linear RGB.
+    pub fn cheek(&self, i: usize) -> Option<[f32; 3]> {
+        self.ln_cheek.get(i).map(|c| c.to_array().map(f32::exp))
+    }
+}
+
+/// A lens's outline in the image: the convex hull of the cells seen through it (pixels, in hull
+/// order) and the hull's centroid.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LensOutline {
+    pub centre: Vec2,
+    pub hull_px: Vec<Vec2>,
 }
 
 /// How far, per axis, a lens's centre may sit from the pupil behind it, as a share of the eye
@@ -438,15 +475,14 @@ fn largest_group(set: &[bool], width: usize, height: usize) -> Vec<usize> {
     best
 }
 
-/// The centroid of the area of `points`' convex hull (Andrew's monotone chain); the points' mean
-/// when the hull has no area (fewer than three points, or all on a line).
-fn hull_centroid(points: &[Vec2]) -> Vec2 {
-    let mean = points.iter().copied().sum::<Vec2>() / points.len().max(1) as f32;
+/// The convex hull of `points` (Andrew's monotone chain), counter-clockwise in a y-down image;
+/// fewer than three distinct points come back as they are.
+fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
     let mut p = points.to_vec();
     p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     p.dedup();
     if p.len() < 3 {
-        return mean;
+        return p;
     }
     // One chain (lower, then upper from the points reversed), its last point left to start the
     // other.
@@ -463,10 +499,20 @@ fn hull_centroid(points: &[Vec2]) -> Vec2 {
     };
     let mut hull = chain(&mut p.iter().copied());
     hull.extend(chain(&mut p.iter().rev().copied()));
-    // Polygon centroid, about the first vertex (for precision).
+    hull
+}
+
+/// The centroid of the polygon `hull` (the area's, not the vertices'); the mean of `points` when
+/// the hull has no area.
+fn centroid_of_hull(hull: &[Vec2], points: &[Vec2]) -> Vec2 {
+    let mean = points.iter().copied().sum::<Vec2>() / points.len().max(1) as f32;
+    if hull.len() < 3 {
+        return mean;
+    }
+    // About the first vertex (for precision).
     let o = hull[0];
     let (mut area, mut sum) = (0.0f32, Vec2::ZERO);
-    for k in 1..hull.len().saturating_sub(1) {
+    for k in 1..hull.len() - 1 {
         let (a, b) = (hull[k] - o, hull[k + 1] - o);
         let cross = a.perp_dot(b);
         area += cross;
@@ -476,6 +522,12 @@ fn hull_centroid(points: &[Vec2]) -> Vec2 {
         return mean;
     }
     o + sum / (3.0 * area)
+}
+
+/// The centroid of the convex hull of `points` (see [`Lenses::centres`]).
+#[cfg(test)]
+fn hull_centroid(points: &[Vec2]) -> Vec2 {
+    centroid_of_hull(&convex_hull(points), points)
 }
 
 /// One sRGB-coded colour ([0, 1]) seen through a lens of `transmission`, as it would be without:
@@ -629,6 +681,73 @@ mod tests {
         let bare_image = super::tests::image(&bare);
         assert!(find_at(&bare_image, left, right).is_none());
         assert_eq!(lenses.centres(&bare_image), [None, None]);
+    }
+
+    /// A thin dark rim around both lenses is found and filled with the cheek's colour; the lens
+    /// inside it and the skin beyond it are left alone; a rimless or a white rim is no rim.
+    #[test]
+    fn a_dark_rim_is_found_around_each_lens_and_filled_with_the_cheek() {
+        let (left, right) = (Vec2::new(60.0, 60.0), Vec2::new(140.0, 60.0));
+        let half = Vec2::new(28.0, 19.6);
+        let glasses = |rim: Option<[f32; 3]>| {
+            face(move |p, skin| {
+                for (centre, f) in [(left, Filter::Red), (right, Filter::Cyan)] {
+                    if in_ellipse(p, centre, half) {
+                        let t = transmission(f);
+                        return [0, 1, 2].map(|k| skin[k] * t[k]);
+                    }
+                    if let Some(colour) = rim
+                        && in_ellipse(p, centre, half + Vec2::splat(3.0))
+                    {
+                        return colour;
+                    }
+                }
+                skin
+            })
+        };
+        let dark = [25u8, 22, 20].map(code_to_linear);
+        let rgba = glasses(Some(dark));
+        let image = image(&rgba);
+        let lenses = find_at(&image, left, right).expect("the glasses");
+        let rims = lenses.rims(&image, &lenses.outlines(&image));
+        let [Some(a), Some(_)] = &rims else {
+            panic!("both rims: {rims:?}")
+        };
+        // 3 px of rim, beyond a hull of cell centres up to a cell inside the lens's edge.
+        assert!((3.0..=6.5).contains(&a.reach_px), "reach {}", a.reach_px);
+        let coded = |lin: [f32; 3]| lin.map(|c| f32::from(linear_to_code(c)) / 255.0);
+        let cheek = lenses.cheek(0).expect("a cheek").map(from_linear_fast);
+        let on_rim = left + Vec2::new(half.x + 1.5, 0.0);
+        let filled = a.filled(on_rim, coded(dark), false).expect("the rim is filled");
+        assert!(
+            filled.iter().zip(cheek).all(|(f, c)| (f - c).abs() < 1e-4),
+            "{filled:?}"
+        );
+        let on_rim_above = left - Vec2::new(0.0, half.y + 1.5);
+        assert!(
+            a.filled(on_rim_above, coded(dark), false).is_some(),
+            "above the lens too"
+        );
+        let grey = a.filled(on_rim, coded(dark), true).expect("a grey crop's rim");
+        assert!(grey[0] == grey[1] && grey[1] == grey[2]);
+        // Inside the lens, on skin beyond the rim, and a dark pixel far out: as they are.
+        let inside = left + Vec2::new(half.x - 4.0, 0.0);
+        assert!(a.filled(inside, coded(dark), false).is_none());
+        let beyond = left + Vec2::new(half.x + 12.0, 0.0);
+        assert!(a.filled(beyond, coded(dark), false).is_none());
+        let skin = [200u8, 150, 120].map(|c| f32::from(c) / 255.0);
+        assert!(a.filled(on_rim, skin, false).is_none(), "skin-coloured: not a rim");
+        // Rimless, or a white cardboard rim: none.
+        for (what, rim) in [
+            ("rimless", None),
+            ("white", Some([235u8, 232, 225].map(code_to_linear))),
+        ] {
+            let rgba = glasses(rim);
+            let image = super::tests::image(&rgba);
+            let lenses = find_at(&image, left, right).expect("the glasses");
+            let rims = lenses.rims(&image, &lenses.outlines(&image));
+            assert_eq!(rims, [None, None], "{what}");
+        }
     }
 
     #[test]

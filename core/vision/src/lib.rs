@@ -78,6 +78,7 @@ mod max_pool;
 mod networks;
 mod prelu;
 mod reduced;
+pub mod rim;
 mod roi;
 mod tracker;
 mod upright;

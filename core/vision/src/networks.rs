@@ -9,7 +9,7 @@
 use crate::detection::{Detection, decode_detections, merge_detections, roi_from_detection};
 use crate::roi::Roi;
 use crate::{FACE_FLAG_MIN, MIN_FACE_CONFIDENCE};
-use crate::{FaceError, FaceFound, Mesh, UprightImage, eye_corners, glasses, max_pool, prelu, sigmoid};
+use crate::{FaceError, FaceFound, Mesh, UprightImage, eye_corners, glasses, max_pool, prelu, rim, sigmoid};
 use glam::Vec2;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -138,7 +138,12 @@ impl FaceModels {
         lenses: Option<&glasses::Lenses>,
     ) -> Result<Option<(Vec<Vec2>, f32)>, FaceError> {
         let crop = match lenses {
-            Some(l) => roi.tensor_with(image, 192, (0.0, 1.0), false, |p, c| l.untint_at(image, p, c)),
+            Some(l) => {
+                let rims = l.rims(image, &l.outlines(image));
+                roi.tensor_with(image, 192, (0.0, 1.0), false, |p, c| {
+                    rim::without_rims(image, &rims, p, c).unwrap_or_else(|| l.untint_at(image, p, c))
+                })
+            }
             None => roi.tensor(image, 192, (0.0, 1.0), false),
         };
         let out = Self::run(&self.mesh, crop, 192)?;
@@ -158,22 +163,24 @@ impl FaceModels {
     }
 
     /// Iris in the eye between the two corner landmarks: centre and diameter, pixels. Under a
-    /// lens (`lens`: the glasses and which of their lenses, 0 for the image-left one), the crop's
-    /// tint is undone first.
+    /// lens (`lens`: the glasses, which of their lenses, 0 for the image-left one, and the
+    /// glasses' dark rims), the crop's tint is undone and the rims filled first.
     fn iris(
         &self,
         image: &UprightImage,
         from: Vec2,
         to: Vec2,
         flip: bool,
-        lens: Option<(&glasses::Lenses, usize)>,
+        lens: Option<(&glasses::Lenses, usize, &[Option<rim::Rim>; 2])>,
     ) -> Result<Option<(Vec2, f32)>, FaceError> {
         let roi = Roi::around([from, to].into_iter(), from, to, 2.3);
         if roi.size.is_nan() || roi.size <= 1.0 {
             return Ok(None);
         }
         let crop = match lens {
-            Some((l, i)) => roi.tensor_with(image, 64, (0.0, 1.0), flip, |p, c| l.untint_all_at(image, i, p, c)),
+            Some((l, i, rims)) => roi.tensor_with(image, 64, (0.0, 1.0), flip, |p, c| {
+                rim::without_rims(image, rims, p, c).unwrap_or_else(|| l.untint_all_at(image, i, p, c))
+            }),
             None => roi.tensor(image, 64, (0.0, 1.0), flip),
         };
         let out = Self::run(&self.iris, crop, 64)?;
@@ -195,15 +202,15 @@ impl FaceModels {
 
     /// Both irises (image left, image right: centre and diameter, pixels) from the four eye
     /// corners (image-left eye's outer and inner, image-right eye's inner and outer), each crop's
-    /// tint undone under `lenses`; `None` unless both are found.
+    /// tint undone and the rims filled under `lenses`; `None` unless both are found.
     fn irises(
         &self,
         image: &UprightImage,
         [la, lb, ra, rb]: [Vec2; 4],
-        lenses: Option<&glasses::Lenses>,
+        lenses: Option<(&glasses::Lenses, &[Option<rim::Rim>; 2])>,
     ) -> Result<Option<[(Vec2, f32); 2]>, FaceError> {
-        let left = self.iris(image, la, lb, false, lenses.map(|l| (l, 0)))?;
-        let right = self.iris(image, ra, rb, true, lenses.map(|l| (l, 1)))?;
+        let left = self.iris(image, la, lb, false, lenses.map(|(l, r)| (l, 0, r)))?;
+        let right = self.iris(image, ra, rb, true, lenses.map(|(l, r)| (l, 1, r)))?;
         Ok(left.zip(right).map(|(l, r)| [l, r]))
     }
 
@@ -246,13 +253,20 @@ impl FaceModels {
         };
         // Glasses, looked for around the eyes' corners' midpoints (the irises are not known yet).
         let lenses = glasses::find_at(image, (la + lb) * 0.5, (ra + rb) * 0.5);
-        let Some([(left_eye_px, dl), (right_eye_px, dr)]) = self.irises(image, [la, lb, ra, rb], lenses.as_ref())?
+        // The lenses' outlines: their dark rims for the iris crops, their centres for the fusion.
+        let outlines = lenses.as_ref().map(|l| l.outlines(image));
+        let rims = match (&lenses, &outlines) {
+            (Some(l), Some(o)) => l.rims(image, o),
+            _ => [None, None],
+        };
+        let Some([(left_eye_px, dl), (right_eye_px, dr)]) =
+            self.irises(image, [la, lb, ra, rb], lenses.as_ref().map(|l| (l, &rims)))?
         else {
             return Ok(None);
         };
         // With glasses on, each lens is a second, independent fix of its eye.
-        let [left_eye_px, right_eye_px] = match &lenses {
-            Some(l) => glasses::with_lens_centres([left_eye_px, right_eye_px], l.centres(image)),
+        let [left_eye_px, right_eye_px] = match outlines {
+            Some(o) => glasses::with_lens_centres([left_eye_px, right_eye_px], o.map(|o| o.map(|o| o.centre))),
             None => [left_eye_px, right_eye_px],
         };
         Ok(Some(FaceFound {
