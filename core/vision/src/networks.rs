@@ -130,7 +130,8 @@ impl FaceModels {
     }
 
     /// FaceMesh in `roi`: the landmarks and the face flag, or `None` if not a face. With
-    /// `lenses` (glasses seen where the eyes were expected), their tint is undone in the crop.
+    /// `lenses` (glasses seen where the eyes were expected), their tint is undone in the crop and
+    /// their dark rims are filled ([`rim`]).
     fn mesh(
         &self,
         image: &UprightImage,
@@ -228,8 +229,8 @@ impl FaceModels {
         }
     }
 
-    /// FaceMesh for the face in `roi` (its crop's tint undone where glasses are seen around
-    /// `eyes_hint`): the landmarks and the face flag, or `None` if not a face.
+    /// FaceMesh for the face in `roi` (its crop's tint undone and rims filled where glasses are
+    /// seen around `eyes_hint`): the landmarks and the face flag, or `None` if not a face.
     pub(crate) fn mesh_in(
         &self,
         image: &UprightImage,
