@@ -20,7 +20,8 @@
 //!
 //! **Glasses** ([`glasses`]): on colour frames (RGBA, or luma with its chroma planes) the skin
 //! under each eye's lens is compared with the cheek's to name the filters of anaglyph glasses.
-//! With glasses on, the crops have the lenses' tint undone, each eye is the iris network's answer
+//! With glasses on, the crops have the lenses' tint undone and their dark rims filled with the
+//! cheek's colour ([`rim`]: a thin dark frame reads as a lid), each eye is the iris network's answer
 //! fused with the centre of the lens in front of it (the coloured lenses as fiducial markers,
 //! as the handheld-phantogram paper suggests), and the distance comes from the eye distance
 //! (calibrated, or 63 mm), not from the tinted iris, which looks smaller than it is.
@@ -38,7 +39,7 @@
 //! * `networks` ([`FaceModels`]): the three networks, their crops and outputs, and every face of
 //!   a still image; `detection`: BlazeFace's anchors, decoding and merging.
 //! * `tracker` ([`FaceTracker`]): which networks run on each frame; [`eye_patch`]: the eyes
-//!   followed between them; [`glasses`]: anaglyph lenses; `worker` ([`FaceWorker`]): the
+//!   followed between them; [`glasses`]: anaglyph lenses, [`rim`]: their dark rims; `worker` ([`FaceWorker`]): the
 //!   tracker on its own thread.
 //! * Here: what they share ([`FaceFound`], FaceMesh's answer, the eye-corner landmarks).
 //!
