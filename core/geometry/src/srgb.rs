@@ -1,5 +1,6 @@
 //! The sRGB transfer curve (IEC 61966-2-1), the one place it is written: camera codes back to
-//! linear light (the room light, the glasses check, drawn test glasses) and linear light to codes.
+//! linear light (the room light, the glasses check, drawn test glasses) and linear light to codes;
+//! and the luminance of a colour in sRGB's primaries ([`luminance`]).
 //!
 //! Values in [0, 1]; inputs outside are clamped and NaN counts as 0. Pure functions, no panics;
 //! the table-backed ones build their tables on first use (thread-safe, once per process).
@@ -62,6 +63,12 @@ pub fn to_linear_fast(c: f32) -> f32 {
 /// [`from_linear`] from a table, within 2·10⁻⁵ of it (under a twentieth of an 8-bit step).
 pub fn from_linear_fast(v: f32) -> f32 {
     read(&FAST.1, v)
+}
+
+/// Relative luminance of a linear-light colour in sRGB's (Rec. 709) primaries: the one weighting
+/// of red, green and blue used wherever the project asks how bright a colour is.
+pub fn luminance(linear: [f32; 3]) -> f32 {
+    0.2126 * linear[0] + 0.7152 * linear[1] + 0.0722 * linear[2]
 }
 
 /// The nearest 8-bit sRGB code of a linear value.

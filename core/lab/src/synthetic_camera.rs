@@ -9,6 +9,7 @@
 
 use glam::{Quat, Vec3};
 use phantogram_assets::ibl::Environment;
+use phantogram_geometry::srgb::luminance;
 use phantogram_roomlight::tone::srgb8_from_linear;
 use phantogram_roomlight::world_from_buffer_camera;
 use phantogram_sensing::camera::{CameraPose, ChromaPlanes, Exposure, Intrinsics, OwnedFrame, PixelFormat};
@@ -81,8 +82,7 @@ impl SyntheticCamera {
                 env.sample(q * ray)
             })
             .collect();
-        let luminance = |c: &[f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-        let mean = radiance.iter().map(luminance).sum::<f32>() / radiance.len().max(1) as f32;
+        let mean = radiance.iter().copied().map(luminance).sum::<f32>() / radiance.len().max(1) as f32;
         let average = if mean > 1e-9 { self.middle_grey / mean } else { 1.0 };
         let exposure = match metering {
             Metering::Average => average,

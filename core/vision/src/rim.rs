@@ -25,7 +25,7 @@
 use crate::UprightImage;
 use crate::glasses::{LensOutline, Lenses};
 use glam::Vec2;
-use phantogram_geometry::srgb::{code_to_linear, from_linear_fast, to_linear_fast};
+use phantogram_geometry::srgb::{code_to_linear, from_linear_fast, luminance, to_linear_fast};
 
 /// Rays from the outline's centre.
 const RAYS: usize = 64;
@@ -55,10 +55,6 @@ pub struct Rim {
     /// grey (luma) crops.
     fill: [f32; 3],
     fill_grey: f32,
-}
-
-fn luminance(linear: [f32; 3]) -> f32 {
-    0.2126 * linear[0] + 0.7152 * linear[1] + 0.0722 * linear[2]
 }
 
 impl Rim {

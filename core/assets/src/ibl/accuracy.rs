@@ -6,6 +6,7 @@
 //! Pure functions; slow (thousands of samples per case), no panics.
 
 use glam::Vec3;
+use phantogram_geometry::srgb::luminance;
 
 use super::anisotropic::{WardImageLight, sample_levels};
 use super::{Environment, prefiltered_levels};
@@ -89,10 +90,6 @@ fn reference(env: &Environment, lobe: WardLobe, frame: Frame, v: Vec3, samples: 
     }
     let n = samples as f64;
     (sum.map(|s| (s / n) as f32), (albedo / n) as f32)
-}
-
-fn luminance(c: [f32; 3]) -> f32 {
-    0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]
 }
 
 /// Both reads' errors for `lobe` under `env` over `count` frames and views (2048 samples each
