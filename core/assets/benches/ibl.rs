@@ -8,37 +8,11 @@
 
 use std::time::Instant;
 
-use glam::Vec3;
 use phantogram_assets::ibl::sh::reference_projection;
 use phantogram_assets::ibl::{Environment, IrradianceSh, prefiltered_levels};
 
 /// The renderer's prefiltered base width (`phantogram_render`'s `PREFILTERED_BASE_WIDTH`).
 const PREFILTERED_BASE_WIDTH: usize = 256;
-
-/// A map with structure (a sky gradient, a sun, per-texel noise), so that nothing is constant.
-fn environment(width: usize) -> Environment {
-    let height = width / 2;
-    let mut env = Environment {
-        width,
-        height,
-        texels: Vec::with_capacity(width * height),
-    };
-    let sun = Vec3::new(0.3, -0.5, 0.8).normalize();
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    for y in 0..height {
-        for x in 0..width {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            let noise = (state >> 40) as f32 / (1u64 << 24) as f32;
-            let d = env.direction(x, y);
-            let s = if d.dot(sun) > 0.9995 { 5000.0 } else { 0.0 };
-            let sky = 0.2 + 0.8 * d.z.max(0.0) + 0.1 * noise;
-            env.texels.push([sky + s, sky * 1.1 + s, sky * 1.3 + s]);
-        }
-    }
-    env
-}
 
 /// Median milliseconds of `runs` calls of `f`, after one warm-up call.
 fn median_ms<R>(runs: usize, mut f: impl FnMut() -> R) -> f64 {
@@ -60,7 +34,7 @@ fn main() {
     println!("| map | SH9 (ours, {cores} cores) | SH9 texel by texel (1 core) | ratio | specular levels (256 base) |");
     println!("|---|---|---|---|---|");
     for width in [1024, 2048, 4096] {
-        let env = environment(width);
+        let env = Environment::benchmark_sky(width);
         let runs = (4096 / width) * 10 + 5;
         let fast = median_ms(runs * 4, || IrradianceSh::from_environment(&env));
         let naive = median_ms(runs.min(9), || reference_projection(&env));

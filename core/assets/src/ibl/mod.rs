@@ -104,6 +104,33 @@ impl Environment {
         env
     }
 
+    /// The benchmarks' map (`benches/ibl.rs` here, `prefilter.rs` in the renderer): `width` ×
+    /// `width / 2` texels of a sky gradient, a 5000× sun and per-texel noise, so that no part of an
+    /// update meets a constant run. Deterministic.
+    pub fn benchmark_sky(width: usize) -> Self {
+        let height = width / 2;
+        let mut env = Self {
+            width,
+            height,
+            texels: Vec::with_capacity(width * height),
+        };
+        let sun = Vec3::new(0.3, -0.5, 0.8).normalize();
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        for y in 0..height {
+            for x in 0..width {
+                state ^= state << 13;
+                state ^= state >> 7;
+                state ^= state << 17;
+                let noise = (state >> 40) as f32 / (1u64 << 24) as f32;
+                let d = env.direction(x, y);
+                let s = if d.dot(sun) > 0.9995 { 5000.0 } else { 0.0 };
+                let sky = 0.2 + 0.8 * d.z.max(0.0) + 0.1 * noise;
+                env.texels.push([sky + s, sky * 1.1 + s, sky * 1.3 + s]);
+            }
+        }
+        env
+    }
+
     /// Loads a Radiance `.hdr` or OpenEXR file, equirectangular, at most [`MAX_WIDTH_PX`] wide.
     pub fn load(path: &std::path::Path) -> Result<Self, EnvironmentError> {
         let err = |message: String| EnvironmentError::Load {
@@ -190,6 +217,40 @@ impl Environment {
         out
     }
 
+    /// `1/factor` of the resolution, each texel the mean of a `factor × factor` block: what
+    /// `log2(factor)` calls of [`Self::downsampled`] give (to rounding), in one pass with rows on
+    /// every core. `factor` must divide both sides (the caller checks; otherwise the edge blocks
+    /// would be short).
+    pub fn box_filtered(&self, factor: usize) -> Self {
+        let factor = factor.max(1);
+        let (w, h) = (self.width / factor, self.height / factor);
+        let rows: Vec<usize> = (0..h).collect();
+        let scale = 1.0 / (factor * factor) as f32;
+        let texels = crate::parallel::map(&rows, |&y| {
+            let mut row = vec![[0.0f32; 3]; w];
+            for sy in y * factor..(y + 1) * factor {
+                let source = &self.texels[sy * self.width..(sy + 1) * self.width];
+                for (out, block) in row.iter_mut().zip(source.chunks_exact(factor)) {
+                    for t in block {
+                        for c in 0..3 {
+                            out[c] += t[c];
+                        }
+                    }
+                }
+            }
+            for t in &mut row {
+                *t = t.map(|c| c * scale);
+            }
+            row
+        })
+        .concat();
+        Self {
+            width: w,
+            height: h,
+            texels,
+        }
+    }
+
     /// Half the resolution, each texel the mean of four (keeps the integral for prefiltering).
     pub fn downsampled(&self) -> Self {
         let (w, h) = ((self.width / 2).max(2), (self.height / 2).max(1));
@@ -232,6 +293,23 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn one_box_filter_equals_repeated_halvings() {
+        // Noise, a gradient and a 5000× sun: every texel differs from its neighbours.
+        let env = Environment::benchmark_sky(256);
+        let twice = env.downsampled().downsampled().downsampled();
+        let once = env.box_filtered(8);
+        assert_eq!((once.width, once.height), (twice.width, twice.height));
+        for (a, b) in once.texels.iter().zip(&twice.texels) {
+            for c in 0..3 {
+                assert!((a[c] - b[c]).abs() <= 1e-5 * b[c].abs().max(1.0), "{a:?} vs {b:?}");
+            }
+        }
+        // A block mean, not a point sample: the mean radiance is kept.
+        let mean = |e: &Environment| e.texels.iter().map(|t| f64::from(t[0])).sum::<f64>() / e.texels.len() as f64;
+        assert!((mean(&once) - mean(&env)).abs() < 1e-4 * mean(&env));
     }
 
     /// An environment of one radiance everywhere.

@@ -36,13 +36,28 @@ pub fn prefilter_base_width(base_width: usize) -> usize {
 /// ([`Environment::downsampled`]), on the CPU here or on the GPU by the renderer.
 pub fn prefilter_base(env: &Environment, base_width: usize) -> Environment {
     let base_width = prefilter_base_width(base_width);
-    // Sample from a source a little coarser than each level, so few samples suffice.
-    let mut source = env.clone();
-    while source.width >= 2 * base_width && source.width > 8 {
-        source = source.downsampled();
+    // Sample from a source a little coarser than each level, so few samples suffice: halved while
+    // at least twice the base's width.
+    let (mut halvings, mut w) = (0u32, env.width);
+    while w >= 2 * base_width && w > 8 {
+        (halvings, w) = (halvings + 1, (w / 2).max(2));
     }
+    let factor = 1usize << halvings;
+    let source = if halvings == 0 {
+        std::borrow::Cow::Borrowed(env)
+    } else if env.width.is_multiple_of(factor) && env.height.is_multiple_of(factor) {
+        // The halvings in one pass, rows on every core (a 4096-wide map took 74 ms as four
+        // halvings on one core of this machine).
+        std::borrow::Cow::Owned(env.box_filtered(factor))
+    } else {
+        let mut source = env.downsampled();
+        for _ in 1..halvings {
+            source = source.downsampled();
+        }
+        std::borrow::Cow::Owned(source)
+    };
     if source.width == base_width && source.height == base_width / 2 {
-        return source;
+        return source.into_owned();
     }
     let mut level0 = Environment {
         width: base_width,
