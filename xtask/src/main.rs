@@ -12,7 +12,8 @@
 //! * `bench diorama` — ms per physics step of the Diorama with 50 bodies, moving and at rest
 //!   (`benchmarks/diorama.md`).
 //! * `bench ibl` — ms to update the image-based light (SH9, specular levels) from 1024-, 2048-
-//!   and 4096-wide maps on the CPU (`benchmarks/ibl.md`).
+//!   and 4096-wide maps on the CPU, then with the specular levels convolved on the GPU (the
+//!   first adapter found; on a machine without a GPU that is a software one) (`benchmarks/ibl.md`).
 //! * `bench face` — ms per 640×480 camera frame in detection and tracking modes (needs the
 //!   models from `models` and `PHANTOGRAM_DATA` for a face photograph).
 //! * `bench orientation` — score the orientation estimators on the recordings in
@@ -60,7 +61,10 @@ fn main() -> Result<()> {
         ["bench", "detail"] => cargo(&["bench", "-p", "phantogram", "--bench", "detail"]),
         ["bench", "face"] => cargo(&["bench", "-p", "phantogram", "--bench", "face"]),
         ["bench", "diorama"] => cargo(&["bench", "-p", "phantogram-physics", "--bench", "step"]),
-        ["bench", "ibl"] => cargo(&["bench", "-p", "phantogram-assets", "--bench", "ibl"]),
+        ["bench", "ibl"] => {
+            cargo(&["bench", "-p", "phantogram-assets", "--bench", "ibl"])?;
+            cargo(&["bench", "-p", "phantogram-render", "--bench", "prefilter"])
+        }
         ["models"] => models(false),
         ["models", "--force"] => models(true),
         ["android"] => phone::android(None),

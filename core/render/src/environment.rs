@@ -43,9 +43,15 @@ impl Renderer {
         sh: &phantogram_assets::ibl::IrradianceSh,
     ) -> Result<(), RenderError> {
         if self.prefilters_on_gpu()
-            && let Some(Some(prefilter)) = &self.gpu_prefilter
+            && let Some(Some(prefilter)) = &mut self.gpu_prefilter
         {
             let texture = prefilter.run(&self.gpu, base)?;
+            if self.ibl.environment_texture == texture {
+                // The same texture, convolved again in place (an update of the same size): the
+                // eyes' bind groups already hold it; only the irradiance changes.
+                self.environment_sh = sh.shader_coefficients();
+                return Ok(());
+            }
             return self.use_ibl(sh, |gpu| IblTextures::with_texture(gpu, &texture));
         }
         let levels = phantogram_assets::ibl::prefiltered_levels(base, PREFILTERED_BASE_WIDTH);

@@ -55,6 +55,8 @@ pub(super) fn brdf_lut_texels() -> &'static [u8] {
 
 /// The GPU side of the specular image-based light.
 pub(super) struct IblTextures {
+    /// The prefiltered environment (a mip chain), and its view.
+    pub(super) environment_texture: wgpu::Texture,
     pub(super) environment: wgpu::TextureView,
     pub(super) brdf_lut: wgpu::TextureView,
     pub(super) sampler: wgpu::Sampler,
@@ -124,6 +126,7 @@ impl IblTextures {
             ..Default::default()
         });
         Self {
+            environment_texture: texture.clone(),
             environment: texture.create_view(&Default::default()),
             brdf_lut: lut.create_view(&Default::default()),
             sampler,

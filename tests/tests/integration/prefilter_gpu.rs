@@ -27,7 +27,7 @@ fn the_gpu_convolves_the_levels_the_cpu_does() {
     let Some(gpu) = phantogram_integration::gpu_or_skip() else {
         return;
     };
-    let Some(prefilter) = GpuPrefilter::new(&gpu) else {
+    let Some(mut prefilter) = GpuPrefilter::new(&gpu) else {
         eprintln!("this device has no compute shaders: the CPU path is used, nothing to compare");
         return;
     };
@@ -39,6 +39,7 @@ fn the_gpu_convolves_the_levels_the_cpu_does() {
             *t = [1e6; 3];
         }
     }
+    let mut first = None;
     for (name, env) in [
         ("studio", Environment::studio()),
         ("sun and band", sun_and_band()),
@@ -50,6 +51,9 @@ fn the_gpu_convolves_the_levels_the_cpu_does() {
         }
         let base = prefilter_base(&env, PREFILTERED_BASE_WIDTH);
         let texture = prefilter.run(&gpu, &base).expect("prefilter");
+        // One size throughout: every run convolves into the same kept texture.
+        let first = first.get_or_insert_with(|| texture.clone());
+        assert!(*first == texture, "{name}: a new texture for a run of the same size");
         let gpu_levels = GpuPrefilter::read_back(&gpu, &texture).expect("read back");
         assert_eq!(gpu_levels.len(), cpu.len(), "{name}: levels");
         for (k, (g, c)) in gpu_levels.iter().zip(&cpu).enumerate() {
@@ -96,4 +100,39 @@ fn a_room_lit_through_the_gpu_path_draws_the_cpus_frame() {
     renderer.set_environment(&Environment::studio()).expect("studio");
     let studio = renderer.render(&input, mono, 180, 320).expect("frame");
     assert!(phantogram_integration::differing_pixels(&through_gpu, &studio) > 1000);
+}
+
+#[test]
+fn a_second_update_of_the_same_size_is_convolved_in_place_and_drawn() {
+    let Some(gpu) = phantogram_integration::gpu_or_skip() else {
+        return;
+    };
+    let model = phantogram::artifact::default_model();
+    let mut renderer = Renderer::new(gpu, &model).expect("renderer");
+    renderer.appearance = phantogram::appearance::Appearance::preset(phantogram::ward::WardPreset::Polished);
+    if !renderer.prefilters_on_gpu() {
+        eprintln!("this device has no compute shaders: nothing to compare");
+        return;
+    }
+    let view = phantogram_integration::held_view(30.0, 0.0);
+    let input = phantogram::engine::frame_input(&view, phantogram::glam::Vec3::ZERO);
+    let mono = phantogram::anaglyph::Method::Mono;
+    // Two live-light updates of one size: the second reuses the first's texture and bind groups
+    // (`GpuPrefilter`'s kept textures) and must still show its own room.
+    renderer.set_environment(&Environment::studio()).expect("studio");
+    let studio = renderer.render(&input, mono, 180, 320).expect("frame");
+    let env = sun_and_band();
+    renderer.set_environment(&env).expect("room, in place");
+    let in_place = renderer.render(&input, mono, 180, 320).expect("frame");
+    renderer
+        .set_prefiltered_environment(
+            &prefiltered_levels(&env, PREFILTERED_BASE_WIDTH),
+            &IrradianceSh::from_environment(&env),
+        )
+        .expect("CPU path");
+    let through_cpu = renderer.render(&input, mono, 180, 320).expect("frame");
+    let differing = phantogram_integration::differing_pixels(&in_place, &through_cpu);
+    println!("{differing} pixels differ by more than 8 levels from the CPU path's");
+    assert!(differing < 180 * 320 / 1000, "{differing} pixels differ");
+    assert!(phantogram_integration::differing_pixels(&in_place, &studio) > 1000);
 }
