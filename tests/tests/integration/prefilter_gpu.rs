@@ -69,19 +69,25 @@ fn the_gpu_convolves_the_levels_the_cpu_does() {
     }
 }
 
-#[test]
-fn a_room_lit_through_the_gpu_path_draws_the_cpus_frame() {
-    let Some(gpu) = phantogram_integration::gpu_or_skip() else {
-        return;
-    };
-    let model = phantogram::artifact::default_model();
-    let mut renderer = Renderer::new(gpu, &model).expect("renderer");
-    // Polished bronze: the image light's sharp levels show in its reflections.
+/// A renderer of the default artifact in polished bronze (the image light's sharp levels show in
+/// its reflections) whose device convolves on the GPU; `None`, said, where there is no device or
+/// it has no compute shaders.
+fn polished_renderer_that_prefilters() -> Option<Renderer> {
+    let gpu = phantogram_integration::gpu_or_skip()?;
+    let mut renderer = Renderer::new(gpu, &phantogram::artifact::default_model()).expect("renderer");
     renderer.appearance = phantogram::appearance::Appearance::preset(phantogram::ward::WardPreset::Polished);
     if !renderer.prefilters_on_gpu() {
         eprintln!("this device has no compute shaders: nothing to compare");
-        return;
+        return None;
     }
+    Some(renderer)
+}
+
+#[test]
+fn a_room_lit_through_the_gpu_path_draws_the_cpus_frame() {
+    let Some(mut renderer) = polished_renderer_that_prefilters() else {
+        return;
+    };
     let env = sun_and_band();
     let sh = IrradianceSh::from_environment(&env);
     let view = phantogram_integration::held_view(30.0, 0.0);
@@ -104,16 +110,9 @@ fn a_room_lit_through_the_gpu_path_draws_the_cpus_frame() {
 
 #[test]
 fn a_second_update_of_the_same_size_is_convolved_in_place_and_drawn() {
-    let Some(gpu) = phantogram_integration::gpu_or_skip() else {
+    let Some(mut renderer) = polished_renderer_that_prefilters() else {
         return;
     };
-    let model = phantogram::artifact::default_model();
-    let mut renderer = Renderer::new(gpu, &model).expect("renderer");
-    renderer.appearance = phantogram::appearance::Appearance::preset(phantogram::ward::WardPreset::Polished);
-    if !renderer.prefilters_on_gpu() {
-        eprintln!("this device has no compute shaders: nothing to compare");
-        return;
-    }
     let view = phantogram_integration::held_view(30.0, 0.0);
     let input = phantogram::engine::frame_input(&view, phantogram::glam::Vec3::ZERO);
     let mono = phantogram::anaglyph::Method::Mono;
