@@ -281,7 +281,9 @@ fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, res
                 prepared.info.preview = true;
                 Some(prepared)
             };
-            if let Ok(Some(prepared)) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(preview)) {
+            if let Ok(Some(prepared)) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                crate::background::in_background_pool(preview)
+            })) {
                 if progress.is_cancelled() {
                     continue;
                 }
@@ -318,7 +320,9 @@ fn load_loop(jobs: Receiver<Work>, library: Library, budget: ResourceBudget, res
             progress.advance_to(0.95);
             Ok(prepared)
         };
-        let result = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(run)) {
+        let result = match std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+            crate::background::in_background_pool(run)
+        })) {
             Ok(Ok(p)) => Ok(p),
             Ok(Err(e)) if e.is_cancelled() => continue,
             Ok(Err(e)) => Err(e.to_string()),

@@ -224,7 +224,9 @@ impl Thumbnails {
                             continue;
                         }
                         let made = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                            make(&library, budget, cache_dir.as_deref(), &job.entry)
+                            crate::background::in_background_pool(|| {
+                                make(&library, budget, cache_dir.as_deref(), &job.entry)
+                            })
                         }))
                         .unwrap_or_else(|_| Made::Failed(job.entry.id.to_string()));
                         if results.send(made).is_err() {
