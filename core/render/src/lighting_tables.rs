@@ -159,6 +159,21 @@ pub(super) fn prefiltered_texture(
     })
 }
 
+/// Appends `level`'s texels as `Rgba16Float` rows of `row_bytes` bytes each (at least eight a
+/// texel; zero-padded beyond), alpha 1.
+pub(super) fn push_rgba16f_rows(bytes: &mut Vec<u8>, level: &phantogram_assets::ibl::Environment, row_bytes: u32) {
+    for row in level.texels.chunks_exact(level.width.max(1)) {
+        let start = bytes.len();
+        for t in row {
+            for c in [t[0], t[1], t[2], 1.0] {
+                // f16 saturates at 65504: clamp so a very bright sun stays finite.
+                bytes.extend_from_slice(&half::f16::from_f32(c.min(65_000.0)).to_le_bytes());
+            }
+        }
+        bytes.resize(start + row_bytes as usize, 0);
+    }
+}
+
 /// Writes `level` into mip `mip` of an `Rgba16Float` texture.
 pub(super) fn write_level(
     queue: &wgpu::Queue,
@@ -166,14 +181,8 @@ pub(super) fn write_level(
     mip: u32,
     level: &phantogram_assets::ibl::Environment,
 ) {
-    let bytes: Vec<u8> = level
-        .texels
-        .iter()
-        .flat_map(|t| [t[0], t[1], t[2], 1.0])
-        // f16 saturates at 65504: clamp so a very bright sun stays finite.
-        .map(|c| half::f16::from_f32(c.min(65_000.0)))
-        .flat_map(|h| h.to_le_bytes())
-        .collect();
+    let mut bytes = Vec::with_capacity(8 * level.texels.len());
+    push_rgba16f_rows(&mut bytes, level, 8 * level.width as u32);
     queue.write_texture(
         wgpu::TexelCopyTextureInfo {
             texture,

@@ -76,20 +76,6 @@ const PARAMS_BYTES: u64 = 32;
 /// Bytes of an `Rgba16Float` texel.
 const TEXEL_BYTES: u32 = 8;
 
-/// Appends `level`'s texels as `Rgba16Float` rows of `padded_row` bytes, clamped to what `f16`
-/// holds as [`lighting_tables::write_level`] clamps them.
-fn push_rows(bytes: &mut Vec<u8>, level: &Environment, padded_row: u32) {
-    for row in level.texels.chunks_exact(level.width.max(1)) {
-        let start = bytes.len();
-        for t in row {
-            for c in [t[0], t[1], t[2], 1.0] {
-                bytes.extend_from_slice(&half::f16::from_f32(c.min(65_000.0)).to_le_bytes());
-            }
-        }
-        bytes.resize(start + padded_row as usize, 0);
-    }
-}
-
 impl GpuPrefilter {
     /// The prefilter, or `None` where the device lacks compute shaders or `Rgba16Float` storage
     /// writes (the caller keeps the CPU path) or the pipeline cannot be made.
@@ -298,7 +284,7 @@ impl GpuPrefilter {
                 } else {
                     &sources[copy.mip as usize]
                 };
-                push_rows(&mut bytes, level, copy.padded_row);
+                lighting_tables::push_rgba16f_rows(&mut bytes, level, copy.padded_row);
             }
             gpu.queue.write_buffer(&kept.upload, 0, &bytes);
             let mut params = vec![0u8; kept.params.size() as usize];
