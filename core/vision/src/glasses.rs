@@ -29,6 +29,9 @@ use std::sync::LazyLock;
 use crate::rim::Rim;
 use crate::{FaceFound, UprightImage};
 
+mod search;
+pub use search::find_in_box;
+
 /// The weakest colour shift (natural-log units, both eyes) taken for a lens: a lens that passes
 /// half of the light it is meant to stop shifts by 0.44 (cyan) to 0.6 (red); bare faces on the
 /// shared photographs shift by far less (printed by the glasses test).
@@ -38,7 +41,7 @@ pub const MIN_STRENGTH: f32 = 0.35;
 const MIN_COSINE: f32 = 0.8;
 
 /// A filter's typical transmission (linear RGB): what its colour shift points at.
-fn transmission(filter: Filter) -> [f32; 3] {
+pub(crate) fn transmission(filter: Filter) -> [f32; 3] {
     match filter {
         Filter::Red => [0.9, 0.08, 0.08],
         Filter::Cyan => [0.08, 0.8, 0.9],
@@ -383,6 +386,11 @@ impl Lenses {
     /// The dark rims around the lenses whose `outlines` were found ([`crate::rim`]).
     pub fn rims(&self, image: &UprightImage, outlines: &[Option<LensOutline>; 2]) -> [Option<Rim>; 2] {
         [0, 1].map(|i| Rim::around(image, self, i, outlines[i].as_ref()?))
+    }
+
+    /// The eyes the lenses were found at (image left, image right), pixels.
+    pub fn eyes_px(&self) -> [Vec2; 2] {
+        self.eyes_px
     }
 
     /// The distance between the eyes the lenses were found at, pixels.

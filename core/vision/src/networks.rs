@@ -238,11 +238,22 @@ impl FaceModels {
         eyes_hint: Option<[Vec2; 2]>,
     ) -> Result<Option<Mesh>, FaceError> {
         let hinted = eyes_hint.and_then(|[l, r]| glasses::find_at(image, l, r));
-        Ok(self.mesh(image, roi, hinted.as_ref())?.map(|(landmarks, flag)| Mesh {
+        self.mesh_with(image, roi, hinted)
+    }
+
+    /// FaceMesh in `roi`, through `lenses` when glasses were seen: the landmarks and the face
+    /// flag, or `None` if not a face.
+    fn mesh_with(
+        &self,
+        image: &UprightImage,
+        roi: &Roi,
+        lenses: Option<glasses::Lenses>,
+    ) -> Result<Option<Mesh>, FaceError> {
+        Ok(self.mesh(image, roi, lenses.as_ref())?.map(|(landmarks, flag)| Mesh {
             landmarks,
             flag,
             detector_score: None,
-            through_glasses: hinted.is_some(),
+            through_glasses: lenses.is_some(),
         }))
     }
 
@@ -281,11 +292,22 @@ impl FaceModels {
     }
 
     /// FaceMesh for the face a detection leads to, keeping the detector's score
-    /// ([`Mesh::confidence`]).
+    /// ([`Mesh::confidence`]). Glasses are looked for at the detector's eyes and, where they are
+    /// not seen there, anywhere in its box ([`glasses::find_in_box`]): tinted eyes can turn all of
+    /// the detector's keypoints, and then its eyes miss the lenses. Glasses found that way also
+    /// turn FaceMesh's crop: the lenses' line is the face's, the keypoints' was not.
     pub(crate) fn mesh_from_detection(&self, image: &UprightImage, d: &Detection) -> Result<Option<Mesh>, FaceError> {
         let [a, b] = [d.keypoints[0], d.keypoints[1]];
-        let eyes = if a.x <= b.x { [a, b] } else { [b, a] };
-        Ok(self.mesh_in(image, &roi_from_detection(d), Some(eyes))?.map(|m| Mesh {
+        let [l, r] = if a.x <= b.x { [a, b] } else { [b, a] };
+        let mut roi = roi_from_detection(d);
+        let lenses = match glasses::find_at(image, l, r) {
+            Some(lenses) => Some(lenses),
+            None => glasses::find_in_box(image, d.min, d.max).inspect(|lenses| {
+                let [l, r] = lenses.eyes_px();
+                roi.angle = (r.y - l.y).atan2(r.x - l.x);
+            }),
+        };
+        Ok(self.mesh_with(image, &roi, lenses)?.map(|m| Mesh {
             detector_score: Some(d.score),
             ..m
         }))

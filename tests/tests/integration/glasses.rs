@@ -495,3 +495,75 @@ fn a_face_with_glasses_in_a_yuv_frame_keeps_its_eyes_as_in_rgba() {
         100.0 * worst(&through_rgba)
     );
 }
+
+/// A swaying face with glasses is found on every detection and has its eyes on the frame after
+/// it, through RGBA and through YUV: the face bench's frames (the astronaut at 480 × 480 in a
+/// 640 × 480 frame, 18 positions up to 7 px apart), with the glasses test's first eight styles
+/// drawn on. The tracker is reset before each position, so each is a fresh detection.
+#[test]
+fn a_swaying_face_with_glasses_is_found_again_at_every_position() {
+    use phantogram::face::{CameraPose, FaceTracker, OwnedFrame, TrackedBy};
+    let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
+        return;
+    };
+    let photo = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
+    let face = image::imageops::resize(&photo, 480, 480, image::imageops::FilterType::Triangle);
+    let clean = {
+        let mut img = image::RgbaImage::from_pixel(480, 480, image::Rgba([40, 40, 40, 255]));
+        image::imageops::overlay(&mut img, &face, 0, 0);
+        faces(&models, &img)
+    };
+    let f = clean.first().expect("the astronaut's face");
+    let mut failures = Vec::new();
+    for seed in 0..8 {
+        let mut with_glasses = face.clone();
+        draw(
+            &mut with_glasses,
+            480,
+            480,
+            f.left_eye_px,
+            f.right_eye_px,
+            &style_for(seed),
+        );
+        let frames: Vec<OwnedFrame> = (0..18)
+            .map(|k| {
+                let x = 80.0 + 20.0 * (std::f64::consts::TAU * f64::from(k) / 18.0).sin();
+                let mut img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
+                image::imageops::overlay(&mut img, &with_glasses, x.round() as i64, 0);
+                OwnedFrame::upright_rgba(
+                    640,
+                    480,
+                    img.into_raw(),
+                    Intrinsics::from_horizontal_fov(640, 480, 60f32.to_radians()),
+                    0,
+                )
+            })
+            .collect();
+        for yuv in [false, true] {
+            let frames: Vec<OwnedFrame> = if yuv {
+                frames.iter().map(phantogram_lab::synthetic_camera::as_yuv420).collect()
+            } else {
+                frames.clone()
+            };
+            let mut tracker = FaceTracker::new(models.clone(), CameraPose::front(phantogram::glam::Vec3::ZERO));
+            for k in 0..frames.len() {
+                tracker.reset();
+                tracker.process(frames[k].as_frame()).expect("a valid frame");
+                let found = tracker.last_step() == TrackedBy::Detector;
+                let next = tracker
+                    .process(frames[(k + 1) % frames.len()].as_frame())
+                    .expect("a valid frame");
+                let ok = found && next.eyes_m.is_some() && next.glasses.is_some();
+                if !ok {
+                    failures.push(format!(
+                        "style {seed} {} position {k}: detected {found}, eyes {}, glasses {}",
+                        if yuv { "YUV" } else { "RGBA" },
+                        next.eyes_m.is_some(),
+                        next.glasses.is_some()
+                    ));
+                }
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
