@@ -161,16 +161,29 @@ pub(super) fn prefiltered_texture(
 
 /// Appends `level`'s texels as `Rgba16Float` rows of `row_bytes` bytes each (at least eight a
 /// texel; zero-padded beyond), alpha 1.
+///
+/// A row at a time through `half`'s slice conversion, which uses the CPU's conversion
+/// instructions eight values at a time where it has them (F16C, detected at run time; aarch64's
+/// FP16): one `f16::from_f32` per value, each with its own feature check, took 1.1 ms of the
+/// render thread's 2.5 ms for a GPU prefilter update at the 256-wide base here (2026-12-04).
 pub(super) fn push_rgba16f_rows(bytes: &mut Vec<u8>, level: &phantogram_assets::ibl::Environment, row_bytes: u32) {
-    for row in level.texels.chunks_exact(level.width.max(1)) {
+    use half::slice::HalfFloatSliceExt;
+    let width = level.width.max(1);
+    let (mut wide, mut narrow) = (Vec::with_capacity(4 * width), vec![half::f16::ZERO; 4 * width]);
+    for row in level.texels.chunks_exact(width) {
+        wide.clear();
+        // f16 saturates at 65504: clamp so a very bright sun stays finite.
+        wide.extend(
+            row.iter()
+                .flat_map(|t| [t[0], t[1], t[2], 1.0].map(|c| c.min(65_000.0))),
+        );
+        narrow.convert_from_f32_slice(&wide);
         let start = bytes.len();
-        for t in row {
-            for c in [t[0], t[1], t[2], 1.0] {
-                // f16 saturates at 65504: clamp so a very bright sun stays finite.
-                bytes.extend_from_slice(&half::f16::from_f32(c.min(65_000.0)).to_le_bytes());
-            }
+        bytes.resize(start + (row_bytes as usize).max(2 * narrow.len()), 0);
+        for (out, h) in bytes[start..].chunks_exact_mut(2).zip(&narrow) {
+            out.copy_from_slice(&h.to_le_bytes());
         }
-        bytes.resize(start + row_bytes as usize, 0);
+        bytes.truncate(start + row_bytes as usize);
     }
 }
 
@@ -202,4 +215,53 @@ pub(super) fn write_level(
             depth_or_array_layers: 1,
         },
     );
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The row writer gives, value for value, `f16::from_f32` of each channel clamped at 65000
+    /// and alpha 1, little-endian, each row zero-padded to its length (round to nearest even,
+    /// subnormals, a sun past f16's range, infinity and NaN included).
+    #[test]
+    fn rows_of_f16_are_each_value_converted_clamped_and_padded() {
+        let values = [
+            0.0f32,
+            1.0,
+            0.1,
+            1.0 / 3.0,
+            2.0e-7,
+            6.1e-5,
+            1.0e5,
+            65_000.0,
+            65_519.0,
+            f32::INFINITY,
+            f32::NAN,
+            -0.5,
+            12.345,
+        ];
+        let texels: Vec<[f32; 3]> = (0..15)
+            .map(|i| [0, 1, 2].map(|k| values[(3 * i + k) % values.len()]))
+            .collect();
+        let level = phantogram_assets::ibl::Environment {
+            width: 5,
+            height: 3,
+            texels,
+        };
+        let row_bytes = 8 * 5 + 24;
+        let mut bytes = vec![7u8];
+        push_rgba16f_rows(&mut bytes, &level, row_bytes);
+        let mut want = vec![7u8];
+        for row in level.texels.chunks_exact(5) {
+            let start = want.len();
+            for t in row {
+                for c in [t[0], t[1], t[2], 1.0] {
+                    want.extend_from_slice(&half::f16::from_f32(c.min(65_000.0)).to_le_bytes());
+                }
+            }
+            want.resize(start + row_bytes as usize, 0);
+        }
+        assert_eq!(bytes, want);
+    }
 }

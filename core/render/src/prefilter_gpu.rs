@@ -255,19 +255,27 @@ impl GpuPrefilter {
         // The source is f16, which ends at 65504: a brighter sun is divided by a power of two
         // (exact) so that its energy reaches the rough levels as on the CPU, and multiplied back
         // in the shader.
-        let peak = base
-            .texels
-            .iter()
-            .flatten()
-            .fold(0.0f32, |m, &c| if c.is_finite() { m.max(c) } else { m });
+        // One running maximum per channel: three independent chains, not one (a float maximum is
+        // not reordered by the compiler).
+        let mut channel_peaks = [0.0f32; 3];
+        for t in &base.texels {
+            for k in 0..3 {
+                if t[k].is_finite() {
+                    channel_peaks[k] = channel_peaks[k].max(t[k]);
+                }
+            }
+        }
+        let peak = channel_peaks[0].max(channel_peaks[1]).max(channel_peaks[2]);
         let scale = if peak > 32_768.0 {
             (peak / 32_768.0).log2().ceil().exp2()
         } else {
             1.0
         };
-        for level in &mut sources {
-            for t in &mut level.texels {
-                *t = t.map(|c| c / scale);
+        if scale != 1.0 {
+            for level in &mut sources {
+                for t in &mut level.texels {
+                    *t = t.map(|c| c / scale);
+                }
             }
         }
         let kept = match self.kept.take() {
