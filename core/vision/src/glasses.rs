@@ -12,6 +12,10 @@
 //! for one that passes half of what it should stop). Glasses are reported when both eyes'
 //! shifts are strong ([`MIN_STRENGTH`]) and point at the two filters of one kind of glasses.
 //!
+//! Where a face's eye estimate is too far off for that (the detector's keypoints on tinted eyes
+//! can all be turned together), [`find_in_box`] looks for the lens pair by colour in the
+//! detector's box and hands its centres to the same test.
+//!
 //! Each lens is then also a fiducial: [`Lenses::centres`] finds the middle of the pixels its
 //! tint colours, and [`with_lens_centres`] fuses it with the iris network's eye, weighted by how
 //! sure each is (the lens counts for more on small or blurred faces).
