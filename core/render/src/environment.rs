@@ -42,10 +42,21 @@ impl Renderer {
         base: &phantogram_assets::ibl::Environment,
         sh: &phantogram_assets::ibl::IrradianceSh,
     ) -> Result<(), RenderError> {
+        self.set_environment_sources(&phantogram_assets::ibl::PrefilterSources::new(base.clone()), sh)
+    }
+
+    /// [`Self::set_environment_base`] with level 0's halvings already made
+    /// ([`phantogram_assets::ibl::PrefilterSources::new`]): a live room light makes them on its
+    /// worker, so that the render thread only packs, uploads and records.
+    pub fn set_environment_sources(
+        &mut self,
+        sources: &phantogram_assets::ibl::PrefilterSources,
+        sh: &phantogram_assets::ibl::IrradianceSh,
+    ) -> Result<(), RenderError> {
         if self.prefilters_on_gpu()
             && let Some(Some(prefilter)) = &mut self.gpu_prefilter
         {
-            let texture = prefilter.run(&self.gpu, base)?;
+            let texture = prefilter.run_sources(&self.gpu, sources)?;
             if self.ibl.environment_texture == texture {
                 // The same texture, convolved again in place (an update of the same size): the
                 // eyes' bind groups already hold it; only the irradiance changes.
@@ -54,6 +65,12 @@ impl Renderer {
             }
             return self.use_ibl(sh, |gpu| IblTextures::with_texture(gpu, &texture));
         }
+        let Some(base) = sources.halvings.first() else {
+            return Err(RenderError::Gpu {
+                what: "the environment",
+                message: "no level 0".into(),
+            });
+        };
         let levels = phantogram_assets::ibl::prefiltered_levels(base, PREFILTERED_BASE_WIDTH);
         self.set_prefiltered_environment(&levels, sh)
     }

@@ -171,7 +171,13 @@ impl GpuPrefilter {
     /// submitted in between keep seeing the levels they were submitted with); read one run's
     /// levels back before the next run if you need them.
     pub fn run(&mut self, gpu: &Gpu, base: &Environment) -> Result<wgpu::Texture, RenderError> {
-        self.record(gpu, base, None)
+        self.record(gpu, &PrefilterSources::new(base.clone()), None)
+    }
+
+    /// [`Self::run`] from level 0's halvings already made ([`PrefilterSources::new`]), as the
+    /// room-light worker makes them off the render thread.
+    pub fn run_sources(&mut self, gpu: &Gpu, sources: &PrefilterSources) -> Result<wgpu::Texture, RenderError> {
+        self.record(gpu, sources, None)
     }
 
     /// [`Self::run`], waited for, with the GPU time of the convolution passes in milliseconds
@@ -180,7 +186,7 @@ impl GpuPrefilter {
     pub fn run_timed(&mut self, gpu: &Gpu, base: &Environment) -> Result<(wgpu::Texture, Option<f64>), RenderError> {
         let device = &gpu.device;
         if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
-            let texture = self.record(gpu, base, None)?;
+            let texture = self.record(gpu, &PrefilterSources::new(base.clone()), None)?;
             device
                 .poll(wgpu::PollType::wait_indefinitely())
                 .map_err(|e| RenderError::Readback(e.to_string()))?;
@@ -204,7 +210,7 @@ impl GpuPrefilter {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let texture = self.record(gpu, base, Some(&set))?;
+        let texture = self.record(gpu, &PrefilterSources::new(base.clone()), Some(&set))?;
         let mut encoder = device.create_command_encoder(&Default::default());
         encoder.resolve_query_set(&set, 0..2, &resolve, 0);
         encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, bytes);
@@ -232,9 +238,15 @@ impl GpuPrefilter {
     fn record(
         &mut self,
         gpu: &Gpu,
-        base: &Environment,
+        given: &PrefilterSources,
         timer: Option<&wgpu::QuerySet>,
     ) -> Result<wgpu::Texture, RenderError> {
+        let Some(base) = given.halvings.first() else {
+            return Err(RenderError::Gpu {
+                what: "the GPU prefilter",
+                message: "no level 0".into(),
+            });
+        };
         let (w0, h0) = (base.width as u32, base.height as u32);
         if !w0.is_power_of_two()
             || w0 < 1 << PREFILTER_LEVELS
@@ -246,12 +258,19 @@ impl GpuPrefilter {
                 message: format!("level 0 must be 2^k × 2^(k−1) texels, k ≥ {PREFILTER_LEVELS}; got {w0} × {h0}"),
             });
         }
+        // Sources made by `PrefilterSources::new` halve level 0 each time and are read by index:
+        // anything else (the fields are public) is refused rather than copied out of shape.
+        let halvings_fit = given.halvings.iter().enumerate().all(|(i, h)| {
+            h.width == base.width >> i && h.height == base.height >> i && h.texels.len() == h.width * h.height
+        });
+        if !halvings_fit || given.read_by.iter().any(|&r| r >= given.halvings.len()) {
+            return Err(RenderError::Gpu {
+                what: "the GPU prefilter",
+                message: "the sources are not level 0's halvings".into(),
+            });
+        }
         let device = &gpu.device;
-        // The halvings each level reads, as prefiltered_levels reads them.
-        let PrefilterSources {
-            halvings: mut sources,
-            read_by,
-        } = PrefilterSources::new(base.clone());
+        let read_by = given.read_by;
         // The source is f16, which ends at 65504: a brighter sun is divided by a power of two
         // (exact) so that its energy reaches the rough levels as on the CPU, and multiplied back
         // in the shader.
@@ -271,17 +290,21 @@ impl GpuPrefilter {
         } else {
             1.0
         };
-        if scale != 1.0 {
-            for level in &mut sources {
-                for t in &mut level.texels {
-                    *t = t.map(|c| c / scale);
-                }
-            }
-        }
+        let scaled: Option<Vec<Environment>> = (scale != 1.0).then(|| {
+            given
+                .halvings
+                .iter()
+                .map(|level| Environment {
+                    texels: level.texels.iter().map(|t| t.map(|c| c / scale)).collect(),
+                    ..*level
+                })
+                .collect()
+        });
+        let sources: &[Environment] = scaled.as_deref().unwrap_or(&given.halvings);
         let kept = match self.kept.take() {
-            Some(kept) if kept.size == (w0, h0) => kept,
+            Some(kept) if kept.size == (w0, h0) && kept.copies.len() == sources.len() + 1 => kept,
             _ => checked(device, "the GPU prefilter", || {
-                self.kept_for(gpu, w0, h0, &read_by, &sources)
+                self.kept_for(gpu, w0, h0, &read_by, sources)
             })?,
         };
         let target = checked(device, "the GPU prefilter", || {
