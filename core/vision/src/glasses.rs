@@ -641,7 +641,9 @@ mod tests {
         rgba
     }
 
-    fn in_ellipse(p: Vec2, centre: Vec2, half: Vec2) -> bool {
+    /// Whether `p` is inside the axis-aligned ellipse about `centre` with half-axes `half` (also
+    /// for [`super::search`]'s tests).
+    pub(super) fn in_ellipse(p: Vec2, centre: Vec2, half: Vec2) -> bool {
         ((p - centre) / half).length_squared() <= 1.0
     }
 
@@ -760,6 +762,25 @@ mod tests {
             let rims = lenses.rims(&image, &lenses.outlines(&image));
             assert_eq!(rims, [None, None], "{what}");
         }
+        // A rimless lens under a dark brow that hugs its top two fifths (±72° about straight
+        // up): a dark run on 40 % of the rays, under the majority a rim needs.
+        let browed = face(|p, skin| {
+            for (centre, f) in [(left, Filter::Red), (right, Filter::Cyan)] {
+                if in_ellipse(p, centre, half) {
+                    let t = transmission(f);
+                    return [0, 1, 2].map(|k| skin[k] * t[k]);
+                }
+                let up = (centre - p).normalize_or_zero().y;
+                if in_ellipse(p, centre, half + Vec2::splat(3.0)) && up > 72f32.to_radians().cos() {
+                    return dark;
+                }
+            }
+            skin
+        });
+        let image = super::tests::image(&browed);
+        let lenses = find_at(&image, left, right).expect("the glasses");
+        let rims = lenses.rims(&image, &lenses.outlines(&image));
+        assert_eq!(rims, [None, None], "a brow over the top two fifths");
     }
 
     #[test]

@@ -123,6 +123,7 @@ pub fn find_in_box(image: &UprightImage, min: Vec2, max: Vec2) -> Option<Lenses>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::glasses::tests::in_ellipse;
     use crate::glasses::transmission;
     use crate::{CameraFrame, Intrinsics, PixelFormat};
     use phantogram_geometry::srgb::{code_to_linear, linear_to_code};
@@ -166,10 +167,6 @@ mod tests {
             }
         }
         rgba
-    }
-
-    fn in_ellipse(p: Vec2, centre: Vec2, half: Vec2) -> bool {
-        ((p - centre) / half).length_squared() <= 1.0
     }
 
     /// Lenses 0.7 eye distances wide of `left` and `right` over the eyes.
