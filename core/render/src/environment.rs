@@ -42,7 +42,12 @@ impl Renderer {
         base: &phantogram_assets::ibl::Environment,
         sh: &phantogram_assets::ibl::IrradianceSh,
     ) -> Result<(), RenderError> {
-        self.set_environment_sources(&phantogram_assets::ibl::PrefilterSources::new(base.clone()), sh)
+        if self.prefilters_on_gpu() {
+            return self.set_environment_sources(&phantogram_assets::ibl::PrefilterSources::new(base.clone()), sh);
+        }
+        // The CPU path makes its own halvings: none made here for it.
+        let levels = phantogram_assets::ibl::prefiltered_levels(base, PREFILTERED_BASE_WIDTH);
+        self.set_prefiltered_environment(&levels, sh)
     }
 
     /// [`Self::set_environment_base`] with level 0's halvings already made
