@@ -383,6 +383,12 @@ fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
     );
 }
 
+/// The astronaut photo at the face bench's size (480 × 480, for a 640 × 480 frame).
+fn astronaut_at_bench_size(faces_dir: &std::path::Path) -> image::RgbaImage {
+    let photo = image::open(faces_dir.join("astronaut.png")).expect("photo").to_rgba8();
+    image::imageops::resize(&photo, 480, 480, image::imageops::FilterType::Triangle)
+}
+
 /// A face with glasses, found by the tracker's whole-frame detector, gets its eyes on the very
 /// next frame as a bare face does: the astronaut at the face bench's size (eyes 40 px apart in a
 /// 640 × 480 frame) with the glasses test's first style, whose tinted eyes the detector scores
@@ -394,8 +400,7 @@ fn a_tracked_face_with_glasses_has_eyes_on_the_frame_after_its_detection() {
     let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
         return;
     };
-    let photo = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
-    let face = image::imageops::resize(&photo, 480, 480, image::imageops::FilterType::Triangle);
+    let face = astronaut_at_bench_size(&dir);
     let mut img = image::RgbaImage::from_pixel(640, 480, image::Rgba([40, 40, 40, 255]));
     image::imageops::overlay(&mut img, &face, 80, 0);
     let clean = faces(&models, &img);
@@ -506,13 +511,8 @@ fn a_swaying_face_with_glasses_is_found_again_at_every_position() {
     let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
         return;
     };
-    let photo = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
-    let face = image::imageops::resize(&photo, 480, 480, image::imageops::FilterType::Triangle);
-    let clean = {
-        let mut img = image::RgbaImage::from_pixel(480, 480, image::Rgba([40, 40, 40, 255]));
-        image::imageops::overlay(&mut img, &face, 0, 0);
-        faces(&models, &img)
-    };
+    let face = astronaut_at_bench_size(&dir);
+    let clean = faces(&models, &face);
     let f = clean.first().expect("the astronaut's face");
     let mut failures = Vec::new();
     for seed in 0..8 {

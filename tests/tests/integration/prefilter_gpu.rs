@@ -22,13 +22,20 @@ fn relative_rms(a: &Environment, b: &Environment) -> f32 {
     (d / n.max(1e-30)).sqrt() as f32
 }
 
+/// A device and its GPU prefilter; `None`, said, where there is no device or it has no compute
+/// shaders (the CPU path is used then, nothing to compare).
+fn gpu_prefilter_or_skip() -> Option<(phantogram::render::Gpu, GpuPrefilter)> {
+    let gpu = phantogram_integration::gpu_or_skip()?;
+    let Some(prefilter) = GpuPrefilter::new(&gpu) else {
+        eprintln!("this device has no compute shaders: the CPU path is used, nothing to compare");
+        return None;
+    };
+    Some((gpu, prefilter))
+}
+
 #[test]
 fn the_gpu_convolves_the_levels_the_cpu_does() {
-    let Some(gpu) = phantogram_integration::gpu_or_skip() else {
-        return;
-    };
-    let Some(mut prefilter) = GpuPrefilter::new(&gpu) else {
-        eprintln!("this device has no compute shaders: the CPU path is used, nothing to compare");
+    let Some((gpu, mut prefilter)) = gpu_prefilter_or_skip() else {
         return;
     };
     // And a sun of 10⁶ (a real sky's; f16 ends at 65504): its energy must reach the rough
@@ -141,11 +148,7 @@ fn a_second_update_of_the_same_size_is_convolved_in_place_and_drawn() {
 #[test]
 fn sources_that_are_not_halvings_are_refused() {
     use phantogram::ibl::PrefilterSources;
-    let Some(gpu) = phantogram_integration::gpu_or_skip() else {
-        return;
-    };
-    let Some(mut prefilter) = GpuPrefilter::new(&gpu) else {
-        eprintln!("this device has no compute shaders: nothing to check");
+    let Some((gpu, mut prefilter)) = gpu_prefilter_or_skip() else {
         return;
     };
     let good = || PrefilterSources::new(prefilter_base(&sun_and_band(), PREFILTERED_BASE_WIDTH));
