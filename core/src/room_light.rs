@@ -1,10 +1,11 @@
 //! The live room light as the engine runs it: camera frames go to a worker thread that blends
 //! them into the room map (`phantogram_roomlight`) with the device's orientation at that moment,
 //! and every [`UPDATE_INTERVAL_NS`] of camera time reduces the map to the image-based light: nine
-//! SH coefficients and the specular levels' level 0 with the halvings the rough levels read, and —
-//! unless the render thread said its GPU convolves them ([`RoomLightWorker::set_prefilter_on_gpu`])
-//! — the rough levels too, tens of milliseconds on the CPU. The render thread then only uploads
-//! ([`crate::render::Renderer::set_environment_sources`], which dispatches the GPU's convolution, or
+//! SH coefficients and the specular levels' level 0 with the halvings the rough levels read,
+//! packed as the GPU takes them, or — unless the render thread said its GPU convolves them
+//! ([`RoomLightWorker::set_prefilter_on_gpu`]) — the rough levels too, tens of milliseconds on
+//! the CPU. The render thread then only uploads
+//! ([`crate::render::Renderer::set_environment_upload`], which dispatches the GPU's convolution, or
 //! [`crate::render::Renderer::set_prefiltered_environment`]).
 //!
 //! **Colour and exposure**: a YUV frame (luma with its chroma planes, as the bridges hand it over)
@@ -26,6 +27,7 @@ use std::sync::{Arc, Condvar, Mutex};
 
 use glam::Quat;
 use phantogram_assets::ibl::{Environment, IrradianceSh, PrefilterSources, prefilter_base, prefiltered_levels};
+use phantogram_render::prefilter_gpu::PrefilterUpload;
 use phantogram_roomlight::{CaptureFrame, CaptureParams, RoomCapture, world_from_buffer_camera};
 use phantogram_sensing::camera::{CameraPose, Exposure, OwnedFrame};
 
@@ -47,9 +49,10 @@ pub struct RoomLightUpdate {
 
 /// The specular image light of an update, as far as the worker reduced it.
 pub enum Specular {
-    /// Level 0 ([`prefilter_base`]) and its halvings ([`PrefilterSources`], made here so that the
-    /// render thread does not): the renderer's GPU convolves the rest.
-    Sources(PrefilterSources),
+    /// Level 0 ([`prefilter_base`]) and its halvings ([`PrefilterSources`]), packed for upload
+    /// ([`PrefilterUpload`]) here so that the render thread does not: the renderer's GPU
+    /// convolves the rest.
+    Upload(PrefilterUpload),
     /// Every level ([`prefiltered_levels`]), convolved on the worker.
     Levels(Vec<Environment>),
 }
@@ -271,11 +274,15 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
             let env = capture.environment();
             RoomLightUpdate {
                 sh: IrradianceSh::from_environment(&env),
-                specular: if on_gpu {
-                    Specular::Sources(PrefilterSources::new(prefilter_base(&env, base_width)))
-                } else {
-                    Specular::Levels(prefiltered_levels(&env, base_width))
-                },
+                // Packed for the GPU here; should packing refuse the base (it cannot, being
+                // prefilter_base's), the levels are convolved here instead.
+                specular: on_gpu
+                    .then(|| PrefilterUpload::new(PrefilterSources::new(prefilter_base(&env, base_width))).ok())
+                    .flatten()
+                    .map_or_else(
+                        || Specular::Levels(prefiltered_levels(&env, base_width)),
+                        Specular::Upload,
+                    ),
                 coverage: capture.coverage(),
                 frames: capture.frames(),
             }
@@ -344,10 +351,7 @@ mod tests {
                     (1, Specular::Levels(levels)) => {
                         assert_eq!(levels.len(), phantogram_assets::ibl::PREFILTER_LEVELS)
                     }
-                    (2, Specular::Sources(sources)) => {
-                        let base = &sources.halvings[0];
-                        assert_eq!((base.width, base.height), (64, 32))
-                    }
+                    (2, Specular::Upload(upload)) => assert_eq!(upload.size(), (64, 32)),
                     _ => panic!("update {made} is not what was asked for"),
                 }
                 assert!(u.coverage > 0.05 && u.sh.irradiance(Vec3::Z)[0] > 0.0);

@@ -5,9 +5,11 @@
 //!
 //! * SH9 on the CPU, every core ([`IrradianceSh::from_environment`]; the renderer's path);
 //! * level 0 resampled on the CPU at the renderer's 256-texel base ([`prefilter_base`]);
+//! * its halvings packed as `f16` rows for upload ([`PrefilterUpload::new`]; the room-light
+//!   worker's share beside SH9 and level 0; timed with a copy of level 0 the worker does not make);
 //! * the convolution of levels 1… on the GPU at that base, from timestamp queries (GPU time
-//!   only), the render thread's share of [`GpuPrefilter::run`] (halvings, uploads, recording,
-//!   submitting; not waited for) and the whole run waited for;
+//!   only), the render thread's share of [`GpuPrefilter::run_upload`] (writing the packed
+//!   bytes, recording, submitting; not waited for) and the whole run waited for;
 //! * the same convolution at the map's own width (level 0 = the map), the paper's setting.
 //!
 //! Medians of several runs after a warm-up. On a machine without a GPU the adapter is a software
@@ -15,8 +17,9 @@
 
 use std::time::Instant;
 
+use phantogram_assets::ibl::PrefilterSources;
 use phantogram_assets::ibl::{Environment, IrradianceSh, prefilter_base};
-use phantogram_render::prefilter_gpu::GpuPrefilter;
+use phantogram_render::prefilter_gpu::{GpuPrefilter, PrefilterUpload};
 use phantogram_render::{Gpu, PREFILTERED_BASE_WIDTH as BASE_WIDTH};
 
 fn median(mut samples: Vec<f64>) -> f64 {
@@ -38,14 +41,18 @@ fn wall_ms<R>(runs: usize, mut f: impl FnMut() -> R) -> f64 {
     )
 }
 
-/// Median wall milliseconds of [`GpuPrefilter::run`] alone — what the render thread spends on an
-/// update: halvings, uploads, recording and submitting, not waiting — over `runs` runs, the GPU
-/// drained after each.
-fn submit_ms(gpu: &Gpu, prefilter: &mut GpuPrefilter, base: &Environment, runs: usize) -> f64 {
+/// Median wall milliseconds of `run` alone (a [`GpuPrefilter`] run, not waited for) over `runs`
+/// runs, the GPU drained after each: what the render thread spends on an update.
+fn submit_ms(
+    gpu: &Gpu,
+    prefilter: &mut GpuPrefilter,
+    runs: usize,
+    mut run_once: impl FnMut(&mut GpuPrefilter) -> Result<phantogram_render::wgpu::Texture, phantogram_render::RenderError>,
+) -> f64 {
     let mut wall = Vec::new();
     for run in 0..=runs {
         let start = Instant::now();
-        if let Err(e) = prefilter.run(gpu, base) {
+        if let Err(e) = run_once(prefilter) {
             eprintln!("the GPU prefilter failed: {e}");
             std::process::exit(1);
         }
@@ -117,23 +124,36 @@ fn main() {
     let shown = |ms: Option<f64>| ms.map_or("no timestamps".to_string(), |ms| format!("{ms:.3}"));
     println!("median of several runs, ms\n");
     println!(
-        "| map | SH9 (CPU, {cores} cores) | level 0 at {BASE_WIDTH} (CPU) | levels on the GPU, {BASE_WIDTH} base | render thread, {BASE_WIDTH} base | whole run at {BASE_WIDTH}, waited | update total | levels on the GPU at the map's width | whole run at the map's width, waited |"
+        "| map | SH9 (CPU, {cores} cores) | level 0 at {BASE_WIDTH} (CPU) | halvings packed (CPU) | levels on the GPU, {BASE_WIDTH} base | render thread, {BASE_WIDTH} base: from the upload / from level 0 | whole run at {BASE_WIDTH}, waited | update total | levels on the GPU at the map's width | whole run at the map's width, waited |"
     );
-    println!("|---|---|---|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|---|---|");
     for width in [1024, 2048, 4096] {
         let env = Environment::benchmark_sky(width);
         let runs = (4096 / width) * 10 + 5;
         let sh = wall_ms(runs * 4, || IrradianceSh::from_environment(&env));
         let resample = wall_ms(runs, || prefilter_base(&env, BASE_WIDTH));
         let base = prefilter_base(&env, BASE_WIDTH);
+        let pack = wall_ms(runs, || PrefilterUpload::new(PrefilterSources::new(base.clone())));
+        let upload = match PrefilterUpload::new(PrefilterSources::new(base.clone())) {
+            Ok(upload) => upload,
+            Err(e) => {
+                eprintln!("level 0 could not be packed: {e}");
+                std::process::exit(1);
+            }
+        };
         let (small_gpu, small_wall) = prefilter_ms(&gpu, &mut prefilter, &base, runs);
-        let submit = submit_ms(&gpu, &mut prefilter, &base, runs);
+        // The render thread's share: from the worker's upload (the live room light), and from
+        // level 0 alone (a still environment set on the render thread: halvings and packing
+        // there too).
+        let submit = submit_ms(&gpu, &mut prefilter, runs, |p| p.run_upload(&gpu, &upload));
+        let submit_base = submit_ms(&gpu, &mut prefilter, runs, |p| p.run(&gpu, &base));
         let full = prefilter_base(&env, width);
         let (full_gpu, full_wall) = prefilter_ms(&gpu, &mut prefilter, &full, runs.min(11));
-        // One update as the renderer makes it: SH9 and level 0 on the CPU, the rest on the GPU.
-        let total = small_gpu.map(|g| sh + resample + g);
+        // One update as the engine makes it: SH9, level 0 and the packing on the room light's
+        // worker, the convolution on the GPU.
+        let total = small_gpu.map(|g| sh + resample + pack + g);
         println!(
-            "| {width}×{} | {sh:.3} | {resample:.3} | {} | {submit:.3} | {small_wall:.3} | {} | {} | {full_wall:.2} |",
+            "| {width}×{} | {sh:.3} | {resample:.3} | {pack:.3} | {} | {submit:.3} / {submit_base:.3} | {small_wall:.3} | {} | {} | {full_wall:.2} |",
             width / 2,
             shown(small_gpu),
             shown(total),

@@ -43,25 +43,27 @@ impl Renderer {
         sh: &phantogram_assets::ibl::IrradianceSh,
     ) -> Result<(), RenderError> {
         if self.prefilters_on_gpu() {
-            return self.set_environment_sources(&phantogram_assets::ibl::PrefilterSources::new(base.clone()), sh);
+            let sources = phantogram_assets::ibl::PrefilterSources::new(base.clone());
+            return self.set_environment_upload(&prefilter_gpu::PrefilterUpload::new(sources)?, sh);
         }
         // The CPU path makes its own halvings: none made here for it.
         let levels = phantogram_assets::ibl::prefiltered_levels(base, PREFILTERED_BASE_WIDTH);
         self.set_prefiltered_environment(&levels, sh)
     }
 
-    /// [`Self::set_environment_base`] with level 0's halvings already made
-    /// ([`phantogram_assets::ibl::PrefilterSources::new`]): a live room light makes them on its
-    /// worker, so that the render thread only packs, uploads and records.
-    pub fn set_environment_sources(
+    /// [`Self::set_environment_base`] with level 0's halvings already made and packed
+    /// ([`prefilter_gpu::PrefilterUpload::new`]): a live room light makes them on its worker, so
+    /// that the render thread only writes the bytes, records and submits. Where this renderer has
+    /// no GPU prefilter after all, the CPU convolves the upload's level 0.
+    pub fn set_environment_upload(
         &mut self,
-        sources: &phantogram_assets::ibl::PrefilterSources,
+        upload: &prefilter_gpu::PrefilterUpload,
         sh: &phantogram_assets::ibl::IrradianceSh,
     ) -> Result<(), RenderError> {
         if self.prefilters_on_gpu()
             && let Some(Some(prefilter)) = &mut self.gpu_prefilter
         {
-            let texture = prefilter.run_sources(&self.gpu, sources)?;
+            let texture = prefilter.run_upload(&self.gpu, upload)?;
             if self.ibl.environment_texture == texture {
                 // The same texture, convolved again in place (an update of the same size): the
                 // eyes' bind groups already hold it; only the irradiance changes.
@@ -70,13 +72,7 @@ impl Renderer {
             }
             return self.use_ibl(sh, |gpu| IblTextures::with_texture(gpu, &texture));
         }
-        let Some(base) = sources.halvings.first() else {
-            return Err(RenderError::Gpu {
-                what: "the environment",
-                message: "no level 0".into(),
-            });
-        };
-        let levels = phantogram_assets::ibl::prefiltered_levels(base, PREFILTERED_BASE_WIDTH);
+        let levels = phantogram_assets::ibl::prefiltered_levels(upload.base(), PREFILTERED_BASE_WIDTH);
         self.set_prefiltered_environment(&levels, sh)
     }
 

@@ -86,9 +86,7 @@ impl Engine {
             self.stats.room_light_coverage = update.coverage;
             // A failed upload keeps the light there was; the next update tries again.
             let _ = match &update.specular {
-                crate::room_light::Specular::Sources(sources) => {
-                    self.renderer.set_environment_sources(sources, &update.sh)
-                }
+                crate::room_light::Specular::Upload(upload) => self.renderer.set_environment_upload(upload, &update.sh),
                 crate::room_light::Specular::Levels(levels) => {
                     self.renderer.set_prefiltered_environment(levels, &update.sh)
                 }

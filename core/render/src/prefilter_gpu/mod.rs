@@ -3,31 +3,36 @@
 //! device has compute shaders and `Rgba16Float` storage textures (phones' Vulkan and Metal, and
 //! lavapipe; not WebGL-class devices, which keep the CPU path).
 //!
-//! The CPU makes level 0 ([`phantogram_assets::ibl::prefilter_base`], a resampling) and its
-//! box-filtered halvings (cheap); the GPU convolves levels 1… from them with the same samples and
-//! weights as [`phantogram_assets::ibl::prefiltered_levels`], so the two paths agree to the
-//! precision of `f16` (tested in `tests/tests/integration/prefilter_gpu.rs`). This moves the tens of
-//! milliseconds of GGX convolution (66–140 ms on this machine's CPU for a room-light update) off
-//! the CPU: on an NVIDIA H200 the convolution takes 0.2 ms of GPU time and this thread's share of
-//! [`GpuPrefilter::run`] 1–2 ms (`benchmarks/ibl.md`, `cargo bench -p phantogram-render --bench
-//! prefilter`); a phone's GPU is not measured (no phone here).
+//! The CPU makes level 0 ([`phantogram_assets::ibl::prefilter_base`], a resampling), its
+//! box-filtered halvings and their `f16` rows ([`PrefilterUpload`], on any thread: the room
+//! light's worker); the GPU convolves levels 1… from them with the same samples, bilinear reads
+//! and weights as [`phantogram_assets::ibl::prefiltered_levels`], so the two paths agree to the
+//! precision of `f16` (tested in `tests/tests/integration/prefilter_gpu.rs`; on an NVIDIA H200
+//! too). This moves the tens of milliseconds of GGX convolution (66–140 ms on this machine's CPU
+//! for a room-light update) off the CPU: on an NVIDIA H200 the convolution takes 0.28 ms of GPU
+//! time and this thread's share of [`GpuPrefilter::run_upload`] 0.11–0.19 ms
+//! (`benchmarks/ibl.md`, `cargo bench -p phantogram-render --bench prefilter`); a phone's GPU is
+//! not measured (no phone here).
 //!
-//! **Threading**: runs on the thread that owns the [`Gpu`] (the render thread); [`GpuPrefilter::run`]
-//! records and submits without waiting; frames submitted after it see the result (queue order).
-//! No panics: validation failures come back as [`RenderError::Gpu`].
+//! **Threading**: runs on the thread that owns the [`Gpu`] (the render thread);
+//! [`GpuPrefilter::run_upload`] writes, records and submits without waiting; frames submitted
+//! after it see the result (queue order). No panics: validation failures come back as
+//! [`RenderError::Gpu`].
+
+mod upload;
 
 use phantogram_assets::ibl::{Environment, PREFILTER_LEVELS, PrefilterSources};
+pub use upload::PrefilterUpload;
 
 use crate::{Gpu, RenderError, checked, lighting_tables};
 
 /// The prefilter's WGSL.
-pub const PREFILTER_WGSL: &str = include_str!("../../../shaders/prefilter.wgsl");
+pub const PREFILTER_WGSL: &str = include_str!("../../../../shaders/prefilter.wgsl");
 
 /// The compute pipeline and what it binds; made once per renderer.
 pub struct GpuPrefilter {
     pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
-    sampler: wgpu::Sampler,
     /// The textures, buffers and bind groups of the last size of level 0 run: a live room light
     /// updates twice a second at one size, and making them anew each time is allocation the
     /// render thread need not do (and the renderer keeps its bind groups when the texture is the
@@ -45,12 +50,9 @@ struct Kept {
     /// every run of this size: a frame submitted before a run samples the old levels, one after
     /// it the new ones (queue order), so it is overwritten in place.
     target: wgpu::Texture,
-    /// Every texel a run uploads (the sources' levels, then level 0 of the target), as `f16`
-    /// rows padded for copying: one write a run instead of one per level (each write is a
-    /// staging buffer of its own).
+    /// The update's bytes ([`PrefilterUpload`]): one write a run instead of one per level (each
+    /// write is a staging buffer of its own).
     upload: wgpu::Buffer,
-    /// Where each level lies in `upload`, in upload order.
-    copies: Vec<LevelCopy>,
     /// Every convolved level's `Params` (prefilter.wgsl), one `params_stride` apart.
     params: wgpu::Buffer,
     params_stride: u64,
@@ -58,23 +60,8 @@ struct Kept {
     levels: Vec<wgpu::BindGroup>,
 }
 
-/// One level's rows in [`Kept::upload`].
-struct LevelCopy {
-    /// Into the target (level 0) rather than the sources.
-    into_target: bool,
-    mip: u32,
-    offset: u64,
-    width: u32,
-    height: u32,
-    /// Bytes per row in the buffer (a multiple of `COPY_BYTES_PER_ROW_ALIGNMENT`).
-    padded_row: u32,
-}
-
 /// Bytes of `Params` in prefilter.wgsl, padded to 32.
 const PARAMS_BYTES: u64 = 32;
-
-/// Bytes of an `Rgba16Float` texel.
-const TEXEL_BYTES: u32 = 8;
 
 impl GpuPrefilter {
     /// The prefilter, or `None` where the device lacks compute shaders or `Rgba16Float` storage
@@ -110,12 +97,6 @@ impl GpuPrefilter {
                         count: None,
                     },
                     wgpu::BindGroupLayoutEntry {
-                        binding: 1,
-                        visibility: wgpu::ShaderStages::COMPUTE,
-                        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                        count: None,
-                    },
-                    wgpu::BindGroupLayoutEntry {
                         binding: 2,
                         visibility: wgpu::ShaderStages::COMPUTE,
                         ty: wgpu::BindingType::StorageTexture {
@@ -141,21 +122,9 @@ impl GpuPrefilter {
                 compilation_options: Default::default(),
                 cache: None,
             });
-            // As Environment::sample reads: wrapping in azimuth, clamped at the poles, bilinear,
-            // one whole level at a time.
-            let sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-                label: Some("prefilter source"),
-                address_mode_u: wgpu::AddressMode::Repeat,
-                address_mode_v: wgpu::AddressMode::ClampToEdge,
-                mag_filter: wgpu::FilterMode::Linear,
-                min_filter: wgpu::FilterMode::Linear,
-                mipmap_filter: wgpu::MipmapFilterMode::Nearest,
-                ..Default::default()
-            });
             Self {
                 pipeline,
                 layout,
-                sampler,
                 kept: None,
             }
         })
@@ -171,13 +140,14 @@ impl GpuPrefilter {
     /// submitted in between keep seeing the levels they were submitted with); read one run's
     /// levels back before the next run if you need them.
     pub fn run(&mut self, gpu: &Gpu, base: &Environment) -> Result<wgpu::Texture, RenderError> {
-        self.record(gpu, &PrefilterSources::new(base.clone()), None)
+        self.record(gpu, &PrefilterUpload::new(PrefilterSources::new(base.clone()))?, None)
     }
 
-    /// [`Self::run`] from level 0's halvings already made ([`PrefilterSources::new`]), as the
-    /// room-light worker makes them off the render thread.
-    pub fn run_sources(&mut self, gpu: &Gpu, sources: &PrefilterSources) -> Result<wgpu::Texture, RenderError> {
-        self.record(gpu, sources, None)
+    /// [`Self::run`] from an update already packed ([`PrefilterUpload::new`]), as the room-light
+    /// worker packs it off the render thread: this thread then only writes its bytes, records
+    /// and submits.
+    pub fn run_upload(&mut self, gpu: &Gpu, upload: &PrefilterUpload) -> Result<wgpu::Texture, RenderError> {
+        self.record(gpu, upload, None)
     }
 
     /// [`Self::run`], waited for, with the GPU time of the convolution passes in milliseconds
@@ -185,8 +155,9 @@ impl GpuPrefilter {
     /// (`core/render/benches/prefilter.rs`). The uploads of the sources are not in that time.
     pub fn run_timed(&mut self, gpu: &Gpu, base: &Environment) -> Result<(wgpu::Texture, Option<f64>), RenderError> {
         let device = &gpu.device;
+        let upload = PrefilterUpload::new(PrefilterSources::new(base.clone()))?;
         if !device.features().contains(wgpu::Features::TIMESTAMP_QUERY) {
-            let texture = self.record(gpu, &PrefilterSources::new(base.clone()), None)?;
+            let texture = self.record(gpu, &upload, None)?;
             device
                 .poll(wgpu::PollType::wait_indefinitely())
                 .map_err(|e| RenderError::Readback(e.to_string()))?;
@@ -210,7 +181,7 @@ impl GpuPrefilter {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let texture = self.record(gpu, &PrefilterSources::new(base.clone()), Some(&set))?;
+        let texture = self.record(gpu, &upload, Some(&set))?;
         let mut encoder = device.create_command_encoder(&Default::default());
         encoder.resolve_query_set(&set, 0..2, &resolve, 0);
         encoder.copy_buffer_to_buffer(&resolve, 0, &readback, 0, bytes);
@@ -238,95 +209,28 @@ impl GpuPrefilter {
     fn record(
         &mut self,
         gpu: &Gpu,
-        given: &PrefilterSources,
+        upload: &PrefilterUpload,
         timer: Option<&wgpu::QuerySet>,
     ) -> Result<wgpu::Texture, RenderError> {
-        let Some(base) = given.halvings.first() else {
-            return Err(RenderError::Gpu {
-                what: "the GPU prefilter",
-                message: "no level 0".into(),
-            });
-        };
-        let (w0, h0) = (base.width as u32, base.height as u32);
-        if !w0.is_power_of_two()
-            || w0 < 1 << PREFILTER_LEVELS
-            || w0 != 2 * h0
-            || base.texels.len() != base.width * base.height
-        {
-            return Err(RenderError::Gpu {
-                what: "the GPU prefilter",
-                message: format!("level 0 must be 2^k × 2^(k−1) texels, k ≥ {PREFILTER_LEVELS}; got {w0} × {h0}"),
-            });
-        }
-        // Sources made by `PrefilterSources::new` halve level 0 each time and are read by index:
-        // anything else (the fields are public) is refused rather than copied out of shape.
-        let halvings_fit = given.halvings.iter().enumerate().all(|(i, h)| {
-            h.width == base.width >> i && h.height == base.height >> i && h.texels.len() == h.width * h.height
-        });
-        if !halvings_fit || given.read_by.iter().any(|&r| r >= given.halvings.len()) {
-            return Err(RenderError::Gpu {
-                what: "the GPU prefilter",
-                message: "the sources are not level 0's halvings".into(),
-            });
-        }
         let device = &gpu.device;
-        let read_by = given.read_by;
-        // The source is f16, which ends at 65504: a brighter sun is divided by a power of two
-        // (exact) so that its energy reaches the rough levels as on the CPU, and multiplied back
-        // in the shader.
-        // One running maximum per channel: three independent chains, not one (a float maximum is
-        // not reordered by the compiler).
-        let mut channel_peaks = [0.0f32; 3];
-        for t in &base.texels {
-            for k in 0..3 {
-                if t[k].is_finite() {
-                    channel_peaks[k] = channel_peaks[k].max(t[k]);
-                }
-            }
-        }
-        let peak = channel_peaks[0].max(channel_peaks[1]).max(channel_peaks[2]);
-        let scale = if peak > 32_768.0 {
-            (peak / 32_768.0).log2().ceil().exp2()
-        } else {
-            1.0
-        };
-        let scaled: Option<Vec<Environment>> = (scale != 1.0).then(|| {
-            given
-                .halvings
-                .iter()
-                .map(|level| Environment {
-                    texels: level.texels.iter().map(|t| t.map(|c| c / scale)).collect(),
-                    ..*level
-                })
-                .collect()
-        });
-        let sources: &[Environment] = scaled.as_deref().unwrap_or(&given.halvings);
+        let (w0, h0) = upload.size();
         let kept = match self.kept.take() {
-            Some(kept) if kept.size == (w0, h0) && kept.copies.len() == sources.len() + 1 => kept,
+            Some(kept) if kept.size == (w0, h0) && kept.source.mip_level_count() == upload.source_levels => kept,
             _ => checked(device, "the GPU prefilter", || {
-                self.kept_for(gpu, w0, h0, &read_by, sources)
+                self.kept_for(gpu, w0, h0, upload.source_levels)
             })?,
         };
         let target = checked(device, "the GPU prefilter", || {
-            let mut bytes = Vec::with_capacity(kept.upload.size() as usize);
-            for copy in &kept.copies {
-                let level = if copy.into_target {
-                    base
-                } else {
-                    &sources[copy.mip as usize]
-                };
-                lighting_tables::push_rgba16f_rows(&mut bytes, level, copy.padded_row);
-            }
-            gpu.queue.write_buffer(&kept.upload, 0, &bytes);
+            gpu.queue.write_buffer(&kept.upload, 0, &upload.bytes);
             let mut params = vec![0u8; kept.params.size() as usize];
-            for (k, &source_level) in read_by.iter().enumerate().skip(1) {
+            for (k, &source_level) in upload.read_by.iter().enumerate().skip(1) {
                 let roughness = k as f32 / (PREFILTER_LEVELS - 1) as f32;
                 let fields = [
                     (roughness * roughness).to_bits(),
                     (source_level as f32).to_bits(),
                     w0 >> k,
                     h0 >> k,
-                    scale.to_bits(),
+                    upload.scale.to_bits(),
                 ];
                 let at = (k - 1) * kept.params_stride as usize;
                 for (i, field) in fields.iter().enumerate() {
@@ -337,7 +241,7 @@ impl GpuPrefilter {
             let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
                 label: Some("prefilter"),
             });
-            for copy in &kept.copies {
+            for copy in &upload.copies {
                 encoder.copy_buffer_to_texture(
                     wgpu::TexelCopyBufferInfo {
                         buffer: &kept.upload,
@@ -385,12 +289,11 @@ impl GpuPrefilter {
         Ok(target)
     }
 
-    /// The textures, buffers and bind groups for a level 0 of `w0` × `h0` whose levels read the
-    /// halvings `read_by` of `sources`.
-    fn kept_for(&self, gpu: &Gpu, w0: u32, h0: u32, read_by: &[usize], sources: &[Environment]) -> Kept {
+    /// The textures, buffers and bind groups for a level 0 of `w0` × `h0` with `source_levels`
+    /// halvings (level 0 included).
+    fn kept_for(&self, gpu: &Gpu, w0: u32, h0: u32, source_levels: u32) -> Kept {
         let device = &gpu.device;
-        let source =
-            lighting_tables::prefiltered_texture(device, w0, h0, sources.len() as u32, wgpu::TextureUsages::empty());
+        let source = lighting_tables::prefiltered_texture(device, w0, h0, source_levels, wgpu::TextureUsages::empty());
         let target = lighting_tables::prefiltered_texture(
             device,
             w0,
@@ -398,43 +301,28 @@ impl GpuPrefilter {
             PREFILTER_LEVELS as u32,
             wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
         );
-        // The sources' levels, then level 0 of the target.
-        let mut copies = Vec::new();
-        let mut offset = 0u64;
-        let shapes = sources
-            .iter()
-            .enumerate()
-            .map(|(m, s)| (false, m, s))
-            .chain([(true, 0, &sources[0])]);
-        for (into_target, mip, level) in shapes {
-            let (width, height) = (level.width as u32, level.height as u32);
-            let padded_row =
-                (TEXEL_BYTES * width).div_ceil(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT) * wgpu::COPY_BYTES_PER_ROW_ALIGNMENT;
-            copies.push(LevelCopy {
-                into_target,
-                mip: mip as u32,
-                offset,
-                width,
-                height,
-                padded_row,
-            });
-            offset += u64::from(padded_row) * u64::from(height);
-        }
+        // The sources' levels and level 0 again, as an upload of this size writes them.
+        let texel_bytes = 8u64;
+        let rows = |w: u32| u64::from((w * texel_bytes as u32).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT));
+        let upload_bytes = rows(w0) * u64::from(h0)
+            + (0..source_levels)
+                .map(|m| rows(w0 >> m) * u64::from(h0 >> m))
+                .sum::<u64>();
         let upload = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("prefilter upload"),
-            size: offset,
+            size: upload_bytes,
             usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let params_stride = u64::from(device.limits().min_uniform_buffer_offset_alignment).max(PARAMS_BYTES);
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("prefilter levels"),
-            size: params_stride * (read_by.len() as u64 - 1),
+            size: params_stride * (PREFILTER_LEVELS as u64 - 1),
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
         let source_view = source.create_view(&Default::default());
-        let levels = (1..read_by.len())
+        let levels = (1..PREFILTER_LEVELS)
             .map(|k| {
                 let target_view = target.create_view(&wgpu::TextureViewDescriptor {
                     base_mip_level: k as u32,
@@ -448,10 +336,6 @@ impl GpuPrefilter {
                         wgpu::BindGroupEntry {
                             binding: 0,
                             resource: wgpu::BindingResource::TextureView(&source_view),
-                        },
-                        wgpu::BindGroupEntry {
-                            binding: 1,
-                            resource: wgpu::BindingResource::Sampler(&self.sampler),
                         },
                         wgpu::BindGroupEntry {
                             binding: 2,
@@ -474,7 +358,6 @@ impl GpuPrefilter {
             source,
             target,
             upload,
-            copies,
             params,
             params_stride,
             levels,
