@@ -1,4 +1,4 @@
-// The specular image light's rough levels on the GPU (core/render/src/prefilter_gpu.rs): one
+// The specular image light's rough levels on the GPU (core/render/src/prefilter_gpu/mod.rs): one
 // level of the prefiltered environment, roughness² = `alpha`, convolved from the box-filtered
 // halving of level 0 at `source_level` (twice the target's width) with the same 96 Hammersley GGX
 // samples a texel and the same n·l weights as phantogram_assets::ibl::prefiltered_levels on the
