@@ -39,6 +39,14 @@ use crate::tone::linear_from_srgb8;
 /// gaps between overlapping frames are filled locally, a region no frame has looked at is not.
 pub const LOCAL_FILL_DEG: f32 = 11.25;
 
+/// The reflectance of a floor or the ground, for a lower hemisphere nothing has been seen of
+/// ([`RoomCapture::environment`]): 0.2, daylighting practice's usual value for both (floors are
+/// taken as 0.2–0.3, the ground outdoors as 0.2). Not fitted to the shared rooms; on their truth
+/// the lower hemisphere's mean over the upper's cosine-weighted mean (an effective reflectance
+/// that includes the walls below eye level) runs from 0.10 (a city street) to 0.91 (the
+/// apartment), 0.26 geometric mean.
+pub const UNSEEN_FLOOR_REFLECTANCE: f32 = 0.2;
+
 /// How the room map is kept.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CaptureParams {
@@ -387,10 +395,19 @@ impl RoomCapture {
     /// - a larger unseen region — in practice the floor, which a visitor's sweep sees last —
     ///   takes the light of the band seen nearest to it in elevation on its side of the horizon:
     ///   at the coarsest level of the pyramid (rows of [`LOCAL_FILL_DEG`]), the solid-angle-
-    ///   weighted mean of that row's seen cells, the same at every azimuth (the other side's
-    ///   nearest row only where one side is wholly unseen). A room's light changes mostly with
-    ///   elevation (ceiling and lamps, walls and windows, floor), and the mean over a whole band
-    ///   keeps one bright object near the edge of what was seen from standing for the floor.
+    ///   weighted mean of that row's seen cells, the same at every azimuth. A room's light
+    ///   changes mostly with elevation (ceiling and lamps, walls and windows, floor), and the
+    ///   mean over a whole band keeps one bright object near the edge of what was seen from
+    ///   standing for the floor;
+    /// - where nothing below the horizon has been seen (a front camera held up before the face
+    ///   sees the ceiling and the room behind the viewer first), the lower hemisphere is a floor
+    ///   lit by the upper one: [`UNSEEN_FLOOR_REFLECTANCE`] × the upper hemisphere's irradiance
+    ///   on it / π, the same everywhere below. The horizon's band would stand for it otherwise,
+    ///   and what lies along the horizon is often a window: along the shared `tilt-sweep` log in
+    ///   the apartment (19 % seen, none of it below the horizon), the band just above the horizon
+    ///   has 5.4 times the apartment's mean luminance, and the map's mean was 3.7 times the
+    ///   room's. (An upper hemisphere wholly unseen still takes the lower's nearest band: the
+    ///   lights a floor does not show cannot be guessed.)
     ///
     /// Measured on the nine shared rooms swept to 80 % (`room_light.rs`, the floor seen last),
     /// irradiance relative RMS: pull-push all the way (the strip seen nearest to each hole)
@@ -478,6 +495,16 @@ impl RoomCapture {
                     *v = fill[i / w].unwrap_or([0.0; 3]);
                 }
             }
+            let lower_unseen = (0..h).filter(|&r| !upper(r)).all(|r| means[r].is_none());
+            let upper_seen = (0..h).any(|r| upper(r) && means[r].is_some());
+            if lower_unseen && upper_seen {
+                let floor = lit_floor(w, h, rgb).map(|e| e * UNSEEN_FLOOR_REFLECTANCE);
+                for (i, v) in rgb.iter_mut().enumerate() {
+                    if !upper(i / w) {
+                        *v = floor;
+                    }
+                }
+            }
         }
         // Push: each hole takes its parent's (already filled) value.
         for k in (0..levels.len() - 1).rev() {
@@ -494,6 +521,29 @@ impl RoomCapture {
         let (width, height, texels, _) = levels.swap_remove(0);
         Environment { width, height, texels }
     }
+}
+
+/// The irradiance that the upper half of an equirectangular map (`w` × `h` cells, row 0 the
+/// zenith, every cell filled) casts on an upward-facing floor, over π: the radiance a white
+/// Lambertian floor would have. Each row's cells share one solid angle, so a row counts by its
+/// mean times cos θ sin θ over its band.
+fn lit_floor(w: usize, h: usize, rgb: &[[f32; 3]]) -> [f32; 3] {
+    let dtheta = std::f32::consts::PI / h as f32;
+    let mut e = [0.0f32; 3];
+    for row in 0..h / 2 {
+        let theta = (row as f32 + 0.5) * dtheta;
+        let mut mean = [0.0f32; 3];
+        for t in &rgb[row * w..(row + 1) * w] {
+            for c in 0..3 {
+                mean[c] += t[c] / w as f32;
+            }
+        }
+        // ∫ L cos θ dω / π over the band: 2π · mean · cos θ sin θ dθ / π.
+        for c in 0..3 {
+            e[c] += 2.0 * mean[c] * theta.cos() * theta.sin() * dtheta;
+        }
+    }
+    e
 }
 
 #[cfg(test)]
@@ -550,6 +600,47 @@ mod tests {
         assert!((filled[0] - t[0]).abs() < 1e-5, "{filled:?} vs {t:?}");
         // A 69° field of view sees about 10 % of the sphere.
         assert!((0.05..0.15).contains(&cap.coverage()), "{}", cap.coverage());
+    }
+
+    #[test]
+    fn a_lower_hemisphere_never_seen_is_a_floor_lit_by_the_upper_one() {
+        // A grey ceiling seen straight up, then a bright window on the horizon's upper edge.
+        let mut cap = RoomCapture::new(CaptureParams::default());
+        let ceiling = grey_frame(64, 48, 118); // 0.18 linear
+        cap.add(&frame(&ceiling, 64, 48, looking(Vec3::Z), Some(1.0)))
+            .expect("ceiling");
+        let env = cap.environment();
+        let at = |x: usize, y: usize| env.texels[y * cap.width + x][0];
+        let (x, nadir, below) = (cap.width / 3, cap.height - 1, cap.height / 2 + 4);
+        assert!(!cap.seen(x, nadir) && !cap.seen(x, below));
+        // Everything above is 0.18 (seen or filled from the band), so the floor is 0.2 × 0.18.
+        let floor = UNSEEN_FLOOR_REFLECTANCE * 0.18;
+        for y in [nadir, below] {
+            assert!(
+                (at(x, y) - floor).abs() < 0.002,
+                "row {y}: {} against {floor}",
+                at(x, y)
+            );
+        }
+        // A window 35° up (its frame's lower edge 8° above the horizon), brighter than the
+        // ceiling: the floor is brighter with its light, and far darker than the window.
+        let window = grey_frame(64, 48, 255);
+        cap.add(&frame(&window, 64, 48, looking(Vec3::new(1.0, 0.0, 0.7)), Some(1.0)))
+            .expect("window");
+        assert!((cap.height / 2..cap.height).all(|y| (0..cap.width).all(|x| !cap.seen(x, y))));
+        let env = cap.environment();
+        let lit = env.texels[nadir * cap.width + x][0];
+        assert!(lit > 1.05 * floor && lit < 0.5, "{lit} against {floor}");
+        // Once the floor is seen, it is what was seen.
+        let dark = grey_frame(64, 48, 30);
+        cap.add(&frame(&dark, 64, 48, looking(Vec3::NEG_Z), Some(1.0)))
+            .expect("floor");
+        let env = cap.environment();
+        let seen_floor = env.texels[nadir * cap.width + x][0];
+        assert!(
+            (seen_floor - crate::tone::linear_from_srgb8(30)).abs() < 0.003,
+            "{seen_floor}"
+        );
     }
 
     #[test]
