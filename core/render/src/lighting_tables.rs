@@ -173,8 +173,7 @@ pub(super) fn push_rgba16f_rows(bytes: &mut Vec<u8>, level: &phantogram_assets::
     let (mut wide, mut narrow) = (vec![0.0f32; 4 * width], vec![half::f16::ZERO; 4 * width]);
     bytes.reserve(row_bytes * level.height);
     for row in level.texels.chunks_exact(width) {
-        // f16 saturates at 65504: clamp so a very bright sun stays finite. A plain loop over
-        // fixed lanes, which the compiler vectorises (an iterator of arrays it did not).
+        // f16 saturates at 65504: clamp so a very bright sun stays finite.
         for (w, t) in wide.chunks_exact_mut(4).zip(row) {
             w[0] = t[0].min(65_000.0);
             w[1] = t[1].min(65_000.0);

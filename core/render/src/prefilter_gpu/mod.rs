@@ -214,11 +214,17 @@ impl GpuPrefilter {
     ) -> Result<wgpu::Texture, RenderError> {
         let device = &gpu.device;
         let (w0, h0) = upload.size();
+        // An upload's layout follows from its size and number of halvings alone
+        // (`PrefilterUpload::new`), so those two decide whether the kept buffer fits it.
         let kept = match self.kept.take() {
-            Some(kept) if kept.size == (w0, h0) && kept.source.mip_level_count() == upload.source_levels => kept,
-            _ => checked(device, "the GPU prefilter", || {
-                self.kept_for(gpu, w0, h0, upload.source_levels)
-            })?,
+            Some(kept)
+                if kept.size == (w0, h0)
+                    && kept.source.mip_level_count() == upload.source_levels
+                    && kept.upload.size() == upload.bytes.len() as u64 =>
+            {
+                kept
+            }
+            _ => checked(device, "the GPU prefilter", || self.kept_for(gpu, upload))?,
         };
         let target = checked(device, "the GPU prefilter", || {
             gpu.queue.write_buffer(&kept.upload, 0, &upload.bytes);
@@ -289,10 +295,10 @@ impl GpuPrefilter {
         Ok(target)
     }
 
-    /// The textures, buffers and bind groups for a level 0 of `w0` × `h0` with `source_levels`
-    /// halvings (level 0 included).
-    fn kept_for(&self, gpu: &Gpu, w0: u32, h0: u32, source_levels: u32) -> Kept {
+    /// The textures, buffers and bind groups for uploads of `upload`'s size and layout.
+    fn kept_for(&self, gpu: &Gpu, upload: &PrefilterUpload) -> Kept {
         let device = &gpu.device;
+        let ((w0, h0), source_levels) = (upload.size(), upload.source_levels);
         let source = lighting_tables::prefiltered_texture(device, w0, h0, source_levels, wgpu::TextureUsages::empty());
         let target = lighting_tables::prefiltered_texture(
             device,
@@ -301,16 +307,9 @@ impl GpuPrefilter {
             PREFILTER_LEVELS as u32,
             wgpu::TextureUsages::STORAGE_BINDING | wgpu::TextureUsages::COPY_SRC,
         );
-        // The sources' levels and level 0 again, as an upload of this size writes them.
-        let texel_bytes = 8u64;
-        let rows = |w: u32| u64::from((w * texel_bytes as u32).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT));
-        let upload_bytes = rows(w0) * u64::from(h0)
-            + (0..source_levels)
-                .map(|m| rows(w0 >> m) * u64::from(h0 >> m))
-                .sum::<u64>();
-        let upload = device.create_buffer(&wgpu::BufferDescriptor {
+        let upload_buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("prefilter upload"),
-            size: upload_bytes,
+            size: upload.bytes.len() as u64,
             usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
@@ -357,7 +356,7 @@ impl GpuPrefilter {
             size: (w0, h0),
             source,
             target,
-            upload,
+            upload: upload_buffer,
             params,
             params_stride,
             levels,
