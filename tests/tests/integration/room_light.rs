@@ -119,6 +119,10 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
         for bracketed in [true, false] {
             let mut capture = RoomCapture::new(CaptureParams::default());
             let mut at_80 = None;
+            // Early in the sweep (bracketed): the irradiance error at these shares seen, for
+            // `benchmarks/ibl.md`'s table of the unseen floor's fill.
+            let mut early_marks = [0.1f32, 0.2, 0.3, 0.5].into_iter().peekable();
+            let mut early = Vec::new();
             for (k, pose) in sweep().into_iter().enumerate() {
                 // Bracketed: every other frame the short one, exposures reported (the platform
                 // sets them). Not: auto-exposure only, exposures estimated from the overlap.
@@ -135,10 +139,21 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
                         exposure: bracketed.then_some(exposure),
                     })
                     .expect("frame");
+                if bracketed && early_marks.next_if(|&m| capture.coverage() >= m).is_some() {
+                    let got = IrradianceSh::from_environment(&capture.environment());
+                    early.push(format!(
+                        "{:.0} % seen: {:.1} %",
+                        capture.coverage() * 100.0,
+                        relative_rms(&got, &want, 1.0, &normals) * 100.0
+                    ));
+                }
                 if at_80.is_none() && capture.coverage() >= 0.8 {
                     let oracle = IrradianceSh::from_environment(&best_one_value_fill(&env, &capture, &want, &normals));
                     at_80 = Some((k + 1, IrradianceSh::from_environment(&capture.environment()), oracle));
                 }
+            }
+            if bracketed {
+                println!("{name} early (bracketed): {}", early.join(", "));
             }
             let (frames_80, sh_80, oracle_80) = at_80.expect("the sweep sees 80 % of the sphere");
             let full = IrradianceSh::from_environment(&capture.environment());
