@@ -14,6 +14,18 @@
 //! ([`RoomLightWorker::note_exposure`]: Camera2 reports it in a capture result that may arrive after
 //! the image), or else the capture estimates it from the overlap with what the map has seen.
 //!
+//! **Level**: the camera gives radiance relative to its exposure (1 s at ISO 100 = 1), in units of
+//! that phone's sensor and processing, and a lounge and daylight differ by a thousand in it; the
+//! renderer's look (its exposure of 1, the world light) was made with a fixed environment. So each
+//! update's map is scaled to the mean luminance of the light it replaces — the studio's or the
+//! configured environment's ([`RoomLightWorker::spawn`]'s `level`) — and takes from the camera
+//! what the camera knows: where the light comes from, its colour and contrast. That is what a
+//! camera's averaging meter and the eye's adaptation do with a room, and it also keeps the level
+//! steady while the map is young (along the shared `tilt-sweep` log in the apartment, the map
+//! seen early had 3.7 times the room's mean before the unseen floor was filled). A desktop replay
+//! whose synthetic camera looks into the configured environment itself gets its level back (a
+//! gain of about 1 once most of it is seen).
+//!
 //! **Threading**: [`RoomLightWorker::submit`], [`RoomLightWorker::note_exposure`] and
 //! [`RoomLightWorker::set_orientation`] from any thread, never waiting for the worker (a frame arriving while one is being blended replaces the
 //! one waiting: the newest view of the room matters most); [`RoomLightWorker::take_update`] on
@@ -43,6 +55,9 @@ pub struct RoomLightUpdate {
     pub sh: IrradianceSh,
     /// Share of the sphere the map has seen, 0 to 1.
     pub coverage: f32,
+    /// What the map's radiance was multiplied by to bring it to the level asked for
+    /// ([`RoomLightWorker::spawn`]); 1 where none was asked for.
+    pub gain: f32,
     /// Frames blended so far.
     pub frames: u64,
 }
@@ -78,6 +93,8 @@ struct Shared {
     updates: u64,
     /// The share of the sphere seen, after the newest frame.
     coverage: f32,
+    /// The newest update's [`RoomLightUpdate::gain`].
+    gain: Option<f32>,
     /// A frame taken from `pending` is being blended.
     busy: bool,
     /// Off: frames handed over are dropped (the settings' studio light); the map is kept.
@@ -94,13 +111,20 @@ pub struct RoomLightWorker {
 }
 
 impl RoomLightWorker {
-    /// Starts the worker for a camera at `pose` on the device.
-    pub fn spawn(pose: CameraPose, params: CaptureParams, base_width: usize) -> std::io::Result<Self> {
+    /// Starts the worker for a camera at `pose` on the device. `level`: the mean luminance
+    /// ([`Environment::mean_luminance`]) each update's map is scaled to — the level of the light
+    /// it replaces (see the module docs, **Level**) — or `None` to keep the camera's own.
+    pub fn spawn(
+        pose: CameraPose,
+        params: CaptureParams,
+        base_width: usize,
+        level: Option<f32>,
+    ) -> std::io::Result<Self> {
         let shared = Arc::new((Mutex::new(Shared::default()), Condvar::new()));
         let inner = shared.clone();
         let thread = std::thread::Builder::new()
             .name("room light".into())
-            .spawn(move || run(&inner, pose, params, base_width))?;
+            .spawn(move || run(&inner, pose, params, base_width, level))?;
         Ok(Self {
             shared,
             thread: Some(thread),
@@ -183,6 +207,11 @@ impl RoomLightWorker {
         self.lock().coverage
     }
 
+    /// The newest update's [`RoomLightUpdate::gain`] (`None` before the first).
+    pub fn gain(&self) -> Option<f32> {
+        self.lock().gain
+    }
+
     /// Frames blended, frames refused, updates made so far.
     pub fn counts(&self) -> (u64, u64, u64) {
         let s = self.lock();
@@ -219,7 +248,13 @@ impl Drop for RoomLightWorker {
     }
 }
 
-fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParams, base_width: usize) {
+fn run(
+    shared: &(Mutex<Shared>, Condvar),
+    pose: CameraPose,
+    params: CaptureParams,
+    base_width: usize,
+    level: Option<f32>,
+) {
     let lock = || shared.0.lock().unwrap_or_else(|p| p.into_inner());
     let mut capture = RoomCapture::new(params);
     let mut last_update_t_ns: Option<i64> = None;
@@ -271,8 +306,15 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
         let on_gpu = lock().prefilter_on_gpu;
         let update = due.then(|| {
             last_update_t_ns = Some(t);
-            let env = capture.environment();
+            let mut env = capture.environment();
+            let gain = level.map_or(1.0, |level| level_gain(level, env.mean_luminance()));
+            if gain != 1.0 {
+                for t in &mut env.texels {
+                    *t = t.map(|c| c * gain);
+                }
+            }
             RoomLightUpdate {
+                gain,
                 sh: IrradianceSh::from_environment(&env),
                 // Packed for the GPU here; should packing refuse the base (it cannot, being
                 // prefilter_base's), the levels are convolved here instead.
@@ -300,11 +342,25 @@ fn run(shared: &(Mutex<Shared>, Condvar), pose: CameraPose, params: CaptureParam
         if let Some(u) = update
             && !s.off
         {
+            s.gain = Some(u.gain);
             s.update = Some(u);
             s.updates += 1;
         }
         drop(s);
         shared.1.notify_all();
+    }
+}
+
+/// The factor that brings a map of mean luminance `mean` to `level`: 1 where either is not a
+/// positive finite number (nothing seen yet but black: no level to go by, and a gain of millions
+/// would show the camera's noise as light).
+fn level_gain(level: f32, mean: f32) -> f32 {
+    const DARKEST: f32 = 1e-6;
+    let gain = level / mean;
+    if level.is_finite() && level > 0.0 && mean.is_finite() && mean > DARKEST && gain.is_finite() {
+        gain
+    } else {
+        1.0
     }
 }
 
@@ -333,7 +389,7 @@ mod tests {
     #[test]
     fn frames_become_updates_twice_a_second_of_camera_time() {
         let worker =
-            RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64).expect("thread");
+            RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64, None).expect("thread");
         // Without an orientation a frame cannot be placed.
         worker.submit(grey(0, 118));
         assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
@@ -366,13 +422,59 @@ mod tests {
     }
 
     #[test]
+    fn the_room_keeps_the_level_of_the_light_it_replaces_whatever_the_cameras_calibration() {
+        // One grey room through a camera whose reported exposure is right, 100 times too long
+        // and 100 times too short: the map's own level spans 10 000, the light handed on does not.
+        let level = 0.18;
+        let light = |time_s: f32| {
+            let worker =
+                RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64, Some(level))
+                    .expect("thread");
+            worker.set_orientation(Quat::IDENTITY);
+            worker.submit(OwnedFrame {
+                exposure: Exposure::new(time_s, 100.0),
+                ..grey(5, 118)
+            });
+            assert!(worker.wait_until(1, std::time::Duration::from_secs(10)));
+            let update = worker.take_update().expect("an update");
+            assert_eq!(worker.gain(), Some(update.gain));
+            update
+        };
+        let mean = |u: &RoomLightUpdate| 0.282_095 * phantogram_geometry::srgb::luminance(u.sh.coefficients[0]);
+        let right = light(1.0);
+        assert!(
+            (mean(&right) - level).abs() < 1e-3 * level,
+            "{} against {level}",
+            mean(&right)
+        );
+        for wrong in [light(100.0), light(0.01)] {
+            assert!((mean(&wrong) - level).abs() < 1e-3 * level, "{}", mean(&wrong));
+            assert!(
+                (wrong.gain / right.gain).log10().abs() > 1.99,
+                "{} against {}",
+                wrong.gain,
+                right.gain
+            );
+            for n in [Vec3::Z, Vec3::NEG_Z, Vec3::X] {
+                let (a, b) = (wrong.sh.irradiance(n)[1], right.sh.irradiance(n)[1]);
+                assert!((a - b).abs() < 1e-3 * b, "{n}: {a} against {b}");
+            }
+        }
+        // Black: no level to go by; the map is kept as it is.
+        assert_eq!(level_gain(level, 0.0), 1.0);
+        assert_eq!(level_gain(level, f32::NAN), 1.0);
+        assert_eq!(level_gain(f32::INFINITY, 1.0), 1.0);
+        assert_eq!(level_gain(0.5, 2.0), 0.25);
+    }
+
+    #[test]
     fn an_exposure_reported_apart_is_matched_to_its_frame_by_time() {
         // The same grey frame, once with its exposure on it (1 s at ISO 100) and once without,
         // its exposure (twice as long) reported apart with a neighbour's: the second room is
         // half as bright, so the noted exposure was used, and only the one of its own time.
         let light = |frame: OwnedFrame, notes: &[(i64, Exposure)]| {
-            let worker =
-                RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64).expect("thread");
+            let worker = RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64, None)
+                .expect("thread");
             worker.set_orientation(Quat::IDENTITY);
             for (t, e) in notes {
                 worker.note_exposure(*t, *e);

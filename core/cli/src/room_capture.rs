@@ -93,8 +93,12 @@ impl RoomSweep {
         let (blended, refused, _) = worker.counts();
         // The newest update goes to the renderer with the next frame drawn.
         let coverage = worker.coverage();
+        let level = worker
+            .gain()
+            .map(|g| format!(", its light scaled by {g:.2} to the studio's level"))
+            .unwrap_or_default();
         eprintln!(
-            "room light: {blended} camera frames of {} along {} ({refused} refused), {:.0} % of the room seen",
+            "room light: {blended} camera frames of {} along {} ({refused} refused), {:.0} % of the room seen{level}",
             self.room_path.display(),
             self.log.display(),
             coverage * 100.0

@@ -287,9 +287,11 @@ pub struct EngineStats {
     /// Whether the last frame's eyes came from the camera.
     pub eyes_from_camera: bool,
     /// Image-based lights made from the room so far, and the share of the sphere (0 to 1) the
-    /// newest had seen ([`EngineConfig::room_light`]).
+    /// newest had seen ([`EngineConfig::room_light`]), and what its map was scaled by to the
+    /// level of the light it replaced (`room_light`'s **Level**).
     pub room_light_updates: u64,
     pub room_light_coverage: f32,
+    pub room_light_gain: f32,
 }
 
 /// What a shell embeds; see the module docs.
@@ -562,10 +564,16 @@ impl Engine {
             return Err(EngineError::NoFaceSupport);
         }
         // The worker waits, idle, while the room light is off, so the setting can switch it on.
+        // The room's light keeps the level of the light it replaces (`room_light`'s **Level**).
+        let level = environment.as_ref().map_or_else(
+            || crate::ibl::Environment::studio().mean_luminance(),
+            |e| e.mean_luminance(),
+        );
         let room_light = match crate::room_light::RoomLightWorker::spawn(
             camera_pose,
             phantogram_roomlight::CaptureParams::default(),
             crate::render::PREFILTERED_BASE_WIDTH,
+            Some(level),
         ) {
             Ok(worker) => {
                 worker.set_on(calibration.room_light.unwrap_or(config.room_light));

@@ -341,8 +341,14 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
         );
         let lit = engine.last_frame().expect("frame").2.to_vec();
         let changed = phantogram_integration::differing_pixels(&before, &lit);
-        println!("{name}: {blended} frames, {updates} updates, {changed} pixels changed");
+        let gain = engine.stats().room_light_gain;
+        println!("{name}: {blended} frames, {updates} updates, {changed} pixels changed, level gain {gain:.3}");
         if name == "studio" {
+            // The room keeps the level of the light it replaces; here that is the room itself.
+            assert!(
+                (gain - 1.0).abs() < 0.05,
+                "the studio seen by the camera scaled by {gain}"
+            );
             // The engine starts lit by this very studio: the room it captured lights it the same.
             assert!(
                 changed < (w * h / 100) as usize,

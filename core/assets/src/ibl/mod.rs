@@ -251,6 +251,28 @@ impl Environment {
         }
     }
 
+    /// The mean luminance (Rec. 709) over the sphere, each texel weighted by its solid angle: the
+    /// level an averaging light meter reads in the middle of this environment. 0 for an empty map;
+    /// non-finite texels count as 0.
+    pub fn mean_luminance(&self) -> f32 {
+        if self.width == 0 || self.height == 0 || self.texels.len() != self.width * self.height {
+            return 0.0;
+        }
+        let (mut sum, mut total) = (0.0f64, 0.0f64);
+        for (y, row) in self.texels.chunks_exact(self.width).enumerate() {
+            let solid = (std::f64::consts::PI * (y as f64 + 0.5) / self.height as f64).sin();
+            let row_sum: f64 = row
+                .iter()
+                .map(|t| phantogram_geometry::srgb::luminance(*t))
+                .filter(|l| l.is_finite())
+                .map(f64::from)
+                .sum();
+            sum += row_sum * solid;
+            total += solid * self.width as f64;
+        }
+        if total > 0.0 { (sum / total) as f32 } else { 0.0 }
+    }
+
     /// Half the resolution, each texel the mean of four (keeps the integral for prefiltering).
     pub fn downsampled(&self) -> Self {
         let (w, h) = ((self.width / 2).max(2), (self.height / 2).max(1));
@@ -310,6 +332,56 @@ mod tests {
         // A block mean, not a point sample: the mean radiance is kept.
         let mean = |e: &Environment| e.texels.iter().map(|t| f64::from(t[0])).sum::<f64>() / e.texels.len() as f64;
         assert!((mean(&once) - mean(&env)).abs() < 1e-4 * mean(&env));
+    }
+
+    #[test]
+    fn the_mean_luminance_weights_each_texel_by_its_solid_angle() {
+        assert!((uniform(2.0).mean_luminance() - 2.0).abs() < 1e-5);
+        // Lit above the horizon only: half the sphere, whatever the rows' count near the poles.
+        let mut half = uniform(1.0);
+        let (w, h) = (half.width, half.height);
+        for t in &mut half.texels[w * h / 2..] {
+            *t = [0.0; 3];
+        }
+        assert!((half.mean_luminance() - 0.5).abs() < 1e-3, "{}", half.mean_luminance());
+        // Only the polar caps (a fifth of the rows, about 5 % of the sphere): an unweighted mean
+        // of the texels would read 20 %.
+        let mut caps = uniform(0.0);
+        let cap_rows = h / 10;
+        for y in (0..cap_rows).chain(h - cap_rows..h) {
+            for t in &mut caps.texels[y * w..(y + 1) * w] {
+                *t = [1.0; 3];
+            }
+        }
+        let want = 1.0 - (std::f32::consts::PI * cap_rows as f32 / h as f32).cos();
+        assert!(
+            (caps.mean_luminance() - want).abs() < 2e-3,
+            "{} vs {want}",
+            caps.mean_luminance()
+        );
+        // Rec. 709's weights; the same as the irradiance's constant term.
+        let red = Environment {
+            texels: vec![[1.0, 0.0, 0.0]; w * h],
+            ..uniform(0.0)
+        };
+        assert!((red.mean_luminance() - 0.2126).abs() < 1e-5);
+        let studio = Environment::studio();
+        let c0 = IrradianceSh::from_environment(&studio).coefficients[0];
+        let from_sh = 0.282_095 * phantogram_geometry::srgb::luminance(c0);
+        assert!(
+            (studio.mean_luminance() - from_sh).abs() < 1e-3 * from_sh,
+            "{} vs {from_sh}",
+            studio.mean_luminance()
+        );
+        assert_eq!(
+            Environment {
+                width: 0,
+                height: 0,
+                texels: vec![]
+            }
+            .mean_luminance(),
+            0.0
+        );
     }
 
     /// An environment of one radiance everywhere.
