@@ -58,6 +58,15 @@ fn orientation_recordings(imu: &Path) -> Result<Vec<(String, PathBuf)>> {
     Ok(out)
 }
 
+/// What follows the generated table in `benchmarks/orientation.md`: from its first `## ` heading
+/// on, with the blank line before it; empty when there is none.
+fn analyses_after_table(old: &str) -> &str {
+    match old.find("\n## ") {
+        Some(i) => &old[i..],
+        None => "",
+    }
+}
+
 fn bench_orientation() -> Result<()> {
     let data = std::env::var_os("PHANTOGRAM_DATA")
         .map(PathBuf::from)
@@ -138,7 +147,25 @@ fn bench_orientation() -> Result<()> {
     );
     let out = workspace_root().join("benchmarks/orientation.md");
     std::fs::create_dir_all(out.parent().expect("has a parent"))?;
-    std::fs::write(&out, text).with_context(|| format!("writing {}", out.display()))?;
+    // The sections written by hand below the table (analyses, parameter sweeps) are kept.
+    let kept = match std::fs::read_to_string(&out) {
+        Ok(old) => analyses_after_table(&old).to_owned(),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => String::new(),
+        Err(e) => return Err(e).with_context(|| format!("reading {}", out.display())),
+    };
+    std::fs::write(&out, text + &kept).with_context(|| format!("writing {}", out.display()))?;
     println!("wrote {}", out.display());
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::analyses_after_table;
+
+    #[test]
+    fn the_hand_written_sections_below_the_table_are_kept() {
+        let old = "# Orientation\n\nintro\n\n```text\ntable\n```\n\n## A sweep\n\nfigures\n\n## Another\n";
+        assert_eq!(analyses_after_table(old), "\n## A sweep\n\nfigures\n\n## Another\n");
+        assert_eq!(analyses_after_table("# Orientation\n\n```text\ntable\n```\n"), "");
+    }
 }
