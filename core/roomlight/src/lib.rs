@@ -7,12 +7,15 @@
 //!
 //! * [`tone`]: camera bytes → linear light (YCbCr → RGB, the inverse tone curve).
 //! * [`capture`]: the map, its exposure normalisation, blending and coverage.
+//! * [`fill`]: what the camera never saw, filled from what it did.
 //!
 //! Layer: above `phantogram-sensing` (camera frames, poses) and `phantogram-assets` (the
 //! environment map type); no GPU, no files. **Threading**: plain data, used from one thread at a
 //! time. **Panics**: none on any input.
 
 pub mod capture;
+pub mod fill;
 pub mod tone;
 
 pub use capture::{AddReport, CaptureError, CaptureFrame, CaptureParams, RoomCapture, world_from_buffer_camera};
+pub use fill::{LOCAL_FILL_DEG, UNSEEN_FLOOR_REFLECTANCE};
