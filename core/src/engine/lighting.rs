@@ -84,7 +84,7 @@ impl Engine {
             worker.set_prefilter_on_gpu(self.renderer.prefilters_on_gpu());
             self.stats.room_light_updates += 1;
             self.stats.room_light_coverage = update.coverage;
-            self.stats.room_light_gain = update.gain;
+            self.stats.room_light_gain = Some(update.gain);
             // A failed upload keeps the light there was; the next update tries again.
             let _ = match &update.specular {
                 crate::room_light::Specular::Upload(upload) => self.renderer.set_environment_upload(upload, &update.sh),

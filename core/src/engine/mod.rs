@@ -288,10 +288,10 @@ pub struct EngineStats {
     pub eyes_from_camera: bool,
     /// Image-based lights made from the room so far, and the share of the sphere (0 to 1) the
     /// newest had seen ([`EngineConfig::room_light`]), and what its map was scaled by to the
-    /// level of the light it replaced (`room_light`'s **Level**).
+    /// level of the light it replaced (`room_light`'s **Level**; `None` before the first).
     pub room_light_updates: u64,
     pub room_light_coverage: f32,
-    pub room_light_gain: f32,
+    pub room_light_gain: Option<f32>,
 }
 
 /// What a shell embeds; see the module docs.

@@ -341,7 +341,7 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
         );
         let lit = engine.last_frame().expect("frame").2.to_vec();
         let changed = phantogram_integration::differing_pixels(&before, &lit);
-        let gain = engine.stats().room_light_gain;
+        let gain = engine.stats().room_light_gain.expect("an update reached the renderer");
         println!("{name}: {blended} frames, {updates} updates, {changed} pixels changed, level gain {gain:.3}");
         if name == "studio" {
             // The room keeps the level of the light it replaces; here that is the room itself.
