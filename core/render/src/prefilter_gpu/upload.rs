@@ -169,11 +169,6 @@ impl PrefilterUpload {
     pub fn size(&self) -> (u32, u32) {
         (self.base.width as u32, self.base.height as u32)
     }
-
-    /// Bytes the render thread writes for this update.
-    pub fn len_bytes(&self) -> usize {
-        self.bytes.len()
-    }
 }
 
 #[cfg(test)]
@@ -211,7 +206,7 @@ mod tests {
             assert_eq!(c.padded_row % wgpu::COPY_BYTES_PER_ROW_ALIGNMENT, 0);
             assert!(c.padded_row >= 8 * c.width);
         }
-        assert_eq!(upload.len_bytes() as u64, upload.copies[4].end());
+        assert_eq!(upload.bytes.len() as u64, upload.copies[4].end());
         // Row 1, texel 3 of level 0: the sun; texel 5 of row 0: its red is 5; in both copies.
         let row = upload.copies[0].padded_row as usize;
         for at in [0, upload.copies[4].offset as usize] {
