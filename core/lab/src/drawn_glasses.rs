@@ -5,7 +5,9 @@
 //! lens's transmission (mixed with clear for a partly transparent lens), then a frame rim
 //! (cardboard or plastic: dark, of a given width) around it, and optionally a specular
 //! reflection (a soft white streak) on it. The lens is centred on the eye's centre, of a width
-//! given as a fraction of the eye distance, and turned with the eye line.
+//! given as a fraction of the eye distance, and turned with the eye line, unless the style
+//! moves the frame off the eyes as real glasses sit (spaced wider or narrower, higher or lower,
+//! to a side, turned).
 //!
 //! Pure function of its inputs. **Panics**: none (positions outside the image draw nothing).
 
@@ -43,6 +45,11 @@ pub struct GlassesStyle {
     /// spacing for every wearer), and how far below the eyes they sit (negative: above).
     pub spacing_ipd: f32,
     pub drop_ipd: f32,
+    /// How far the frame sits to the side of the eyes' midpoint (share of the eye distance,
+    /// positive towards the image-right eye) and how far it is turned against the eye line
+    /// (radians, positive clockwise in the image: the image-right lens lower).
+    pub shift_ipd: f32,
+    pub tilt_rad: f32,
 }
 
 /// Linear transmission of a drawn filter: values chosen to resemble cheap anaglyph gels (not
@@ -73,12 +80,16 @@ pub fn draw(
     if !(ipd.is_finite() && ipd > 1.0) || rgba.len() < (width * height * 4) as usize {
         return;
     }
-    let across = (image_right_eye - image_left_eye) / ipd;
+    let eye_line = (image_right_eye - image_left_eye) / ipd;
+    // The frame's own axes: the eye line turned by the frame's tilt.
+    let across = Vec2::from_angle(style.tilt_rad).rotate(eye_line);
     let down = Vec2::new(-across.y, across.x);
     let half = Vec2::new(style.width_ipd * 0.5, style.width_ipd * style.aspect * 0.5) * ipd;
     let rim = style.rim_ipd * ipd;
     let (mid, spread) = (
-        (image_left_eye + image_right_eye) * 0.5 + down * (style.drop_ipd * ipd),
+        (image_left_eye + image_right_eye) * 0.5
+            + Vec2::new(-eye_line.y, eye_line.x) * (style.drop_ipd * ipd)
+            + eye_line * (style.shift_ipd * ipd),
         across * (0.5 * style.spacing_ipd * ipd),
     );
     let lenses = [
@@ -168,6 +179,8 @@ pub fn style_for(seed: u32) -> GlassesStyle {
         reflection: [0.0, 0.25][pick(2, 7) as usize],
         spacing_ipd: 1.0,
         drop_ipd: 0.0,
+        shift_ipd: 0.0,
+        tilt_rad: 0.0,
     }
 }
 
@@ -243,6 +256,8 @@ mod tests {
             reflection: 0.0,
             spacing_ipd: 1.0,
             drop_ipd: 0.0,
+            shift_ipd: 0.0,
+            tilt_rad: 0.0,
         };
         draw(&mut img, w, h, Vec2::new(16.0, 16.0), Vec2::new(48.0, 16.0), &style);
         let px = |x: u32, y: u32| {
@@ -281,6 +296,43 @@ mod tests {
         );
         assert!(at(&wide, 6, 16)[1] < 80, "{:?}", at(&wide, 6, 16));
         assert_eq!(at(&wide, 24, 16), [180, 180, 180]);
+        // A frame shifted towards the image-right eye by 0.5 of the eye distance: the red lens
+        // sits on the midpoint, the left eye is clear.
+        let mut shifted = vec![180u8; (w * h * 4) as usize];
+        let style_shifted = GlassesStyle {
+            shift_ipd: 0.5,
+            ..style
+        };
+        draw(
+            &mut shifted,
+            w,
+            h,
+            Vec2::new(16.0, 16.0),
+            Vec2::new(48.0, 16.0),
+            &style_shifted,
+        );
+        assert_eq!(at(&shifted, 10, 16), [180, 180, 180]);
+        assert!(at(&shifted, 32, 16)[1] < 80, "{:?}", at(&shifted, 32, 16));
+        // A frame turned by 20° clockwise: the image-right lens sits lower (by about 5 px at 16
+        // px from the middle), so below the right eye is tinted and above it is not.
+        let mut tilted = vec![180u8; (w * h * 4) as usize];
+        let style_tilted = GlassesStyle {
+            tilt_rad: 20f32.to_radians(),
+            width_ipd: 0.4,
+            aspect: 0.5,
+            ..style
+        };
+        draw(
+            &mut tilted,
+            w,
+            h,
+            Vec2::new(16.0, 16.0),
+            Vec2::new(48.0, 16.0),
+            &style_tilted,
+        );
+        assert!(at(&tilted, 48, 23)[0] < 80, "{:?}", at(&tilted, 48, 23));
+        assert_eq!(at(&tilted, 48, 14), [180, 180, 180]);
+        assert!(at(&tilted, 16, 9)[1] < 80, "{:?}", at(&tilted, 16, 9));
         // Eyes on one pixel, or nonsense: nothing drawn, no panic.
         let before = img.clone();
         draw(&mut img, w, h, Vec2::new(5.0, 5.0), Vec2::new(5.0, 5.0), &style);

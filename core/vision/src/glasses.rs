@@ -421,7 +421,10 @@ pub struct LensOutline {
 /// adults' eye distances span about 54–74 mm (so ±1.75 mm a side for one standard deviation), and
 /// glasses sit a little higher or lower on each nose; about 2.5 mm of 63 in all. The glasses
 /// test's main sets centre each lens on its eye and would favour a smaller value; its set with
-/// lenses off the eyes (5.7 % off) shows the price of a smaller one (`benchmarks/face.md`).
+/// lenses off the eyes (spaced wider or narrower, higher or lower, shifted to a side and turned:
+/// 2–9 % off) shows the price of a smaller one (`benchmarks/face.md`). A model with the frame's
+/// offsets correlated between the lenses (one rigid frame on the nose) was tried there and not
+/// kept: it gains only where the frame sits better than assumed.
 pub const LENS_OFFSET_IPD: f32 = 0.04;
 
 /// The iris network's error per axis, as a share of the eye distance, for eyes `eye_distance_px`

@@ -63,7 +63,8 @@ struct Outcome {
 
 /// Draws four styles over each face of `img` (clean faces `clean`; `img` is the photo enlarged
 /// `enlarged` times) and compares. `off_centre`: the lenses sit off the eyes as real glasses do
-/// (spaced 8 % of the eye distance wider or narrower than the eyes, 4 % higher or lower).
+/// (spaced 8 % of the eye distance wider or narrower than the eyes, 4 % higher or lower, 3 % to
+/// one side, turned by 2.5°).
 fn try_styles(
     models: &FaceModels,
     case: &str,
@@ -84,9 +85,13 @@ fn try_styles(
         for _ in 0..4 {
             let mut style = style_for(*seed);
             if off_centre {
-                // Each kind of glasses (`seed % 4`) both ways, spaced wide and narrow.
+                // Each kind of glasses (`seed % 4`) both ways, spaced wide and narrow, high and
+                // low, shifted to either side and turned either way (each offset one to one and
+                // a half standard deviations of `glasses::LENS_OFFSET_MM`'s assumptions).
                 style.spacing_ipd = [0.92, 1.08][(*seed / 4 % 2) as usize];
                 style.drop_ipd = [-0.04, 0.04][(*seed / 8 % 2) as usize];
+                style.shift_ipd = [-0.03, 0.03][(*seed / 16 % 2) as usize];
+                style.tilt_rad = [-2.5f32, 2.5][(*seed / 32 % 2) as usize].to_radians();
             }
             *seed += 1;
             let mut with = img.clone();
@@ -292,7 +297,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
         // The goals (issue 21): every face found again, the glasses named, eyes within 3 % of
         // the eye distance, distance within 5 % — met by the median; the tail is printed above
         // and guarded (a regression beyond today's figures fails). Lenses off the eyes (a
-        // harder set than the goal's: each lens 5.7 % of the eye distance off its eye) pull the
+        // harder set than the goal's: each lens 2–9 % of the eye distance off its eye) pull the
         // lens-fused eyes off by design, so its bounds are today's figures with a margin.
         let off = set == "photos, lenses off the eyes";
         let lost = outcomes.len() - found.len();
