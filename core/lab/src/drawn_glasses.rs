@@ -50,6 +50,10 @@ pub struct GlassesStyle {
     /// (radians, positive clockwise in the image: the image-right lens lower).
     pub shift_ipd: f32,
     pub tilt_rad: f32,
+    /// The two lenses' own linear transmissions (image left, image right) in place of the
+    /// filters': ordinary glasses — clear, grey or both one colour — which are not anaglyph
+    /// glasses (`None`: the filters').
+    pub tints: Option<[[f32; 3]; 2]>,
 }
 
 /// Linear transmission of a drawn filter: values chosen to resemble cheap anaglyph gels (not
@@ -92,10 +96,11 @@ pub fn draw(
             + eye_line * (style.shift_ipd * ipd),
         across * (0.5 * style.spacing_ipd * ipd),
     );
-    let lenses = [
-        (mid - spread, filter_transmission(style.filters.0)),
-        (mid + spread, filter_transmission(style.filters.1)),
-    ];
+    let [left_t, right_t] = style.tints.unwrap_or([
+        filter_transmission(style.filters.0),
+        filter_transmission(style.filters.1),
+    ]);
+    let lenses = [(mid - spread, left_t), (mid + spread, right_t)];
     // Signed distance-like measure: < 1 inside the lens outline, scaled by the half sizes.
     let inside = |q: Vec2, grow: f32| -> bool {
         let h = half + Vec2::splat(grow);
@@ -181,6 +186,7 @@ pub fn style_for(seed: u32) -> GlassesStyle {
         drop_ipd: 0.0,
         shift_ipd: 0.0,
         tilt_rad: 0.0,
+        tints: None,
     }
 }
 
@@ -258,6 +264,7 @@ mod tests {
             drop_ipd: 0.0,
             shift_ipd: 0.0,
             tilt_rad: 0.0,
+            tints: None,
         };
         draw(&mut img, w, h, Vec2::new(16.0, 16.0), Vec2::new(48.0, 16.0), &style);
         let px = |x: u32, y: u32| {
@@ -333,6 +340,24 @@ mod tests {
         assert!(at(&tilted, 48, 23)[0] < 80, "{:?}", at(&tilted, 48, 23));
         assert_eq!(at(&tilted, 48, 14), [180, 180, 180]);
         assert!(at(&tilted, 16, 9)[1] < 80, "{:?}", at(&tilted, 16, 9));
+        // Ordinary glasses: both lenses grey, the filters ignored.
+        let mut grey = vec![180u8; (w * h * 4) as usize];
+        let style_grey = GlassesStyle {
+            tints: Some([[0.2; 3]; 2]),
+            ..style
+        };
+        draw(
+            &mut grey,
+            w,
+            h,
+            Vec2::new(16.0, 16.0),
+            Vec2::new(48.0, 16.0),
+            &style_grey,
+        );
+        for x in [16, 48] {
+            let c = at(&grey, x, 16);
+            assert!(c[0] == c[1] && c[1] == c[2] && c[0] < 120, "{c:?}");
+        }
         // Eyes on one pixel, or nonsense: nothing drawn, no panic.
         let before = img.clone();
         draw(&mut img, w, h, Vec2::new(5.0, 5.0), Vec2::new(5.0, 5.0), &style);

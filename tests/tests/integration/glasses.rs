@@ -6,7 +6,9 @@
 //! distance in a 640 × 480 frame, as a phone's front camera sees a viewer at arm's length), at
 //! selfie scale turned by 20° (either way), and on the photos with the lenses off the eyes as real
 //! glasses sit (the tracker takes the lens centres as a second fix of each eye, so lenses drawn
-//! exactly on the eyes alone would flatter it). Needs `$PHANTOGRAM_DATA/faces` and
+//! exactly on the eyes alone would flatter it). Also ordinary glasses (clear, sunglasses, tinted
+//! both one colour) drawn the same way, which must not be taken for anaglyph glasses. Needs
+//! `$PHANTOGRAM_DATA/faces` and
 //! `$PHANTOGRAM_MODELS`; skipped with a notice without them.
 
 use std::sync::Arc;
@@ -571,4 +573,121 @@ fn a_swaying_face_with_glasses_is_found_again_at_every_position() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// Ordinary glasses — clear prescription lenses, grey, brown or green sunglasses, glasses tinted
+/// rose or yellow, both lenses one colour — are not anaglyph glasses: drawn over every face of the
+/// shared photos, at photo and at selfie scale (a museum's visitors wear their own glasses), no
+/// face is said to wear anaglyph glasses, and behind clear lenses the eyes stay where the clean
+/// photo has them. (Dark sunglasses may hide the eyes: those faces are counted, not required.)
+#[test]
+fn ordinary_glasses_are_not_taken_for_anaglyph_glasses() {
+    let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
+        return;
+    };
+    // Name, both lenses' linear transmission, rim (share of the eye distance), reflection.
+    let kinds: [(&str, [f32; 3], f32, f32); 7] = [
+        ("clear, dark rims, a reflection", [0.92; 3], 0.025, 0.25),
+        ("clear, rimless, a reflection", [0.92; 3], 0.0, 0.25),
+        ("grey sunglasses", [0.12; 3], 0.025, 0.0),
+        ("brown sunglasses", [0.3, 0.18, 0.07], 0.025, 0.25),
+        ("green (G-15) sunglasses", [0.12, 0.2, 0.1], 0.025, 0.0),
+        ("rose-tinted", [0.85, 0.5, 0.55], 0.0, 0.0),
+        ("yellow (blue-blocking)", [0.85, 0.75, 0.12], 0.025, 0.0),
+    ];
+    let (mut cases, mut named, mut lost) = (0usize, Vec::new(), vec![0usize; kinds.len()]);
+    let mut clear_errors = Vec::new();
+    let mut seed = 2000u32;
+    for name in PHOTOS {
+        let img = image::open(dir.join(name)).expect("photo").to_rgba8();
+        for f in faces(&models, &img) {
+            let ipd_px = f.left_eye_px.distance(f.right_eye_px);
+            let mid = (f.left_eye_px + f.right_eye_px) * 0.5;
+            // At photo scale, and the face enlarged to a 120-pixel eye distance in a 640 × 480 frame.
+            let selfie = warp_into_frame(&img, mid, 120.0 / ipd_px, 0.0);
+            let scales: [(&image::RgbaImage, f32); 2] = [(&img, 1.0), (&selfie, 120.0 / ipd_px)];
+            for (picture, scale) in scales {
+                let centre = |p: Vec2| {
+                    if scale == 1.0 {
+                        p
+                    } else {
+                        (p - mid) * scale + Vec2::new(320.0, 240.0)
+                    }
+                };
+                let (left, right) = (centre(f.left_eye_px), centre(f.right_eye_px));
+                let near = |g: &&FaceFound| {
+                    ((g.left_eye_px + g.right_eye_px) * 0.5).distance((left + right) * 0.5) < 0.5 * left.distance(right)
+                };
+                // The reference: the clean picture's own result for this face.
+                let Some(clean) = faces(&models, picture).into_iter().find(|g| near(&g)) else {
+                    continue;
+                };
+                for (k, (kind, tint, rim, reflection)) in kinds.iter().enumerate() {
+                    let style = phantogram_lab::drawn_glasses::GlassesStyle {
+                        tints: Some([*tint; 2]),
+                        rim_ipd: *rim,
+                        rim_rgb: [25, 22, 20],
+                        reflection: *reflection,
+                        ..style_for(seed)
+                    };
+                    seed += 1;
+                    let mut with = picture.clone();
+                    let (w, h) = with.dimensions();
+                    draw(&mut with, w, h, clean.left_eye_px, clean.right_eye_px, &style);
+                    cases += 1;
+                    let found = faces(&models, &with);
+                    let Some(g) = found.iter().find(near) else {
+                        lost[k] += 1;
+                        continue;
+                    };
+                    if g.lenses.is_some() || found.iter().any(|g| g.lenses.is_some()) {
+                        named.push(format!("{name} ×{scale:.1} {kind}: {:?}", g.lenses));
+                    }
+                    if *tint == [0.92; 3] {
+                        let ipd = clean.left_eye_px.distance(clean.right_eye_px);
+                        clear_errors.push((
+                            scale == 1.0,
+                            g.left_eye_px
+                                .distance(clean.left_eye_px)
+                                .max(g.right_eye_px.distance(clean.right_eye_px))
+                                / ipd,
+                        ));
+                    }
+                }
+            }
+        }
+    }
+    for (k, (kind, ..)) in kinds.iter().enumerate() {
+        println!("{kind}: {} of {} faces lost", lost[k], cases / kinds.len());
+    }
+    let mut all_clear = Vec::new();
+    for (at_photo_scale, set) in [(true, "photos"), (false, "selfie scale")] {
+        let errors: Vec<f32> = clear_errors
+            .iter()
+            .filter(|e| e.0 == at_photo_scale)
+            .map(|e| e.1)
+            .collect();
+        println!(
+            "behind clear lenses, {set}: eye error / eye distance median {:.3}, 90 % {:.3}, max {:.3} ({} faces)",
+            percentile(errors.clone(), 0.5),
+            percentile(errors.clone(), 0.9),
+            percentile(errors.clone(), 1.0),
+            errors.len()
+        );
+        all_clear.extend(errors);
+    }
+    assert!(cases > 100, "only {cases} cases");
+    assert!(
+        named.is_empty(),
+        "anaglyph glasses named on ordinary ones:\n{}",
+        named.join("\n")
+    );
+    // Clear lenses leave the face found, and its eyes near: a guard at today's median with a
+    // margin (a reflection across a clear lens moves the iris network's answer; the glasses-
+    // aware path undoes nothing here, there is no tint to find; `benchmarks/face.md`).
+    assert!(lost[0] + lost[1] <= cases / kinds.len() / 10, "{lost:?}");
+    assert!(
+        percentile(all_clear, 0.5) <= 0.05,
+        "behind clear lenses: median eye error"
+    );
 }
