@@ -8,8 +8,7 @@
 //! glasses sit (the tracker takes the lens centres as a second fix of each eye, so lenses drawn
 //! exactly on the eyes alone would flatter it). Also ordinary glasses (clear, sunglasses, tinted
 //! both one colour) drawn the same way, which must not be taken for anaglyph glasses. Needs
-//! `$PHANTOGRAM_DATA/faces` and
-//! `$PHANTOGRAM_MODELS`; skipped with a notice without them.
+//! `$PHANTOGRAM_DATA/faces` and `$PHANTOGRAM_MODELS`; skipped with a notice without them.
 
 use std::sync::Arc;
 
