@@ -275,84 +275,65 @@ mod tests {
         assert!(red[0] > 150 && red[1] < 80 && red[2] < 80, "{red:?}");
         assert!(cyan[0] < 80 && cyan[1] > 140 && cyan[2] > 150, "{cyan:?}");
         assert_eq!(between, [180, 180, 180]);
-        // Lenses sitting low (by 0.3 of the eye distance, more than half a lens height) leave
-        // the eye's own pixel clear and tint below it.
-        let mut low = vec![180u8; (w * h * 4) as usize];
-        let style_low = GlassesStyle { drop_ipd: 0.3, ..style };
-        draw(&mut low, w, h, Vec2::new(16.0, 10.0), Vec2::new(48.0, 10.0), &style_low);
+        // A fresh grey picture with `style` drawn over eyes at (16, y) and (48, y), and one of
+        // its pixels.
+        let drawn = |style: GlassesStyle, eye_y: f32| {
+            let mut img = vec![180u8; (w * h * 4) as usize];
+            draw(&mut img, w, h, Vec2::new(16.0, eye_y), Vec2::new(48.0, eye_y), &style);
+            img
+        };
         let at = |img: &[u8], x: u32, y: u32| {
             let i = ((y * w + x) * 4) as usize;
             [img[i], img[i + 1], img[i + 2]]
         };
+        // Lenses sitting low (by 0.3 of the eye distance, more than half a lens height) leave
+        // the eye's own pixel clear and tint below it.
+        let low = drawn(GlassesStyle { drop_ipd: 0.3, ..style }, 10.0);
         assert_eq!(at(&low, 16, 10), [180, 180, 180]);
         assert!(at(&low, 16, 20)[1] < 80, "{:?}", at(&low, 16, 20));
         // Lenses spaced wider than the eyes: the pixel beside the eye, outwards, is tinted, the
         // one inwards (still inside a centred lens) is not.
-        let mut wide = vec![180u8; (w * h * 4) as usize];
-        let style_wide = GlassesStyle {
-            spacing_ipd: 1.5,
-            ..style
-        };
-        draw(
-            &mut wide,
-            w,
-            h,
-            Vec2::new(16.0, 16.0),
-            Vec2::new(48.0, 16.0),
-            &style_wide,
+        let wide = drawn(
+            GlassesStyle {
+                spacing_ipd: 1.5,
+                ..style
+            },
+            16.0,
         );
         assert!(at(&wide, 6, 16)[1] < 80, "{:?}", at(&wide, 6, 16));
         assert_eq!(at(&wide, 24, 16), [180, 180, 180]);
         // A frame shifted towards the image-right eye by 0.5 of the eye distance: the red lens
         // sits on the midpoint, the left eye is clear.
-        let mut shifted = vec![180u8; (w * h * 4) as usize];
-        let style_shifted = GlassesStyle {
-            shift_ipd: 0.5,
-            ..style
-        };
-        draw(
-            &mut shifted,
-            w,
-            h,
-            Vec2::new(16.0, 16.0),
-            Vec2::new(48.0, 16.0),
-            &style_shifted,
+        let shifted = drawn(
+            GlassesStyle {
+                shift_ipd: 0.5,
+                ..style
+            },
+            16.0,
         );
         assert_eq!(at(&shifted, 10, 16), [180, 180, 180]);
         assert!(at(&shifted, 32, 16)[1] < 80, "{:?}", at(&shifted, 32, 16));
         // A frame turned by 20° clockwise: the image-right lens sits lower (by about 5 px at 16
         // px from the middle), so below the right eye is tinted and above it is not.
-        let mut tilted = vec![180u8; (w * h * 4) as usize];
-        let style_tilted = GlassesStyle {
-            tilt_rad: 20f32.to_radians(),
-            width_ipd: 0.4,
-            aspect: 0.5,
-            ..style
-        };
-        draw(
-            &mut tilted,
-            w,
-            h,
-            Vec2::new(16.0, 16.0),
-            Vec2::new(48.0, 16.0),
-            &style_tilted,
+        let tilted = drawn(
+            GlassesStyle {
+                tilt_rad: 20f32.to_radians(),
+                width_ipd: 0.4,
+                aspect: 0.5,
+                ..style
+            },
+            16.0,
         );
         assert!(at(&tilted, 48, 23)[0] < 80, "{:?}", at(&tilted, 48, 23));
         assert_eq!(at(&tilted, 48, 14), [180, 180, 180]);
         assert!(at(&tilted, 16, 9)[1] < 80, "{:?}", at(&tilted, 16, 9));
         // Ordinary glasses: both lenses grey, the filters ignored.
-        let mut grey = vec![180u8; (w * h * 4) as usize];
-        let style_grey = GlassesStyle {
-            tints: Some([[0.2; 3]; 2]),
-            ..style
-        };
-        draw(
-            &mut grey,
-            w,
-            h,
-            Vec2::new(16.0, 16.0),
-            Vec2::new(48.0, 16.0),
-            &style_grey,
+        let grey = drawn(
+            GlassesStyle {
+                tints: Some([[0.2; 3]; 2]),
+                ..style
+            },
+            16.0,
         );
         for x in [16, 48] {
             let c = at(&grey, x, 16);
