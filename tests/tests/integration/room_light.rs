@@ -80,6 +80,16 @@ fn holding(dir: Vec3) -> Quat {
     Quat::from_mat3(&Mat3::from_cols(x, y, z))
 }
 
+/// The azimuth the sweep starts at, degrees: 0, or `PHANTOGRAM_SWEEP_START_DEG` to measure how
+/// much the figures at 80 % seen depend on where the visitor starts turning (they do, a lot:
+/// `benchmarks/ibl.md`, "eighth session").
+fn sweep_start_deg() -> f32 {
+    std::env::var("PHANTOGRAM_SWEEP_START_DEG")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0.0)
+}
+
 /// A visitor turning on the spot, the phone at one tilt per turn, then the next, in 15° steps of
 /// azimuth: first nearly flat in the hand as a phantogram is held (the front camera sees the
 /// ceiling), then raised towards upright (the walls behind the visitor), then lowered past it
@@ -88,7 +98,7 @@ fn sweep() -> Vec<Quat> {
     let mut poses = Vec::new();
     for elevation_deg in [85.0f32, 60.0, 35.0, 10.0, -15.0, -40.0, -65.0, -85.0] {
         for step in 0..24 {
-            let az = (step as f32 * 15.0).to_radians();
+            let az = (step as f32 * 15.0 + sweep_start_deg()).to_radians();
             let el = elevation_deg.to_radians();
             poses.push(holding(Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())));
         }
@@ -225,6 +235,10 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
     // towards the nadir below anything seen: the unseen fifth filled with the best single value
     // there is — chosen knowing the true irradiance — is still 5.6 % off there (printed as "best
     // fill of one value"). This bound (set after measuring 5.9 %) guards against regressions only.
+    // And these figures are for one starting azimuth: started at each of eight (every 45°,
+    // `PHANTOGRAM_SWEEP_START_DEG`), the sweep misses 5 % in 11 of the 72 room × start cases,
+    // the apartment up to 11.1 % (mean 2.4 % over all; `benchmarks/ibl.md`); the bound above is
+    // for the start at 0 and fails at others.
     assert!(
         worst_80.0 <= 0.07,
         "{:.1} % off at 80 % seen in {}",
