@@ -100,10 +100,8 @@ fn try_styles(
             let (w, h) = with.dimensions();
             draw(&mut with, w, h, f.left_eye_px, f.right_eye_px, &style);
             let found = faces(models, &with);
-            let mid = (f.left_eye_px + f.right_eye_px) * 0.5;
-            let hit = found
-                .iter()
-                .find(|g| ((g.left_eye_px + g.right_eye_px) * 0.5).distance(mid) < 0.5 * ipd_px);
+            let mid = eyes_midpoint(f);
+            let hit = found.iter().find(|g| eyes_midpoint(g).distance(mid) < 0.5 * ipd_px);
             let rel = |a: Option<f32>, b: Option<f32>| Some(a? / b? - 1.0);
             out.push(match hit {
                 None => Outcome {
@@ -124,12 +122,7 @@ fn try_styles(
                     ipd_px,
                     photo_ipd_px: ipd_px / enlarged,
                     reflection: style.reflection > 0.0,
-                    eye_error: Some(
-                        g.left_eye_px
-                            .distance(f.left_eye_px)
-                            .max(g.right_eye_px.distance(f.right_eye_px))
-                            / ipd_px,
-                    ),
+                    eye_error: Some(eye_error(g, f)),
                     distance_error: rel(g.distance_m(&k, g.ipd_for_distance(ipd_m)), clean_distance),
                     iris_distance_error: rel(g.distance_m(&k, None), clean_distance),
                     glasses_right: g.lenses.is_some_and(|l| (l.image_left, l.image_right) == style.filters),
@@ -145,6 +138,21 @@ fn percentile(mut v: Vec<f32>, p: f32) -> f32 {
     v.get(((v.len() as f32 - 1.0) * p).round() as usize)
         .copied()
         .unwrap_or(f32::NAN)
+}
+
+/// The middle between a face's eyes, pixels.
+fn eyes_midpoint(f: &FaceFound) -> Vec2 {
+    (f.left_eye_px + f.right_eye_px) * 0.5
+}
+
+/// How far `found`'s eyes are from `reference`'s, the farther of the two, as a share of
+/// `reference`'s eye distance.
+fn eye_error(found: &FaceFound, reference: &FaceFound) -> f32 {
+    found
+        .left_eye_px
+        .distance(reference.left_eye_px)
+        .max(found.right_eye_px.distance(reference.right_eye_px))
+        / reference.left_eye_px.distance(reference.right_eye_px)
 }
 
 #[test]
@@ -179,7 +187,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
         off_centre.extend(try_styles(&models, name, &img, &clean, 1.0, &mut off_seed, true));
         for f in &clean {
             let ipd_px = f.left_eye_px.distance(f.right_eye_px);
-            let mid = (f.left_eye_px + f.right_eye_px) * 0.5;
+            let mid = eyes_midpoint(f);
             // Upright, and turned by 20° one way or the other (alternating between faces).
             let turn = if seed % 8 < 4 { 20.0 } else { -20.0 };
             for angle_deg in [0.0f32, turn] {
@@ -187,7 +195,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
                 // The reference: the face in the middle of the enlarged, clean frame.
                 let clean_selfie: Vec<FaceFound> = faces(&models, &selfie)
                     .into_iter()
-                    .filter(|g| ((g.left_eye_px + g.right_eye_px) * 0.5).distance(Vec2::new(320.0, 240.0)) < 40.0)
+                    .filter(|g| eyes_midpoint(g).distance(Vec2::new(320.0, 240.0)) < 40.0)
                     .take(1)
                     .collect();
                 for g in &clean_selfie {
@@ -200,7 +208,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
                         let ipd = g.left_eye_px.distance(g.right_eye_px);
                         if let Some(m) = faces(&models, &moved)
                             .into_iter()
-                            .find(|m| ((m.left_eye_px + m.right_eye_px) * 0.5).distance(Vec2::new(320.0, 240.0)) < 40.0)
+                            .find(|m| eyes_midpoint(m).distance(Vec2::new(320.0, 240.0)) < 40.0)
                         {
                             jitter.push(
                                 (m.left_eye_px - shift)
@@ -604,7 +612,7 @@ fn ordinary_glasses_are_not_taken_for_anaglyph_glasses() {
         let img = image::open(dir.join(name)).expect("photo").to_rgba8();
         for f in faces(&models, &img) {
             let ipd_px = f.left_eye_px.distance(f.right_eye_px);
-            let mid = (f.left_eye_px + f.right_eye_px) * 0.5;
+            let mid = eyes_midpoint(&f);
             // At photo scale, and the face enlarged to a 120-pixel eye distance in a 640 × 480 frame.
             let selfie = warp_into_frame(&img, mid, 120.0 / ipd_px, 0.0);
             let scales: [(&image::RgbaImage, f32); 2] = [(&img, 1.0), (&selfie, 120.0 / ipd_px)];
@@ -617,13 +625,19 @@ fn ordinary_glasses_are_not_taken_for_anaglyph_glasses() {
                     }
                 };
                 let (left, right) = (centre(f.left_eye_px), centre(f.right_eye_px));
-                let near = |g: &&FaceFound| {
-                    ((g.left_eye_px + g.right_eye_px) * 0.5).distance((left + right) * 0.5) < 0.5 * left.distance(right)
+                let near =
+                    |g: &&FaceFound| eyes_midpoint(g).distance((left + right) * 0.5) < 0.5 * left.distance(right);
+                // The reference: the clean picture's own result for this face (at photo scale,
+                // the face itself).
+                let clean = if scale == 1.0 {
+                    Some(f.clone())
+                } else {
+                    faces(&models, picture).into_iter().find(|g| near(&g))
                 };
-                // The reference: the clean picture's own result for this face.
-                let Some(clean) = faces(&models, picture).into_iter().find(|g| near(&g)) else {
+                let Some(clean) = clean else {
                     continue;
                 };
+                let intrinsics = frame(picture).intrinsics;
                 for (k, (kind, tint, rim, reflection)) in kinds.iter().enumerate() {
                     let style = phantogram_lab::drawn_glasses::GlassesStyle {
                         tints: Some([*tint; 2]),
@@ -645,20 +659,12 @@ fn ordinary_glasses_are_not_taken_for_anaglyph_glasses() {
                     if g.lenses.is_some() || found.iter().any(|g| g.lenses.is_some()) {
                         named.push(format!("{name} ×{scale:.1} {kind}: {:?}", g.lenses));
                     }
-                    let intrinsics = frame(picture).intrinsics;
                     if let (Some(d), Some(d0)) = (g.distance_m(&intrinsics, None), clean.distance_m(&intrinsics, None))
                     {
                         distance_errors[k].push((d / d0 - 1.0).abs());
                     }
                     if *tint == [0.92; 3] {
-                        let ipd = clean.left_eye_px.distance(clean.right_eye_px);
-                        clear_errors.push((
-                            scale == 1.0,
-                            g.left_eye_px
-                                .distance(clean.left_eye_px)
-                                .max(g.right_eye_px.distance(clean.right_eye_px))
-                                / ipd,
-                        ));
+                        clear_errors.push((scale == 1.0, eye_error(g, &clean)));
                     }
                 }
             }
