@@ -95,10 +95,10 @@ fn sweep_start_deg() -> f32 {
 /// ceiling), then raised towards upright (the walls behind the visitor), then lowered past it
 /// (the floor, seen last and least).
 fn sweep() -> Vec<Quat> {
-    let mut poses = Vec::new();
+    let (mut poses, start_deg) = (Vec::new(), sweep_start_deg());
     for elevation_deg in [85.0f32, 60.0, 35.0, 10.0, -15.0, -40.0, -65.0, -85.0] {
         for step in 0..24 {
-            let az = (step as f32 * 15.0 + sweep_start_deg()).to_radians();
+            let az = (step as f32 * 15.0 + start_deg).to_radians();
             let el = elevation_deg.to_radians();
             poses.push(holding(Vec3::new(el.cos() * az.cos(), el.cos() * az.sin(), el.sin())));
         }
