@@ -228,19 +228,17 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
         worst_full.0 * 100.0,
         worst_full.1
     );
-    // TODO(issue 20): the goal is 5 % at 80 % seen. The unseen fifth is mostly the floor, filled
-    // with the band seen nearest to it on its side of the horizon (`RoomCapture::environment`):
-    // within 2.9 % on eight of the nine rooms, 5.9 % in the apartment (8.9 % with the mean of
-    // everything seen below the horizon, 20.6 % with the nearest-seen fill). Its floor darkens
-    // towards the nadir below anything seen: the unseen fifth filled with the best single value
-    // there is — chosen knowing the true irradiance — is still 5.6 % off there (printed as "best
-    // fill of one value"). This bound (set after measuring 5.9 %) guards against regressions only.
-    // And these figures are for one starting azimuth: started at each of eight (every 45°,
-    // `PHANTOGRAM_SWEEP_START_DEG`), the sweep misses 5 % in 11 of the 72 room × start cases,
-    // the apartment up to 11.1 % (mean 2.4 % over all; `benchmarks/ibl.md`); the bound above is
-    // for the start at 0 and fails at others.
+    // Issue 20's goal: within 5 % at 80 % seen. The unseen fifth is mostly the floor, filled
+    // from the band seen nearest to it on its side of the horizon, that band's mean estimated
+    // for every azimuth from the band seen everywhere above it (`fill.rs`, `band_means`): at
+    // this start within 3.4 % in every room (the apartment; 5.9 % with the partly seen band's
+    // plain mean, 8.9 % with the mean of everything seen below the horizon, 20.6 % with the
+    // nearest-seen fill). TODO(issue 20): this holds for the start at 0 only. Started at each
+    // of eight azimuths (every 45°, `PHANTOGRAM_SWEEP_START_DEG`), 8 of the 72 room × start
+    // cases miss 5 %, the apartment by up to 9.6 % (mean 2.1 % over all; `benchmarks/ibl.md`),
+    // and this bound fails there.
     assert!(
-        worst_80.0 <= 0.07,
+        worst_80.0 <= 0.05,
         "{:.1} % off at 80 % seen in {}",
         worst_80.0 * 100.0,
         worst_80.1
