@@ -152,7 +152,8 @@ pub(crate) fn fill_unseen(width: usize, height: usize, rgb: Vec<[f32; 3]>, weigh
 /// mean is a ratio estimate (Cochran, *Sampling Techniques*, ch. 6), with the nearest row
 /// towards the horizon on the same side that is seen at every azimuth as the auxiliary band:
 /// the seen cells' mean × that band's mean over every azimuth / its mean over the azimuths seen
-/// in the row (both weighted by the row's weights, luminance only, so the row keeps its colour).
+/// in the row (the latter weighted by the row's weights; luminance only, so the row keeps its
+/// colour).
 /// Where the seen azimuths are brighter than the band's average one level nearer the horizon, a
 /// bright thing there is taken to reach down into the row as well. Without such a band on its
 /// side (early in a sweep) a row keeps its seen cells' mean.

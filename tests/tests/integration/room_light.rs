@@ -235,7 +235,7 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
     // plain mean, 8.9 % with the mean of everything seen below the horizon, 20.6 % with the
     // nearest-seen fill). TODO(issue 20): this holds for the start at 0 only. Started at each
     // of eight azimuths (every 45°, `PHANTOGRAM_SWEEP_START_DEG`), 8 of the 72 room × start
-    // cases miss 5 %, the apartment by up to 9.6 % (mean 2.1 % over all; `benchmarks/ibl.md`),
+    // cases miss 5 %, the apartment reaching 9.6 % (mean 2.1 % over all; `benchmarks/ibl.md`),
     // and this bound fails there.
     assert!(
         worst_80.0 <= 0.05,
