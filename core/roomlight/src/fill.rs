@@ -64,7 +64,8 @@ pub const UNSEEN_FLOOR_REFLECTANCE: f32 = 0.2;
 /// 13.1 % (two worse).
 /// The reach was set at 11.25° before any of this; with the nearest band's seen mean, 5.6°
 /// gave a worst of 10.2 % (the apartment), 22.5° and 45° 6.1 %, the other rooms within 4.7 %
-/// at every reach.
+/// at every reach. With the ratio estimate, over the eight starts: 5.6° 2.27 % mean, 9.7 %
+/// worst, 10 cases over 5 %; 22.5° 2.16 %, 9.1 %, 10 cases; 11.25° the best mean and fewest.
 ///
 /// All zero where nothing was seen.
 pub(crate) fn fill_unseen(width: usize, height: usize, rgb: Vec<[f32; 3]>, weight: Vec<f32>) -> Environment {
