@@ -7,6 +7,7 @@
 //! passes its own map, whose sizes agree.
 
 use phantogram_assets::ibl::Environment;
+use phantogram_geometry::srgb::luminance;
 
 /// How far from what was seen a hole is filled from its neighbourhood, degrees; beyond, from the
 /// band seen nearest to it on its side of the horizon ([`crate::RoomCapture::environment`]). A few
@@ -102,7 +103,7 @@ pub(crate) fn fill_unseen(width: usize, height: usize, rgb: Vec<[f32; 3]>, weigh
     // elevation and on their side of the horizon, that has seen cells.
     if let Some((w, h, rgb, weight)) = levels.last_mut() {
         let (w, h) = (*w, *h);
-        let upper = |row: usize| 2 * row + 1 < h;
+        let upper = |row: usize| above_horizon(row, h);
         let means = band_means(w, h, rgb, weight);
         let fill: Vec<Option<[f32; 3]>> = (0..h)
             .map(|row| {
@@ -159,30 +160,31 @@ pub(crate) fn fill_unseen(width: usize, height: usize, rgb: Vec<[f32; 3]>, weigh
 /// bright thing there is taken to reach down into the row as well. Without such a band on its
 /// side (early in a sweep) a row keeps its seen cells' mean.
 fn band_means(w: usize, h: usize, rgb: &[[f32; 3]], weight: &[f32]) -> Vec<Option<[f32; 3]>> {
-    let upper = |row: usize| 2 * row + 1 < h;
-    let luminance = |c: &[f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let upper = |row: usize| above_horizon(row, h);
     let cells = |row: usize| row * w..(row + 1) * w;
-    let seen_mean = |row: usize| -> Option<[f32; 3]> {
-        let (mut sum, mut total) = ([0.0f32; 3], 0.0f32);
-        for i in cells(row) {
-            for c in 0..3 {
-                sum[c] += rgb[i][c] * weight[i];
+    let seen_means: Vec<Option<[f32; 3]>> = (0..h)
+        .map(|row| {
+            let (mut sum, mut total) = ([0.0f32; 3], 0.0f32);
+            for i in cells(row) {
+                for c in 0..3 {
+                    sum[c] += rgb[i][c] * weight[i];
+                }
+                total += weight[i];
             }
-            total += weight[i];
-        }
-        (total > 0.0).then(|| sum.map(|s| s / total))
-    };
-    let seen_everywhere = |row: usize| cells(row).all(|i| weight[i] > 0.0);
+            (total > 0.0).then(|| sum.map(|s| s / total))
+        })
+        .collect();
+    let seen_everywhere: Vec<bool> = (0..h).map(|row| cells(row).all(|i| weight[i] > 0.0)).collect();
     (0..h)
         .map(|row| {
-            let mean = seen_mean(row)?;
-            if seen_everywhere(row) {
+            let mean = seen_means[row]?;
+            if seen_everywhere[row] {
                 return Some(mean);
             }
             let auxiliary = if upper(row) {
-                (row + 1..h).find(|&r| upper(r) && seen_everywhere(r))
+                (row + 1..h).find(|&r| upper(r) && seen_everywhere[r])
             } else {
-                (0..row).rev().find(|&r| !upper(r) && seen_everywhere(r))
+                (0..row).rev().find(|&r| !upper(r) && seen_everywhere[r])
             };
             let Some(aux) = auxiliary else {
                 return Some(mean);
@@ -190,10 +192,10 @@ fn band_means(w: usize, h: usize, rgb: &[[f32; 3]], weight: &[f32]) -> Vec<Optio
             let (mut at_seen, mut total) = (0.0f32, 0.0f32);
             for x in 0..w {
                 let wt = weight[row * w + x];
-                at_seen += wt * luminance(&rgb[aux * w + x]);
+                at_seen += wt * luminance(rgb[aux * w + x]);
                 total += wt;
             }
-            let everywhere = seen_mean(aux).map_or(0.0, |m| luminance(&m));
+            let everywhere = seen_means[aux].map_or(0.0, luminance);
             let at_seen = at_seen / total;
             if at_seen > 0.0 && everywhere > 0.0 {
                 Some(mean.map(|v| v * everywhere / at_seen))
@@ -202,6 +204,11 @@ fn band_means(w: usize, h: usize, rgb: &[[f32; 3]], weight: &[f32]) -> Vec<Optio
             }
         })
         .collect()
+}
+
+/// Whether row `row` of a map `h` rows high (row 0 the zenith) lies above the horizon.
+fn above_horizon(row: usize, h: usize) -> bool {
+    2 * row + 1 < h
 }
 
 /// The irradiance that the upper half of an equirectangular map (`w` × `h` cells, row 0 the
