@@ -10,7 +10,8 @@
 //! `c = ln T − mean(ln T)` points towards the filter's colour and its length says how strongly it
 //! tints (about 0 with no lens or clear glass; ≈ 2.5 for a saturated red or cyan lens; 0.44–0.6
 //! for one that passes half of what it should stop). Glasses are reported when both eyes'
-//! shifts are strong ([`MIN_STRENGTH`]) and point at the two filters of one kind of glasses.
+//! shifts are strong ([`MIN_STRENGTH`]) and point at the two filters of one kind of glasses
+//! (named as a pair, so that a clearly named lens settles a partner that lies between two filters).
 //!
 //! Where a face's eye estimate is too far off for that (the detector's keypoints on tinted eyes
 //! can all be turned together), [`find_in_box`] looks for the lens pair by colour in the
@@ -139,6 +140,28 @@ fn nearest_filter(shift: Vec3) -> (Filter, f32) {
         .unwrap_or((Filter::Red, 0.0))
 }
 
+/// The kind of glasses (and which way round) that a pair of eye shifts points at: the filter
+/// pair whose weaker cosine, each eye against its filter, is the highest, and that cosine.
+///
+/// Named as a pair, not eye by eye: a lens's measured shift can lie between two filters (a
+/// magenta lens over skin that is bluer by the eye than on the cheek reads nearer red than
+/// magenta), and then the other lens, named clearly, says which of the two it is. The cosine
+/// each eye must reach ([`MIN_COSINE`]) is the same either way.
+fn nearest_pair(a: Vec3, b: Vec3) -> (Filter, Filter, f32) {
+    Filter::ALL
+        .into_iter()
+        .map(|f| {
+            let p = f.partner();
+            (
+                f,
+                p,
+                cosine(a, log_chroma(transmission(f))).min(cosine(b, log_chroma(transmission(p)))),
+            )
+        })
+        .max_by(|x, y| x.2.total_cmp(&y.2))
+        .unwrap_or((Filter::Red, Filter::Cyan, 0.0))
+}
+
 /// What each eye's lens (if any) does (image-left eye at `left`, image-right at `right`; see
 /// [`eye_transmission`]), and each side's cheek colour (linear), where colour allows.
 fn transmissions_and_cheeks(image: &UprightImage, left: Vec2, right: Vec2) -> Option<[([f32; 3], [f32; 3]); 2]> {
@@ -199,8 +222,8 @@ pub fn find_at(image: &UprightImage, left: Vec2, right: Vec2) -> Option<Lenses> 
     if strength < MIN_STRENGTH {
         return None;
     }
-    let ((fa, ca), (fb, cb)) = (nearest_filter(a), nearest_filter(b));
-    (fb == fa.partner() && ca >= MIN_COSINE && cb >= MIN_COSINE).then_some(Lenses {
+    let (fa, fb, cosine) = nearest_pair(a, b);
+    (cosine >= MIN_COSINE).then_some(Lenses {
         image_left: fa,
         image_right: fb,
         strength,
@@ -698,6 +721,42 @@ mod tests {
         let bare_image = super::tests::image(&bare);
         assert!(find_at(&bare_image, left, right).is_none());
         assert_eq!(lenses.centres(&bare_image), [None, None]);
+    }
+
+    /// A lens whose shift lies between two filters is named by its partner: this left lens
+    /// (measured so on a drawn magenta lens, opacity 0.7, over the astronaut's eye, whose lids are
+    /// less blue than her cheek) is nearer red than magenta, so beside a green lens it is the
+    /// magenta one, beside a cyan lens the red one. Named eye by eye it was red beside green, no
+    /// pair, and the glasses were missed.
+    #[test]
+    fn a_lens_between_two_filters_is_named_by_its_partner() {
+        let (left, right) = (Vec2::new(60.0, 60.0), Vec2::new(140.0, 60.0));
+        let between = [0.378, 0.130, 0.217];
+        assert_eq!(nearest_filter(log_chroma(between)).0, Filter::Red);
+        for (partner, named) in [(Filter::Green, Filter::Magenta), (Filter::Cyan, Filter::Red)] {
+            let rgba = face(|p, skin| {
+                let t = if p.distance(left) < 25.0 {
+                    between
+                } else if p.distance(right) < 25.0 {
+                    transmission(partner)
+                } else {
+                    [1.0; 3]
+                };
+                [0, 1, 2].map(|k| skin[k] * t[k])
+            });
+            let lenses = find_at(&image(&rgba), left, right).expect("the glasses");
+            assert_eq!((lenses.image_left, lenses.image_right), (named, partner));
+        }
+        // Both lenses that colour: not a pair of any kind.
+        let rgba = face(|p, skin| {
+            let t = if p.distance(left) < 25.0 || p.distance(right) < 25.0 {
+                between
+            } else {
+                [1.0; 3]
+            };
+            [0, 1, 2].map(|k| skin[k] * t[k])
+        });
+        assert!(find_at(&image(&rgba), left, right).is_none());
     }
 
     /// A thin dark rim around both lenses is found and filled with the cheek's colour; the lens
