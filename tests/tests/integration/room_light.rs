@@ -5,7 +5,8 @@
 //! give the environment's irradiance (relative RMS over 2000 normals spread evenly over the
 //! sphere): within 5 % once the sweep has seen the whole sphere, with an exposure bracket whose
 //! exposures the platform reports; at 80 % seen the figures are printed and guarded (the goal
-//! of 5 % there is reached on eight of the nine rooms: see the TODO). Auto-exposure alone, exposures
+//! of 5 % there is reached by every room with the sweep started at azimuth 0, not at every other
+//! start: see the TODO). Auto-exposure alone, exposures
 //! estimated, is printed for comparison (up to the unknown overall scale), and so is the error at
 //! 80 % seen with the map's level set as the renderer sets it (its mean luminance made the
 //! room's: `RoomLightWorker` scales each map to the light it replaces).
