@@ -144,7 +144,7 @@ fn nearest_filter(shift: Vec3) -> (Filter, f32) {
 /// pair whose weaker cosine, each eye against its filter, is the highest, and that cosine.
 ///
 /// Named as a pair, not eye by eye: a lens's measured shift can lie between two filters (a
-/// magenta lens over skin that is bluer by the eye than on the cheek reads nearer red than
+/// magenta lens over lids less blue than the cheek it is measured against reads nearer red than
 /// magenta), and then the other lens, named clearly, says which of the two it is. The cosine
 /// each eye must reach ([`MIN_COSINE`]) is the same either way.
 fn nearest_pair(a: Vec3, b: Vec3) -> (Filter, Filter, f32) {
