@@ -131,11 +131,16 @@ fn eye_transmission(
     Some(([0, 1, 2].map(|k| l[k].max(1e-4) / c[k].max(1e-4)), c))
 }
 
+/// How closely (cosine) a colour shift points at `filter`'s colour.
+fn filter_cosine(shift: Vec3, filter: Filter) -> f32 {
+    cosine(shift, log_chroma(transmission(filter)))
+}
+
 /// The filter whose colour an eye's shift points at, and how closely.
 fn nearest_filter(shift: Vec3) -> (Filter, f32) {
     Filter::ALL
         .into_iter()
-        .map(|f| (f, cosine(shift, log_chroma(transmission(f)))))
+        .map(|f| (f, filter_cosine(shift, f)))
         .max_by(|a, b| a.1.total_cmp(&b.1))
         .unwrap_or((Filter::Red, 0.0))
 }
@@ -152,11 +157,7 @@ fn nearest_pair(a: Vec3, b: Vec3) -> (Filter, Filter, f32) {
         .into_iter()
         .map(|f| {
             let p = f.partner();
-            (
-                f,
-                p,
-                cosine(a, log_chroma(transmission(f))).min(cosine(b, log_chroma(transmission(p)))),
-            )
+            (f, p, filter_cosine(a, f).min(filter_cosine(b, p)))
         })
         .max_by(|x, y| x.2.total_cmp(&y.2))
         .unwrap_or((Filter::Red, Filter::Cyan, 0.0))
