@@ -15,6 +15,7 @@ use std::sync::Arc;
 use phantogram::face::glasses;
 use phantogram::face::{CameraFrame, FaceFound, FaceModels, Intrinsics, PixelFormat, UprightImage};
 use phantogram::glam::Vec2;
+use phantogram_geometry::srgb::{code_to_linear, linear_to_code};
 use phantogram_integration::{data_subdir, warp_into_frame};
 use phantogram_lab::drawn_glasses::{draw, style_for};
 
@@ -717,5 +718,118 @@ fn ordinary_glasses_are_not_taken_for_anaglyph_glasses() {
             percentile(distance_errors[k].clone(), 0.5) <= 0.10,
             "{kind}: median distance error"
         );
+    }
+}
+
+/// The light the photograph was taken in, changed: each pixel's linear colour times `gains`
+/// (per channel), back to 8-bit sRGB (clipped, as a camera clips).
+fn relit(img: &image::RgbaImage, gains: [f32; 3]) -> image::RgbaImage {
+    let mut out = img.clone();
+    for p in out.pixels_mut() {
+        for (code, gain) in p.0.iter_mut().zip(gains) {
+            *code = linear_to_code(code_to_linear(*code) * gain);
+        }
+    }
+    out
+}
+
+/// The glasses are named, and bare faces are not taken for glasses, under other light than the
+/// photographs': two stops darker (a dim gallery, or darker skin at the same exposure: the lens
+/// then tints a darker, noisier skin), a tungsten lamp's warm cast and a cool daylight one. The
+/// lens's colour is measured against the cheek's, which cancels the light's colour; this checks
+/// that it does, on the photos as they are and at selfie scale (not the turned or off-centre
+/// sets: the light changes nothing about geometry). A camera's white balance would take most of a
+/// cast out; here none is, the harder case.
+///
+/// Overexposure is not covered: with the cheek clipped, its colour (the reference) is wrong in
+/// the clipped channels. Measured with the photos 1.3 stops brighter (`benchmarks/face.md`,
+/// eleventh session): no bare face named, but 8 of 160 glasses not named.
+#[test]
+fn glasses_are_named_under_other_light() {
+    let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
+        return;
+    };
+    let lights: [(&str, [f32; 3]); 3] = [
+        ("two stops darker", [0.25; 3]),
+        ("tungsten", [1.0, 0.6, 0.25]),
+        ("cool daylight", [0.7, 0.85, 1.0]),
+    ];
+    for (light, gains) in lights {
+        let mut seed = 0u32;
+        let (mut photos, mut selfies) = (Vec::new(), Vec::new());
+        for name in PHOTOS {
+            let path = dir.join(name);
+            let img = image::open(&path)
+                .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+                .to_rgba8();
+            let img = relit(&img, gains);
+            let clean = faces(&models, &img);
+            for f in &clean {
+                assert!(f.lenses.is_none(), "{name}, {light}: glasses seen on a bare face");
+            }
+            photos.extend(try_styles(&models, name, &img, &clean, 1.0, &mut seed, false));
+            for f in &clean {
+                let ipd_px = f.left_eye_px.distance(f.right_eye_px);
+                let selfie = warp_into_frame(&img, eyes_midpoint(f), 120.0 / ipd_px, 0.0);
+                let clean_selfie: Vec<FaceFound> = faces(&models, &selfie)
+                    .into_iter()
+                    .filter(|g| eyes_midpoint(g).distance(Vec2::new(320.0, 240.0)) < 40.0)
+                    .take(1)
+                    .collect();
+                for g in &clean_selfie {
+                    assert!(
+                        g.lenses.is_none(),
+                        "{name} at selfie scale, {light}: glasses on a bare face"
+                    );
+                }
+                let case = format!("{name} ×{:.1}", 120.0 / ipd_px);
+                selfies.extend(try_styles(
+                    &models,
+                    &case,
+                    &selfie,
+                    &clean_selfie,
+                    120.0 / ipd_px,
+                    &mut seed,
+                    false,
+                ));
+            }
+        }
+        for (set, outcomes) in [("photos", &photos), ("selfie scale", &selfies)] {
+            let found: Vec<&Outcome> = outcomes.iter().filter(|o| o.eye_error.is_some()).collect();
+            let eyes: Vec<f32> = found.iter().filter_map(|o| o.eye_error).collect();
+            let dist: Vec<f32> = found.iter().filter_map(|o| o.distance_error.map(f32::abs)).collect();
+            let right = found.iter().filter(|o| o.glasses_right).count();
+            println!(
+                "{light}, {set}: {} of {} found; glasses right {right}; eye error median {:.3}, 90 % {:.3}; \
+                 distance error median {:.3}, 90 % {:.3}",
+                found.len(),
+                outcomes.len(),
+                percentile(eyes.clone(), 0.5),
+                percentile(eyes.clone(), 0.9),
+                percentile(dist.clone(), 0.5),
+                percentile(dist.clone(), 0.9)
+            );
+            for o in outcomes.iter().filter(|o| !o.glasses_right) {
+                println!(
+                    "  {} (eye distance {:.0} px): glasses not named right",
+                    o.case, o.ipd_px
+                );
+            }
+            // As the glasses test asks of the photographs' own light: faces found again (a few
+            // may be lost at photo scale), the glasses named, the eyes and distance kept.
+            let lost = outcomes.len() - found.len();
+            let lost_allowed = if set == "photos" { outcomes.len() / 20 } else { 0 };
+            assert!(
+                lost <= lost_allowed,
+                "{light}, {set}: {lost} faces lost with glasses on"
+            );
+            assert!(
+                right as f32 >= 0.95 * found.len() as f32,
+                "{light}, {set}: glasses named on {right} of {}",
+                found.len()
+            );
+            assert!(percentile(eyes, 0.5) <= 0.03, "{light}, {set}: median eye error");
+            assert!(percentile(dist, 0.5) <= 0.02, "{light}, {set}: median distance error");
+        }
     }
 }
