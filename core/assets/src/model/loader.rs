@@ -10,6 +10,7 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use super::meshopt_views::{self, DecodedViews};
+use super::topology;
 use super::*;
 use crate::budget::{OverBudget, ResourceBudget, Spending};
 use crate::progress::{Progress, Span};
@@ -1266,16 +1267,35 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     .borrow_mut()
                     .charge_primitive(|| format!("{what} (in node {})", node.index()))
                     .map_err(|e| over_budget(path, e))?;
-                if prim.mode() != gltf::mesh::Mode::Triangles {
+                let draco = prim.extension_value("KHR_draco_mesh_compression");
+                // Points and lines have no surface to show; Draco's decoder hands back faces,
+                // whose relation to a strip or fan the extension leaves to the encoder.
+                let drawn = match prim.mode() {
+                    gltf::mesh::Mode::Triangles => true,
+                    gltf::mesh::Mode::TriangleStrip | gltf::mesh::Mode::TriangleFan => draco.is_none(),
+                    _ => false,
+                };
+                if !drawn {
                     model
                         .warnings
                         .push(format!("{what}: {:?} primitives are not drawn", prim.mode()));
                     continue;
                 }
-                let attributes = match prim.extension_value("KHR_draco_mesh_compression") {
+                let mut attributes = match draco {
                     Some(ext) => read_draco(&ctx, &prim, ext, &views)?,
                     None => read_plain(&ctx, &prim)?,
                 };
+                if prim.mode() != gltf::mesh::Mode::Triangles {
+                    let count = (attributes.positions.len() / 3) as u32;
+                    let sequence = attributes.indices.take().unwrap_or_else(|| (0..count).collect());
+                    attributes.indices = topology::triangle_list(prim.mode(), sequence);
+                    if attributes.indices.as_ref().is_none_or(Vec::is_empty) {
+                        model
+                            .warnings
+                            .push(format!("{what}: a {:?} without a triangle is not drawn", prim.mode()));
+                        continue;
+                    }
+                }
                 // Charged before the mesh is built (for Draco, its counts are known only now).
                 let vertices = (attributes.positions.len() / 3) as u64;
                 let indices = attributes.indices.as_ref().map_or(vertices, |i| i.len() as u64);

@@ -10,6 +10,9 @@
 //!   buffer views (gltfpack's `-c`) are decoded with meshoptimizer before any accessor reads
 //!   them; their fallback buffers are never read (`meshopt_views`).
 //! * Node transforms are baked into the vertices (negative determinants flip the winding).
+//! * Triangle strips and fans become the triangle lists they stand for, wound as glTF orders their
+//!   corners (`topology`); points and lines have no surface to show and are left out with a
+//!   warning each (as is a strip or fan of a Draco primitive, whose decoder hands back faces).
 //! * Materials: base colour, metallic–roughness, normal (with scale), occlusion (with strength)
 //!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform` on every
 //!   slot (gltf-rs types it only on `textureInfo`, so for normal and occlusion textures it is read
@@ -654,6 +657,7 @@ pub use loader::{
 mod loader;
 mod meshopt_views;
 mod split;
+mod topology;
 
 #[cfg(test)]
 mod tests {
