@@ -25,7 +25,7 @@ pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load, one merely
 /// using another loads with a warning naming it.
-pub const SUPPORTED_EXTENSIONS: [&str; 7] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 8] = [
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -33,6 +33,7 @@ pub const SUPPORTED_EXTENSIONS: [&str; 7] = [
     "KHR_texture_transform",
     "KHR_materials_emissive_strength",
     "KHR_materials_unlit",
+    "EXT_texture_webp",
 ];
 
 #[derive(Debug, Error)]
@@ -292,6 +293,20 @@ fn check_structure(root: &gltf::json::Root) -> Result<(), String> {
             _ => {}
         }
     }
+    // A texture's WebP image, by index as its `source` would be (`texture_image`).
+    for (t, texture) in root.textures.iter().enumerate() {
+        let webp = texture
+            .extensions
+            .as_ref()
+            .and_then(|e| e.others.get("EXT_texture_webp"));
+        if let Some(source) = webp.and_then(|w| w.get("source"))
+            && source.as_u64().is_none_or(|i| i >= root.images.len() as u64)
+        {
+            return Err(format!(
+                "textures[{t}].extensions.EXT_texture_webp.source: image {source} does not exist"
+            ));
+        }
+    }
     let mut errors = Vec::new();
     root.validate(root, gltf::json::Path::new, &mut |path, error| {
         let path = path().to_string();
@@ -425,19 +440,42 @@ fn sampler_of(t: &gltf::Texture) -> Sampler {
     }
 }
 
+/// The image a texture shows: its `source` (PNG or JPEG), or else the WebP image its
+/// `EXT_texture_webp` names (a file made for the web may carry WebP only). `None` when it names
+/// neither (glTF 2.0 lets an extension we do not know supply the image).
+fn texture_image(t: &gltf::Texture) -> Option<usize> {
+    t.source().map(|i| i.index()).or_else(|| {
+        let source = t.extension_value("EXT_texture_webp")?.get("source")?.as_u64()?;
+        usize::try_from(source).ok()
+    })
+}
+
 /// A texture reference; `transform` is `KHR_texture_transform` with its optional texCoord
-/// override.
-fn texture_ref(t: &gltf::Texture, tex_coord: u32, transform: Option<(UvTransform, Option<u32>)>) -> TextureRef {
+/// override. `None` (and a warning) for a texture whose image we cannot find ([`texture_image`]).
+fn texture_ref(
+    t: &gltf::Texture,
+    tex_coord: u32,
+    transform: Option<(UvTransform, Option<u32>)>,
+    what: &str,
+    warnings: &mut Vec<String>,
+) -> Option<TextureRef> {
+    let Some(image) = texture_image(t) else {
+        warnings.push(format!(
+            "{what}: texture {} has no image this loader reads; left out",
+            t.index()
+        ));
+        return None;
+    };
     let (transform, tex_coord) = match transform {
         Some((uv, set)) => (uv, set.unwrap_or(tex_coord)),
         None => (UvTransform::default(), tex_coord),
     };
-    TextureRef {
-        image: t.source().index(),
+    Some(TextureRef {
+        image,
         tex_coord: tex_coord.min(1),
         transform,
         sampler: sampler_of(t),
-    }
+    })
 }
 
 fn typed_transform(tt: gltf::texture::TextureTransform) -> (UvTransform, Option<u32>) {
@@ -476,18 +514,36 @@ fn raw_transform(
 
 fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
     let pbr = m.pbr_metallic_roughness();
-    let info =
-        |i: gltf::texture::Info| texture_ref(&i.texture(), i.tex_coord(), i.texture_transform().map(typed_transform));
     let name = m.name().unwrap_or("unnamed");
-    let normal_texture = m.normal_texture().map(|n| {
+    let mut info = |i: Option<gltf::texture::Info>, slot: &str| {
+        let i = i?;
+        let what = format!("material {name}, {slot} texture");
+        texture_ref(
+            &i.texture(),
+            i.tex_coord(),
+            i.texture_transform().map(typed_transform),
+            &what,
+            warnings,
+        )
+    };
+    let base_color_texture = info(pbr.base_color_texture(), "base colour");
+    let metallic_roughness_texture = info(pbr.metallic_roughness_texture(), "metallic-roughness");
+    let emissive_texture = info(m.emissive_texture(), "emissive");
+    let normal_texture = m.normal_texture().and_then(|n| {
         let what = format!("material {name}, normal texture");
         let transform = raw_transform(n.extension_value("KHR_texture_transform"), &what, warnings);
-        (texture_ref(&n.texture(), n.tex_coord(), transform), n.scale())
+        Some((
+            texture_ref(&n.texture(), n.tex_coord(), transform, &what, warnings)?,
+            n.scale(),
+        ))
     });
-    let occlusion_texture = m.occlusion_texture().map(|o| {
+    let occlusion_texture = m.occlusion_texture().and_then(|o| {
         let what = format!("material {name}, occlusion texture");
         let transform = raw_transform(o.extension_value("KHR_texture_transform"), &what, warnings);
-        (texture_ref(&o.texture(), o.tex_coord(), transform), o.strength())
+        Some((
+            texture_ref(&o.texture(), o.tex_coord(), transform, &what, warnings)?,
+            o.strength(),
+        ))
     });
     let strength = m.emissive_strength().unwrap_or(1.0);
     let e = m.emissive_factor();
@@ -505,11 +561,11 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
         },
         double_sided: m.double_sided(),
         unlit: m.unlit(),
-        base_color_texture: pbr.base_color_texture().map(info),
-        metallic_roughness_texture: pbr.metallic_roughness_texture().map(info),
+        base_color_texture,
+        metallic_roughness_texture,
         normal_texture,
         occlusion_texture,
-        emissive_texture: m.emissive_texture().map(info),
+        emissive_texture,
         scenery: false,
     }
 }
@@ -1109,12 +1165,16 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
             what: what(),
             message,
         };
-        // glTF images are PNG or JPEG; anything else (an EXR, say) is refused before a
-        // decoder meant for other files sees it.
+        // glTF images are PNG or JPEG, or WebP with `EXT_texture_webp`; anything else (an
+        // EXR, say) is refused before a decoder meant for other files sees it.
         let format = match image::guess_format(&raw) {
-            Ok(format @ (image::ImageFormat::Png | image::ImageFormat::Jpeg)) => format,
-            Ok(other) => return Err(data_error(format!("{other:?} data; glTF images must be PNG or JPEG"))),
-            Err(_) => return Err(data_error("neither PNG nor JPEG data".to_owned())),
+            Ok(format @ (image::ImageFormat::Png | image::ImageFormat::Jpeg | image::ImageFormat::WebP)) => format,
+            Ok(other) => {
+                return Err(data_error(format!(
+                    "{other:?} data; glTF images must be PNG, JPEG or WebP"
+                )));
+            }
+            Err(_) => return Err(data_error("neither PNG, JPEG nor WebP data".to_owned())),
         };
         let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&raw), format)
             .into_dimensions()

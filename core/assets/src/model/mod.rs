@@ -17,7 +17,10 @@
 //!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform` on every
 //!   slot (gltf-rs types it only on `textureInfo`, so for normal and occlusion textures it is read
 //!   from the raw extension object; a malformed one becomes a warning), alpha
-//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded (PNG, JPEG) to RGBA8.
+//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded (PNG, JPEG, and WebP for
+//!   `EXT_texture_webp`, which web tools write often with no PNG or JPEG beside; the `image`
+//!   crate's pure-Rust `image-webp` decoder) to RGBA8. A texture whose image comes only from an
+//!   extension we do not read is left out with a warning.
 //! * Tangents come from the file or, where a normal map needs them, from MikkTSpace
 //!   (`bevy_mikktspace`, the reference algorithm that normal maps are baked against).
 //! * Smithsonian Voyager scans: when a `scene.svx.json` beside the file lists it as a derivative,
