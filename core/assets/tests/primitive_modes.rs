@@ -55,7 +55,7 @@ fn model_with(name: &str, sequences: &[(u32, Vec<u16>)]) -> Model {
         nodes.join(","),
         (0..nodes.len()).map(|k| k.to_string()).collect::<Vec<_>>().join(",")
     );
-    let dir = Scratch::new("primitive-modes");
+    let dir = Scratch::new(&format!("primitive-modes-{name}"));
     let path = dir.join(format!("{name}.gltf"));
     std::fs::write(&path, gltf).expect("write");
     load_gltf(&path).expect("a valid file")

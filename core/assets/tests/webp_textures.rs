@@ -46,7 +46,8 @@ fn gltf_with_texture(texture: &str) -> String {
 }
 
 fn load(name: &str, text: &str) -> Result<phantogram_assets::model::Model, ModelError> {
-    let dir = Scratch::new("webp-textures");
+    // A folder per file: tests run in parallel, and a scratch folder is its name's alone.
+    let dir = Scratch::new(&format!("webp-{}", name.replace('.', "-")));
     let path = dir.join(name);
     std::fs::write(&path, text).expect("write");
     load_gltf(&path)

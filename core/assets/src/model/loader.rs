@@ -10,6 +10,7 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use super::meshopt_views::{self, DecodedViews};
+use super::spec_gloss::{self, SpecGloss};
 use super::topology;
 use super::*;
 use crate::budget::{OverBudget, ResourceBudget, Spending};
@@ -25,7 +26,7 @@ pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load, one merely
 /// using another loads with a warning naming it.
-pub const SUPPORTED_EXTENSIONS: [&str; 8] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 9] = [
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -34,6 +35,7 @@ pub const SUPPORTED_EXTENSIONS: [&str; 8] = [
     "KHR_materials_emissive_strength",
     "KHR_materials_unlit",
     "EXT_texture_webp",
+    "KHR_materials_pbrSpecularGlossiness",
 ];
 
 #[derive(Debug, Error)]
@@ -568,6 +570,83 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
         emissive_texture,
         scenery: false,
     }
+}
+
+/// `material` in the specular–glossiness workflow `value` describes
+/// (`KHR_materials_pbrSpecularGlossiness`), converted to metallic–roughness (`spec_gloss`): from
+/// the factors, or texel by texel into new images appended to `images` (charged to `spending`).
+/// A malformed extension is ignored with a warning.
+fn with_spec_gloss(
+    material: &mut Material,
+    value: &serde_json::Value,
+    doc: &gltf::Document,
+    images: &mut Vec<Image>,
+    spending: &std::cell::RefCell<Spending>,
+    warnings: &mut Vec<String>,
+) -> Result<(), OverBudget> {
+    let name = material.name.clone();
+    let sg: SpecGloss = match spec_gloss::read(value) {
+        Ok(sg) => sg,
+        Err(e) => {
+            warnings.push(format!(
+                "material {name}: KHR_materials_pbrSpecularGlossiness ignored ({e})"
+            ));
+            return Ok(());
+        }
+    };
+    let image_count = images.len();
+    let mut texture = |info: &spec_gloss::TextureInfo, slot: &str| {
+        let what = format!("material {name}, {slot} texture");
+        let Some(t) = doc.textures().nth(info.index) else {
+            warnings.push(format!("{what}: texture {} does not exist; left out", info.index));
+            return None;
+        };
+        let transform = raw_transform(info.transform.as_ref(), &what, warnings);
+        texture_ref(&t, info.tex_coord, transform, &what, warnings).filter(|r| r.image < image_count)
+    };
+    let diffuse_texture = sg.diffuse_texture.as_ref().and_then(|i| texture(i, "diffuse"));
+    let sg_texture = sg
+        .specular_glossiness_texture
+        .as_ref()
+        .and_then(|i| texture(i, "specular-glossiness"));
+    let diffuse = [sg.diffuse[0], sg.diffuse[1], sg.diffuse[2]];
+    let Some(sg_texture) = sg_texture else {
+        let metallic = spec_gloss::metallic(diffuse, sg.specular);
+        let [r, g, b] = spec_gloss::base_colour(diffuse, sg.specular, metallic);
+        material.base_color = [r, g, b, sg.diffuse[3]];
+        material.metallic = metallic;
+        material.roughness = 1.0 - sg.glossiness;
+        material.base_color_texture = diffuse_texture;
+        material.metallic_roughness_texture = None;
+        return Ok(());
+    };
+    // The base colour is baked with the specular only where both textures cover the surface alike.
+    let alike = diffuse_texture.filter(|d| (d.tex_coord, d.transform) == (sg_texture.tex_coord, sg_texture.transform));
+    let (metal_rough, base) = spec_gloss::bake(&sg, &images[sg_texture.image], alike.map(|d| &images[d.image]));
+    let mut add = |image: Image| -> Result<usize, OverBudget> {
+        spending
+            .borrow_mut()
+            .charge_image(|| format!("material {name}: {}", image.name), image.width, image.height)?;
+        images.push(image);
+        Ok(images.len() - 1)
+    };
+    material.metallic_roughness_texture = Some(TextureRef {
+        image: add(metal_rough)?,
+        ..sg_texture
+    });
+    material.metallic = 1.0;
+    material.roughness = 1.0;
+    match (base, alike) {
+        (Some(base), Some(d)) => {
+            material.base_color_texture = Some(TextureRef { image: add(base)?, ..d });
+            material.base_color = [1.0; 4];
+        }
+        _ => {
+            material.base_color_texture = diffuse_texture;
+            material.base_color = sg.diffuse;
+        }
+    }
+    Ok(())
 }
 
 /// Attribute data of one primitive before assembly.
@@ -1276,7 +1355,16 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         })
         .chain(image_notes.into_iter().flatten())
         .collect();
-    let mut materials: Vec<Material> = doc.materials().map(|m| material_of(&m, &mut warnings)).collect();
+    let mut images = images;
+    let mut materials = Vec::with_capacity(doc.materials().len() + 1);
+    for m in doc.materials() {
+        let mut material = material_of(&m, &mut warnings);
+        if let Some(value) = m.extension_value("KHR_materials_pbrSpecularGlossiness") {
+            with_spec_gloss(&mut material, value, doc, &mut images, &ctx.spending, &mut warnings)
+                .map_err(|e| over_budget(path, e))?;
+        }
+        materials.push(material);
+    }
     let default_material = materials.len();
     materials.push(Material::default());
 
