@@ -412,6 +412,32 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                 "scene.svx.json",
                 br#"{"models":[{"rotation":[0,0,0,1],"derivatives":[{"usage":"Web3D","quality":"High","assets":[{"uri":"model.glb"}]}]}]}"#,
             )?;
+            // Strips and fans, and a specular-glossiness material over a WebP-only texture.
+            put(
+                "strip.gltf",
+                tri_gltf
+                    .replace(r#""material":0"#, r#""material":0,"mode":5"#)
+                    .as_bytes(),
+            )?;
+            put(
+                "fan.gltf",
+                tri_gltf
+                    .replace(r#""material":0"#, r#""material":0,"mode":6"#)
+                    .as_bytes(),
+            )?;
+            put(
+                "spec-gloss-webp.gltf",
+                tri_gltf
+                    .replace(
+                        r#""textures":[{"source":0}]"#,
+                        r#""textures":[{"extensions":{"EXT_texture_webp":{"source":0}}}]"#,
+                    )
+                    .replace(
+                        r#""pbrMetallicRoughness":{"baseColorTexture":{"index":0}}"#,
+                        r#""extensions":{"KHR_materials_pbrSpecularGlossiness":{"diffuseTexture":{"index":0},"specularGlossinessTexture":{"index":0},"glossinessFactor":0.5}}"#,
+                    )
+                    .as_bytes(),
+            )?;
             put(
                 "triangle.glb",
                 &glb(tri_gltf.replace(r#","uri":"tri.bin""#, "").as_bytes(), &triangle_bin()),
