@@ -141,6 +141,16 @@ fn percentile(mut v: Vec<f32>, p: f32) -> f32 {
         .unwrap_or(f32::NAN)
 }
 
+/// The face found in the middle of a 640 × 480 frame a face was enlarged into
+/// (`warp_into_frame`), if any: none or one.
+fn centred_face(models: &FaceModels, frame_img: &image::RgbaImage) -> Vec<FaceFound> {
+    faces(models, frame_img)
+        .into_iter()
+        .filter(|g| eyes_midpoint(g).distance(Vec2::new(320.0, 240.0)) < 40.0)
+        .take(1)
+        .collect()
+}
+
 /// The middle between a face's eyes, pixels.
 fn eyes_midpoint(f: &FaceFound) -> Vec2 {
     (f.left_eye_px + f.right_eye_px) * 0.5
@@ -194,11 +204,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
             for angle_deg in [0.0f32, turn] {
                 let selfie = warp_into_frame(&img, mid, 120.0 / ipd_px, angle_deg.to_radians());
                 // The reference: the face in the middle of the enlarged, clean frame.
-                let clean_selfie: Vec<FaceFound> = faces(&models, &selfie)
-                    .into_iter()
-                    .filter(|g| eyes_midpoint(g).distance(Vec2::new(320.0, 240.0)) < 40.0)
-                    .take(1)
-                    .collect();
+                let clean_selfie = centred_face(&models, &selfie);
                 for g in &clean_selfie {
                     assert!(g.lenses.is_none(), "{name} at selfie scale: glasses on a bare face");
                     if angle_deg == 0.0 {
@@ -207,10 +213,7 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
                         let shift = Vec2::new(0.5, 0.3);
                         let moved = warp_into_frame(&img, mid - shift * ipd_px / 120.0, 120.0 / ipd_px, 0.0);
                         let ipd = g.left_eye_px.distance(g.right_eye_px);
-                        if let Some(m) = faces(&models, &moved)
-                            .into_iter()
-                            .find(|m| eyes_midpoint(m).distance(Vec2::new(320.0, 240.0)) < 40.0)
-                        {
+                        if let Some(m) = centred_face(&models, &moved).pop() {
                             jitter.push(
                                 (m.left_eye_px - shift)
                                     .distance(g.left_eye_px)
@@ -771,11 +774,7 @@ fn glasses_are_named_under_other_light() {
             for f in &clean {
                 let ipd_px = f.left_eye_px.distance(f.right_eye_px);
                 let selfie = warp_into_frame(&img, eyes_midpoint(f), 120.0 / ipd_px, 0.0);
-                let clean_selfie: Vec<FaceFound> = faces(&models, &selfie)
-                    .into_iter()
-                    .filter(|g| eyes_midpoint(g).distance(Vec2::new(320.0, 240.0)) < 40.0)
-                    .take(1)
-                    .collect();
+                let clean_selfie = centred_face(&models, &selfie);
                 for g in &clean_selfie {
                     assert!(
                         g.lenses.is_none(),
