@@ -10,6 +10,7 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use super::meshopt_views::{self, DecodedViews};
+use super::skin;
 use super::spec_gloss::{self, SpecGloss};
 use super::topology;
 use super::*;
@@ -649,6 +650,42 @@ fn with_spec_gloss(
     Ok(())
 }
 
+/// Each joint's world matrix times its inverse bind matrix (identity where the skin gives
+/// none), for [`skin::apply`].
+fn skin_matrices(ctx: &Ctx, s: &gltf::Skin, node_worlds: &[Mat4]) -> Result<Vec<Mat4>, ModelError> {
+    let what = || format!("skin {}", s.index());
+    let joints: Vec<usize> = s.joints().map(|j| j.index()).collect();
+    let inverse_binds = match s.inverse_bind_matrices() {
+        Some(accessor) => {
+            if accessor.dimensions() != Dimensions::Mat4 || accessor.count() < joints.len() {
+                return Err(ctx.data(
+                    what(),
+                    format!(
+                        "inverseBindMatrices must be {} MAT4s (accessor {})",
+                        joints.len(),
+                        accessor.index()
+                    ),
+                ));
+            }
+            ctx.read_f32(&accessor, 16)?
+                .chunks_exact(16)
+                .map(Mat4::from_cols_slice)
+                .collect()
+        }
+        None => vec![Mat4::IDENTITY; joints.len()],
+    };
+    joints
+        .iter()
+        .zip(&inverse_binds)
+        .map(|(&j, inverse_bind)| {
+            node_worlds
+                .get(j)
+                .map(|world| *world * *inverse_bind)
+                .ok_or_else(|| ctx.data(what(), format!("joint node {j} does not exist")))
+        })
+        .collect()
+}
+
 /// Attribute data of one primitive before assembly.
 #[derive(Default)]
 struct Attributes {
@@ -659,6 +696,8 @@ struct Attributes {
     uv1: Option<Vec<f32>>,
     colors: Option<(Vec<f32>, usize)>,
     indices: Option<Vec<u32>>,
+    /// `JOINTS_0` and `WEIGHTS_0`, four per vertex each, where both are present.
+    skin: Option<(Vec<f32>, Vec<f32>)>,
 }
 
 /// The shapes glTF 2.0 allows each attribute we read ("Meshes", attribute table): a `NORMAL`
@@ -669,16 +708,8 @@ fn allowed_dimensions(semantic: &gltf::Semantic) -> &'static [Dimensions] {
         Semantic::Positions | Semantic::Normals => &[Dimensions::Vec3],
         Semantic::Tangents => &[Dimensions::Vec4],
         Semantic::TexCoords(_) => &[Dimensions::Vec2],
+        Semantic::Joints(_) | Semantic::Weights(_) => &[Dimensions::Vec4],
         Semantic::Colors(_) => &[Dimensions::Vec3, Dimensions::Vec4],
-        _ => &[
-            Dimensions::Scalar,
-            Dimensions::Vec2,
-            Dimensions::Vec3,
-            Dimensions::Vec4,
-            Dimensions::Mat2,
-            Dimensions::Mat3,
-            Dimensions::Mat4,
-        ],
     }
 }
 
@@ -721,6 +752,9 @@ fn read_plain(ctx: &Ctx, prim: &gltf::Primitive) -> Result<Attributes, ModelErro
     }
     if let Some(idx) = prim.indices() {
         a.indices = Some(ctx.read_indices(&idx)?);
+    }
+    if let (Some(joints), Some(weights)) = (prim.get(&Semantic::Joints(0)), prim.get(&Semantic::Weights(0))) {
+        a.skin = Some((ctx.read_f32(&joints, 4)?, ctx.read_f32(&weights, 4)?));
     }
     Ok(a)
 }
@@ -781,6 +815,8 @@ fn read_draco(
         uv1: get("TEXCOORD_1", 2)?,
         colors,
         indices: Some(indices),
+        // Joints and weights in a Draco stream are not read: such a mesh is placed by its node.
+        skin: None,
     })
 }
 
@@ -1396,6 +1432,23 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     // The primitives the file declares: drawn ones may be more (instancing) or fewer.
     let declared_primitives = doc.meshes().map(|m| m.primitives().len()).sum::<usize>().max(1) as f32;
     let mut built_primitives = 0usize;
+    // Every node's world matrix, for the joints of skins (which need not lie on the path to the
+    // mesh they move).
+    let node_worlds = if doc.skins().len() > 0 {
+        let mut parent = vec![None; doc.nodes().len()];
+        for n in doc.nodes() {
+            for c in n.children() {
+                parent[c.index()] = Some(n.index());
+            }
+        }
+        let local: Vec<Mat4> = doc
+            .nodes()
+            .map(|n| Mat4::from_cols_array_2d(&n.transform().matrix()))
+            .collect();
+        skin::node_worlds(&local, &parent)
+    } else {
+        Vec::new()
+    };
     let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut visited[node.index()], true) {
@@ -1454,12 +1507,22 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                         ResourceBudget::mesh_bytes(vertices, indices),
                     )
                     .map_err(|e| over_budget(path, e))?;
+                let skin_data = attributes.skin.take();
                 let mut m = assemble(&ctx, attributes, &what)?;
                 built_primitives += 1;
                 meshes_share
                     .step(built_primitives as f32 / declared_primitives)
                     .map_err(cancelled)?;
-                m.transform(world);
+                match (node.skin(), skin_data) {
+                    // glTF: a skinned mesh is placed by its joints alone, its node's transform
+                    // ignored.
+                    (Some(s), Some((joints, weights))) => {
+                        let matrices = skin_matrices(&ctx, &s, &node_worlds)?;
+                        skin::apply(&mut m, &joints, &weights, &matrices)
+                            .map_err(|e| ctx.data(format!("{what} (skin {})", s.index()), e))?;
+                    }
+                    _ => m.transform(world),
+                }
                 // Checked after the node transforms, which can overflow finite positions too.
                 if let Some((i, v)) = m
                     .vertices

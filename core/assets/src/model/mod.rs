@@ -10,6 +10,9 @@
 //!   buffer views (gltfpack's `-c`) are decoded with meshoptimizer before any accessor reads
 //!   them; their fallback buffers are never read (`meshopt_views`).
 //! * Node transforms are baked into the vertices (negative determinants flip the winding).
+//! * Skinned meshes are drawn in the pose the node hierarchy holds, each vertex moved by its joints
+//!   (`JOINTS_0`/`WEIGHTS_0`, inverse bind matrices) with the skinned node's own transform ignored,
+//!   as glTF defines (`skin`); no animation is played.
 //! * Triangle strips and fans become the triangle lists they stand for, wound as glTF orders their
 //!   corners (`topology`); points and lines have no surface to show and are left out with a
 //!   warning each (as is a strip or fan of a Draco primitive, whose decoder hands back faces).
@@ -661,6 +664,7 @@ pub use loader::{
 
 mod loader;
 mod meshopt_views;
+mod skin;
 mod spec_gloss;
 mod split;
 mod topology;
