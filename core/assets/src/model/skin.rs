@@ -15,24 +15,32 @@ use glam::{Mat3, Mat4, Vec3, Vec4};
 use super::Mesh;
 
 /// The world matrix of every node (index by node), each its parents' product with its own local
-/// matrix. `parent[i]` is node i's parent. A chain longer than the node count (a cycle, which the
-/// loader refuses elsewhere) stops there.
+/// matrix. `parent[i]` is node i's parent. Each node is computed once (a chain of many nodes
+/// costs no more than as many products); a cycle (which the loader refuses elsewhere) is cut
+/// where it closes.
 pub(super) fn node_worlds(local: &[Mat4], parent: &[Option<usize>]) -> Vec<Mat4> {
     let n = local.len();
-    (0..n)
-        .map(|i| {
-            let mut world = local[i];
-            let mut at = parent.get(i).copied().flatten();
-            for _ in 0..n {
-                let Some(p) = at.filter(|&p| p < n) else {
-                    break;
-                };
-                world = local[p] * world;
-                at = parent.get(p).copied().flatten();
-            }
-            world
-        })
-        .collect()
+    let mut world: Vec<Option<Mat4>> = vec![None; n];
+    let mut on_path = vec![false; n];
+    let mut path = Vec::new();
+    for start in 0..n {
+        // Up to the first ancestor already known (or the root), then back down.
+        let mut at = Some(start);
+        while let Some(i) = at.filter(|&i| i < n && world[i].is_none() && !on_path[i]) {
+            on_path[i] = true;
+            path.push(i);
+            at = parent.get(i).copied().flatten();
+        }
+        let mut above = at
+            .and_then(|i| world.get(i).copied().flatten())
+            .unwrap_or(Mat4::IDENTITY);
+        while let Some(i) = path.pop() {
+            above *= local[i];
+            world[i] = Some(above);
+            on_path[i] = false;
+        }
+    }
+    world.into_iter().map(|w| w.unwrap_or(Mat4::IDENTITY)).collect()
 }
 
 /// Moves `mesh`'s vertices (positions, normals, tangents) by their joints: `joints` and
@@ -115,9 +123,15 @@ mod tests {
         let t = |x: f32| Mat4::from_translation(Vec3::new(x, 0.0, 0.0));
         let worlds = node_worlds(&[t(1.0), t(10.0), t(100.0)], &[None, Some(0), Some(1)]);
         assert_eq!(worlds[2].transform_point3(Vec3::ZERO), Vec3::new(111.0, 0.0, 0.0));
-        // A cycle ends after as many steps as there are nodes.
+        // A cycle is cut where it closes.
         let looped = node_worlds(&[t(1.0), t(1.0)], &[Some(1), Some(0)]);
         assert!(looped.iter().all(|m| m.is_finite()));
+        // A long chain, listed leaf first: each node's world once, every one right.
+        let n = 20_000;
+        let parent: Vec<Option<usize>> = (0..n).map(|i| (i + 1 < n).then_some(i + 1)).collect();
+        let worlds = node_worlds(&vec![t(1.0); n], &parent);
+        assert_eq!(worlds[0].transform_point3(Vec3::ZERO).x, n as f32);
+        assert_eq!(worlds[n - 1].transform_point3(Vec3::ZERO).x, 1.0);
     }
 
     #[test]
