@@ -438,6 +438,12 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                     )
                     .as_bytes(),
             )?;
+            // A skinned triangle over the target's `tri.bin` (joints and weights read from its
+            // bytes).
+            put(
+                "skinned.gltf",
+                br#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"tri.bin"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},{"bufferView":0,"componentType":5121,"count":3,"type":"VEC4"},{"bufferView":0,"byteOffset":12,"componentType":5121,"normalized":true,"count":3,"type":"VEC4"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0,"JOINTS_0":1,"WEIGHTS_0":2}}]}],"skins":[{"joints":[1]}],"nodes":[{"mesh":0,"skin":0},{"translation":[0,1,0]}],"scenes":[{"nodes":[0,1]}],"scene":0}"#,
+            )?;
             put(
                 "triangle.glb",
                 &glb(tri_gltf.replace(r#","uri":"tri.bin""#, "").as_bytes(), &triangle_bin()),
