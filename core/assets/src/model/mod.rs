@@ -24,8 +24,9 @@
 //!   `EXT_texture_webp`, which web tools write often with no PNG or JPEG beside; the `image`
 //!   crate's pure-Rust `image-webp` decoder) to RGBA8. A texture whose image comes only from an
 //!   extension we do not read is left out with a warning.
-//! * `KHR_materials_pbrSpecularGlossiness` (archived, but on many older scans) is converted to
-//!   metallic–roughness as Khronos published, texel by texel where it has a texture (`spec_gloss`).
+//! * `KHR_materials_pbrSpecularGlossiness` (archived by Khronos, but found in older exports) is
+//!   converted to metallic–roughness as Khronos published, texel by texel where it has a texture
+//!   (`spec_gloss`).
 //! * Tangents come from the file or, where a normal map needs them, from MikkTSpace
 //!   (`bevy_mikktspace`, the reference algorithm that normal maps are baked against).
 //! * Smithsonian Voyager scans: when a `scene.svx.json` beside the file lists it as a derivative,

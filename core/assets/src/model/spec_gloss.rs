@@ -1,6 +1,6 @@
 //! Materials in the specular–glossiness workflow (`KHR_materials_pbrSpecularGlossiness`, archived
-//! by Khronos but common in older exports: many scans published before 2021 carry it), turned
-//! into the metallic–roughness materials the renderer draws.
+//! by Khronos in favour of `KHR_materials_specular` but found in older exports), turned into the
+//! metallic–roughness materials the renderer draws.
 //!
 //! Without this a file that uses it shows glTF's default material (white, fully metallic): the
 //! scan's colour is lost. The conversion is the one Khronos published beside the extension
