@@ -1462,6 +1462,9 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
+            // The node's joint matrices, made by its first skinned primitive and kept for the
+            // others.
+            let mut joint_matrices: Option<Vec<Mat4>> = None;
             for prim in mesh.primitives() {
                 let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
                 ctx.spending
@@ -1517,8 +1520,11 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     // glTF: a skinned mesh is placed by its joints alone, its node's transform
                     // ignored.
                     (Some(s), Some((joints, weights))) => {
-                        let matrices = skin_matrices(&ctx, &s, &node_worlds)?;
-                        skin::apply(&mut m, &joints, &weights, &matrices)
+                        if joint_matrices.is_none() {
+                            joint_matrices = Some(skin_matrices(&ctx, &s, &node_worlds)?);
+                        }
+                        let matrices = joint_matrices.as_deref().unwrap_or_default();
+                        skin::apply(&mut m, &joints, &weights, matrices)
                             .map_err(|e| ctx.data(format!("{what} (skin {})", s.index()), e))?;
                     }
                     _ => m.transform(world),

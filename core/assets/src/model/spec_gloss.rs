@@ -52,17 +52,14 @@ pub(super) struct SpecGloss {
 
 /// Reads the extension's object; an error names what is malformed.
 pub(super) fn read(value: &Value) -> Result<SpecGloss, String> {
+    // A factor: a finite number, clamped to the schema's [0, 1].
+    let number = |v: &Value| v.as_f64().filter(|v| v.is_finite()).map(|v| (v as f32).clamp(0.0, 1.0));
     let numbers = |key: &str, n: usize, default: &[f32]| -> Result<Vec<f32>, String> {
         match value.get(key) {
             None => Ok(default.to_vec()),
             Some(Value::Array(a)) if a.len() == n => a
                 .iter()
-                .map(|v| {
-                    v.as_f64()
-                        .filter(|v| v.is_finite())
-                        .map(|v| (v as f32).clamp(0.0, 1.0))
-                        .ok_or_else(|| format!("{key} holds a non-number"))
-                })
+                .map(|v| number(v).ok_or_else(|| format!("{key} holds a non-number")))
                 .collect(),
             Some(_) => Err(format!("{key} is not an array of {n} numbers")),
         }
@@ -97,11 +94,7 @@ pub(super) fn read(value: &Value) -> Result<SpecGloss, String> {
     let s = numbers("specularFactor", 3, &[1.0; 3])?;
     let glossiness = match value.get("glossinessFactor") {
         None => 1.0,
-        Some(g) => g
-            .as_f64()
-            .filter(|g| g.is_finite())
-            .map(|g| (g as f32).clamp(0.0, 1.0))
-            .ok_or("glossinessFactor is not a number")?,
+        Some(g) => number(g).ok_or("glossinessFactor is not a number")?,
     };
     Ok(SpecGloss {
         diffuse: [d[0], d[1], d[2], d[3]],
