@@ -448,6 +448,33 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                 "triangle.glb",
                 &glb(tri_gltf.replace(r#","uri":"tri.bin""#, "").as_bytes(), &triangle_bin()),
             )?;
+            // The triangle textured by each KTX 2.0 / Basis Universal test texture (ETC1S with
+            // mips, UASTC under Zstandard), embedded after the positions.
+            for name in ["pattern-rgba-etc1s.ktx2", "pattern-rgb-uastc.ktx2"] {
+                let ktx2 = std::fs::read(workspace_root().join("core/assets/tests/data/ktx2").join(name))
+                    .with_context(|| format!("reading the test texture {name}"))?;
+                let mut bin = triangle_bin();
+                bin.extend_from_slice(&ktx2);
+                let json = tri_gltf
+                    .replace(r#","uri":"tri.bin""#, "")
+                    .replace(
+                        r#""buffers":[{"byteLength":36}]"#,
+                        &format!(r#""buffers":[{{"byteLength":{}}}]"#, bin.len()),
+                    )
+                    .replace(
+                        r#""bufferViews":[{"buffer":0,"byteLength":36}]"#,
+                        &format!(
+                            r#""bufferViews":[{{"buffer":0,"byteLength":36}},{{"buffer":0,"byteOffset":36,"byteLength":{}}}]"#,
+                            ktx2.len()
+                        ),
+                    )
+                    .replace(r#""images":[{"uri":"tex.png"}]"#, r#""images":[{"bufferView":1,"mimeType":"image/ktx2"}]"#)
+                    .replace(
+                        r#""textures":[{"source":0}]"#,
+                        r#""extensionsRequired":["KHR_texture_basisu"],"textures":[{"extensions":{"KHR_texture_basisu":{"source":0}}}]"#,
+                    );
+                put(&format!("{name}.glb"), &glb(json.as_bytes(), &bin))?;
+            }
             for p in shared("models", &[".glb", ".gltf", ".svx.json"]) {
                 if std::fs::metadata(&p).is_ok_and(|m| m.len() as usize <= max_len) {
                     put(&seed_name(&p), &std::fs::read(&p)?)?;

@@ -561,7 +561,7 @@ fn a_broken_image_is_named_in_the_error() {
         Err(ModelError::Data { what, message, .. }) => {
             assert!(what.starts_with("image 1"), "{what}");
             assert!(
-                message.contains("Hdr data; glTF images must be PNG, JPEG or WebP"),
+                message.contains("Hdr data; glTF images must be PNG, JPEG, WebP or KTX 2.0"),
                 "{message}"
             );
         }

@@ -9,6 +9,7 @@ use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
+use super::encoded_image::Encoded;
 use super::meshopt_views::{self, DecodedViews};
 use super::skin;
 use super::spec_gloss::{self, SpecGloss};
@@ -27,7 +28,7 @@ pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load, one merely
 /// using another loads with a warning naming it.
-pub const SUPPORTED_EXTENSIONS: [&str; 9] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 10] = [
     "KHR_draco_mesh_compression",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
@@ -36,6 +37,7 @@ pub const SUPPORTED_EXTENSIONS: [&str; 9] = [
     "KHR_materials_emissive_strength",
     "KHR_materials_unlit",
     "EXT_texture_webp",
+    "KHR_texture_basisu",
     "KHR_materials_pbrSpecularGlossiness",
 ];
 
@@ -296,18 +298,18 @@ fn check_structure(root: &gltf::json::Root) -> Result<(), String> {
             _ => {}
         }
     }
-    // A texture's WebP image, by index as its `source` would be (`texture_image`).
+    // A texture's image named by an extension, by index as its `source` would be
+    // (`texture_image`).
     for (t, texture) in root.textures.iter().enumerate() {
-        let webp = texture
-            .extensions
-            .as_ref()
-            .and_then(|e| e.others.get("EXT_texture_webp"));
-        if let Some(source) = webp.and_then(|w| w.get("source"))
-            && source.as_u64().is_none_or(|i| i >= root.images.len() as u64)
-        {
-            return Err(format!(
-                "textures[{t}].extensions.EXT_texture_webp.source: image {source} does not exist"
-            ));
+        for name in IMAGE_EXTENSIONS {
+            let extension = texture.extensions.as_ref().and_then(|e| e.others.get(name));
+            if let Some(source) = extension.and_then(|w| w.get("source"))
+                && source.as_u64().is_none_or(|i| i >= root.images.len() as u64)
+            {
+                return Err(format!(
+                    "textures[{t}].extensions.{name}.source: image {source} does not exist"
+                ));
+            }
         }
     }
     let mut errors = Vec::new();
@@ -443,13 +445,22 @@ fn sampler_of(t: &gltf::Texture) -> Sampler {
     }
 }
 
-/// The image a texture shows: its `source` (PNG or JPEG), or else the WebP image its
-/// `EXT_texture_webp` names (a file made for the web may carry WebP only). `None` when it names
-/// neither (glTF 2.0 lets an extension we do not know supply the image).
+/// Texture extensions that name an image in place of the texture's `source`, with its own
+/// codec: WebP, and KTX 2.0 with Basis Universal ([`super::encoded_image`]).
+const IMAGE_EXTENSIONS: [&str; 2] = ["EXT_texture_webp", "KHR_texture_basisu"];
+
+/// The image a texture shows: its `source` (PNG or JPEG), or else the image one of
+/// [`IMAGE_EXTENSIONS`] names (a file made for the web may carry only those). Where both are
+/// given, `source` is the fallback the extensions define; it is preferred because every texture
+/// is uploaded as RGBA8 anyway, and the fallback is the lossless copy (a Basis texture is a
+/// lossy recompression). `None` when it names no image (glTF 2.0 lets an extension we do not
+/// know supply it).
 fn texture_image(t: &gltf::Texture) -> Option<usize> {
     t.source().map(|i| i.index()).or_else(|| {
-        let source = t.extension_value("EXT_texture_webp")?.get("source")?.as_u64()?;
-        usize::try_from(source).ok()
+        IMAGE_EXTENSIONS.iter().find_map(|name| {
+            let source = t.extension_value(name)?.get("source")?.as_u64()?;
+            usize::try_from(source).ok()
+        })
     })
 }
 
@@ -1280,79 +1291,49 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
             what: what(),
             message,
         };
-        // glTF images are PNG or JPEG, or WebP with `EXT_texture_webp`; anything else (an
-        // EXR, say) is refused before a decoder meant for other files sees it.
-        let format = match image::guess_format(&raw) {
-            Ok(format @ (image::ImageFormat::Png | image::ImageFormat::Jpeg | image::ImageFormat::WebP)) => format,
-            Ok(other) => {
-                return Err(data_error(format!(
-                    "{other:?} data; glTF images must be PNG, JPEG or WebP"
-                )));
-            }
-            Err(_) => return Err(data_error("neither PNG, JPEG nor WebP data".to_owned())),
-        };
-        let (width, height) = image::ImageReader::with_format(std::io::Cursor::new(&raw), format)
-            .into_dimensions()
-            .map_err(|e| data_error(e.to_string()))?;
+        // glTF images are PNG or JPEG, WebP with `EXT_texture_webp` or KTX 2.0 with
+        // `KHR_texture_basisu`; anything else (an EXR, say) is refused before a decoder meant for
+        // other files sees it.
+        let header = Encoded::probe(&raw).map_err(data_error)?;
         let fitted = spending
-            .charge_image(what, width, height)
+            .charge_image(what, header.width, header.height)
             .map_err(|e| over_budget(path, e))?;
-        encoded.push((img.index(), raw, name, format, width, height, fitted));
+        encoded.push((img.index(), raw, name, header, fitted));
     }
     let images_share = Span::new(progress, IMAGES_SHARE[0], IMAGES_SHARE[1]);
     let decoded_count = std::sync::atomic::AtomicUsize::new(0);
     let image_count = encoded.len().max(1) as f32;
-    let images = crate::parallel::map(&encoded, |(index, raw, name, format, width, height, fitted)| {
+    let images = crate::parallel::map(&encoded, |(index, raw, name, header, fitted)| {
         let what = || format!("image {index} ({name})");
         // A cancelled load skips the images not yet begun (the error is reported below).
         if progress.is_cancelled() {
             return Err((what(), "cancelled".to_owned()));
         }
-        let mut reader = image::ImageReader::with_format(std::io::Cursor::new(raw), *format);
-        // The header was checked; the decoder holds to it (a damaged stream claiming more
-        // fails instead of allocating).
-        let mut limits = image::Limits::default();
-        limits.max_image_width = Some(*width);
-        limits.max_image_height = Some(*height);
-        limits.max_alloc = Some(
-            ResourceBudget::texture_bytes(*width, *height)
-                .saturating_mul(2)
-                .min(budget.memory_bytes),
-        );
-        reader.limits(limits);
-        // A decoder panic on a damaged image is this file's error, not the app's end.
-        std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| reader.decode()))
-            .map_err(|_| (what(), "the decoder failed on damaged data".to_owned()))?
-            .map(|decoded| decoded.into_rgba8())
-            .map_err(|e| (what(), e.to_string()))
-            .map(|decoded| {
-                let done = decoded_count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
-                images_share.advance(done as f32 / image_count);
-                // Larger than the device's textures: scaled down (a triangle filter averages
-                // the texels each new one covers), and the user told.
-                let (fw, fh) = *fitted;
-                let (decoded, note) = if (fw, fh) != (decoded.width(), decoded.height()) {
-                    let note = format!(
-                        "{} ({width}×{height}) scaled down to {fw}×{fh}, the largest texture this device draws",
-                        what()
-                    );
-                    (
-                        image::imageops::resize(&decoded, fw, fh, image::imageops::FilterType::Triangle),
-                        Some(note),
-                    )
-                } else {
-                    (decoded, None)
-                };
-                (
-                    Image {
-                        name: name.clone(),
-                        width: decoded.width(),
-                        height: decoded.height(),
-                        rgba8: decoded.into_raw(),
-                    },
-                    note,
-                )
-            })
+        let decoded = header
+            .decode(raw, *fitted, budget.memory_bytes)
+            .map_err(|e| (what(), e))?;
+        let done = decoded_count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
+        images_share.advance(done as f32 / image_count);
+        // Larger than the device's textures: the user is told it was scaled down.
+        let note = (*fitted != (header.width, header.height)).then(|| {
+            format!(
+                "{} ({}×{}) scaled down to {}×{}, the largest texture this device draws",
+                what(),
+                header.width,
+                header.height,
+                fitted.0,
+                fitted.1
+            )
+        });
+        Ok((
+            Image {
+                name: name.clone(),
+                width: decoded.width(),
+                height: decoded.height(),
+                rgba8: decoded.into_raw(),
+            },
+            note,
+        ))
     })
     .into_iter()
     .collect::<Result<Vec<(Image, Option<String>)>, _>>()

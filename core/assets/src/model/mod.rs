@@ -20,10 +20,12 @@
 //!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform` on every
 //!   slot (gltf-rs types it only on `textureInfo`, so for normal and occlusion textures it is read
 //!   from the raw extension object; a malformed one becomes a warning), alpha
-//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded (PNG, JPEG, and WebP for
-//!   `EXT_texture_webp`, which web tools write often with no PNG or JPEG beside; the `image`
-//!   crate's pure-Rust `image-webp` decoder) to RGBA8. A texture whose image comes only from an
-//!   extension we do not read is left out with a warning.
+//!   `OPAQUE`/`MASK`/`BLEND`, double-sided. Images are decoded to RGBA8 (`encoded_image`): PNG,
+//!   JPEG, WebP for `EXT_texture_webp` (which web tools write often with no PNG or JPEG beside;
+//!   the `image` crate's pure-Rust `image-webp` decoder) and KTX 2.0 with Basis Universal for
+//!   `KHR_texture_basisu` (ETC1S or UASTC, gltfpack's `-tc`; the pure-Rust `basisu` transcoder).
+//!   Where a texture names both, the core `source` (the lossless fallback) is used. A texture
+//!   whose image comes only from an extension we do not read is left out with a warning.
 //! * `KHR_materials_pbrSpecularGlossiness` (archived by Khronos, but found in older exports) is
 //!   converted to metallic–roughness as Khronos published, texel by texel where it has a texture
 //!   (`spec_gloss`).
@@ -663,6 +665,7 @@ pub use loader::{
     voyager_scan,
 };
 
+mod encoded_image;
 mod loader;
 mod meshopt_views;
 mod skin;
