@@ -444,6 +444,21 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                 "skinned.gltf",
                 br#"{"asset":{"version":"2.0"},"buffers":[{"byteLength":36,"uri":"tri.bin"}],"bufferViews":[{"buffer":0,"byteLength":36}],"accessors":[{"bufferView":0,"componentType":5126,"count":3,"type":"VEC3"},{"bufferView":0,"componentType":5121,"count":3,"type":"VEC4"},{"bufferView":0,"byteOffset":12,"componentType":5121,"normalized":true,"count":3,"type":"VEC4"}],"meshes":[{"primitives":[{"attributes":{"POSITION":0,"JOINTS_0":1,"WEIGHTS_0":2}}]}],"skins":[{"joints":[1]}],"nodes":[{"mesh":0,"skin":0},{"translation":[0,1,0]}],"scenes":[{"nodes":[0,1]}],"scene":0}"#,
             )?;
+            // The triangle drawn twice by `EXT_mesh_gpu_instancing` (the instances' translations
+            // read from `tri.bin`'s first two vertices).
+            put(
+                "instanced.gltf",
+                tri_gltf
+                    .replace(
+                        r#""nodes":[{"mesh":0}]"#,
+                        r#""nodes":[{"mesh":0,"extensions":{"EXT_mesh_gpu_instancing":{"attributes":{"TRANSLATION":1}}}}]"#,
+                    )
+                    .replace(
+                        r#""type":"VEC3","min":[0,0,0],"max":[1,1,0]}]"#,
+                        r#""type":"VEC3","min":[0,0,0],"max":[1,1,0]},{"bufferView":0,"componentType":5126,"count":2,"type":"VEC3"}]"#,
+                    )
+                    .as_bytes(),
+            )?;
             put(
                 "triangle.glb",
                 &glb(tri_gltf.replace(r#","uri":"tri.bin""#, "").as_bytes(), &triangle_bin()),

@@ -10,6 +10,7 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use super::encoded_image::Encoded;
+use super::instancing;
 use super::meshopt_views::{self, DecodedViews};
 use super::skin;
 use super::spec_gloss::{self, SpecGloss};
@@ -28,8 +29,9 @@ pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load, one merely
 /// using another loads with a warning naming it.
-pub const SUPPORTED_EXTENSIONS: [&str; 10] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 11] = [
     "KHR_draco_mesh_compression",
+    "EXT_mesh_gpu_instancing",
     "EXT_meshopt_compression",
     "KHR_meshopt_compression",
     "KHR_mesh_quantization",
@@ -695,6 +697,49 @@ fn skin_matrices(ctx: &Ctx, s: &gltf::Skin, node_worlds: &[Mat4]) -> Result<Vec<
                 .ok_or_else(|| ctx.data(what(), format!("joint node {j} does not exist")))
         })
         .collect()
+}
+
+/// The transforms of a node's `EXT_mesh_gpu_instancing` instances, `None` without the extension
+/// ([`instancing`]). Each attribute must be the extension's type (`TRANSLATION` and `SCALE`
+/// VEC3, `ROTATION` VEC4, integer rotations normalised), all of one count.
+fn instance_transforms(ctx: &Ctx, doc: &gltf::Document, node: &gltf::Node) -> Result<Option<Vec<Mat4>>, ModelError> {
+    let Some(extension) = node.extension_value("EXT_mesh_gpu_instancing") else {
+        return Ok(None);
+    };
+    let what = format!("node {} (EXT_mesh_gpu_instancing)", node.index());
+    let attributes = extension.get("attributes").and_then(|a| a.as_object());
+    let mut count = None;
+    let mut read = |name: &str, dimensions: Dimensions| -> Result<Option<Vec<f32>>, ModelError> {
+        let Some(index) = attributes.and_then(|a| a.get(name)) else {
+            return Ok(None);
+        };
+        let accessor = index
+            .as_u64()
+            .and_then(|i| doc.accessors().nth(usize::try_from(i).ok()?))
+            .ok_or_else(|| ctx.data(&what, format!("{name}: accessor {index} does not exist")))?;
+        if accessor.dimensions() != dimensions {
+            return Err(ctx.data(
+                &what,
+                format!(
+                    "{name}: accessor {} is {:?}, not {dimensions:?}",
+                    accessor.index(),
+                    accessor.dimensions()
+                ),
+            ));
+        }
+        if *count.get_or_insert(accessor.count()) != accessor.count() {
+            return Err(ctx.data(&what, "its attributes have different counts"));
+        }
+        ctx.read_f32(&accessor, dimensions.multiplicity()).map(Some)
+    };
+    let translation = read("TRANSLATION", Dimensions::Vec3)?;
+    let rotation = read("ROTATION", Dimensions::Vec4)?;
+    let scale = read("SCALE", Dimensions::Vec3)?;
+    // No attribute: glTF leaves the count undefined; one instance where the node stands.
+    let count = count.unwrap_or(1);
+    instancing::matrices(count, translation.as_deref(), rotation.as_deref(), scale.as_deref())
+        .map(Some)
+        .map_err(|message| ctx.data(what, message))
 }
 
 /// Attribute data of one primitive before assembly.
@@ -1446,6 +1491,13 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
             // The node's joint matrices, made by its first skinned primitive and kept for the
             // others.
             let mut joint_matrices: Option<Vec<Mat4>> = None;
+            let instances = instance_transforms(&ctx, doc, &node)?;
+            if instances.is_some() && node.skin().is_some() {
+                model.warnings.push(format!(
+                    "node {}: a skinned mesh is drawn once, where its joints put it (EXT_mesh_gpu_instancing ignored)",
+                    node.index()
+                ));
+            }
             for prim in mesh.primitives() {
                 let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
                 ctx.spending
@@ -1508,7 +1560,25 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                         skin::apply(&mut m, &joints, &weights, matrices)
                             .map_err(|e| ctx.data(format!("{what} (skin {})", s.index()), e))?;
                     }
-                    _ => m.transform(world),
+                    _ => match &instances {
+                        // Each further copy charged before it is made.
+                        Some(list) => {
+                            let copies = list.len().saturating_sub(1) as u64;
+                            ctx.spending
+                                .borrow_mut()
+                                .charge_bytes(
+                                    || format!("{what} ({} instances in node {})", list.len(), node.index()),
+                                    ResourceBudget::mesh_bytes(
+                                        vertices.saturating_mul(copies),
+                                        indices.saturating_mul(copies),
+                                    ),
+                                )
+                                .map_err(|e| over_budget(path, e))?;
+                            let worlds: Vec<Mat4> = list.iter().map(|instance| world * *instance).collect();
+                            m = instancing::replicate(&m, &worlds);
+                        }
+                        None => m.transform(world),
+                    },
                 }
                 // Checked after the node transforms, which can overflow finite positions too.
                 if let Some((i, v)) = m

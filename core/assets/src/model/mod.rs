@@ -9,7 +9,9 @@
 //!   toolchain on the phone builds). `EXT_meshopt_compression` / `KHR_meshopt_compression`
 //!   buffer views (gltfpack's `-c`) are decoded with meshoptimizer before any accessor reads
 //!   them; their fallback buffers are never read (`meshopt_views`).
-//! * Node transforms are baked into the vertices (negative determinants flip the winding).
+//! * Node transforms are baked into the vertices (negative determinants flip the winding), and so
+//!   are the instances of `EXT_mesh_gpu_instancing` (gltfpack's `-mi`): one mesh per primitive
+//!   holding every copy, each charged to the budget before it is made (`instancing`).
 //! * Skinned meshes are drawn in the pose the node hierarchy holds, each vertex moved by its joints
 //!   (`JOINTS_0`/`WEIGHTS_0`, inverse bind matrices) with the skinned node's own transform ignored,
 //!   as glTF defines (`skin`); no animation is played.
@@ -666,6 +668,7 @@ pub use loader::{
 };
 
 mod encoded_image;
+mod instancing;
 mod loader;
 mod meshopt_views;
 mod skin;
