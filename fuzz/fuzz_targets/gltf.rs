@@ -1,5 +1,5 @@
-//! The glTF 2.0 / Voyager loader on any bytes, as a `.glb`, a `.gltf` or a `scene.svx.json`
-//! (by the first byte), beside a small valid buffer and PNG that URIs may name. Within the phone
+//! The model loader on any bytes, as a `.glb`, a `.gltf`, a `scene.svx.json`, a `.ply` or an
+//! `.stl` (by the first bytes), beside a small valid buffer and PNG that URIs may name. Within the phone
 //! budget: an input may fail, never panic, hang or take more than the budget.
 #![no_main]
 
@@ -29,6 +29,9 @@ fuzz_target!(|data: &[u8]| {
     let name = match data.first() {
         Some(b'{') if data.windows(8).any(|w| w == b"\"models\"") => "scene.svx.json",
         Some(b'{') => "model.gltf",
+        Some(b'p') => "model.ply",
+        // ASCII STL, and binary STL whose header begins with the same word, as many do.
+        Some(b's') => "model.stl",
         _ => "model.glb",
     };
     let path = scratch::write(dir, name, data);

@@ -490,6 +490,36 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                     );
                 put(&format!("{name}.glb"), &glb(json.as_bytes(), &bin))?;
             }
+            // A tetrahedron as binary STL (its header begins "solid", as many do), as ASCII STL,
+            // and as binary PLY with a colour per vertex.
+            let corners = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            let faces = [[0usize, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+            let mut stl = b"solid tetrahedron".to_vec();
+            stl.resize(80, b' ');
+            stl.extend(4u32.to_le_bytes());
+            let mut ascii = String::from("solid tetrahedron\n");
+            for f in faces {
+                stl.extend([0u8; 12]);
+                ascii += "facet normal 0 0 0\nouter loop\n";
+                for &i in &f {
+                    stl.extend(corners[i].iter().flat_map(|c| c.to_le_bytes()));
+                    ascii += &format!("vertex {} {} {}\n", corners[i][0], corners[i][1], corners[i][2]);
+                }
+                stl.extend([0u8; 2]);
+                ascii += "endloop\nendfacet\n";
+            }
+            put("tetrahedron-binary.stl", &stl)?;
+            put("tetrahedron-ascii.stl", format!("{ascii}endsolid\n").as_bytes())?;
+            let mut ply = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 4\nproperty list uchar int vertex_indices\nend_header\n".to_vec();
+            for c in corners {
+                ply.extend(c.iter().flat_map(|v| v.to_le_bytes()));
+                ply.extend([200u8, 120, 40]);
+            }
+            for f in faces {
+                ply.push(3);
+                ply.extend(f.iter().flat_map(|&i| (i as i32).to_le_bytes()));
+            }
+            put("tetrahedron.ply", &ply)?;
             for p in shared("models", &[".glb", ".gltf", ".svx.json"]) {
                 if std::fs::metadata(&p).is_ok_and(|m| m.len() as usize <= max_len) {
                     put(&seed_name(&p), &std::fs::read(&p)?)?;

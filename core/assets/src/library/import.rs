@@ -1,6 +1,6 @@
 //! Turning bytes the user opened (a file picker's document, an "Open with" intent, a share) into a
-//! folder of the library: a `.glb`, a self-contained `.gltf`, or a zip holding either or a
-//! Smithsonian Voyager download (`scene.svx.json` beside its scans).
+//! folder of the library: a `.glb`, a self-contained `.gltf`, an `.stl` or `.ply` scan, or a zip
+//! holding one of those or a Smithsonian Voyager download (`scene.svx.json` beside its scans).
 //!
 //! Zip archives are unpacked with the same care as any file from outside: names only inside the
 //! folder (`..`, absolute paths and links are refused), at most [`MAX_ZIP_ENTRIES`] entries, and
@@ -11,6 +11,7 @@ use std::io::{Read, Write};
 use std::path::{Path, PathBuf};
 
 use super::LibraryError;
+use crate::model::MeshFormat;
 
 /// Most entries unpacked from one archive (a Voyager download has a dozen).
 pub const MAX_ZIP_ENTRIES: usize = 4096;
@@ -21,6 +22,8 @@ pub enum Format {
     Glb,
     GltfJson,
     Zip,
+    /// STL or PLY.
+    Mesh(MeshFormat),
 }
 
 /// Recognises a file by its first bytes (names lie: shares often arrive as `document.bin`).
@@ -33,13 +36,17 @@ pub fn sniff(bytes: &[u8]) -> Option<Format> {
     }
     let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     let first = text.iter().find(|b| !b.is_ascii_whitespace());
-    (first == Some(&b'{')).then_some(Format::GltfJson)
+    if first == Some(&b'{') {
+        return Some(Format::GltfJson);
+    }
+    MeshFormat::sniff(bytes).map(Format::Mesh)
 }
 
 /// Writes `bytes` as one model file `stem` in `folder`, with its format's extension.
 pub fn write_single(folder: &Path, stem: &str, format: Format, bytes: &[u8]) -> Result<PathBuf, LibraryError> {
     let extension = match format {
         Format::Glb => "glb",
+        Format::Mesh(mesh) => mesh.extension(),
         _ => "gltf",
     };
     let path = folder.join(format!("{stem}.{extension}"));
@@ -114,7 +121,7 @@ fn copy(from: &mut impl Read, to: &mut std::fs::File) -> std::io::Result<u64> {
 }
 
 /// The model an unpacked folder holds: the shallowest Voyager scene's folder, else its only
-/// `.glb`/`.gltf` file.
+/// `.glb`/`.gltf`/`.stl`/`.ply` file.
 pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> {
     let mut scenes = Vec::new();
     let mut models = Vec::new();
@@ -129,7 +136,7 @@ pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> 
                 stack.push((path, depth + 1));
             } else if kind.is_file() && name.ends_with(".svx.json") {
                 scenes.push((depth, path));
-            } else if kind.is_file() && (name.ends_with(".glb") || name.ends_with(".gltf")) {
+            } else if kind.is_file() && super::is_model_name(&name) {
                 models.push(path);
             }
         }

@@ -79,7 +79,7 @@ pub enum ModelError {
     Cancelled { path: PathBuf },
 }
 
-fn over_budget(path: &Path, error: OverBudget) -> ModelError {
+pub(super) fn over_budget(path: &Path, error: OverBudget) -> ModelError {
     ModelError::OverBudget {
         path: path.to_path_buf(),
         error,
@@ -957,7 +957,7 @@ fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
         indices,
     };
     if a.normals.is_none() {
-        smooth_normals(&mut mesh);
+        super::mesh_file::smooth_normals(&mut mesh);
     }
     if a.tangents.is_none()
         && a.uv0.is_some()
@@ -966,20 +966,6 @@ fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
         // Degenerate UVs: keep the placeholder tangents; normal maps then shade as flat.
     }
     Ok(mesh)
-}
-
-fn smooth_normals(mesh: &mut Mesh) {
-    let mut acc = vec![Vec3::ZERO; mesh.vertices.len()];
-    for tri in mesh.indices.chunks(3) {
-        let p = |k: usize| Vec3::from(mesh.vertices[tri[k] as usize].position);
-        let n = (p(1) - p(0)).cross(p(2) - p(0));
-        for &i in tri {
-            acc[i as usize] += n;
-        }
-    }
-    for (v, n) in mesh.vertices.iter_mut().zip(acc) {
-        v.normal = n.normalize_or(Vec3::Z).to_array();
-    }
 }
 
 /// The orientation a Smithsonian Voyager scene gives this model file: Voyager scenes
@@ -1184,6 +1170,12 @@ pub fn load_model_within(path: &Path, budget: ResourceBudget) -> Result<Model, M
 /// [`load_model_within`], reporting to `progress` and giving up when it is cancelled
 /// ([`ModelError::Cancelled`]).
 pub fn load_model_with(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
+    // Scans published as bare meshes: STL and PLY, by their extension.
+    if !path.is_dir()
+        && let Some(format) = super::mesh_file::MeshFormat::of(path)
+    {
+        return super::mesh_file::load(path, format, budget, progress);
+    }
     // Any `*.svx.json` is a Voyager scene (downloads rename them), never a glTF file.
     let is_scene = path.is_dir()
         || path

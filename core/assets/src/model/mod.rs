@@ -1,5 +1,5 @@
 //! Models: triangle meshes with metallic–roughness materials and textures, in the device frame,
-//! and the glTF 2.0 loader that produces them.
+//! and the loaders that produce them (glTF 2.0, STL, PLY).
 //!
 //! ## Loading glTF
 //! * `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary container).
@@ -52,6 +52,12 @@
 //!   vertex must be finite and within ±[`MAX_COORDINATE`] after its node transforms. A Draco
 //!   stream is decoded before its counts are known (bounded by its own size in the file), then
 //!   charged.
+//!
+//! ## Loading STL and PLY
+//! Scans published as bare meshes (3D-printing STL, scanners' PLY) load by their extension as a
+//! model of one primitive: welded, with smooth normals, PLY's vertex colours kept; STL read as
+//! millimetres with +Z up, PLY as metres with +Y up, both turned into the frame below
+//! (`mesh_file`, `stl`, `ply`; the same budget and no-panic rules as glTF).
 //!
 //! ## Frames
 //! glTF is +Y up, +Z front, metres. [`Model::fit_to_diorama`] turns a standing object's +Y into
@@ -666,14 +672,18 @@ pub use loader::{
     load_model_with, load_model_within, resolve_inside, voyager_annotations, voyager_preview, voyager_rotation,
     voyager_scan,
 };
+pub use mesh_file::MeshFormat;
 
 mod encoded_image;
 mod instancing;
 mod loader;
+mod mesh_file;
 mod meshopt_views;
+mod ply;
 mod skin;
 mod spec_gloss;
 mod split;
+mod stl;
 mod topology;
 
 #[cfg(test)]

@@ -1,0 +1,291 @@
+//! Scans published as bare meshes rather than glTF: STL (`stl`) and PLY (`ply`), loaded into a
+//! [`Model`] of one primitive.
+//!
+//! **Conventions** (neither format states them): STL is read as millimetres with +Z up, as 3D
+//! printing writes it (Scan the World's museum scans, museums' "download for printing"), and
+//! turned into glTF's metres with +Y up; PLY is read as metres with +Y up, as the Stanford scans
+//! and most scanner software write it. Either way the artifact is fitted to the diorama unless
+//! the user asks for true size, so a wrong guess changes only true size.
+//!
+//! **Surface**: an STL soup is welded (corners at the same position become one vertex) and given
+//! smooth, area-weighted normals, so a scan is not drawn as facets; a PLY keeps its vertices and
+//! its normals where it has all three components, else gets the same smooth normals. PLY colours
+//! (sRGB, as scanners write them) become the vertex colours, over a white material; without colour
+//! the material is a matte, light stone-like grey (plaster: a cast's colour, not a claim about the
+//! object). **Budget**: the parsers never allocate more than the file's size implies; the mesh
+//! built from it is charged before it is made. **Panics**: none.
+
+use std::collections::HashMap;
+use std::path::Path;
+
+use glam::{Mat4, Vec3};
+
+use super::loader::{ModelError, over_budget};
+use super::{Material, Mesh, Model, Primitive, Vertex, ply, stl};
+use crate::budget::{ResourceBudget, Spending};
+use crate::progress::Progress;
+
+/// What a parser hands back: positions, optional per-vertex normals and colours (0–1, sRGB),
+/// triangles as index triples.
+#[derive(Debug, Default, PartialEq)]
+pub struct Soup {
+    pub positions: Vec<[f32; 3]>,
+    pub normals: Option<Vec<[f32; 3]>>,
+    pub colors: Option<Vec<[f32; 4]>>,
+    pub indices: Vec<u32>,
+}
+
+impl Soup {
+    /// Unshared triangles: three positions each.
+    pub fn triangles(positions: Vec<[f32; 3]>) -> Soup {
+        let indices = (0..positions.len() as u32).collect();
+        Soup {
+            positions,
+            indices,
+            ..Soup::default()
+        }
+    }
+}
+
+/// The mesh formats read besides glTF, by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    Stl,
+    Ply,
+}
+
+impl MeshFormat {
+    /// The format a file name's extension says, if one of these.
+    pub fn of(path: &Path) -> Option<MeshFormat> {
+        let extension = path.extension()?.to_str()?.to_ascii_lowercase();
+        match extension.as_str() {
+            "stl" => Some(MeshFormat::Stl),
+            "ply" => Some(MeshFormat::Ply),
+            _ => None,
+        }
+    }
+
+    /// The format of a file's bytes, if one of these (a share may arrive without its name): PLY
+    /// by its first line, STL by its first word or by a binary file's exact size.
+    pub fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
+        if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
+            return Some(MeshFormat::Ply);
+        }
+        let binary_stl = bytes.get(80..84).is_some_and(|n| {
+            let count = u64::from(u32::from_le_bytes([n[0], n[1], n[2], n[3]]));
+            84 + 50 * count == bytes.len() as u64
+        });
+        (binary_stl || bytes.trim_ascii_start().starts_with(b"solid")).then_some(MeshFormat::Stl)
+    }
+
+    pub fn extension(self) -> &'static str {
+        match self {
+            MeshFormat::Stl => "stl",
+            MeshFormat::Ply => "ply",
+        }
+    }
+}
+
+/// Loads an STL or PLY file (`format`) into a model of one primitive, within `budget`.
+pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
+    let cancelled = |_| ModelError::Cancelled {
+        path: path.to_path_buf(),
+    };
+    progress.step(0.0).map_err(cancelled)?;
+    let bytes = phantogram_files::read_regular_file(path, budget.memory_bytes).map_err(|error| ModelError::Io {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    progress.step(0.1).map_err(cancelled)?;
+    let parsed = match format {
+        MeshFormat::Stl => stl::parse(&bytes),
+        MeshFormat::Ply => ply::parse(&bytes),
+    };
+    drop(bytes);
+    let mut soup = parsed.map_err(|message| ModelError::Parse {
+        path: path.to_path_buf(),
+        message,
+    })?;
+    progress.step(0.5).map_err(cancelled)?;
+    if format == MeshFormat::Stl {
+        soup = weld(soup);
+    }
+    let mut spending = Spending::new(budget);
+    spending
+        .charge_primitive(|| "the mesh".to_owned())
+        .and_then(|()| {
+            spending.charge_bytes(
+                || "the mesh".to_owned(),
+                ResourceBudget::mesh_bytes(soup.positions.len() as u64, soup.indices.len() as u64),
+            )
+        })
+        .map_err(|e| over_budget(path, e))?;
+    let mut mesh = build(soup);
+    if mesh.indices.is_empty() {
+        return Err(ModelError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    if let Some(v) = mesh.vertices.iter().find(|v| !v.position.iter().all(|c| c.is_finite())) {
+        return Err(ModelError::Data {
+            path: path.to_path_buf(),
+            what: "the mesh".to_owned(),
+            message: format!("a vertex at {:?}, not a finite position", v.position),
+        });
+    }
+    if format == MeshFormat::Stl {
+        // Millimetres, +Z up → metres, +Y up (a quarter turn about x).
+        mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(0.001)));
+    }
+    progress.step(0.9).map_err(cancelled)?;
+    let coloured = mesh.vertices.iter().any(|v| v.color != [1.0; 4]);
+    let material = if coloured {
+        Material {
+            name: "vertex colours".into(),
+            metallic: 0.0,
+            roughness: 0.8,
+            ..Material::default()
+        }
+    } else {
+        Material {
+            name: "plaster".into(),
+            // A light, warm grey (linear), matte: a cast's colour.
+            base_color: [0.62, 0.6, 0.56, 1.0],
+            metallic: 0.0,
+            roughness: 0.75,
+            ..Material::default()
+        }
+    };
+    Ok(Model {
+        name: path
+            .file_stem()
+            .map(|s| s.to_string_lossy().into_owned())
+            .unwrap_or_default(),
+        primitives: vec![Primitive {
+            mesh,
+            material: 0,
+            is_floor: false,
+            lods: Vec::new(),
+        }],
+        materials: vec![material],
+        ..Model::default()
+    })
+}
+
+/// Corners at exactly the same position become one vertex (an STL soup's triangles share none).
+fn weld(soup: Soup) -> Soup {
+    let mut index_of: HashMap<[u32; 3], u32> = HashMap::with_capacity(soup.positions.len() / 4);
+    let mut positions = Vec::with_capacity(soup.positions.len() / 4);
+    let indices = soup
+        .indices
+        .iter()
+        .map(|&i| {
+            let p = soup.positions[i as usize];
+            *index_of.entry(p.map(f32::to_bits)).or_insert_with(|| {
+                positions.push(p);
+                (positions.len() - 1) as u32
+            })
+        })
+        .collect();
+    Soup {
+        positions,
+        indices,
+        ..Soup::default()
+    }
+}
+
+/// The vertices and triangles of a soup; normals from the file when it has them, else smooth.
+fn build(soup: Soup) -> Mesh {
+    let vertices = soup
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(i, p)| Vertex {
+            position: *p,
+            normal: soup
+                .normals
+                .as_ref()
+                .and_then(|n| n.get(i))
+                .map_or([0.0; 3], |n| Vec3::from(*n).normalize_or_zero().to_array()),
+            tangent: [1.0, 0.0, 0.0, 1.0],
+            uv: [0.0; 4],
+            color: soup.colors.as_ref().and_then(|c| c.get(i)).map_or([1.0; 4], |c| {
+                let linear = phantogram_geometry::srgb::to_linear;
+                [linear(c[0]), linear(c[1]), linear(c[2]), c[3]]
+            }),
+            material: [1.0, 1.0],
+        })
+        .collect();
+    let mut mesh = Mesh {
+        vertices,
+        indices: soup.indices,
+    };
+    // Degenerate triangles (repeated corners, common in scans) draw nothing and bend smooth
+    // normals towards nothing: left out.
+    let keep: Vec<u32> = mesh
+        .indices
+        .chunks_exact(3)
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        .flatten()
+        .copied()
+        .collect();
+    mesh.indices = keep;
+    if soup.normals.is_none() || mesh.vertices.iter().any(|v| v.normal == [0.0; 3]) {
+        smooth_normals(&mut mesh);
+    }
+    mesh
+}
+
+/// Area-weighted vertex normals from the triangles' windings.
+pub(super) fn smooth_normals(mesh: &mut Mesh) {
+    let mut acc = vec![Vec3::ZERO; mesh.vertices.len()];
+    for tri in mesh.indices.chunks(3) {
+        let p = |k: usize| Vec3::from(mesh.vertices[tri[k] as usize].position);
+        let n = (p(1) - p(0)).cross(p(2) - p(0));
+        for &i in tri {
+            acc[i as usize] += n;
+        }
+    }
+    for (v, n) in mesh.vertices.iter_mut().zip(acc) {
+        v.normal = n.normalize_or(Vec3::Z).to_array();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn welding_shares_equal_corners_and_keeps_the_triangles() {
+        let square = Soup::triangles(vec![
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 0.0, 0.0],
+            [1.0, 1.0, 0.0],
+            [0.0, 1.0, 0.0],
+        ]);
+        let welded = weld(square);
+        assert_eq!(welded.positions.len(), 4);
+        assert_eq!(welded.indices, [0, 1, 2, 0, 2, 3]);
+    }
+
+    #[test]
+    fn formats_are_known_by_name_and_by_content() {
+        assert_eq!(MeshFormat::of(Path::new("bust.STL")), Some(MeshFormat::Stl));
+        assert_eq!(MeshFormat::of(Path::new("scan.ply")), Some(MeshFormat::Ply));
+        assert_eq!(MeshFormat::of(Path::new("scan.glb")), None);
+        assert_eq!(MeshFormat::sniff(b"ply\nformat ascii 1.0\n"), Some(MeshFormat::Ply));
+        assert_eq!(MeshFormat::sniff(b"  solid bust\n"), Some(MeshFormat::Stl));
+        let mut binary = vec![0u8; 84 + 50];
+        binary[80] = 1;
+        assert_eq!(MeshFormat::sniff(&binary), Some(MeshFormat::Stl));
+        binary.push(0);
+        assert_eq!(
+            MeshFormat::sniff(&binary),
+            None,
+            "a size that does not match is not STL"
+        );
+        assert_eq!(MeshFormat::sniff(b"glTF"), None);
+    }
+}

@@ -1,0 +1,181 @@
+//! Scans published as bare meshes: STL (binary and ASCII, millimetres, +Z up, as 3D printing
+//! writes them) and PLY (metres, +Y up, with vertex colours) load as models in glTF's frame
+//! (metres, +Y up), with smooth outward normals, and open from the library as glTF does.
+//! Before, neither was read.
+
+use glam::Vec3;
+use phantogram_assets::budget::ResourceBudget;
+use phantogram_assets::library::Library;
+use phantogram_assets::model::{Model, ModelError, load_model};
+use phantogram_assets::progress::Progress;
+use phantogram_testkit::Scratch;
+
+/// A box 10 mm wide (x), 20 mm deep (y) and 30 mm tall (z), its corner at the origin: twelve
+/// triangles wound counter-clockwise seen from outside.
+fn box_triangles() -> Vec<[[f32; 3]; 3]> {
+    let (w, d, h) = (10.0, 20.0, 30.0);
+    let c = |i: usize| [[0.0, w][i & 1], [0.0, d][(i >> 1) & 1], [0.0, h][(i >> 2) & 1]];
+    // Faces as corner quads, counter-clockwise from outside.
+    let quads = [
+        [0, 2, 3, 1], // z = 0, facing −z
+        [4, 5, 7, 6], // z = h
+        [0, 1, 5, 4], // y = 0
+        [2, 6, 7, 3], // y = d
+        [0, 4, 6, 2], // x = 0
+        [1, 3, 7, 5], // x = w
+    ];
+    quads
+        .iter()
+        .flat_map(|q| [[c(q[0]), c(q[1]), c(q[2])], [c(q[0]), c(q[2]), c(q[3])]])
+        .collect()
+}
+
+fn binary_stl(triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut out = b"solid but binary".to_vec();
+    out.resize(80, 0);
+    out.extend((triangles.len() as u32).to_le_bytes());
+    for t in triangles {
+        out.extend([0u8; 12]);
+        for c in t.iter().flatten() {
+            out.extend(c.to_le_bytes());
+        }
+        out.extend([0u8; 2]);
+    }
+    out
+}
+
+fn ascii_stl(triangles: &[[[f32; 3]; 3]]) -> Vec<u8> {
+    let mut out = String::from("solid box\n");
+    for t in triangles {
+        out += "  facet normal 0 0 0\n    outer loop\n";
+        for p in t {
+            out += &format!("      vertex {} {} {}\n", p[0], p[1], p[2]);
+        }
+        out += "    endloop\n  endfacet\n";
+    }
+    out += "endsolid box\n";
+    out.into_bytes()
+}
+
+fn load(test: &str, name: &str, bytes: &[u8]) -> Result<Model, ModelError> {
+    let dir = Scratch::new(&format!("mesh-files-{test}"));
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).expect("write");
+    load_model(&path)
+}
+
+/// The box as loaded: one primitive of the eight corners, in metres, +Y up, normals outward.
+fn assert_is_the_box(model: &Model) {
+    assert_eq!(model.primitives.len(), 1);
+    let mesh = &model.primitives[0].mesh;
+    assert_eq!(mesh.vertices.len(), 8, "the corners welded");
+    assert_eq!(mesh.indices.len(), 36);
+    let bounds = mesh.bounds().expect("bounds");
+    // x stays, z (up) becomes y, y becomes −z; millimetres become metres.
+    let (min, max) = (bounds.min, bounds.max);
+    assert!((min - Vec3::new(0.0, 0.0, -0.02)).length() < 1e-6, "{min}");
+    assert!((max - Vec3::new(0.01, 0.03, 0.0)).length() < 1e-6, "{max}");
+    let centre = (min + max) / 2.0;
+    for v in &mesh.vertices {
+        let out = Vec3::from(v.position) - centre;
+        assert!(
+            Vec3::from(v.normal).dot(out) > 0.0,
+            "an inward normal at {:?}",
+            v.position
+        );
+    }
+    // Every triangle still faces outward after the turn (its winding against its centre).
+    for t in mesh.indices.chunks(3) {
+        let p = |k: usize| Vec3::from(mesh.vertices[t[k] as usize].position);
+        let n = (p(1) - p(0)).cross(p(2) - p(0));
+        assert!(n.dot((p(0) + p(1) + p(2)) / 3.0 - centre) > 0.0, "{t:?}");
+    }
+    let material = &model.materials[model.primitives[0].material];
+    assert_eq!(material.metallic, 0.0, "a scan without colour is not shown as metal");
+}
+
+#[test]
+fn a_binary_stl_is_the_box_in_metres_standing_up() {
+    let model = load("binary", "box.stl", &binary_stl(&box_triangles())).expect("loads");
+    assert_is_the_box(&model);
+    assert_eq!(model.name, "box");
+}
+
+#[test]
+fn an_ascii_stl_is_the_same_box() {
+    let model = load("ascii", "box.STL", &ascii_stl(&box_triangles())).expect("loads");
+    assert_is_the_box(&model);
+}
+
+#[test]
+fn a_ply_keeps_its_frame_and_shows_its_vertex_colours() {
+    // A quad in metres, +Y up, facing +z; the second corner a mid grey in sRGB (128 → 0.216).
+    let ply = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 255 0 0\n0.1 0 0 128 128 128\n0.1 0.2 0 0 0 255\n0 0.2 0 255 255 255\n4 0 1 2 3\n";
+    let model = load("ply", "quad.ply", ply.as_bytes()).expect("loads");
+    let mesh = &model.primitives[0].mesh;
+    assert_eq!(mesh.indices, [0, 1, 2, 0, 2, 3]);
+    assert_eq!(mesh.vertices[2].position, [0.1, 0.2, 0.0]);
+    assert!(mesh.vertices.iter().all(|v| v.normal == [0.0, 0.0, 1.0]));
+    assert_eq!(mesh.vertices[0].color, [1.0, 0.0, 0.0, 1.0]);
+    let grey = mesh.vertices[1].color[0];
+    assert!((grey - 0.2158).abs() < 1e-3, "sRGB 128 is linear 0.216, not {grey}");
+    let material = &model.materials[model.primitives[0].material];
+    assert_eq!(material.base_color, [1.0; 4], "white, so the colours show as they are");
+}
+
+#[test]
+fn damaged_mesh_files_are_named_errors() {
+    let mut cut = binary_stl(&box_triangles());
+    cut.truncate(cut.len() - 7);
+    match load("damaged", "cut.stl", &cut) {
+        Err(ModelError::Parse { message, .. }) => assert!(message.contains("12 triangles"), "{message}"),
+        other => panic!("{other:?}"),
+    }
+    match load("damaged", "points.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n") {
+        Err(ModelError::Parse { message, .. }) => assert!(message.contains("point cloud"), "{message}"),
+        other => panic!("{other:?}"),
+    }
+    // Only degenerate triangles: nothing to draw.
+    let flat = [[[1.0f32, 1.0, 1.0]; 3]];
+    assert!(matches!(
+        load("damaged", "flat.stl", &binary_stl(&flat)),
+        Err(ModelError::Empty { .. })
+    ));
+    let nan = [[[f32::NAN, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]];
+    assert!(matches!(
+        load("damaged", "nan.stl", &binary_stl(&nan)),
+        Err(ModelError::Data { .. })
+    ));
+}
+
+#[test]
+fn an_stl_over_the_budget_is_refused_before_the_mesh_is_built() {
+    let dir = Scratch::new("mesh-files-budget");
+    let path = dir.join("box.stl");
+    let bytes = binary_stl(&box_triangles());
+    std::fs::write(&path, &bytes).expect("write");
+    let small = ResourceBudget {
+        memory_bytes: bytes.len() as u64,
+        ..ResourceBudget::default()
+    };
+    match phantogram_assets::model::load_model_within(&path, small) {
+        Err(ModelError::OverBudget { error, .. }) => assert!(error.what.contains("the mesh"), "{error}"),
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn an_stl_opened_from_bytes_is_kept_and_loaded_whatever_its_name() {
+    let dir = Scratch::new("mesh-files-library");
+    let lib = Library::new(Some(dir.to_path_buf()), None);
+    let stl = binary_stl(&box_triangles());
+    // A share may arrive without its extension: the content says it is STL.
+    let imported = lib
+        .import("document.bin", &stl, ResourceBudget::PHONE, &Progress::new())
+        .expect("imported");
+    assert_eq!(imported.model.triangle_count(), 12);
+    let again = lib
+        .load(&imported.entry.id, ResourceBudget::PHONE, &Progress::new())
+        .expect("loads again");
+    assert_eq!(again.model.triangle_count(), 12);
+}
