@@ -796,7 +796,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCalibrationWarning
     })
 }
 
-/// Imports a file the user opened (its display name and bytes: `.glb`, `.gltf`, `.stl`, `.ply` or `.zip`), in
+/// Imports a file the user opened (its display name and bytes: `.glb`, `.gltf`, `.stl`, `.ply`, `.obj` or `.zip`), in
 /// the background; see `nativeImportArtifactFd` for large files.
 #[unsafe(no_mangle)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeImportArtifact<'local>(

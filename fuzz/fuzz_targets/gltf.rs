@@ -1,5 +1,6 @@
-//! The model loader on any bytes, as a `.glb`, a `.gltf`, a `scene.svx.json`, a `.ply` or an
-//! `.stl` (by the first bytes), beside a small valid buffer and PNG that URIs may name. Within the phone
+//! The model loader on any bytes, as a `.glb`, a `.gltf`, a `scene.svx.json`, a `.ply`, an
+//! `.stl` or an `.obj` (by the first bytes), beside a small valid buffer and PNG that URIs and
+//! material libraries may name. Within the phone
 //! budget: an input may fail, never panic, hang or take more than the budget.
 #![no_main]
 
@@ -30,6 +31,7 @@ fuzz_target!(|data: &[u8]| {
         Some(b'{') if data.windows(8).any(|w| w == b"\"models\"") => "scene.svx.json",
         Some(b'{') => "model.gltf",
         Some(b'p') => "model.ply",
+        Some(b'v' | b'o' | b'#' | b'm') => "model.obj",
         // ASCII STL, and binary STL whose header begins with the same word, as many do.
         Some(b's') => "model.stl",
         _ => "model.glb",

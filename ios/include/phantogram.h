@@ -66,7 +66,7 @@ typedef struct PgConfig {
   // Where imported artifacts are kept (a folder in Application Support); null: nothing can
   // be imported.
   const char *library_dir;
-  // Artifacts shipped in the app bundle (a folder of `.glb`/`.gltf`/`.stl`/`.ply` files or Voyager
+  // Artifacts shipped in the app bundle (a folder of `.glb`/`.gltf`/`.stl`/`.ply`/`.obj` files or Voyager
   // folders); null: none.
   const char *bundled_dir;
   // The artifact to show first (`builtin:medal`, `imported:…`: what the app saved last time
@@ -327,7 +327,7 @@ enum PgStatus pg_read_frame(const struct PgEngine *engine,
                             uint32_t *height);
 
 // Imports a file the user opened (`UIDocumentPickerViewController`, "Open in"): its display
-// `name` and `len` bytes (copied before returning), a `.glb`, `.gltf`, `.stl`, `.ply` or `.zip` (a Voyager
+// `name` and `len` bytes (copied before returning), a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj` or `.zip` (a Voyager
 // download included). It is loaded in the background and shown when ready, with a banner on
 // screen meanwhile; a damaged file is reported there and the artifact on screen stays. Needs
 // `PgConfig::library_dir`.
@@ -379,7 +379,7 @@ enum PgStatus pg_set_text_scale(const struct PgEngine *engine, float scale);
 enum PgStatus pg_camera_permission_needed(const struct PgEngine *engine);
 
 // Takes the oldest thing the core's screens asked of the app since the last call: `*request`
-// receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf`, `.stl`, `.ply` or `.zip`, then
+// receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj` or `.zip`, then
 // `pg_import_artifact`), 2 (ask for the camera permission: the core's camera page has said
 // why; start the camera when granted), 3 or 4 (share the view: `pg_snapshot_png` of kind 0,
 // the anaglyph, or 1, the side-by-side pair, through the system's share sheet). Call after

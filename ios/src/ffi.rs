@@ -91,7 +91,7 @@ pub struct PgConfig {
     /// Where imported artifacts are kept (a folder in Application Support); null: nothing can
     /// be imported.
     pub library_dir: *const c_char,
-    /// Artifacts shipped in the app bundle (a folder of `.glb`/`.gltf`/`.stl`/`.ply` files or Voyager
+    /// Artifacts shipped in the app bundle (a folder of `.glb`/`.gltf`/`.stl`/`.ply`/`.obj` files or Voyager
     /// folders); null: none.
     pub bundled_dir: *const c_char,
     /// The artifact to show first (`builtin:medal`, `imported:…`: what the app saved last time
@@ -803,7 +803,7 @@ pub unsafe extern "C" fn pg_read_frame(
 }
 
 /// Imports a file the user opened (`UIDocumentPickerViewController`, "Open in"): its display
-/// `name` and `len` bytes (copied before returning), a `.glb`, `.gltf`, `.stl`, `.ply` or `.zip` (a Voyager
+/// `name` and `len` bytes (copied before returning), a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj` or `.zip` (a Voyager
 /// download included). It is loaded in the background and shown when ready, with a banner on
 /// screen meanwhile; a damaged file is reported there and the artifact on screen stays. Needs
 /// `PgConfig::library_dir`.
@@ -922,7 +922,7 @@ pub unsafe extern "C" fn pg_camera_permission_needed(engine: *const PgEngine) ->
 }
 
 /// Takes the oldest thing the core's screens asked of the app since the last call: `*request`
-/// receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf`, `.stl`, `.ply` or `.zip`, then
+/// receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj` or `.zip`, then
 /// `pg_import_artifact`), 2 (ask for the camera permission: the core's camera page has said
 /// why; start the camera when granted), 3 or 4 (share the view: `pg_snapshot_png` of kind 0,
 /// the anaglyph, or 1, the side-by-side pair, through the system's share sheet). Call after

@@ -520,6 +520,11 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                 ply.extend(f.iter().flat_map(|&i| (i as i32).to_le_bytes()));
             }
             put("tetrahedron.ply", &ply)?;
+            // The same as OBJ with a material whose texture is the target's `tex.png`.
+            put(
+                "tetrahedron.obj",
+                b"mtllib tex.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nvt 0 0\nvt 1 0\nvt 0 1\nusemtl a\nf 1/1 3/3 2/2\nf 1/1 2/2 4/3\nf 1 4 3\nf 2 3 4\n",
+            )?;
             for p in shared("models", &[".glb", ".gltf", ".svx.json"]) {
                 if std::fs::metadata(&p).is_ok_and(|m| m.len() as usize <= max_len) {
                     put(&seed_name(&p), &std::fs::read(&p)?)?;

@@ -79,7 +79,7 @@ fn copy_face_models(to: &Path) -> Result<()> {
     Ok(())
 }
 
-/// A museum's own scans (`--artifacts DIR`: `.glb`/`.gltf`/`.stl`/`.ply` files and Voyager folders), each
+/// A museum's own scans (`--artifacts DIR`: `.glb`/`.gltf`/`.stl`/`.ply`/`.obj` files and Voyager folders), each
 /// loaded as the phone will load it (`phantogram check-artifacts`: the library, the phone
 /// budget) and copied to `to`, where the app bundles them; without a folder, `to` is emptied
 /// (no artifacts of an earlier build linger).

@@ -366,7 +366,7 @@ impl ApplicationHandler for App {
                 while let Some(request) = self.engine.take_shell_request() {
                     match request {
                         phantogram::engine::ShellRequest::OpenFile => {
-                            eprintln!("drop a .glb, .gltf, .stl, .ply or .zip file on the window to open it")
+                            eprintln!("drop a .glb, .gltf, .stl, .ply, .obj or .zip file on the window to open it")
                         }
                         // The desktop asks no permission (the viewer never reports one missing).
                         phantogram::engine::ShellRequest::CameraPermission => {}

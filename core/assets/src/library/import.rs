@@ -1,6 +1,7 @@
 //! Turning bytes the user opened (a file picker's document, an "Open with" intent, a share) into a
-//! folder of the library: a `.glb`, a self-contained `.gltf`, an `.stl` or `.ply` scan, or a zip
-//! holding one of those or a Smithsonian Voyager download (`scene.svx.json` beside its scans).
+//! folder of the library: a `.glb`, a self-contained `.gltf`, an `.stl`, `.ply` or `.obj` scan,
+//! or a zip holding one of those (an OBJ with its materials and textures comes as one) or a
+//! Smithsonian Voyager download (`scene.svx.json` beside its scans).
 //!
 //! Zip archives are unpacked with the same care as any file from outside: names only inside the
 //! folder (`..`, absolute paths and links are refused), at most [`MAX_ZIP_ENTRIES`] entries, and
@@ -22,7 +23,7 @@ pub enum Format {
     Glb,
     GltfJson,
     Zip,
-    /// STL or PLY.
+    /// STL, PLY or OBJ.
     Mesh(MeshFormat),
 }
 
@@ -121,7 +122,7 @@ fn copy(from: &mut impl Read, to: &mut std::fs::File) -> std::io::Result<u64> {
 }
 
 /// The model an unpacked folder holds: the shallowest Voyager scene's folder, else its only
-/// `.glb`/`.gltf`/`.stl`/`.ply` file.
+/// `.glb`/`.gltf`/`.stl`/`.ply`/`.obj` file.
 pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> {
     let mut scenes = Vec::new();
     let mut models = Vec::new();

@@ -1,5 +1,6 @@
-//! Scans published as bare meshes rather than glTF: STL (`stl`) and PLY (`ply`), loaded into a
-//! [`Model`] of one primitive.
+//! Scans published as meshes rather than glTF: STL (`stl`) and PLY (`ply`), loaded into a
+//! [`Model`] of one primitive; OBJ with its materials is `obj`'s, reached through the
+//! same [`MeshFormat`].
 //!
 //! **Conventions** (neither format states them): STL is read as millimetres with +Z up, as 3D
 //! printing writes it (Scan the World's museum scans, museums' "download for printing"), and
@@ -52,6 +53,8 @@ impl Soup {
 pub enum MeshFormat {
     Stl,
     Ply,
+    /// Wavefront OBJ, with its MTL materials (the `obj` module).
+    Obj,
 }
 
 impl MeshFormat {
@@ -61,12 +64,14 @@ impl MeshFormat {
         match extension.as_str() {
             "stl" => Some(MeshFormat::Stl),
             "ply" => Some(MeshFormat::Ply),
+            "obj" => Some(MeshFormat::Obj),
             _ => None,
         }
     }
 
     /// The format of a file's bytes, if one of these (a share may arrive without its name): PLY
-    /// by its first line, STL by its first word or by a binary file's exact size.
+    /// by its first line, STL by its first word or by a binary file's exact size, OBJ by its
+    /// first statement that is not a comment (a vertex, a group, a material library…).
     pub fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
         if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
             return Some(MeshFormat::Ply);
@@ -75,19 +80,34 @@ impl MeshFormat {
             let count = u64::from(u32::from_le_bytes([n[0], n[1], n[2], n[3]]));
             84 + 50 * count == bytes.len() as u64
         });
-        (binary_stl || bytes.trim_ascii_start().starts_with(b"solid")).then_some(MeshFormat::Stl)
+        if binary_stl || bytes.trim_ascii_start().starts_with(b"solid") {
+            return Some(MeshFormat::Stl);
+        }
+        let head = &bytes[..bytes.len().min(4096)];
+        let statement = head
+            .split(|&b| b == b'\n')
+            .map(<[u8]>::trim_ascii)
+            .find(|line| !line.is_empty() && !line.starts_with(b"#"))?;
+        let keyword = statement.split(u8::is_ascii_whitespace).next()?;
+        const OBJ: [&[u8]; 9] = [b"v", b"vt", b"vn", b"f", b"o", b"g", b"s", b"mtllib", b"usemtl"];
+        (OBJ.contains(&keyword) && statement.len() > keyword.len()).then_some(MeshFormat::Obj)
     }
 
     pub fn extension(self) -> &'static str {
         match self {
             MeshFormat::Stl => "stl",
             MeshFormat::Ply => "ply",
+            MeshFormat::Obj => "obj",
         }
     }
 }
 
-/// Loads an STL or PLY file (`format`) into a model of one primitive, within `budget`.
+/// Loads an STL or PLY file (`format`) into a model of one primitive, or an OBJ with its
+/// materials, within `budget`.
 pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
+    if format == MeshFormat::Obj {
+        return super::obj::load(path, budget, progress);
+    }
     let cancelled = |_| ModelError::Cancelled {
         path: path.to_path_buf(),
     };
@@ -99,7 +119,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     progress.step(0.1).map_err(cancelled)?;
     let parsed = match format {
         MeshFormat::Stl => stl::parse(&bytes),
-        MeshFormat::Ply => ply::parse(&bytes),
+        _ => ply::parse(&bytes),
     };
     drop(bytes);
     let mut soup = parsed.map_err(|message| ModelError::Parse {
@@ -287,5 +307,17 @@ mod tests {
             "a size that does not match is not STL"
         );
         assert_eq!(MeshFormat::sniff(b"glTF"), None);
+        assert_eq!(MeshFormat::of(Path::new("statue.obj")), Some(MeshFormat::Obj));
+        assert_eq!(
+            MeshFormat::sniff(b"# Exported by a scanner\nmtllib statue.mtl\nv 0 0 0\n"),
+            Some(MeshFormat::Obj)
+        );
+        assert_eq!(MeshFormat::sniff(b"v 0 0 0\nv 1 0 0\n"), Some(MeshFormat::Obj));
+        assert_eq!(
+            MeshFormat::sniff(b"Dear visitor,\nthank you"),
+            None,
+            "a letter is not OBJ"
+        );
+        assert_eq!(MeshFormat::sniff(b"version 2\n"), None);
     }
 }

@@ -1,5 +1,5 @@
 //! Models: triangle meshes with metallic–roughness materials and textures, in the device frame,
-//! and the loaders that produce them (glTF 2.0, STL, PLY).
+//! and the loaders that produce them (glTF 2.0, STL, PLY, OBJ).
 //!
 //! ## Loading glTF
 //! * `.gltf` (JSON with external or data-URI buffers and images) and `.glb` (binary container).
@@ -53,11 +53,13 @@
 //!   stream is decoded before its counts are known (bounded by its own size in the file), then
 //!   charged.
 //!
-//! ## Loading STL and PLY
-//! Scans published as bare meshes (3D-printing STL, scanners' PLY) load by their extension as a
-//! model of one primitive: welded, with smooth normals, PLY's vertex colours kept; STL read as
-//! millimetres with +Z up, PLY as metres with +Y up, both turned into the frame below
-//! (`mesh_file`, `stl`, `ply`; the same budget and no-panic rules as glTF).
+//! ## Loading STL, PLY and OBJ
+//! Scans published as meshes (3D-printing STL, scanners' PLY, download pages' OBJ) load by their
+//! extension. STL and PLY become a model of one primitive: welded, with smooth normals, PLY's
+//! vertex colours kept; STL read as millimetres with +Z up, PLY as metres with +Y up, both turned
+//! into the frame below (`mesh_file`, `stl`, `ply`). OBJ keeps its objects and MTL materials with
+//! their colour textures, opened only inside its folder (`obj`). The same budget and no-panic
+//! rules as glTF.
 //!
 //! ## Frames
 //! glTF is +Y up, +Z front, metres. [`Model::fit_to_diorama`] turns a standing object's +Y into
@@ -679,6 +681,7 @@ mod instancing;
 mod loader;
 mod mesh_file;
 mod meshopt_views;
+mod obj;
 mod ply;
 mod skin;
 mod spec_gloss;

@@ -302,13 +302,13 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         const val PREF_ASSETS_STAMP = "assets_stamp"
         /** The APK's assets folder of bundled artifacts, and its copy in the app's files. */
         const val BUNDLED = "artifacts"
-        /** What the document picker offers: glTF binary and JSON, STL and PLY (under the types
+        /** What the document picker offers: glTF binary and JSON, STL, PLY and OBJ (under the types
          *  apps report them as), zip (Voyager downloads), and octet-stream, as which many
          *  providers report a .glb or .stl. */
         val MODEL_TYPES = arrayOf(
             "model/gltf-binary", "model/gltf+json",
             "model/stl", "model/x.stl-binary", "model/x.stl-ascii", "application/sla", "application/vnd.ms-pki.stl",
-            "application/ply", "model/ply",
+            "application/ply", "model/ply", "model/obj",
             "application/zip", "application/octet-stream"
         )
     }

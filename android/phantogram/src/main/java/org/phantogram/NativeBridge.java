@@ -120,7 +120,7 @@ public final class NativeBridge {
 
     /** Requests of the core's screens, from nativeTakeShellRequest. */
     public static final int REQUEST_NONE = 0;
-    /** Show ACTION_OPEN_DOCUMENT for a .glb, .gltf, .stl, .ply or .zip, then nativeImportArtifactFd. */
+    /** Show ACTION_OPEN_DOCUMENT for a .glb, .gltf, .stl, .ply, .obj or .zip, then nativeImportArtifactFd. */
     public static final int REQUEST_OPEN_FILE = 1;
     /** Ask for the CAMERA permission (the core's camera page has said why); start the camera
      *  when granted. */
