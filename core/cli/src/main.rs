@@ -139,7 +139,7 @@ enum Command {
     },
     /// Summarise a log: duration, events and rate per sensor.
     Info { log: PathBuf },
-    /// Load every artifact in a folder (.glb/.gltf files, Voyager folders) as a phone will, as
+    /// Load every artifact in a folder (.glb/.gltf/.stl/.ply/.obj files, Voyager folders) as a phone will, as
     /// `cargo xtask android|ios --artifacts FOLDER` does before bundling them.
     CheckArtifacts { folder: PathBuf },
     /// Score estimators against recorded ground truth.

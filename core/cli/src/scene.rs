@@ -13,8 +13,8 @@ use phantogram::model::{DioramaFit, Placement};
 /// what the frames will hold.
 #[derive(clap::Args)]
 pub struct SceneArgs {
-    /// A glTF 2.0 model (.gltf or .glb), or a Smithsonian Voyager folder or its scene.svx.json
-    /// (its best scan present); the default artifact when omitted.
+    /// A glTF 2.0 model (.gltf or .glb), a Smithsonian Voyager folder or its scene.svx.json
+    /// (its best scan present), or an .stl, .ply or .obj scan; the default artifact when omitted.
     model: Option<PathBuf>,
     /// One of the built-in artifacts instead: amphora (the default), medal or tablet; or the
     /// Diorama (marbles, dice, coins and vessels in a tray, under the log's gravity).

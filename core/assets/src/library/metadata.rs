@@ -129,12 +129,11 @@ pub fn of_scene_file(path: &Path) -> Metadata {
 /// A readable title from a file or folder name: extension dropped, `_` and `-` as spaces, the
 /// first letter upper-case ("sea_turtle-150k.glb" → "Sea turtle 150k").
 pub fn title_from_name(name: &str) -> String {
-    let stem = name
-        .strip_suffix(".glb")
-        .or_else(|| name.strip_suffix(".gltf"))
-        .or_else(|| name.strip_suffix(".zip"))
-        .or_else(|| name.strip_suffix(".svx.json"))
-        .unwrap_or(name);
+    let lower = name.to_ascii_lowercase();
+    let stem = [".glb", ".gltf", ".zip", ".svx.json", ".stl", ".ply", ".obj"]
+        .iter()
+        .find(|e| lower.ends_with(*e))
+        .map_or(name, |e| &name[..name.len() - e.len()]);
     let words: Vec<&str> = stem.split(['_', '-', ' ']).filter(|w| !w.is_empty()).collect();
     let joined = words.join(" ");
     let mut chars = joined.chars();
@@ -184,6 +183,8 @@ mod tests {
         let j: Value = serde_json::json!({"asset": {"extras": {"title": long}}});
         assert_eq!(of_gltf_json(&j).title.unwrap().chars().count(), 201);
         assert_eq!(title_from_name("sea_turtle-150k.glb"), "Sea turtle 150k");
+        assert_eq!(title_from_name("bust_of_nefertiti.STL"), "Bust of nefertiti");
+        assert_eq!(title_from_name("scan.obj"), "Scan");
         assert_eq!(title_from_name("émail.gltf"), "Émail");
         assert_eq!(title_from_name(".glb"), "Untitled");
     }
