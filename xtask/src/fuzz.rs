@@ -438,6 +438,17 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                     )
                     .as_bytes(),
             )?;
+            // The triangle with a morph target (its own positions, at half weight).
+            put(
+                "morph.gltf",
+                tri_gltf
+                    .replace(
+                        r#""attributes":{"POSITION":0},"material":0"#,
+                        r#""attributes":{"POSITION":0},"targets":[{"POSITION":0}],"material":0"#,
+                    )
+                    .replace(r#""nodes":[{"mesh":0}]"#, r#""nodes":[{"mesh":0,"weights":[0.5]}]"#)
+                    .as_bytes(),
+            )?;
             // A skinned triangle over the target's `tri.bin` (joints and weights read from its
             // bytes).
             put(

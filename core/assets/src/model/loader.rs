@@ -815,6 +815,59 @@ fn read_plain(ctx: &Ctx, prim: &gltf::Primitive) -> Result<Attributes, ModelErro
     Ok(a)
 }
 
+/// Morph targets at the weights the file gives (the node's, else the mesh's): glTF draws a mesh
+/// with weights at its targets' weighted sum, and no animation is played here, so these are the
+/// pose it shows. `POSITION`, `NORMAL` and `TANGENT` displacements (VEC3, one per vertex) are
+/// added; normals and tangents are renormalised with the node's transform.
+fn apply_morph_targets(
+    ctx: &Ctx,
+    prim: &gltf::Primitive,
+    weights: &[f32],
+    a: &mut Attributes,
+) -> Result<(), ModelError> {
+    let vertices = a.positions.len() / 3;
+    for (i, target) in prim.morph_targets().enumerate() {
+        let w = weights.get(i).copied().unwrap_or(0.0);
+        if w == 0.0 || !w.is_finite() {
+            continue;
+        }
+        let what = || format!("mesh primitive {} morph target {i}", prim.index());
+        let read = |accessor: gltf::Accessor| -> Result<Vec<f32>, ModelError> {
+            if accessor.dimensions() != Dimensions::Vec3 || accessor.count() != vertices {
+                return Err(ctx.data(
+                    what(),
+                    format!(
+                        "accessor {} is {} {:?}, not {vertices} VEC3 displacements",
+                        accessor.index(),
+                        accessor.count(),
+                        accessor.dimensions()
+                    ),
+                ));
+            }
+            ctx.read_f32(&accessor, 3)
+        };
+        if let Some(accessor) = target.positions() {
+            for (p, d) in a.positions.iter_mut().zip(read(accessor)?) {
+                *p += w * d;
+            }
+        }
+        if let (Some(normals), Some(accessor)) = (a.normals.as_mut(), target.normals()) {
+            for (n, d) in normals.iter_mut().zip(read(accessor)?) {
+                *n += w * d;
+            }
+        }
+        if let (Some(tangents), Some(accessor)) = (a.tangents.as_mut(), target.tangents()) {
+            // Tangents are xyzw; the target moves xyz.
+            for (t, d) in tangents.chunks_exact_mut(4).zip(read(accessor)?.chunks_exact(3)) {
+                for c in 0..3 {
+                    t[c] += w * d[c];
+                }
+            }
+        }
+    }
+    Ok(())
+}
+
 fn read_draco(
     ctx: &Ctx,
     prim: &gltf::Primitive,
@@ -1514,6 +1567,17 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     Some(ext) => read_draco(&ctx, &prim, ext, &views)?,
                     None => read_plain(&ctx, &prim)?,
                 };
+                if let Some(weights) = node.weights().or(mesh.weights())
+                    && prim.morph_targets().len() > 0
+                {
+                    if draco.is_some() {
+                        model.warnings.push(format!(
+                            "{what}: morph targets of a Draco primitive are not applied (drawn as its base shape)"
+                        ));
+                    } else {
+                        apply_morph_targets(&ctx, &prim, weights, &mut attributes)?;
+                    }
+                }
                 if prim.mode() != gltf::mesh::Mode::Triangles {
                     let count = (attributes.positions.len() / 3) as u32;
                     let sequence = attributes.indices.take().unwrap_or_else(|| (0..count).collect());

@@ -14,7 +14,8 @@
 //!   holding every copy, each charged to the budget before it is made (`instancing`).
 //! * Skinned meshes are drawn in the pose the node hierarchy holds, each vertex moved by its joints
 //!   (`JOINTS_0`/`WEIGHTS_0`, inverse bind matrices) with the skinned node's own transform ignored,
-//!   as glTF defines (`skin`); no animation is played.
+//!   as glTF defines (`skin`); no animation is played. Morph targets are applied at the weights the
+//!   file gives (the node's, else the mesh's), the shape glTF draws without animation.
 //! * Triangle strips and fans become the triangle lists they stand for, wound as glTF orders their
 //!   corners (`topology`); points and lines have no surface to show and are left out with a
 //!   warning each (as is a strip or fan of a Draco primitive, whose decoder hands back faces).
