@@ -34,7 +34,9 @@ pub fn check_artifacts_command(folder: &Path) -> Result<()> {
     for name in names {
         if !entries.iter().any(|e| e.id.key == name) {
             problems.push(format!(
-                "{name}: not a .glb or .gltf file, nor a folder holding one or a Voyager scene"
+                "{name}: not a model file (.glb, .gltf, .stl, .ply, .obj), nor a folder holding one or a \
+                 Voyager scene (a model with files beside it, such as an .obj with its .mtl and \
+                 textures, goes in a folder of its own)"
             ));
         }
     }
