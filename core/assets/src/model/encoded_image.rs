@@ -100,6 +100,17 @@ impl Encoded {
         })
     }
 
+    /// What the user is told when the image is drawn at `fitted`, smaller than it is (`what`
+    /// names it); `None` at its own size.
+    pub fn scaled_down_note(&self, what: &str, fitted: (u32, u32)) -> Option<String> {
+        (fitted != (self.width, self.height)).then(|| {
+            format!(
+                "{what} ({}×{}) scaled down to {}×{}, the largest texture this device draws",
+                self.width, self.height, fitted.0, fitted.1
+            )
+        })
+    }
+
     fn decode_raster(
         &self,
         raw: &[u8],

@@ -1010,7 +1010,7 @@ fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
         indices,
     };
     if a.normals.is_none() {
-        super::mesh_file::smooth_normals(&mut mesh);
+        mesh.smooth_normals();
     }
     if a.tangents.is_none()
         && a.uv0.is_some()
@@ -1405,16 +1405,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         let done = decoded_count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         images_share.advance(done as f32 / image_count);
         // Larger than the device's textures: the user is told it was scaled down.
-        let note = (*fitted != (header.width, header.height)).then(|| {
-            format!(
-                "{} ({}×{}) scaled down to {}×{}, the largest texture this device draws",
-                what(),
-                header.width,
-                header.height,
-                fitted.0,
-                fitted.1
-            )
-        });
+        let note = header.scaled_down_note(&what(), *fitted);
         Ok((
             Image {
                 name: name.clone(),

@@ -251,24 +251,9 @@ fn build(soup: Soup) -> Mesh {
         .collect();
     mesh.indices = keep;
     if soup.normals.is_none() || mesh.vertices.iter().any(|v| v.normal == [0.0; 3]) {
-        smooth_normals(&mut mesh);
+        mesh.smooth_normals();
     }
     mesh
-}
-
-/// Area-weighted vertex normals from the triangles' windings.
-pub(super) fn smooth_normals(mesh: &mut Mesh) {
-    let mut acc = vec![Vec3::ZERO; mesh.vertices.len()];
-    for tri in mesh.indices.chunks(3) {
-        let p = |k: usize| Vec3::from(mesh.vertices[tri[k] as usize].position);
-        let n = (p(1) - p(0)).cross(p(2) - p(0));
-        for &i in tri {
-            acc[i as usize] += n;
-        }
-    }
-    for (v, n) in mesh.vertices.iter_mut().zip(acc) {
-        v.normal = n.normalize_or(Vec3::Z).to_array();
-    }
 }
 
 #[cfg(test)]

@@ -106,6 +106,22 @@ impl Mesh {
         Some(Aabb::new(min, max))
     }
 
+    /// Area-weighted vertex normals from the triangles' windings (for files that give none);
+    /// a vertex no triangle uses faces +z.
+    pub fn smooth_normals(&mut self) {
+        let mut acc = vec![Vec3::ZERO; self.vertices.len()];
+        for tri in self.indices.chunks(3) {
+            let p = |k: usize| Vec3::from(self.vertices[tri[k] as usize].position);
+            let n = (p(1) - p(0)).cross(p(2) - p(0));
+            for &i in tri {
+                acc[i as usize] += n;
+            }
+        }
+        for (v, n) in self.vertices.iter_mut().zip(acc) {
+            v.normal = n.normalize_or(Vec3::Z).to_array();
+        }
+    }
+
     /// Applies an affine transform to positions, normals and tangents.
     pub fn transform(&mut self, m: Mat4) {
         let linear = Mat3::from_mat4(m);

@@ -139,7 +139,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
             });
         }
         if !has_normals || built.vertices.iter().any(|v| v.normal == [0.0; 3]) {
-            super::mesh_file::smooth_normals(&mut built);
+            built.smooth_normals();
         } else {
             for v in &mut built.vertices {
                 v.normal = glam::Vec3::from(v.normal).normalize_or(glam::Vec3::Z).to_array();
@@ -258,16 +258,7 @@ fn texture(
         .map_err(|e| over_budget(path, e))?;
     match header.decode(&raw, fitted, memory) {
         Ok(decoded) => {
-            if fitted != (header.width, header.height) {
-                warnings.push(format!(
-                    "{} ({}×{}) scaled down to {}×{}, the largest texture this device draws",
-                    what(),
-                    header.width,
-                    header.height,
-                    fitted.0,
-                    fitted.1
-                ));
-            }
+            warnings.extend(header.scaled_down_note(&what(), fitted));
             images.push(Image {
                 name: name.to_owned(),
                 width: decoded.width(),
