@@ -160,3 +160,21 @@ fn every_copy_is_charged_to_the_budget_before_it_is_made() {
     let model = load("budget", &text, within(loads)).expect("loads");
     assert_eq!(model.primitives[0].mesh.vertices.len(), 600);
 }
+
+#[test]
+fn an_instance_count_the_budget_cannot_hold_is_refused_before_the_transforms_are_made() {
+    // Four million instances whose translations have no data (zeros, as glTF reads an accessor
+    // without a bufferView): 48 MB of translations, but 512 MB of instance and world matrices,
+    // over the phone's 384 MiB.
+    let text = instanced(r#"{"TRANSLATION":5}"#).replace(
+        r#"{"bufferView":4,"componentType":5126,"count":200,"type":"VEC3"}"#,
+        r#"{"componentType":5126,"count":4000000,"type":"VEC3"}"#,
+    );
+    match load("count", &text, ResourceBudget::default()) {
+        Err(ModelError::OverBudget { error, .. }) => {
+            assert!(error.what.contains("EXT_mesh_gpu_instancing"), "{error}");
+            assert_eq!(error.needed, 4_000_000 * 128, "{error}");
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -737,6 +737,9 @@ fn instance_transforms(ctx: &Ctx, doc: &gltf::Document, node: &gltf::Node) -> Re
     let scale = read("SCALE", Dimensions::Vec3)?;
     // No attribute: glTF leaves the count undefined; one instance where the node stands.
     let count = count.unwrap_or(1);
+    // Each instance's matrix, and its world matrix after it (`Mat4`: 64 bytes), before either
+    // is made: an accessor with no data reads as zeros, so its count alone sizes them.
+    ctx.check_bytes(|| what.clone(), (count as u64).saturating_mul(128))?;
     instancing::matrices(count, translation.as_deref(), rotation.as_deref(), scale.as_deref())
         .map(Some)
         .map_err(|message| ctx.data(what, message))
@@ -1223,7 +1226,7 @@ pub fn load_model_within(path: &Path, budget: ResourceBudget) -> Result<Model, M
 /// [`load_model_within`], reporting to `progress` and giving up when it is cancelled
 /// ([`ModelError::Cancelled`]).
 pub fn load_model_with(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
-    // Scans published as bare meshes: STL and PLY, by their extension.
+    // Scans published as meshes rather than glTF: STL, PLY and OBJ, by their extension.
     if !path.is_dir()
         && let Some(format) = super::mesh_file::MeshFormat::of(path)
     {
