@@ -727,7 +727,7 @@ fn check_artifacts_names_every_entry_that_would_not_show() {
     assert!(
         stderr.contains("2 entries would not show")
             && stderr.contains("broken.glb: ")
-            && stderr.contains("notes.txt: not a .glb"),
+            && stderr.contains("notes.txt: not a model file"),
         "{stderr}"
     );
     assert!(String::from_utf8_lossy(&run.stdout).contains("ok fine.glb"));
