@@ -387,7 +387,8 @@ enum PgStatus pg_camera_permission_needed(const struct PgEngine *engine);
 //
 // # Safety
 // `engine` is a live handle; `request` is valid for a write.
-enum PgStatus pg_take_shell_request(const struct PgEngine *engine, int32_t *request);
+enum PgStatus pg_take_shell_request(const struct PgEngine *engine,
+                                    int32_t *request);
 
 // Loading state, for the app's own use (the core draws the banner): `*state` 0 idle, 1
 // loading (`*fraction` 0 to 1), 2 the last load failed (the banner says why). Either pointer
