@@ -146,6 +146,12 @@ fn damaged_mesh_files_are_named_errors() {
         load("damaged", "nan.stl", &binary_stl(&nan)),
         Err(ModelError::Data { .. })
     ));
+    // Finite, but beyond the ±1e9 m every model's vertices are held to (10^15 mm).
+    let far = [[[1e15f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]]];
+    match load("damaged", "far.stl", &binary_stl(&far)) {
+        Err(ModelError::Data { message, .. }) => assert!(message.contains("within ±1e9"), "{message}"),
+        other => panic!("{other:?}"),
+    }
 }
 
 #[test]

@@ -1281,6 +1281,29 @@ const READ_SHARE: [f32; 2] = [0.0, 0.1];
 const IMAGES_SHARE: [f32; 2] = [0.1, 0.5];
 const MESHES_SHARE: [f32; 2] = [0.5, 0.9];
 
+/// The bytes of the model file at `path`: one larger than the whole budget is refused by name
+/// (over budget) before it is read.
+pub(super) fn read_model_file(path: &Path, spending: &Spending) -> Result<Vec<u8>, ModelError> {
+    if let Ok(meta) = std::fs::metadata(path)
+        && meta.is_file()
+    {
+        spending
+            .check_bytes(|| "the file".to_owned(), meta.len())
+            .map_err(|e| over_budget(path, e))?;
+    }
+    phantogram_files::read_regular_file(path, spending.budget().memory_bytes).map_err(|error| ModelError::Io {
+        path: path.to_path_buf(),
+        error,
+    })
+}
+
+/// A model's name: its file's name without the extension.
+pub(super) fn model_name(path: &Path) -> String {
+    path.file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default()
+}
+
 /// [`load_gltf_within`], reporting to `progress` and giving up when it is cancelled.
 pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
     let cancelled = |_| ModelError::Cancelled {
@@ -1289,18 +1312,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     let read = Span::new(progress, READ_SHARE[0], READ_SHARE[1]);
     read.step(0.0).map_err(cancelled)?;
     let mut spending = Spending::new(budget);
-    // A file larger than the whole budget is refused by name before it is read.
-    if let Ok(meta) = std::fs::metadata(path)
-        && meta.is_file()
-    {
-        spending
-            .check_bytes(|| "the file".to_owned(), meta.len())
-            .map_err(|e| over_budget(path, e))?;
-    }
-    let bytes = phantogram_files::read_regular_file(path, budget.memory_bytes).map_err(|error| ModelError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes = read_model_file(path, &spending)?;
     read.step(0.5).map_err(cancelled)?;
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| ModelError::Parse {
         path: path.to_path_buf(),
@@ -1470,10 +1482,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     materials.push(Material::default());
 
     let mut model = Model {
-        name: path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
+        name: model_name(path),
         images,
         warnings,
         ..Model::default()
@@ -1631,17 +1640,11 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     },
                 }
                 // Checked after the node transforms, which can overflow finite positions too.
-                if let Some((i, v)) = m
-                    .vertices
-                    .iter()
-                    .enumerate()
-                    .find(|(_, v)| !v.position.iter().all(|c| c.is_finite() && c.abs() <= MAX_COORDINATE))
-                {
+                if let Some((i, position)) = m.out_of_range_vertex() {
                     return Err(ctx.data(
                         what,
                         format!(
-                            "vertex {i} lies at {:?}, not a finite position within ±{MAX_COORDINATE:e} (in node {})",
-                            v.position,
+                            "vertex {i} lies at {position:?}, not a finite position within ±{MAX_COORDINATE:e} (in node {})",
                             node.index()
                         ),
                     ));

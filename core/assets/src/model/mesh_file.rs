@@ -21,7 +21,7 @@ use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
-use super::loader::{ModelError, over_budget};
+use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file};
 use super::{Material, Mesh, Model, Primitive, Vertex, ply, stl};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
@@ -76,11 +76,7 @@ impl MeshFormat {
         if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
             return Some(MeshFormat::Ply);
         }
-        let binary_stl = bytes.get(80..84).is_some_and(|n| {
-            let count = u64::from(u32::from_le_bytes([n[0], n[1], n[2], n[3]]));
-            84 + 50 * count == bytes.len() as u64
-        });
-        if binary_stl || bytes.trim_ascii_start().starts_with(b"solid") {
+        if stl::recognises(bytes) {
             return Some(MeshFormat::Stl);
         }
         let head = &bytes[..bytes.len().min(4096)];
@@ -112,10 +108,8 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
         path: path.to_path_buf(),
     };
     progress.step(0.0).map_err(cancelled)?;
-    let bytes = phantogram_files::read_regular_file(path, budget.memory_bytes).map_err(|error| ModelError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let mut spending = Spending::new(budget);
+    let bytes = read_model_file(path, &spending)?;
     progress.step(0.1).map_err(cancelled)?;
     let parsed = match format {
         MeshFormat::Stl => stl::parse(&bytes),
@@ -130,7 +124,6 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     if format == MeshFormat::Stl {
         soup = weld(soup);
     }
-    let mut spending = Spending::new(budget);
     spending
         .charge_primitive(|| "the mesh".to_owned())
         .and_then(|()| {
@@ -146,16 +139,17 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
             path: path.to_path_buf(),
         });
     }
-    if let Some(v) = mesh.vertices.iter().find(|v| !v.position.iter().all(|c| c.is_finite())) {
-        return Err(ModelError::Data {
-            path: path.to_path_buf(),
-            what: "the mesh".to_owned(),
-            message: format!("a vertex at {:?}, not a finite position", v.position),
-        });
-    }
     if format == MeshFormat::Stl {
         // Millimetres, +Z up → metres, +Y up (a quarter turn about x).
         mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(0.001)));
+    }
+    // Checked in the model's frame, as glTF's vertices are after their node transforms.
+    if let Some((i, position)) = mesh.out_of_range_vertex() {
+        return Err(ModelError::Data {
+            path: path.to_path_buf(),
+            what: "the mesh".to_owned(),
+            message: format!("vertex {i} lies at {position:?}, not a finite position within ±{MAX_COORDINATE:e}"),
+        });
     }
     progress.step(0.9).map_err(cancelled)?;
     let coloured = mesh.vertices.iter().any(|v| v.color != [1.0; 4]);
@@ -167,20 +161,10 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
             ..Material::default()
         }
     } else {
-        Material {
-            name: "plaster".into(),
-            // A light, warm grey (linear), matte: a cast's colour.
-            base_color: [0.62, 0.6, 0.56, 1.0],
-            metallic: 0.0,
-            roughness: 0.75,
-            ..Material::default()
-        }
+        Material::plaster()
     };
     Ok(Model {
-        name: path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
+        name: model_name(path),
         primitives: vec![Primitive {
             mesh,
             material: 0,

@@ -106,6 +106,16 @@ impl Mesh {
         Some(Aabb::new(min, max))
     }
 
+    /// The first vertex that is not finite or lies beyond ±[`MAX_COORDINATE`] (index and
+    /// position): past it the bounds and the fit to the screen overflow, and the frame is blank.
+    pub fn out_of_range_vertex(&self) -> Option<(usize, [f32; 3])> {
+        self.vertices
+            .iter()
+            .enumerate()
+            .find(|(_, v)| !v.position.iter().all(|c| c.is_finite() && c.abs() <= MAX_COORDINATE))
+            .map(|(i, v)| (i, v.position))
+    }
+
     /// Area-weighted vertex normals from the triangles' windings (for files that give none);
     /// a vertex no triangle uses faces +z.
     pub fn smooth_normals(&mut self) {
@@ -303,6 +313,18 @@ impl Default for Material {
 
 impl Material {
     /// For meshes that paint colour and metallic/roughness per vertex (the procedural artifact).
+    /// A scan without a colour of its own (STL, PLY without colours, OBJ without materials):
+    /// a light, warm grey (linear), matte, a cast's colour, not a claim about the object.
+    pub fn plaster() -> Self {
+        Self {
+            name: "plaster".into(),
+            base_color: [0.62, 0.6, 0.56, 1.0],
+            metallic: 0.0,
+            roughness: 0.75,
+            ..Self::default()
+        }
+    }
+
     pub fn vertex_painted() -> Self {
         Self {
             name: "vertex painted".into(),

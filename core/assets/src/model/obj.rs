@@ -18,7 +18,7 @@ use std::cell::RefCell;
 use std::path::Path;
 
 use super::encoded_image::Encoded;
-use super::loader::{ModelError, over_budget, resolve_inside};
+use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file, resolve_inside};
 use super::{AlphaMode, Image, Material, Mesh, Model, Primitive, TextureRef, Vertex};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
@@ -30,10 +30,8 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
     };
     progress.step(0.0).map_err(cancelled)?;
     let folder = path.parent().unwrap_or(Path::new("."));
-    let bytes = phantogram_files::read_regular_file(path, budget.memory_bytes).map_err(|error| ModelError::Io {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let mut spending = Spending::new(budget);
+    let bytes = read_model_file(path, &spending)?;
     let warnings = RefCell::new(Vec::new());
     // An MTL library: inside the folder, a regular file, within the budget; else a warning.
     let library = |name: &Path| -> tobj::MTLLoadResult {
@@ -71,20 +69,13 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
     let materials = materials.unwrap_or_default();
     progress.step(0.2).map_err(cancelled)?;
 
-    let mut spending = Spending::new(budget);
     let mut images = Vec::new();
     let mut model_materials: Vec<Material> = materials
         .iter()
         .map(|m| material(m, folder, path, &mut spending, &mut images, &mut warnings))
         .collect::<Result<_, _>>()?;
     let plain = model_materials.len();
-    model_materials.push(Material {
-        name: "plaster".into(),
-        base_color: [0.62, 0.6, 0.56, 1.0],
-        metallic: 0.0,
-        roughness: 0.75,
-        ..Material::default()
-    });
+    model_materials.push(Material::plaster());
     progress.step(0.6).map_err(cancelled)?;
 
     let mut primitives = Vec::new();
@@ -127,15 +118,11 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
             vertices,
             indices: mesh.indices.clone(),
         };
-        if let Some(v) = built
-            .vertices
-            .iter()
-            .find(|v| !v.position.iter().all(|c| c.is_finite()))
-        {
+        if let Some((i, position)) = built.out_of_range_vertex() {
             return Err(ModelError::Data {
                 path: path.to_path_buf(),
                 what: format!("object {:.60}", m.name),
-                message: format!("a vertex at {:?}, not a finite position", v.position),
+                message: format!("vertex {i} lies at {position:?}, not a finite position within ±{MAX_COORDINATE:e}"),
             });
         }
         if !has_normals || built.vertices.iter().any(|v| v.normal == [0.0; 3]) {
@@ -154,10 +141,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
     }
     progress.step(0.9).map_err(cancelled)?;
     let model = Model {
-        name: path
-            .file_stem()
-            .map(|s| s.to_string_lossy().into_owned())
-            .unwrap_or_default(),
+        name: model_name(path),
         primitives,
         materials: model_materials,
         images,

@@ -26,7 +26,7 @@ pub fn parse(bytes: &[u8]) -> Result<Soup, String> {
         }
         return Ok(Soup::triangles(positions));
     }
-    let text = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
+    let text = ascii_text(bytes);
     // Not text after "solid" (or no "solid"): a binary file whose size does not match its count.
     let binary_mismatch = || match bytes.get(80..84) {
         Some(n) => {
@@ -46,6 +46,17 @@ pub fn parse(bytes: &[u8]) -> Result<Soup, String> {
         Ok(text) => parse_ascii(text),
         Err(_) => Err(binary_mismatch()),
     }
+}
+
+/// Whether `bytes` are STL as [`parse`] reads it: binary of exactly the size its count states, or
+/// text beginning (after a byte-order mark and blanks) with "solid".
+pub fn recognises(bytes: &[u8]) -> bool {
+    binary_count(bytes).is_some() || ascii_text(bytes).trim_ascii_start().starts_with(b"solid")
+}
+
+/// The text of an ASCII STL: its bytes without a UTF-8 byte-order mark.
+fn ascii_text(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
 }
 
 /// The triangle count of a binary STL, when the file's size is exactly what it states.
