@@ -47,8 +47,8 @@ fn main() {
     };
     println!("model load: {:.0} ms", t.elapsed().as_secs_f64() * 1e3);
     let path = std::path::Path::new(&data).join("faces/astronaut.png");
-    let face = match image::open(&path) {
-        Ok(i) => i.to_rgba8(),
+    let face = match phantogram_lab::photo::open_photo(&path) {
+        Ok(p) => p.rgba,
         Err(e) => {
             eprintln!("error: {}: {e}", path.display());
             std::process::exit(1);

@@ -447,6 +447,41 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
     assert_eq!(face["glasses"]["swapped"], false);
     assert_eq!(face["distance_from"], "eye distance");
 
+    // The same bare photo as a phone held upright stores it: the sensor's landscape pixels,
+    // with EXIF Orientation 6 (turn 90° clockwise to show). Read upright, its eyes are where
+    // they are in the upright photo, to the pixel.
+    {
+        use image::ImageEncoder as _;
+        let upright = image::open(faces.join("astronaut.png")).unwrap().to_rgba8();
+        let stored = image::imageops::rotate270(&upright);
+        // Little-endian TIFF header, IFD0 at 8 with one entry: Orientation (0x0112), SHORT, 6.
+        let mut exif = b"II*\0\x08\0\0\0\x01\0".to_vec();
+        exif.extend_from_slice(&[0x12, 0x01, 3, 0, 1, 0, 0, 0, 6, 0, 0, 0, 0, 0, 0, 0]);
+        let turned = glasses_dir.join("astronaut-as-stored.png");
+        let mut enc = image::codecs::png::PngEncoder::new(std::fs::File::create(&turned).unwrap());
+        enc.set_exif_metadata(exif).unwrap();
+        enc.write_image(
+            stored.as_raw(),
+            stored.width(),
+            stored.height(),
+            image::ExtendedColorType::Rgba8,
+        )
+        .unwrap();
+        let out = bin()
+            .args(["eval", "face", "--json", "--models"])
+            .arg(&models)
+            .arg(&turned)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let line: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+        let turned_face = &line["faces"][0];
+        for side in ["left_eye", "right_eye"] {
+            let d = eye(&turned_face[side]).distance(eye(&lines[0]["faces"][0][side]));
+            assert!(d < 0.01, "{side} {d} px from the upright photo's: {turned_face}");
+        }
+    }
+
     // A PNG whose header claims 60000 × 60000 pixels (14 GB to decode) and a Radiance HDR are
     // refused by name; the photo between them is still read.
     let dir = Scratch::new("cli-faces");

@@ -23,9 +23,10 @@ fn setup() -> Option<(Arc<FaceModels>, PathBuf)> {
 }
 
 fn rgba(path: &Path) -> image::RgbaImage {
-    image::open(path)
+    // Upright, as the CLI reads photos (the EXIF orientation applied).
+    phantogram_lab::photo::open_photo(path)
         .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-        .to_rgba8()
+        .rgba
 }
 
 fn frame(img: &image::RgbaImage, intrinsics: Intrinsics) -> CameraFrame<'_> {

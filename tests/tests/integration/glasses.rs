@@ -18,6 +18,7 @@ use phantogram::glam::Vec2;
 use phantogram_geometry::srgb::{code_to_linear, linear_to_code};
 use phantogram_integration::{data_subdir, warp_into_frame};
 use phantogram_lab::drawn_glasses::{draw, style_for};
+use phantogram_lab::photo::open_photo;
 
 fn models() -> Option<Arc<FaceModels>> {
     phantogram_integration::face_models()
@@ -179,9 +180,9 @@ fn drawn_glasses_are_seen_and_keep_the_eyes_and_the_distance() {
     let mut jitter = Vec::new();
     for name in PHOTOS {
         let path = dir.join(name);
-        let img = image::open(&path)
+        let img = open_photo(&path)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-            .to_rgba8();
+            .rgba;
         let clean = faces(&models, &img);
         let image = UprightImage::new(frame(&img)).expect("frame");
         for f in &clean {
@@ -363,7 +364,7 @@ fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
         return;
     };
     let shared = SharedEngine::new(engine);
-    let img = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
+    let img = open_photo(&dir.join("astronaut.png")).expect("photo").rgba;
     let clean = faces(&models().expect("models"), &img);
     let f = clean.first().expect("the astronaut's face");
     let mut with = img.clone();
@@ -404,7 +405,7 @@ fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
 
 /// The astronaut photo at the face bench's size (480 × 480, for a 640 × 480 frame).
 fn astronaut_at_bench_size(faces_dir: &std::path::Path) -> image::RgbaImage {
-    let photo = image::open(faces_dir.join("astronaut.png")).expect("photo").to_rgba8();
+    let photo = open_photo(&faces_dir.join("astronaut.png")).expect("photo").rgba;
     image::imageops::resize(&photo, 480, 480, image::imageops::FilterType::Triangle)
 }
 
@@ -460,7 +461,7 @@ fn a_face_with_glasses_in_a_yuv_frame_keeps_its_eyes_as_in_rgba() {
     let (Some(dir), Some(models)) = (data_subdir("faces"), models()) else {
         return;
     };
-    let photo = image::open(dir.join("astronaut.png")).expect("photo").to_rgba8();
+    let photo = open_photo(&dir.join("astronaut.png")).expect("photo").rgba;
     let (w, h) = photo.dimensions();
     let owned = |img: &image::RgbaImage| {
         OwnedFrame::upright_rgba(
@@ -613,7 +614,7 @@ fn ordinary_glasses_are_not_taken_for_anaglyph_glasses() {
     let mut distance_errors = vec![Vec::new(); kinds.len()];
     let mut seed = 2000u32;
     for name in PHOTOS {
-        let img = image::open(dir.join(name)).expect("photo").to_rgba8();
+        let img = open_photo(&dir.join(name)).expect("photo").rgba;
         for f in faces(&models, &img) {
             let ipd_px = f.left_eye_px.distance(f.right_eye_px);
             let mid = eyes_midpoint(&f);
@@ -762,9 +763,9 @@ fn glasses_are_named_under_other_light() {
         let (mut photos, mut selfies) = (Vec::new(), Vec::new());
         for name in PHOTOS {
             let path = dir.join(name);
-            let img = image::open(&path)
+            let img = open_photo(&path)
                 .unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-                .to_rgba8();
+                .rgba;
             let img = relit(&img, gains);
             let clean = faces(&models, &img);
             for f in &clean {
