@@ -5,8 +5,8 @@
 //! |---|---|---|
 //! | project log | file starting `phantogram-sensor-log` | see [`super`] |
 //! | Android raw dump | folder with `accelerometer.txt[.gz]` | `t x y z` per line, phone-clock seconds; `gyroscope[-calibrated]`, `magnetometer[-calibrated]`, `rotation-vector` (`t x y z w [accuracy]`) optional; `mocap.csv.gz` + `timeAlignment.txt` become ground truth |
-//! | Sensor Logger | folder with `Accelerometer.csv` whose header has `seconds_elapsed` | `time` in ns, columns named `x y z` in any order; its `Accelerometer.csv` has gravity removed and becomes linear acceleration; `AccelerometerUncalibrated.csv` (with gravity) is used as the accelerometer when present; `Orientation.csv` (`qx qy qz qw`) as the rotation vector |
-//! | phyphox | folder with `Accelerometer.csv` whose header has `"Time (s)"` | seconds, Android frame, accelerometer with gravity |
+//! | Sensor Logger | folder with `Accelerometer.csv` whose header has `seconds_elapsed` | `time` in ns, columns named `x y z` in any order; the accelerometer (with gravity) is `TotalAcceleration.csv` (Android), else `AccelerometerUncalibrated.csv` (an iPhone's in g with the opposite sign, told by gravity's magnitude and converted); without either, `Accelerometer.csv` (gravity removed) becomes linear acceleration; `Orientation.csv` (`qx qy qz qw`) as the rotation vector |
+//! | phyphox | folder with `Accelerometer.csv` whose header has `"Time (s)"` | seconds, Android frame, accelerometer with gravity; any of its CSV exports (comma, tab or semicolon between fields, a decimal point or comma), axis columns named `X` or `… x`, `NaN` cells (no data) skipped |
 //! | BROAD | CSV (gzip or not) with header `t_s,acc_x,…` | one row per sample with all three sensors and the ground-truth quaternion; rows with NaN ground truth simply have none |
 //!
 //! All of Android, phyphox and BROAD already use (or, for BROAD's IMU, define) a right-handed
@@ -97,8 +97,14 @@ pub fn detect(path: &Path) -> Result<SourceFormat, LogError> {
         if find(path, "accelerometer.txt").is_some() {
             return Ok(SourceFormat::AndroidRaw);
         }
-        if let Some(acc) = find(path, "Accelerometer.csv") {
-            let header: Vec<String> = first_line(&acc)?.split(',').map(header_name).collect();
+        // Sensor Logger writes no Accelerometer.csv on phones that cannot take gravity out.
+        let acc = find(path, "Accelerometer.csv").or_else(|| find(path, "TotalAcceleration.csv"));
+        if let Some(acc) = acc {
+            let line = first_line(&acc)?;
+            let header: Vec<String> = line
+                .split(char::from(sniff_delimiter(&line)))
+                .map(header_name)
+                .collect();
             if header.iter().any(|h| h == "seconds_elapsed") {
                 return Ok(SourceFormat::SensorLogger);
             }
@@ -113,7 +119,7 @@ pub fn detect(path: &Path) -> Result<SourceFormat, LogError> {
         }
         return Err(LogError::format(
             path,
-            "unrecognised folder: expected an Android raw dump (accelerometer.txt[.gz]) or a Sensor Logger / phyphox export (Accelerometer.csv)",
+            "unrecognised folder: expected an Android raw dump (accelerometer.txt[.gz]) or a Sensor Logger / phyphox export (Accelerometer.csv or TotalAcceleration.csv)",
         ));
     }
     let line = first_line(path)?;
@@ -196,17 +202,63 @@ fn header_name(h: &str) -> String {
     h.trim().to_lowercase()
 }
 
+/// The field separator of a CSV, from its header line: a tab or a semicolon outside quotes, else
+/// a comma. phyphox offers all three ("CSV (Tabulator, decimal comma)", "CSV (Semicolon, decimal
+/// point)", …), and spreadsheets in locales whose decimal mark is a comma write semicolons.
+/// Column names have neither, so one occurrence decides.
+fn sniff_delimiter(header: &str) -> u8 {
+    let mut quoted = false;
+    let (mut tab, mut semicolon) = (false, false);
+    for c in header.chars() {
+        match c {
+            '"' => quoted = !quoted,
+            '\t' if !quoted => tab = true,
+            ';' if !quoted => semicolon = true,
+            _ => {}
+        }
+    }
+    if tab {
+        b'\t'
+    } else if semicolon {
+        b';'
+    } else {
+        b','
+    }
+}
+
+/// The column that stands for `wanted` (a header name as [`header_name`] gives it): the one
+/// named exactly so, else the only one whose last word it is ("acceleration x" for `x`, as
+/// phyphox's single-sensor experiments name their columns).
+fn column_index(names: &[String], wanted: &str) -> Result<usize, String> {
+    if let Some(i) = names.iter().position(|n| n == wanted) {
+        return Ok(i);
+    }
+    let suffix = format!(" {wanted}");
+    let mut by_last_word = names.iter().enumerate().filter(|(_, n)| n.ends_with(&suffix));
+    match (by_last_word.next(), by_last_word.next()) {
+        (Some((i, _)), None) => Ok(i),
+        (Some((_, a)), Some((_, b))) => Err(format!(
+            "CSV header has more than one column for {wanted:?} ({a:?}, {b:?})"
+        )),
+        _ => Err(format!("CSV header lacks column {wanted:?}")),
+    }
+}
+
 /// A CSV with a header row: calls `row` with the raw fields of the `wanted` columns, in that order.
 ///
 /// Read by the `csv` crate (RFC 4180: quoted fields, CRLF, a byte-order mark): every row must have
-/// as many fields as the header. A row with more is how a decimal comma shows up (`0,5` read as
-/// two fields): it is an error naming its line, never data shifted into the next column. A line
-/// longer than [`MAX_LINE_BYTES`] is an error before it is held in memory.
+/// as many fields as the header. The separator is the header's ([`sniff_delimiter`]); where it is
+/// a tab or a semicolon, a comma in a field is a decimal comma and is handed on as a point. With
+/// comma-separated fields a row with more fields than the header is how a decimal comma shows up
+/// (`0,5` read as two fields): it is an error naming its line, never data shifted into the next
+/// column. A line longer than [`MAX_LINE_BYTES`] is an error before it is held in memory.
 fn read_csv(path: &Path, wanted: &[&str], mut row: impl FnMut(&[&str]) -> Result<(), String>) -> Result<(), LogError> {
+    let delimiter = sniff_delimiter(&first_line(path)?);
     let reader = LineLengthGuard::new(super::open_maybe_gz(path)?);
     let mut csv = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(false)
+        .delimiter(delimiter)
         .from_reader(reader);
     let csv_error = |e: csv::Error| -> LogError {
         let line = e.position().map_or(0, |p| p.line());
@@ -230,10 +282,7 @@ fn read_csv(path: &Path, wanted: &[&str], mut row: impl FnMut(&[&str]) -> Result
     }
     let mut index = Vec::with_capacity(wanted.len());
     for w in wanted {
-        match names.iter().position(|n| n == w) {
-            Some(i) => index.push(i),
-            None => return Err(LogError::parse(path, 1, format!("CSV header lacks column {w:?}"))),
-        }
+        index.push(column_index(&names, w).map_err(|m| LogError::parse(path, 1, m))?);
     }
     let mut record = csv::StringRecord::new();
     loop {
@@ -247,7 +296,18 @@ fn read_csv(path: &Path, wanted: &[&str], mut row: impl FnMut(&[&str]) -> Result
         if record.len() == 1 && record[0].trim().is_empty() {
             continue;
         }
-        let picked: Vec<&str> = index.iter().map(|&i| &record[i]).collect();
+        let picked: Vec<std::borrow::Cow<str>> = index
+            .iter()
+            .map(|&i| {
+                let f = &record[i];
+                if delimiter != b',' && f.contains(',') {
+                    f.replace(',', ".").into()
+                } else {
+                    f.into()
+                }
+            })
+            .collect();
+        let picked: Vec<&str> = picked.iter().map(|f| f.as_ref()).collect();
         row(&picked).map_err(|m| LogError::parse(path, line, m))?;
     }
 }
@@ -404,22 +464,26 @@ fn import_mocap(path: &Path, align_s: f64, out: &mut Vec<SensorEvent>) -> Result
 
 pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
     let mut log = started(SourceFormat::SensorLogger, dir);
+    // The accelerometer with gravity, best first (Sensor Logger's units reference): Android's
+    // TotalAcceleration.csv (calibrated, m/s²); AccelerometerUncalibrated.csv (m/s², or on
+    // iPhones in g with the opposite sign, below). Accelerometer.csv has gravity taken out
+    // (linear acceleration): kept only when neither exists.
+    let total = find(dir, "TotalAcceleration.csv");
     let uncal = find(dir, "AccelerometerUncalibrated.csv");
+    let with_gravity = total.or(uncal.clone());
+    let linear = if with_gravity.is_some() {
+        None
+    } else {
+        find(dir, "Accelerometer.csv")
+    };
     let streams = [
-        (
-            find(dir, "Accelerometer.csv"),
-            if uncal.is_some() {
-                None
-            } else {
-                Some(SensorKind::LinearAcceleration)
-            },
-        ),
-        (uncal, Some(SensorKind::Accelerometer)),
-        (find(dir, "Gyroscope.csv"), Some(SensorKind::Gyroscope)),
-        (find(dir, "Magnetometer.csv"), Some(SensorKind::Magnetometer)),
+        (linear, SensorKind::LinearAcceleration),
+        (with_gravity.clone(), SensorKind::Accelerometer),
+        (find(dir, "Gyroscope.csv"), SensorKind::Gyroscope),
+        (find(dir, "Magnetometer.csv"), SensorKind::Magnetometer),
     ];
     for (path, kind) in streams {
-        let (Some(path), Some(kind)) = (path, kind) else {
+        let Some(path) = path else {
             continue;
         };
         let events = &mut log.events;
@@ -429,6 +493,12 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
             push(events, SensorEvent::vector(kind, t_ns, vec3(&v)))
         })?;
         log.note("read", display_name(&path));
+    }
+    if with_gravity.is_some() && with_gravity == uncal && iphone_units(&mut log.events) {
+        log.note(
+            "note",
+            "AccelerometerUncalibrated.csv is in g with iOS's sign (gravity reads −1 g): turned into m/s² with Android's",
+        );
     }
     if log.count(SensorKind::LinearAcceleration) > 0 {
         log.note(
@@ -447,6 +517,34 @@ pub fn import_sensor_logger(dir: &Path) -> Result<ImportedLog, LogError> {
         log.note("read", display_name(&path));
     }
     Ok(log.finish())
+}
+
+/// Sensor Logger on an iPhone, with its default "Standardise Units & Frames" off, writes the
+/// uncalibrated accelerometer in g and with every axis negated against Android's convention
+/// (its units and cross-platform references). The file does not say which phone made it, but
+/// gravity does: the median magnitude of a hand-held recording is about 1 g, 9.8 in m/s² and
+/// 1.0 in g, so a median under 3 (about the geometric mean of the two) can only be g.
+/// Such readings are turned into m/s² with Android's sign; the answer is whether they were.
+fn iphone_units(events: &mut [SensorEvent]) -> bool {
+    let mut magnitudes: Vec<f32> = events
+        .iter()
+        .filter(|e| e.kind == SensorKind::Accelerometer)
+        .map(|e| e.vec3().length())
+        .filter(|m| m.is_finite())
+        .collect();
+    if magnitudes.is_empty() {
+        return false;
+    }
+    let mid = magnitudes.len() / 2;
+    let (_, median, _) = magnitudes.select_nth_unstable_by(mid, f32::total_cmp);
+    if *median >= 3.0 {
+        return false;
+    }
+    const STANDARD_GRAVITY_M_S2: f32 = 9.806_65;
+    for e in events.iter_mut().filter(|e| e.kind == SensorKind::Accelerometer) {
+        *e = SensorEvent::vector(e.kind, e.t_ns, e.vec3() * -STANDARD_GRAVITY_M_S2);
+    }
+    true
 }
 
 /// Integer nanoseconds, or a float (some exports write `1.76e18`).
@@ -476,14 +574,23 @@ pub fn import_phyphox(dir: &Path) -> Result<ImportedLog, LogError> {
         ("Magnetometer.csv", SensorKind::Magnetometer),
         ("Linear Accelerometer.csv", SensorKind::LinearAcceleration),
     ];
+    let mut empty_rows = 0usize;
     for (name, kind) in streams {
         let Some(path) = find(dir, name) else { continue };
         let events = &mut log.events;
         read_csv(&path, &["time", "x", "y", "z"], |f| {
             let v = parse_fields(f)?;
+            // phyphox fills the cells of a column shorter than the longest with "NaN": no data.
+            if v.iter().any(|x| x.is_nan()) {
+                empty_rows += 1;
+                return Ok(());
+            }
             push(events, SensorEvent::vector(kind, seconds_to_ns(v[0])?, vec3(&v[1..])))
         })?;
         log.note("read", display_name(&path));
+    }
+    if empty_rows > 0 {
+        log.note("note", format!("{empty_rows} row(s) without data (NaN) skipped"));
     }
     Ok(log.finish())
 }
@@ -625,6 +732,56 @@ mod tests {
         );
         assert_eq!(log.events[1].t_ns, 2000);
 
+        // Android's TotalAcceleration.csv (with gravity) is the accelerometer; the linear
+        // acceleration beside it is not imported, and the folder is recognised without it.
+        std::fs::write(
+            dir.join("TotalAcceleration.csv"),
+            "time,seconds_elapsed,z,y,x\n1000,0.0,9.7,0.5,0.2\n",
+        )
+        .unwrap();
+        let log = import(&dir).unwrap();
+        assert_eq!(log.count(SensorKind::LinearAcceleration), 0);
+        assert_eq!(log.count(SensorKind::Accelerometer), 1);
+        assert_eq!(log.events[0].vec3(), Vec3::new(0.2, 0.5, 9.7));
+        std::fs::remove_file(dir.join("Accelerometer.csv")).unwrap();
+        assert_eq!(detect(&dir).unwrap(), SourceFormat::SensorLogger);
+        assert_eq!(import(&dir).unwrap().count(SensorKind::Accelerometer), 1);
+
+        // An iPhone's uncalibrated accelerometer, in g with gravity reading −1 g face up:
+        // m/s² with Android's sign. An Android one (m/s²) is left as it is.
+        let dir = temp_dir("sl-iphone");
+        std::fs::write(
+            dir.join("AccelerometerUncalibrated.csv"),
+            "time,seconds_elapsed,z,y,x\n1000,0.0,-0.98,-0.1,0.05\n2000,0.01,-1.02,-0.1,0.0\n3000,0.02,-0.5,-0.9,0.0\n",
+        )
+        .unwrap();
+        std::fs::write(
+            dir.join("Accelerometer.csv"),
+            "time,seconds_elapsed,z,y,x\n1000,0.0,0.1,0,0\n",
+        )
+        .unwrap();
+        let log = import(&dir).unwrap();
+        assert_eq!(log.count(SensorKind::LinearAcceleration), 0);
+        let acc: Vec<Vec3> = log.events.iter().map(|e| e.vec3()).collect();
+        assert_eq!(acc.len(), 3);
+        assert!(
+            (acc[0] - Vec3::new(-0.05, 0.1, 0.98) * 9.80665).length() < 1e-4,
+            "{acc:?}"
+        );
+        assert!(
+            log.meta.iter().any(|(_, v)| v.contains("in g with iOS's sign")),
+            "{:?}",
+            log.meta
+        );
+        std::fs::write(
+            dir.join("AccelerometerUncalibrated.csv"),
+            "time,seconds_elapsed,z,y,x\n1000,0.0,9.6,-1,0.5\n2000,0.01,10.1,-1,0.0\n",
+        )
+        .unwrap();
+        let log = import(&dir).unwrap();
+        assert_eq!(log.events[0].vec3(), Vec3::new(0.5, -1.0, 9.6));
+        assert!(!log.meta.iter().any(|(_, v)| v.contains("iOS")));
+
         let dir = temp_dir("phyphox");
         std::fs::write(
             dir.join("Accelerometer.csv"),
@@ -635,6 +792,98 @@ mod tests {
         let log = import(&dir).unwrap();
         assert_eq!(log.events[0].t_ns, 3_400_000);
         assert_eq!(log.events[0].kind, SensorKind::Accelerometer);
+    }
+
+    /// phyphox's five CSV exports (comma, tab or semicolon between fields; a decimal point or,
+    /// with tabs and semicolons, a decimal comma) as its exporter writes them: quoted names,
+    /// numbers as `0.000000000E0`, "NaN" where a column has no data.
+    #[test]
+    fn every_phyphox_csv_export_reads_the_same() {
+        let rows = [
+            [3.446083327e-3, -4.806504822e-1, 1.707798615, 9.449848938],
+            [1.337908334e-2, -5.548960876e-1, 1.533411255, 9.562863922],
+        ];
+        let gyro = [[1.958608333e-2, 0.1314016283, 0.1265425533, 0.07930336893]];
+        let write = |dir: &Path, name: &str, names: [&str; 4], values: &[[f64; 4]], sep: char, comma: bool| {
+            let mut text = names.map(|n| format!("\"{n}\"")).join(&sep.to_string());
+            text.push('\n');
+            for r in values {
+                let fields = r.map(|v| {
+                    let f = format!("{v:.9E}");
+                    if comma { f.replace('.', ",") } else { f }
+                });
+                text.push_str(&fields.join(&sep.to_string()));
+                text.push('\n');
+            }
+            // A padded row, as the exporter writes one for a shorter column.
+            text.push_str(&["NaN"; 4].join(&sep.to_string()));
+            text.push('\n');
+            std::fs::write(dir.join(name), text).unwrap();
+        };
+        let mut reference = None;
+        for (sep, comma) in [(',', false), ('\t', false), (';', false), ('\t', true), (';', true)] {
+            let dir = temp_dir(&format!("phyphox-{}-{comma}", sep as u32));
+            write(
+                &dir,
+                "Accelerometer.csv",
+                ["Time (s)", "X (m/s^2)", "Y (m/s^2)", "Z (m/s^2)"],
+                &rows,
+                sep,
+                comma,
+            );
+            // A single-sensor experiment's column names: the axis is the name's last word.
+            write(
+                &dir,
+                "Gyroscope.csv",
+                [
+                    "Time (s)",
+                    "Gyroscope x (rad/s)",
+                    "Gyroscope y (rad/s)",
+                    "Gyroscope z (rad/s)",
+                ],
+                &gyro,
+                sep,
+                comma,
+            );
+            assert_eq!(detect(&dir).unwrap(), SourceFormat::Phyphox, "{sep:?} {comma}");
+            let log = import(&dir).unwrap_or_else(|e| panic!("{sep:?} {comma}: {e}"));
+            assert_eq!(log.count(SensorKind::Accelerometer), 2);
+            assert_eq!(log.count(SensorKind::Gyroscope), 1);
+            let acc = log.events.iter().find(|e| e.kind == SensorKind::Accelerometer).unwrap();
+            assert_eq!(acc.t_ns, 3_446_083);
+            let expected = |r: [f64; 4]| Vec3::new(r[1] as f32, r[2] as f32, r[3] as f32);
+            assert!((acc.vec3() - expected(rows[0])).length() < 1e-6);
+            let gyr = log.events.iter().find(|e| e.kind == SensorKind::Gyroscope).unwrap();
+            assert!((gyr.vec3() - expected(gyro[0])).length() < 1e-6);
+            assert!(
+                log.meta
+                    .iter()
+                    .any(|(k, v)| k == "note" && v.contains("2 row(s) without data")),
+                "{:?}",
+                log.meta
+            );
+            match &reference {
+                None => reference = Some(log.events),
+                Some(r) => assert_eq!(&log.events, r, "{sep:?} {comma}"),
+            }
+        }
+        // Two columns that could each be "x": refused by name, not guessed.
+        let dir = temp_dir("phyphox-ambiguous");
+        write(
+            &dir,
+            "Accelerometer.csv",
+            [
+                "Time (s)",
+                "Acceleration x (m/s^2)",
+                "Linear Acceleration x (m/s^2)",
+                "Z (m/s^2)",
+            ],
+            &rows,
+            ',',
+            false,
+        );
+        let err = import(&dir).unwrap_err().to_string();
+        assert!(err.contains("more than one column for \"x\""), "{err}");
     }
 
     #[test]
