@@ -531,6 +531,12 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                 ply.extend(f.iter().flat_map(|&i| (i as i32).to_le_bytes()));
             }
             put("tetrahedron.ply", &ply)?;
+            // Its corners alone, with normals: a point cloud.
+            let mut cloud = b"ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nend_header\n".to_vec();
+            for c in corners {
+                cloud.extend(c.iter().chain(c.iter()).flat_map(|v| v.to_le_bytes()));
+            }
+            put("tetrahedron-points.ply", &cloud)?;
             // The same as OBJ with a material whose texture is the target's `tex.png`.
             put(
                 "tetrahedron.obj",

@@ -131,10 +131,15 @@ fn damaged_mesh_files_are_named_errors() {
         Err(ModelError::Parse { message, .. }) => assert!(message.contains("12 triangles"), "{message}"),
         other => panic!("{other:?}"),
     }
-    match load("damaged", "points.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n") {
-        Err(ModelError::Parse { message, .. }) => assert!(message.contains("point cloud"), "{message}"),
-        other => panic!("{other:?}"),
-    }
+    // A cloud of one point (or of points all in one place) has nothing to show.
+    assert!(matches!(
+        load(
+            "damaged",
+            "points.ply",
+            b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n"
+        ),
+        Err(ModelError::Empty { .. })
+    ));
     // Only degenerate triangles: nothing to draw.
     let flat = [[[1.0f32, 1.0, 1.0]; 3]];
     assert!(matches!(
@@ -184,4 +189,73 @@ fn an_stl_opened_from_bytes_is_kept_and_loaded_whatever_its_name() {
         .load(&imported.entry.id, ResourceBudget::PHONE, &Progress::new())
         .expect("loads again");
     assert_eq!(again.model.triangle_count(), 12);
+}
+
+/// A scanner's point cloud: a PLY of coloured vertices on a sphere of radius 0.1 m, no faces.
+fn point_cloud_ply(n: usize) -> String {
+    let mut text = format!(
+        "ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"
+    );
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    for i in 0..n {
+        let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+        let r = (1.0 - z * z).sqrt();
+        let a = golden * i as f64;
+        let red = if z > 0.0 { 200 } else { 40 };
+        text.push_str(&format!(
+            "{} {} {} {red} 90 60\n",
+            0.1 * r * a.cos(),
+            0.1 * z,
+            0.1 * r * a.sin()
+        ));
+    }
+    text
+}
+
+#[test]
+fn a_point_cloud_ply_is_drawn_as_discs_that_close_its_surface() {
+    let model = load("cloud", "sphere.ply", point_cloud_ply(3000).as_bytes()).expect("loads");
+    assert_eq!(model.primitives.len(), 1);
+    let mesh = &model.primitives[0].mesh;
+    assert_eq!(mesh.vertices.len(), 3000 * 6, "a hexagon per point");
+    assert_eq!(mesh.indices.len(), 3000 * 12);
+    let material = &model.materials[model.primitives[0].material];
+    assert!(material.double_sided, "a disc turned the wrong way still draws");
+    // The colours of the file, linear; the discs facing out from the centre.
+    let top = mesh
+        .vertices
+        .iter()
+        .find(|v| v.position[1] > 0.09)
+        .expect("a disc near the top");
+    assert!(
+        (top.color[0] - 0.578).abs() < 0.01,
+        "sRGB 200 is linear 0.578: {:?}",
+        top.color
+    );
+    for disc in mesh.vertices.chunks(6) {
+        let centre = disc.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
+        assert!(Vec3::from(disc[0].normal).dot(centre.normalize()) > 0.98);
+    }
+    // The bounds are the sphere's, grown by at most a disc.
+    let bounds = mesh.bounds().expect("bounds");
+    assert!(
+        (bounds.max.y - 0.1).abs() < 0.01 && (bounds.min.y + 0.1).abs() < 0.01,
+        "{bounds:?}"
+    );
+}
+
+#[test]
+fn a_point_cloud_over_the_budget_is_thinned_to_fit() {
+    let dir = Scratch::new("mesh-files-cloud-budget");
+    let path = dir.join("sphere.ply");
+    std::fs::write(&path, point_cloud_ply(3000)).expect("write");
+    // Room for the file and about 1000 discs (528 bytes each).
+    let file_bytes = std::fs::metadata(&path).expect("size").len();
+    let small = ResourceBudget {
+        memory_bytes: file_bytes.max(1000 * 528 + 1000),
+        ..ResourceBudget::default()
+    };
+    let model = phantogram_assets::model::load_model_within(&path, small).expect("loads thinned");
+    let discs = model.primitives[0].mesh.vertices.len() / 6;
+    assert!((500..=1001).contains(&discs), "{discs} discs");
 }

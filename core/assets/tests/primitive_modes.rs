@@ -1,6 +1,7 @@
 //! Every primitive mode glTF 2.0 allows, in one file made here (as Khronos's MeshPrimitiveModes
 //! sample lays them out): triangle strips and fans are drawn as the triangles they stand for,
-//! wound as the triangle list of the same surface; points and lines are not drawn, and say so.
+//! wound as the triangle list of the same surface; points are drawn as discs (a point cloud);
+//! lines are not drawn, and say so.
 
 use base64::Engine as _;
 use glam::Vec3;
@@ -78,7 +79,7 @@ fn strip_as_list() -> Vec<u16> {
 }
 
 #[test]
-fn strips_and_fans_are_drawn_as_triangles_and_points_and_lines_say_they_are_not() {
+fn strips_and_fans_are_drawn_as_triangles_points_as_discs_and_lines_say_they_are_not() {
     let one = |name: &str, mode: u32, indices: Vec<u16>| {
         let model = model_with(name, &[(mode, indices)]);
         assert!(model.warnings.is_empty(), "{name}: {:?}", model.warnings);
@@ -99,7 +100,8 @@ fn strips_and_fans_are_drawn_as_triangles_and_points_and_lines_say_they_are_not(
     assert!((area(&fan_n) - 2.0).abs() < 1e-6 && (area(&list_n) - 2.0).abs() < 1e-6);
     assert!(list_n.iter().all(|n| n.z < 0.0), "{list_n:?}");
     assert!(fan_n.iter().all(|n| n.z > 0.0), "{fan_n:?}");
-    // Points and lines: nothing drawn, and a warning naming each, the triangles beside them kept.
+    // Lines: nothing drawn, and a warning naming each; points: a disc each, in the points'
+    // plane, under a double-sided copy of their material; the triangles beside them kept.
     let mixed = model_with(
         "mixed",
         &[
@@ -110,9 +112,9 @@ fn strips_and_fans_are_drawn_as_triangles_and_points_and_lines_say_they_are_not(
             (4, strip_as_list()),
         ],
     );
-    assert_eq!(mixed.primitives.len(), 1);
-    assert_eq!(mixed.warnings.len(), 4, "{:?}", mixed.warnings);
-    for mode in ["Points", "Lines", "LineLoop", "LineStrip"] {
+    assert_eq!(mixed.primitives.len(), 2);
+    assert_eq!(mixed.warnings.len(), 3, "{:?}", mixed.warnings);
+    for mode in ["Lines", "LineLoop", "LineStrip"] {
         assert!(
             mixed
                 .warnings
@@ -122,6 +124,23 @@ fn strips_and_fans_are_drawn_as_triangles_and_points_and_lines_say_they_are_not(
             mixed.warnings
         );
     }
+    let (discs, triangles) = match &mixed.primitives[..] {
+        [a, b] if a.mesh.vertices.len() == 36 => (a, b),
+        [a, b] => (b, a),
+        _ => unreachable!(),
+    };
+    assert_eq!(discs.mesh.vertices.len(), 6 * 6);
+    assert_eq!(discs.mesh.indices.len(), 6 * 12);
+    for (k, disc) in discs.mesh.vertices.chunks(6).enumerate() {
+        let centre = disc.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
+        assert!(centre.distance(Vec3::new((k / 2) as f32, (k % 2) as f32, 0.0)) < 1e-5);
+        assert!(
+            disc.iter()
+                .all(|v| v.position[2].abs() < 1e-6 && v.normal[2].abs() > 0.999)
+        );
+    }
+    assert!(mixed.materials[discs.material].double_sided);
+    assert!(!mixed.materials[triangles.material].double_sided);
     // A strip too short for a triangle is not drawn either, and says so.
     let short = model_with("short", &[(5, vec![0, 1]), (4, strip_as_list())]);
     assert_eq!(short.primitives.len(), 1);

@@ -12,6 +12,7 @@ use thiserror::Error;
 use super::encoded_image::Encoded;
 use super::instancing;
 use super::meshopt_views::{self, DecodedViews};
+use super::point_cloud;
 use super::skin;
 use super::spec_gloss::{self, SpecGloss};
 use super::topology;
@@ -1553,11 +1554,15 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     .charge_primitive(|| format!("{what} (in node {})", node.index()))
                     .map_err(|e| over_budget(path, e))?;
                 let draco = prim.extension_value("KHR_draco_mesh_compression");
-                // Points and lines have no surface to show; Draco's decoder hands back faces,
-                // whose relation to a strip or fan the extension leaves to the encoder.
+                // Lines have no surface to show; points are drawn as discs (`point_cloud`).
+                // Draco's decoder hands back faces, whose relation to a strip or fan (or to
+                // points) the extension leaves to the encoder.
+                let points = prim.mode() == gltf::mesh::Mode::Points;
                 let drawn = match prim.mode() {
                     gltf::mesh::Mode::Triangles => true,
-                    gltf::mesh::Mode::TriangleStrip | gltf::mesh::Mode::TriangleFan => draco.is_none(),
+                    gltf::mesh::Mode::TriangleStrip | gltf::mesh::Mode::TriangleFan | gltf::mesh::Mode::Points => {
+                        draco.is_none()
+                    }
                     _ => false,
                 };
                 if !drawn {
@@ -1581,7 +1586,27 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                         apply_morph_targets(&ctx, &prim, weights, &mut attributes)?;
                     }
                 }
-                if prim.mode() != gltf::mesh::Mode::Triangles {
+                // A point cloud's points (its indices, else every vertex) pass through the mesh
+                // builder as degenerate triangles, which it checks and keeps; the discs are made
+                // once the points stand where the node puts them.
+                let had_normals = attributes.normals.is_some();
+                let mut discs = 0;
+                if points {
+                    let count = (attributes.positions.len() / 3) as u32;
+                    let sequence = attributes.indices.take().unwrap_or_else(|| (0..count).collect());
+                    discs = point_cloud::affordable(sequence.len(), ctx.spending.borrow().bytes_left());
+                    ctx.spending
+                        .borrow_mut()
+                        .charge_bytes(
+                            || format!("{what}'s discs (in node {})", node.index()),
+                            ResourceBudget::mesh_bytes(
+                                discs as u64 * point_cloud::VERTICES_PER_SURFEL,
+                                discs as u64 * point_cloud::INDICES_PER_SURFEL,
+                            ),
+                        )
+                        .map_err(|e| over_budget(path, e))?;
+                    attributes.indices = Some(sequence.iter().flat_map(|&i| [i, i, i]).collect());
+                } else if prim.mode() != gltf::mesh::Mode::Triangles {
                     let count = (attributes.positions.len() / 3) as u32;
                     let sequence = attributes.indices.take().unwrap_or_else(|| (0..count).collect());
                     attributes.indices = topology::triangle_list(prim.mode(), sequence);
@@ -1639,6 +1664,26 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                         None => m.transform(world),
                     },
                 }
+                if points {
+                    let cloud: Vec<Vertex> = m
+                        .indices
+                        .iter()
+                        .step_by(3)
+                        .filter_map(|&i| m.vertices.get(i as usize))
+                        .map(|v| Vertex {
+                            // The builder's smooth normals of degenerate triangles are no normals.
+                            normal: if had_normals { v.normal } else { [0.0; 3] },
+                            ..*v
+                        })
+                        .collect();
+                    m = point_cloud::surfels(&cloud, discs);
+                    if m.indices.is_empty() {
+                        model
+                            .warnings
+                            .push(format!("{what}: points all in one place are not drawn"));
+                        continue;
+                    }
+                }
                 // Checked after the node transforms, which can overflow finite positions too.
                 if let Some((i, position)) = m.out_of_range_vertex() {
                     return Err(ctx.data(
@@ -1649,9 +1694,19 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                         ),
                     ));
                 }
+                let mut material = prim.material().index().unwrap_or(default_material);
+                // Discs show from both sides (an estimated normal may face in); the material is
+                // copied so that triangles sharing it keep theirs.
+                if points && let Some(single) = materials.get(material).filter(|m| !m.double_sided) {
+                    materials.push(Material {
+                        double_sided: true,
+                        ..single.clone()
+                    });
+                    material = materials.len() - 1;
+                }
                 model.primitives.push(Primitive {
                     mesh: m,
-                    material: prim.material().index().unwrap_or(default_material),
+                    material,
                     is_floor: false,
                     lods: Vec::new(),
                 });

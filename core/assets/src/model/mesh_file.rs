@@ -13,7 +13,8 @@
 //! its normals where it has all three components, else gets the same smooth normals. PLY colours
 //! (sRGB, as scanners write them) become the vertex colours, over a white material; without colour
 //! the material is a matte, light stone-like grey (plaster: a cast's colour, not a claim about the
-//! object). **Budget**: the parsers never allocate more than the file's size implies; the mesh
+//! object). A PLY with vertices and no faces is a point cloud, drawn as small discs
+//! (`point_cloud`). **Budget**: the parsers never allocate more than the file's size implies; the mesh
 //! built from it is charged before it is made. **Panics**: none.
 
 use std::collections::HashMap;
@@ -22,7 +23,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file};
-use super::{Material, Mesh, Model, Primitive, Vertex, ply, stl};
+use super::{Material, Mesh, Model, Primitive, Vertex, ply, point_cloud, stl};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
 
@@ -124,17 +125,38 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     if format == MeshFormat::Stl {
         soup = weld(soup);
     }
-    spending
-        .charge_primitive(|| "the mesh".to_owned())
-        .and_then(|()| {
-            spending.charge_bytes(
-                || "the mesh".to_owned(),
-                ResourceBudget::mesh_bytes(soup.positions.len() as u64, soup.indices.len() as u64),
-            )
-        })
-        .map_err(|e| over_budget(path, e))?;
-    let mut mesh = build(soup);
-    if mesh.indices.is_empty() {
+    let cloud = soup.indices.is_empty() && !soup.positions.is_empty();
+    let mut mesh = if cloud {
+        // As many discs as the budget holds, up to the cap, then charged like any mesh.
+        let discs = point_cloud::affordable(soup.positions.len(), spending.bytes_left());
+        spending
+            .charge_primitive(|| "the point cloud".to_owned())
+            .and_then(|()| {
+                spending.charge_bytes(
+                    || "the point cloud".to_owned(),
+                    ResourceBudget::mesh_bytes(
+                        discs as u64 * point_cloud::VERTICES_PER_SURFEL,
+                        discs as u64 * point_cloud::INDICES_PER_SURFEL,
+                    ),
+                )
+            })
+            .map_err(|e| over_budget(path, e))?;
+        point_cloud::surfels(&vertices(&soup), discs)
+    } else {
+        spending
+            .charge_primitive(|| "the mesh".to_owned())
+            .and_then(|()| {
+                spending.charge_bytes(
+                    || "the mesh".to_owned(),
+                    ResourceBudget::mesh_bytes(soup.positions.len() as u64, soup.indices.len() as u64),
+                )
+            })
+            .map_err(|e| over_budget(path, e))?;
+        build(soup)
+    };
+    // Nothing to draw: every triangle degenerate, or a cloud whose points all coincide.
+    let flat = mesh.bounds().is_none_or(|b| b.max == b.min);
+    if mesh.indices.is_empty() || flat {
         return Err(ModelError::Empty {
             path: path.to_path_buf(),
         });
@@ -153,7 +175,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     }
     progress.step(0.9).map_err(cancelled)?;
     let coloured = mesh.vertices.iter().any(|v| v.color != [1.0; 4]);
-    let material = if coloured {
+    let mut material = if coloured {
         Material {
             name: "vertex colours".into(),
             metallic: 0.0,
@@ -163,6 +185,8 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     } else {
         Material::plaster()
     };
+    // A disc turned the wrong way by its estimated normal still draws.
+    material.double_sided = cloud;
     Ok(Model {
         name: model_name(path),
         primitives: vec![Primitive {
@@ -200,8 +224,30 @@ fn weld(soup: Soup) -> Soup {
 
 /// The vertices and triangles of a soup; normals from the file when it has them, else smooth.
 fn build(soup: Soup) -> Mesh {
-    let vertices = soup
-        .positions
+    let mut mesh = Mesh {
+        vertices: vertices(&soup),
+        indices: soup.indices,
+    };
+    // Degenerate triangles (repeated corners, common in scans) draw nothing and bend smooth
+    // normals towards nothing: left out.
+    let keep: Vec<u32> = mesh
+        .indices
+        .chunks_exact(3)
+        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
+        .flatten()
+        .copied()
+        .collect();
+    mesh.indices = keep;
+    if soup.normals.is_none() || mesh.vertices.iter().any(|v| v.normal == [0.0; 3]) {
+        mesh.smooth_normals();
+    }
+    mesh
+}
+
+/// A soup's vertices: its normals where given (else zero), its sRGB colours linearised (else
+/// white).
+fn vertices(soup: &Soup) -> Vec<Vertex> {
+    soup.positions
         .iter()
         .enumerate()
         .map(|(i, p)| Vertex {
@@ -219,25 +265,7 @@ fn build(soup: Soup) -> Mesh {
             }),
             material: [1.0, 1.0],
         })
-        .collect();
-    let mut mesh = Mesh {
-        vertices,
-        indices: soup.indices,
-    };
-    // Degenerate triangles (repeated corners, common in scans) draw nothing and bend smooth
-    // normals towards nothing: left out.
-    let keep: Vec<u32> = mesh
-        .indices
-        .chunks_exact(3)
-        .filter(|t| t[0] != t[1] && t[1] != t[2] && t[0] != t[2])
-        .flatten()
-        .copied()
-        .collect();
-    mesh.indices = keep;
-    if soup.normals.is_none() || mesh.vertices.iter().any(|v| v.normal == [0.0; 3]) {
-        mesh.smooth_normals();
-    }
-    mesh
+        .collect()
 }
 
 #[cfg(test)]

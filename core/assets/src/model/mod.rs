@@ -17,8 +17,9 @@
 //!   as glTF defines (`skin`); no animation is played. Morph targets are applied at the weights the
 //!   file gives (the node's, else the mesh's), the shape glTF draws without animation.
 //! * Triangle strips and fans become the triangle lists they stand for, wound as glTF orders their
-//!   corners (`topology`); points and lines have no surface to show and are left out with a
-//!   warning each (as is a strip or fan of a Draco primitive, whose decoder hands back faces).
+//!   corners (`topology`); points become small discs that close into a surface (`point_cloud`,
+//!   as a PLY without faces does); lines have no surface to show and are left out with a warning
+//!   each (as is a strip, fan or point primitive of Draco, whose decoder hands back faces).
 //! * Materials: base colour, metallic–roughness, normal (with scale), occlusion (with strength)
 //!   and emissive textures (`KHR_materials_emissive_strength`), `KHR_texture_transform` on every
 //!   slot (gltf-rs types it only on `textureInfo`, so for normal and occlusion textures it is read
@@ -57,7 +58,8 @@
 //! ## Loading STL, PLY and OBJ
 //! Scans published as meshes (3D-printing STL, scanners' PLY, download pages' OBJ) load by their
 //! extension. STL and PLY become a model of one primitive: welded, with smooth normals, PLY's
-//! vertex colours kept; STL read as millimetres with +Z up, PLY as metres with +Y up, both turned
+//! vertex colours kept (a PLY without faces is a point cloud, drawn as discs: `point_cloud`);
+//! STL read as millimetres with +Z up, PLY as metres with +Y up, both turned
 //! into the frame below (`mesh_file`, `stl`, `ply`). OBJ keeps its objects and MTL materials with
 //! their colour textures, opened only inside its folder (`obj`). The same budget and no-panic
 //! rules as glTF.
@@ -722,6 +724,7 @@ mod mesh_file;
 mod meshopt_views;
 mod obj;
 mod ply;
+mod point_cloud;
 mod skin;
 mod spec_gloss;
 mod split;

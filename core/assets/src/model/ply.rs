@@ -171,8 +171,9 @@ pub fn parse(bytes: &[u8]) -> Result<Soup, String> {
             }
         }
     }
-    if !saw_faces {
-        return Err("no faces: a point cloud, which has no surface to show".to_owned());
+    // Without faces it is a point cloud: handed back with no indices (`point_cloud` draws it).
+    if !saw_faces && soup.positions.is_empty() {
+        return Err("neither faces nor vertices".to_owned());
     }
     if let Some(&bad) = soup.indices.iter().find(|&&i| i as usize >= soup.positions.len()) {
         return Err(format!(
@@ -423,8 +424,8 @@ mod tests {
             (ASCII.replace("end_header", "end_headr"), "end_header"),
             (ASCII.replace("format ascii", "format text"), "unknown PLY format"),
             (
-                ASCII.replace("element face 1\nproperty list uchar int vertex_indices\n", ""),
-                "point cloud",
+                "ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nproperty float y\nproperty float z\nend_header\n".to_owned(),
+                "neither faces nor vertices",
             ),
             (
                 ASCII.replace("0 1 0 255 255 255", "0 1 zero 255 255 255"),

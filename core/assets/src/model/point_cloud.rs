@@ -1,0 +1,446 @@
+//! Point clouds drawn as surfaces: a scanner's PLY with vertices and no faces, or a glTF primitive
+//! of mode POINTS, becomes a mesh of small flat discs ("surfels", Pfister et al., SIGGRAPH 2000),
+//! one per kept point, each lying in the plane its neighbours lie in and as wide as the gaps to
+//! them, so that the discs overlap into a closed skin. The renderer then lights, shadows and
+//! draws it in stereo like any mesh.
+//!
+//! * **Points kept**: at most [`MAX_SURFELS`] (or fewer where the budget is smaller), every k-th
+//!   in the file's order; the discs of a thinned cloud grow with the gaps, so it stays closed.
+//! * **Size**: a disc's radius is the distance to its 6th nearest neighbour / √3 × 1.25. On a
+//!   hexagonal lattice of spacing `s` six neighbours lie at `s` and discs of radius `s/√3` just
+//!   cover the plane; the quarter more covers irregular sampling.
+//! * **Normal**: the point's where it has a non-zero one; else the direction in which the point
+//!   and its neighbours spread least (the covariance's smallest eigenvector, Hoppe et al.,
+//!   SIGGRAPH 1992), turned away from the cloud's centre, as a scanned object is seen from
+//!   outside. Draw the discs double-sided, so that one turned the wrong way still shows.
+//! * **Neighbours** come from a k-d tree: O(n log n) for any spread of points.
+//! * Every corner of a disc carries its point's colour, texture coordinates and material values.
+//!
+//! Panics: none. Cost: O(n log n) for n points, whatever their spread.
+
+use glam::{DMat3, DVec3};
+
+use super::{Mesh, Vertex};
+
+/// Most points drawn: 150 k discs are 600 k triangles and 72 MB of vertices, a fifth of a
+/// phone's memory budget for one artifact; a denser cloud is thinned.
+pub const MAX_SURFELS: usize = 150_000;
+
+/// Vertices and indices of one disc (a hexagon as four triangles).
+pub const VERTICES_PER_SURFEL: u64 = 6;
+pub const INDICES_PER_SURFEL: u64 = 12;
+
+/// Neighbours that set a disc's radius and plane.
+const NEIGHBOURS: usize = 6;
+
+/// How many discs [`surfels`] makes of `points` within `bytes` of mesh memory.
+pub fn affordable(points: usize, bytes: u64) -> usize {
+    let per_point = crate::budget::ResourceBudget::mesh_bytes(VERTICES_PER_SURFEL, INDICES_PER_SURFEL);
+    let affordable = usize::try_from(bytes / per_point).unwrap_or(usize::MAX);
+    points.min(MAX_SURFELS).min(affordable)
+}
+
+/// The surfel mesh of a cloud (each point a vertex; a zero normal is none), with at most
+/// `max_points` discs. Empty for an empty cloud or one whose points all coincide.
+pub fn surfels(cloud: &[Vertex], max_points: usize) -> Mesh {
+    let n = cloud.len();
+    let max_points = max_points.max(1);
+    let stride = n.div_ceil(max_points).max(1);
+    let kept: Vec<&Vertex> = cloud.iter().step_by(stride).collect();
+    let points: Vec<DVec3> = kept.iter().map(|v| DVec3::from(v.position.map(f64::from))).collect();
+    if points.is_empty() {
+        return Mesh::default();
+    }
+    let tree = KdTree::new(&points);
+    let centre = points.iter().copied().sum::<DVec3>() / points.len() as f64;
+    let mut found = Vec::with_capacity(64);
+    let mut radii = Vec::with_capacity(points.len());
+    let mut normals = Vec::with_capacity(points.len());
+    for (k, &p) in points.iter().enumerate() {
+        tree.nearest(&points, k, &mut found);
+        let given = Some(DVec3::from(kept[k].normal.map(f64::from)))
+            .filter(|v| v.is_finite() && v.length_squared() > 0.0)
+            .map(DVec3::normalize);
+        let normal = given.unwrap_or_else(|| {
+            let spread = least_spread(p, found.iter().map(|&(_, j)| points[j]));
+            if spread.dot(p - centre) < 0.0 { -spread } else { spread }
+        });
+        normals.push(normal);
+        radii.push(found.last().map(|&(d2, _)| d2.sqrt()));
+    }
+    // A point with no neighbour in reach (a lone outlier, or a cloud of one) takes the median
+    // radius; a cloud where none has one takes a hundredth of its size.
+    let mut known: Vec<f64> = radii.iter().flatten().copied().filter(|r| *r > 0.0).collect();
+    let fallback = if known.is_empty() {
+        tree.extent * 0.01
+    } else {
+        let mid = known.len() / 2;
+        *known.select_nth_unstable_by(mid, f64::total_cmp).1
+    };
+    // Every point in one place: no surface to show.
+    if fallback.is_nan() || fallback <= 0.0 {
+        return Mesh::default();
+    }
+    let scale = 1.25 / 3f64.sqrt();
+    let mut mesh = Mesh {
+        vertices: Vec::with_capacity(points.len() * VERTICES_PER_SURFEL as usize),
+        indices: Vec::with_capacity(points.len() * INDICES_PER_SURFEL as usize),
+    };
+    for (k, &p) in points.iter().enumerate() {
+        let r = radii[k].filter(|r| *r > 0.0).unwrap_or(fallback) * scale;
+        let n = normals[k].as_vec3();
+        let (u, v) = n.any_orthonormal_pair();
+        let first = mesh.vertices.len() as u32;
+        for corner in 0..6 {
+            let angle = corner as f32 * std::f32::consts::FRAC_PI_3;
+            let offset = (u * angle.cos() + v * angle.sin()) * r as f32;
+            mesh.vertices.push(Vertex {
+                position: (p.as_vec3() + offset).to_array(),
+                normal: n.to_array(),
+                tangent: [u.x, u.y, u.z, 1.0],
+                ..*kept[k]
+            });
+        }
+        // u × v = n: corners in increasing angle wind counter-clockwise seen from the front.
+        for t in 1..5 {
+            mesh.indices.extend([first, first + t, first + t + 1]);
+        }
+    }
+    mesh
+}
+
+/// The unit direction in which `p` and `others` spread least: the smallest eigenvector of their
+/// covariance. +z where they do not span a plane's worth (fewer than three points).
+fn least_spread(p: DVec3, others: impl Iterator<Item = DVec3>) -> DVec3 {
+    let mut sum = p;
+    let mut outer = DMat3::from_cols(p * p.x, p * p.y, p * p.z);
+    let mut count = 1.0;
+    for q in others {
+        sum += q;
+        outer += DMat3::from_cols(q * q.x, q * q.y, q * q.z);
+        count += 1.0;
+    }
+    if count < 3.0 {
+        return DVec3::Z;
+    }
+    let mean = sum / count;
+    let covariance = outer * (1.0 / count) - DMat3::from_cols(mean * mean.x, mean * mean.y, mean * mean.z);
+    smallest_eigenvector(covariance)
+}
+
+/// The eigenvector of the smallest eigenvalue of a symmetric 3 × 3 matrix, by Jacobi rotations
+/// (each zeroes one off-diagonal element; a few sweeps converge to machine precision).
+fn smallest_eigenvector(m: DMat3) -> DVec3 {
+    let mut a = m.to_cols_array_2d();
+    let mut v = DMat3::IDENTITY.to_cols_array_2d();
+    for _sweep in 0..12 {
+        let off = a[0][1] * a[0][1] + a[0][2] * a[0][2] + a[1][2] * a[1][2];
+        let scale = a[0][0] * a[0][0] + a[1][1] * a[1][1] + a[2][2] * a[2][2];
+        if off <= 1e-30 * scale.max(f64::MIN_POSITIVE) {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let t = if theta == 0.0 { 1.0 } else { t };
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            // A ← Jᵀ A J with J the rotation in the (p, q) plane; V ← V J.
+            for row in &mut a {
+                let (akp, akq) = (row[p], row[q]);
+                row[p] = c * akp - s * akq;
+                row[q] = s * akp + c * akq;
+            }
+            let (rp, rq) = (a[p], a[q]);
+            a[p] = std::array::from_fn(|k| c * rp[k] - s * rq[k]);
+            a[q] = std::array::from_fn(|k| s * rp[k] + c * rq[k]);
+            for row in &mut v {
+                let (vp, vq) = (row[p], row[q]);
+                row[p] = c * vp - s * vq;
+                row[q] = s * vp + c * vq;
+            }
+        }
+    }
+    let smallest = (0..3).min_by(|&i, &j| a[i][i].total_cmp(&a[j][j])).unwrap_or(2);
+    let e = DVec3::new(v[0][smallest], v[1][smallest], v[2][smallest]);
+    e.try_normalize().unwrap_or(DVec3::Z)
+}
+
+/// A k-d tree over the points (an index array split at the median of its widest axis, leaves of
+/// at most [`LEAF`] points), for nearest neighbours. Balanced whatever the points' spread, so a
+/// dense clump beside a few far-off points costs O(log n) a query like an even scan (a uniform
+/// grid would put the clump in one cell and look at all of it for each of its points).
+struct KdTree {
+    /// Point indices, each node's points a contiguous run.
+    order: Vec<u32>,
+    nodes: Vec<Node>,
+    /// The bounding box's diagonal.
+    extent: f64,
+}
+
+/// Points per leaf: a leaf is searched whole.
+const LEAF: usize = 8;
+
+enum Node {
+    Leaf {
+        start: usize,
+        end: usize,
+    },
+    Split {
+        axis: usize,
+        at: f64,
+        below: usize,
+        above: usize,
+    },
+}
+
+impl KdTree {
+    fn new(points: &[DVec3]) -> KdTree {
+        let (lo, hi) = points
+            .iter()
+            .fold((points[0], points[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+        let mut tree = KdTree {
+            order: (0..points.len() as u32).collect(),
+            nodes: Vec::with_capacity(2 * points.len() / LEAF + 1),
+            extent: (hi - lo).length(),
+        };
+        // Built iteratively (an explicit stack): a recursion's depth is fine at log₂ n, but the
+        // stack needs no argument.
+        tree.nodes.push(Node::Leaf { start: 0, end: 0 });
+        let mut pending = vec![(0usize, 0usize, points.len())];
+        while let Some((node, start, end)) = pending.pop() {
+            if end - start <= LEAF {
+                tree.nodes[node] = Node::Leaf { start, end };
+                continue;
+            }
+            let run = &mut tree.order[start..end];
+            let (lo, hi) = run.iter().fold(
+                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+                |(lo, hi), &i| (lo.min(points[i as usize]), hi.max(points[i as usize])),
+            );
+            let size = hi - lo;
+            let axis = if size.x >= size.y && size.x >= size.z {
+                0
+            } else if size.y >= size.z {
+                1
+            } else {
+                2
+            };
+            let mid = run.len() / 2;
+            run.select_nth_unstable_by(mid, |&a, &b| {
+                points[a as usize][axis].total_cmp(&points[b as usize][axis])
+            });
+            let at = points[run[mid] as usize][axis];
+            let below = tree.nodes.len();
+            tree.nodes.push(Node::Leaf { start: 0, end: 0 });
+            let above = tree.nodes.len();
+            tree.nodes.push(Node::Leaf { start: 0, end: 0 });
+            tree.nodes[node] = Node::Split { axis, at, below, above };
+            pending.push((below, start, start + mid));
+            pending.push((above, start + mid, end));
+        }
+        tree
+    }
+
+    /// The [`NEIGHBOURS`] nearest other points of `points[k]` (squared distance, index), nearest
+    /// first; fewer in a cloud of fewer points.
+    fn nearest(&self, points: &[DVec3], k: usize, found: &mut Vec<(f64, usize)>) {
+        let p = points[k];
+        found.clear();
+        let mut pending = vec![(0usize, 0.0f64)];
+        while let Some((node, plane_d2)) = pending.pop() {
+            // A side no nearer than the worst kept neighbour holds nothing better.
+            if found.len() == NEIGHBOURS && plane_d2 >= found[NEIGHBOURS - 1].0 {
+                continue;
+            }
+            match self.nodes[node] {
+                Node::Leaf { start, end } => {
+                    for &j in &self.order[start..end] {
+                        let j = j as usize;
+                        if j == k {
+                            continue;
+                        }
+                        let d2 = points[j].distance_squared(p);
+                        if found.len() < NEIGHBOURS || d2 < found[NEIGHBOURS - 1].0 {
+                            let at = found.partition_point(|&(e, _)| e <= d2);
+                            found.insert(at, (d2, j));
+                            found.truncate(NEIGHBOURS);
+                        }
+                    }
+                }
+                Node::Split { axis, at, below, above } => {
+                    let d = p[axis] - at;
+                    let (near, far) = if d < 0.0 { (below, above) } else { (above, below) };
+                    // The far side first onto the stack, so the near side is searched first.
+                    pending.push((far, d * d));
+                    pending.push((near, 0.0));
+                }
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::Vec3;
+
+    /// Points on a sphere of radius 1, spread evenly (a Fibonacci lattice).
+    fn sphere(n: usize) -> Vec<[f32; 3]> {
+        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+        (0..n)
+            .map(|i| {
+                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
+                let r = (1.0 - z * z).sqrt();
+                let a = golden * i as f64;
+                [(r * a.cos()) as f32, (r * a.sin()) as f32, z as f32]
+            })
+            .collect()
+    }
+
+    fn cloud(positions: &[[f32; 3]]) -> Vec<Vertex> {
+        positions
+            .iter()
+            .map(|&position| Vertex {
+                position,
+                normal: [0.0; 3],
+                tangent: [1.0, 0.0, 0.0, 1.0],
+                uv: [0.0; 4],
+                color: [1.0; 4],
+                material: [1.0, 1.0],
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_sphere_of_points_becomes_discs_facing_out_that_cover_it() {
+        let n = 4000;
+        let mesh = surfels(&cloud(&sphere(n)), MAX_SURFELS);
+        assert_eq!(mesh.vertices.len(), n * 6);
+        assert_eq!(mesh.indices.len(), n * 12);
+        // Each disc's normal is the sphere's outward normal at its point (estimated: no normals
+        // in the file), within a few degrees.
+        for disc in mesh.vertices.chunks(6) {
+            let centre = disc.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
+            let n = Vec3::from(disc[0].normal);
+            assert!(n.dot(centre.normalize()) > 0.99, "{n:?} at {centre:?}");
+            // Wound counter-clockwise seen from the front.
+            let (a, b, c) = (
+                Vec3::from(disc[0].position),
+                Vec3::from(disc[1].position),
+                Vec3::from(disc[2].position),
+            );
+            assert!((b - a).cross(c - a).dot(n) > 0.0);
+        }
+        // Covered: directions on the sphere are all within some disc. Each disc is tested as a
+        // flat circle. A hexagonal lattice of n points on the unit sphere (area 4π) has spacing
+        // √(8π / (√3·n)).
+        let discs: Vec<(Vec3, Vec3, f32)> = mesh
+            .vertices
+            .chunks(6)
+            .map(|d| {
+                let c = d.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
+                (c, Vec3::from(d[0].normal), Vec3::from(d[0].position).distance(c))
+            })
+            .collect();
+        let spacing = (8.0 * std::f32::consts::PI / (3f32.sqrt() * n as f32)).sqrt();
+        for probe in sphere(997) {
+            let dir = Vec3::from(probe).normalize();
+            let covered = discs.iter().any(|&(c, nrm, r)| {
+                // Where the ray from the centre along `dir` meets the disc's plane.
+                let t = c.dot(nrm) / dir.dot(nrm);
+                t > 0.0 && (dir * t).distance(c) <= r
+            });
+            assert!(covered, "a hole at {dir:?}");
+        }
+        // Not grossly larger than needed (1.25/√3 = 0.72 spacings on a perfect lattice).
+        for &(_, _, r) in &discs {
+            assert!(
+                r > 0.5 * spacing && r < 1.2 * spacing,
+                "radius {r} for spacing {spacing}"
+            );
+        }
+    }
+
+    #[test]
+    fn given_normals_and_colours_are_kept_and_a_dense_cloud_is_thinned() {
+        let positions = sphere(1000);
+        let mut points = cloud(&positions);
+        for v in &mut points {
+            v.normal = v.position.map(|c| -c);
+            v.color = [1.0, 0.5, 0.0, 1.0];
+            v.uv = [0.25, 0.75, 0.0, 0.0];
+        }
+        let mesh = surfels(&points, 250);
+        assert_eq!(mesh.vertices.len(), 250 * 6, "every 4th point kept");
+        let first = &mesh.vertices[0];
+        // The point's normal (pointing in), not the estimate (pointing out).
+        assert!(Vec3::from(first.normal).dot(Vec3::from(positions[0])) < -0.99);
+        assert_eq!(first.color, [1.0, 0.5, 0.0, 1.0]);
+        assert_eq!(first.uv, [0.25, 0.75, 0.0, 0.0]);
+    }
+
+    #[test]
+    fn degenerate_clouds_give_discs_without_panicking() {
+        for positions in [
+            vec![[0.0, 0.0, 0.0]],
+            vec![[1.0, 2.0, 3.0]; 50],
+            (0..50).map(|i| [i as f32, 0.0, 0.0]).collect(),
+            vec![[0.0, 0.0, 0.0], [1e9, -1e9, 1e9]],
+        ] {
+            let mesh = surfels(&cloud(&positions), MAX_SURFELS);
+            let expected = if positions.iter().all(|p| *p == positions[0]) {
+                0
+            } else {
+                positions.len() * 6
+            };
+            assert_eq!(mesh.vertices.len(), expected);
+            assert!(mesh.vertices.iter().all(|v| v.position.iter().all(|c| c.is_finite())));
+        }
+        assert!(surfels(&[], 10).vertices.is_empty());
+    }
+
+    /// Against a brute-force search, on a cloud a uniform grid handles worst: a dense clump
+    /// (with exact duplicates) beside a few far-off points.
+    #[test]
+    fn the_tree_finds_the_same_neighbours_as_brute_force() {
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let mut points: Vec<DVec3> = (0..3000).map(|_| DVec3::new(next(), next(), next()) * 1e-3).collect();
+        points.extend([DVec3::splat(100.0), DVec3::new(-50.0, 3.0, 0.0)]);
+        points.extend(std::iter::repeat_n(DVec3::splat(5e-4), 20));
+        let tree = KdTree::new(&points);
+        let mut found = Vec::new();
+        for k in (0..points.len()).step_by(7) {
+            tree.nearest(&points, k, &mut found);
+            let mut all: Vec<f64> = (0..points.len())
+                .filter(|&j| j != k)
+                .map(|j| points[j].distance_squared(points[k]))
+                .collect();
+            all.sort_by(f64::total_cmp);
+            let got: Vec<f64> = found.iter().map(|&(d2, _)| d2).collect();
+            assert_eq!(got, all[..NEIGHBOURS], "point {k}");
+        }
+    }
+
+    #[test]
+    fn the_least_spread_of_a_tilted_plane_is_its_normal() {
+        let normal = DVec3::new(1.0, 2.0, 2.0).normalize();
+        let (u, v) = normal.any_orthonormal_pair();
+        let pts: Vec<DVec3> = (0..30)
+            .map(|i| {
+                u * (i as f64 * 0.37).sin() * 3.0 + v * (i as f64 * 0.91).cos() * 2.0 + normal * 1e-4 * (i % 3) as f64
+            })
+            .collect();
+        let e = least_spread(pts[0], pts[1..].iter().copied());
+        assert!(e.dot(normal).abs() > 0.9999, "{e:?}");
+    }
+}
