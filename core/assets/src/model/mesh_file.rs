@@ -143,18 +143,19 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
             .map_err(|e| over_budget(path, e))?;
         // Thinned before the points become vertices (80 bytes each, against the file's 12 or
         // so): only the kept ones are made.
-        let stride = soup.positions.len().div_ceil(discs.max(1)).max(1);
-        let thin = |v: &[[f32; 3]]| v.iter().step_by(stride).copied().collect::<Vec<_>>();
+        let thinned = point_cloud::kept(&soup.positions, discs);
+        let chosen = &thinned.indices;
+        let pick = |v: &[[f32; 3]]| chosen.iter().filter_map(|&i| v.get(i).copied()).collect::<Vec<_>>();
         let kept = Soup {
-            positions: thin(&soup.positions),
-            normals: soup.normals.as_deref().map(thin),
+            positions: pick(&soup.positions),
+            normals: soup.normals.as_deref().map(pick),
             colors: soup
                 .colors
                 .as_deref()
-                .map(|c| c.iter().step_by(stride).copied().collect()),
+                .map(|c| chosen.iter().filter_map(|&i| c.get(i).copied()).collect()),
             indices: Vec::new(),
         };
-        point_cloud::surfels(&vertices(&kept), discs)
+        point_cloud::discs(&vertices(&kept), thinned.cell_m)
     } else {
         spending
             .charge_primitive(|| "the mesh".to_owned())

@@ -4,8 +4,11 @@
 //! them, so that the discs overlap into a closed skin. The renderer then lights, shadows and
 //! draws it in stereo like any mesh.
 //!
-//! * **Points kept**: at most [`MAX_SURFELS`] (or fewer where the budget is smaller), every k-th
-//!   in the file's order; the discs of a thinned cloud grow with the gaps, so it stays closed.
+//! * **Points kept**: at most [`MAX_SURFELS`] (or fewer where the budget is smaller), chosen at
+//!   random ([`kept`]): every k-th in the file's order would keep a scanner's lines whole and
+//!   thin each, leaving gaps across them wider than the discs that the nearest neighbours along
+//!   them size (seen on a Fibonacci sphere: a ring of holes where its spiral arms alias). The
+//!   discs of a thinned cloud grow with the gaps, so it stays closed.
 //! * **Size**: a disc's radius is the distance to its 6th nearest neighbour / √3 × 1.25. On a
 //!   hexagonal lattice of spacing `s` six neighbours lie at `s` and discs of radius `s/√3` just
 //!   cover the plane; the quarter more covers irregular sampling.
@@ -40,13 +43,99 @@ pub fn affordable(points: usize, bytes: u64) -> usize {
     points.min(MAX_SURFELS).min(affordable)
 }
 
+/// Which points to keep, at most `max`, in their order: all of them, or one per cell of the
+/// finest grid that leaves no more than `max` cells occupied (the point nearest its cell's
+/// centre). Spatially even: every dropped point has a kept one within its cell, so the gaps
+/// stay under a cell's diagonal. Neither every k-th point (a scanner's lines kept whole and each
+/// thinned, leaving gaps across them wider than the discs that neighbours along them size; on a
+/// Fibonacci sphere, a ring of holes where its spiral's arms alias) nor a random choice (its
+/// clumps and gaps) keeps the surface closed.
+pub fn kept(positions: &[[f32; 3]], max: usize) -> Thinned {
+    let n = positions.len();
+    let all = |n: usize| Thinned {
+        indices: (0..n).collect(),
+        cell_m: None,
+    };
+    if n <= max {
+        return all(n);
+    }
+    if max == 0 {
+        return all(0);
+    }
+    let points: Vec<DVec3> = positions.iter().map(|p| DVec3::from(p.map(f64::from))).collect();
+    let (lo, hi) = points
+        .iter()
+        .fold((points[0], points[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let extent = (hi - lo).length();
+    if !(extent.is_finite() && extent > 0.0) {
+        return all(max);
+    }
+    let cell_of = |p: DVec3, h: f64| {
+        let c = ((p - lo) / h).floor();
+        [c.x as i64, c.y as i64, c.z as i64]
+    };
+    let occupied = |h: f64| {
+        let mut cells = std::collections::HashSet::with_capacity(max + 1);
+        for &p in &points {
+            cells.insert(cell_of(p, h));
+            if cells.len() > max {
+                return None;
+            }
+        }
+        Some(cells.len())
+    };
+    // The finest cell (to 1 %) with at most `max` occupied: bisected in log scale between a cell
+    // too fine (a billionth of the extent holds each point alone, as n > max) and the whole
+    // extent (one cell).
+    let (mut fine, mut coarse) = (extent * 1e-9, extent * 1.01);
+    while coarse / fine > 1.01 {
+        let mid = (fine * coarse).sqrt();
+        if occupied(mid).is_some() {
+            coarse = mid;
+        } else {
+            fine = mid;
+        }
+    }
+    let h = coarse;
+    let mut best: std::collections::HashMap<[i64; 3], (f64, usize)> = std::collections::HashMap::with_capacity(max);
+    for (i, &p) in points.iter().enumerate() {
+        let cell = cell_of(p, h);
+        let centre = lo + (DVec3::new(cell[0] as f64, cell[1] as f64, cell[2] as f64) + 0.5) * h;
+        let d2 = p.distance_squared(centre);
+        let entry = best.entry(cell).or_insert((d2, i));
+        if d2 < entry.0 {
+            *entry = (d2, i);
+        }
+    }
+    let mut indices: Vec<usize> = best.into_values().map(|(_, i)| i).collect();
+    indices.sort_unstable();
+    Thinned {
+        indices,
+        cell_m: Some(h),
+    }
+}
+
+/// The points [`kept`] chose, and the side of the cells each stands for when it thinned.
+#[derive(Debug)]
+pub struct Thinned {
+    pub indices: Vec<usize>,
+    pub cell_m: Option<f64>,
+}
+
 /// The surfel mesh of a cloud (each point a vertex; a zero normal is none), with at most
 /// `max_points` discs. Empty for an empty cloud or one whose points all coincide.
 pub fn surfels(cloud: &[Vertex], max_points: usize) -> Mesh {
-    let n = cloud.len();
-    let max_points = max_points.max(1);
-    let stride = n.div_ceil(max_points).max(1);
-    let kept: Vec<&Vertex> = cloud.iter().step_by(stride).collect();
+    let positions: Vec<[f32; 3]> = cloud.iter().map(|v| v.position).collect();
+    let thinned = kept(&positions, max_points.max(1));
+    let points: Vec<Vertex> = thinned.indices.iter().map(|&i| cloud[i]).collect();
+    discs(&points, thinned.cell_m)
+}
+
+/// A disc for every point of `kept` (the points [`kept`] chose; `cell_m` its cell side when it
+/// thinned). A point that stands for a thinning cell covers the points dropped from it: its disc
+/// is at least the cell's diagonal (√3 sides) in radius, the farthest a dropped point can lie
+/// from it. (At one side, single-pixel holes showed on a 400 k-point sphere thinned to 133 k.)
+pub fn discs(kept: &[Vertex], cell_m: Option<f64>) -> Mesh {
     let points: Vec<DVec3> = kept.iter().map(|v| DVec3::from(v.position.map(f64::from))).collect();
     if points.is_empty() {
         return Mesh::default();
@@ -87,7 +176,7 @@ pub fn surfels(cloud: &[Vertex], max_points: usize) -> Mesh {
         indices: Vec::with_capacity(points.len() * INDICES_PER_SURFEL as usize),
     };
     for (k, &p) in points.iter().enumerate() {
-        let r = radii[k].filter(|r| *r > 0.0).unwrap_or(fallback) * scale;
+        let r = (radii[k].filter(|r| *r > 0.0).unwrap_or(fallback) * scale).max(cell_m.unwrap_or(0.0) * 3f64.sqrt());
         let n = normals[k].as_vec3();
         let (u, v) = n.any_orthonormal_pair();
         let first = mesh.vertices.len() as u32;
@@ -98,7 +187,7 @@ pub fn surfels(cloud: &[Vertex], max_points: usize) -> Mesh {
                 position: (p.as_vec3() + offset).to_array(),
                 normal: n.to_array(),
                 tangent: [u.x, u.y, u.z, 1.0],
-                ..*kept[k]
+                ..kept[k]
             });
         }
         // u × v = n: corners in increasing angle wind counter-clockwise seen from the front.
@@ -335,18 +424,33 @@ mod tests {
             );
             assert!((b - a).cross(c - a).dot(n) > 0.0);
         }
-        // Covered: directions on the sphere are all within some disc. Each disc is tested as a
-        // flat circle. A hexagonal lattice of n points on the unit sphere (area 4π) has spacing
+        let discs = discs_of(&mesh);
+        assert_covers_the_unit_sphere(&discs);
+        // A hexagonal lattice of n points on the unit sphere (area 4π) has spacing
         // √(8π / (√3·n)).
-        let discs: Vec<(Vec3, Vec3, f32)> = mesh
-            .vertices
+        let spacing = (8.0 * std::f32::consts::PI / (3f32.sqrt() * n as f32)).sqrt();
+        // Not grossly larger than needed (1.25/√3 = 0.72 spacings on a perfect lattice).
+        for &(_, _, r) in &discs {
+            assert!(
+                r > 0.5 * spacing && r < 1.2 * spacing,
+                "radius {r} for spacing {spacing}"
+            );
+        }
+    }
+
+    /// Each disc of a surfel mesh: centre, normal, radius.
+    fn discs_of(mesh: &Mesh) -> Vec<(Vec3, Vec3, f32)> {
+        mesh.vertices
             .chunks(6)
             .map(|d| {
                 let c = d.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
                 (c, Vec3::from(d[0].normal), Vec3::from(d[0].position).distance(c))
             })
-            .collect();
-        let spacing = (8.0 * std::f32::consts::PI / (3f32.sqrt() * n as f32)).sqrt();
+            .collect()
+    }
+
+    /// Every one of 997 directions from the centre meets some disc (each tested as a flat circle).
+    fn assert_covers_the_unit_sphere(discs: &[(Vec3, Vec3, f32)]) {
         for probe in sphere(997) {
             let dir = Vec3::from(probe).normalize();
             let covered = discs.iter().any(|&(c, nrm, r)| {
@@ -356,13 +460,20 @@ mod tests {
             });
             assert!(covered, "a hole at {dir:?}");
         }
-        // Not grossly larger than needed (1.25/√3 = 0.72 spacings on a perfect lattice).
-        for &(_, _, r) in &discs {
-            assert!(
-                r > 0.5 * spacing && r < 1.2 * spacing,
-                "radius {r} for spacing {spacing}"
-            );
-        }
+    }
+
+    /// A thinned cloud stays closed. Every third point of a Fibonacci sphere would not: its
+    /// spiral's arms alias into seven near the poles, with gaps between them wider than the
+    /// discs that neighbours along an arm size.
+    #[test]
+    fn a_thinned_sphere_stays_closed() {
+        let mesh = surfels(&cloud(&sphere(12_000)), 4_000);
+        assert!(
+            (3_600 * 6..=4_000 * 6).contains(&mesh.vertices.len()),
+            "{}",
+            mesh.vertices.len()
+        );
+        assert_covers_the_unit_sphere(&discs_of(&mesh));
     }
 
     #[test]
@@ -375,7 +486,10 @@ mod tests {
             v.uv = [0.25, 0.75, 0.0, 0.0];
         }
         let mesh = surfels(&points, 250);
-        assert_eq!(mesh.vertices.len(), 250 * 6, "every 4th point kept");
+        assert!(
+            (200 * 6..=250 * 6).contains(&mesh.vertices.len()),
+            "about a quarter of the points kept"
+        );
         let first = &mesh.vertices[0];
         // The point's normal (pointing in), not the estimate (pointing out).
         assert!(Vec3::from(first.normal).dot(Vec3::from(positions[0])) < -0.99);
@@ -401,6 +515,29 @@ mod tests {
             assert!(mesh.vertices.iter().all(|v| v.position.iter().all(|c| c.is_finite())));
         }
         assert!(surfels(&[], 10).vertices.is_empty());
+    }
+
+    /// Thinning keeps no more than asked (and not far fewer), in order, spread evenly: no two
+    /// kept points of a dense line much nearer than the kept spacing.
+    #[test]
+    fn thinning_keeps_an_even_spread_of_at_most_the_asked_number() {
+        let line: Vec<[f32; 3]> = (0..5).map(|i| [i as f32, 0.0, 0.0]).collect();
+        assert_eq!(kept(&line, 10).indices, [0, 1, 2, 3, 4]);
+        assert!(kept(&line, 0).indices.is_empty());
+        let points = sphere(30_000);
+        let k = kept(&points, 10_000).indices;
+        assert!((8_000..=10_000).contains(&k.len()), "{}", k.len());
+        assert!(k.windows(2).all(|w| w[0] < w[1]));
+        // Each tenth of the sphere's height (equal areas) holds about a tenth of the kept points.
+        for tenth in 0..10 {
+            let inside = k.iter().filter(|&&i| i / 3000 == tenth).count();
+            assert!(
+                (k.len() / 10 * 8 / 10..=k.len() / 10 * 12 / 10).contains(&inside),
+                "{inside} in tenth {tenth}"
+            );
+        }
+        // Coincident points: a few kept, no panic.
+        assert!(kept(&vec![[1.0, 2.0, 3.0]; 50], 10).indices.len() <= 10);
     }
 
     /// Against a brute-force search, on a cloud a uniform grid handles worst: a dense clump
