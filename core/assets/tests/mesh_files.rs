@@ -196,18 +196,9 @@ fn point_cloud_ply(n: usize) -> String {
     let mut text = format!(
         "ply\nformat ascii 1.0\nelement vertex {n}\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nend_header\n"
     );
-    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-    for i in 0..n {
-        let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-        let r = (1.0 - z * z).sqrt();
-        let a = golden * i as f64;
-        let red = if z > 0.0 { 200 } else { 40 };
-        text.push_str(&format!(
-            "{} {} {} {red} 90 60\n",
-            0.1 * r * a.cos(),
-            0.1 * z,
-            0.1 * r * a.sin()
-        ));
+    for p in phantogram_geometry::sphere::fibonacci(n) {
+        let red = if p.z > 0.0 { 200 } else { 40 };
+        text.push_str(&format!("{} {} {} {red} 90 60\n", 0.1 * p.x, 0.1 * p.z, 0.1 * p.y));
     }
     text
 }

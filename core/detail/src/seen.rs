@@ -63,7 +63,7 @@ pub struct SeenSides {
 impl SeenSides {
     /// Summarises `model`'s surface (the floor excluded).
     pub fn new(model: &Model) -> Self {
-        let bins = fibonacci_sphere(DIRECTIONS);
+        let bins = phantogram_geometry::sphere::fibonacci(DIRECTIONS);
         let mut area = vec![0.0f32; DIRECTIONS];
         // Area-weighted normals per bin: the bin's direction is its surfaces' mean normal, not
         // the lattice point (up to ~15° away from it).
@@ -195,19 +195,6 @@ fn nearest(directions: &[Vec3], n: Vec3) -> usize {
         .enumerate()
         .max_by(|a, b| a.1.dot(n).total_cmp(&b.1.dot(n)))
         .map_or(0, |(i, _)| i)
-}
-
-/// `n` directions spread evenly over the sphere.
-fn fibonacci_sphere(n: usize) -> Vec<Vec3> {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - (i as f32 + 0.5) * 2.0 / n as f32;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let a = golden * i as f32;
-            Vec3::new(r * a.cos(), r * a.sin(), z)
-        })
-        .collect()
 }
 
 #[cfg(test)]

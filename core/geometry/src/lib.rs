@@ -3,8 +3,8 @@
 //! The physical model a phantogram is drawn from, as pure maths (glam, no GPU, no I/O, no
 //! threads): the screen ([`screen`]) and the viewer's eyes ([`eyes`]), the off-axis stereo
 //! projection ([`projection`]), the paper's gravity viewpoint ([`viewpoint`]), the world-fixed
-//! light ([`light`]), front-space containment ([`containment`]) and the anaglyph colour matrices
-//! ([`anaglyph`]). The lowest layer of the workspace: every other crate depends on it, it on
+//! light ([`light`]), front-space containment ([`containment`]), the anaglyph colour matrices
+//! ([`anaglyph`]) and directions spread evenly over the sphere ([`sphere`]). The lowest layer of the workspace: every other crate depends on it, it on
 //! nothing of ours (see `ARCHITECTURE.md`).
 //!
 //! ## Frames and units (defined here, once, and used everywhere)
@@ -45,6 +45,7 @@ pub mod eyes;
 pub mod light;
 pub mod projection;
 pub mod screen;
+pub mod sphere;
 pub mod srgb;
 pub mod viewpoint;
 

@@ -33,19 +33,6 @@ use phantogram_lab::synthetic_camera::{Metering, SyntheticCamera};
 const BRACKET: Metering = Metering::Highlights { min_ratio: 1e-4 };
 use phantogram_roomlight::{CaptureFrame, CaptureParams, RoomCapture};
 
-/// Normals spread evenly over the sphere (a Fibonacci lattice).
-fn normals(n: usize) -> Vec<Vec3> {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
-            let r = (1.0 - z * z).sqrt();
-            let a = golden * i as f32;
-            Vec3::new(r * a.cos(), r * a.sin(), z)
-        })
-        .collect()
-}
-
 /// Relative RMS difference of two irradiances over the normals, after scaling `got` by `scale`.
 fn relative_rms(got: &IrradianceSh, want: &IrradianceSh, scale: f32, normals: &[Vec3]) -> f32 {
     let (mut err, mut norm) = (0.0f64, 0.0f64);
@@ -113,7 +100,7 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
         return;
     };
     let camera = SyntheticCamera::phone_front();
-    let normals = normals(2000);
+    let normals = phantogram_geometry::sphere::fibonacci(2000);
     let (mut worst_full, mut worst_80) = ((0.0f32, String::new()), (0.0f32, String::new()));
     for path in &files {
         let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
@@ -405,7 +392,7 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
 #[test]
 fn a_tiny_bright_lamp_anywhere_is_captured() {
     let camera = SyntheticCamera::phone_front();
-    let normals = normals(2000);
+    let normals = phantogram_geometry::sphere::fibonacci(2000);
     for (azimuth_deg, elevation_deg) in [(30.0f32, 20.0f32), (200.0, -50.0), (110.0, 70.0)] {
         let (width, height) = (256usize, 128usize);
         let mut room = Environment {

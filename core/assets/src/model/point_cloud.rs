@@ -379,14 +379,9 @@ mod tests {
 
     /// Points on a sphere of radius 1, spread evenly (a Fibonacci lattice).
     fn sphere(n: usize) -> Vec<[f32; 3]> {
-        let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
-        (0..n)
-            .map(|i| {
-                let z = 1.0 - 2.0 * (i as f64 + 0.5) / n as f64;
-                let r = (1.0 - z * z).sqrt();
-                let a = golden * i as f64;
-                [(r * a.cos()) as f32, (r * a.sin()) as f32, z as f32]
-            })
+        phantogram_geometry::sphere::fibonacci(n)
+            .iter()
+            .map(|p| p.to_array())
             .collect()
     }
 
