@@ -433,14 +433,18 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
     let glasses_dir = Scratch::new("cli-glasses");
     let with = glasses_dir.join("astronaut-glasses.png");
     img.save(&with).unwrap();
-    let out = bin()
-        .args(["eval", "face", "--json", "--models"])
-        .arg(&models)
-        .arg(&with)
-        .output()
-        .unwrap();
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let line: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+    // `eval face --json` of one image: its one line.
+    let eval_one = |image: &std::path::Path| -> serde_json::Value {
+        let out = bin()
+            .args(["eval", "face", "--json", "--models"])
+            .arg(&models)
+            .arg(image)
+            .output()
+            .unwrap();
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap()
+    };
+    let line = eval_one(&with);
     let face = &line["faces"][0];
     assert_eq!(face["glasses"]["left"], "red", "{face}");
     assert_eq!(face["glasses"]["right"], "cyan");
@@ -467,14 +471,7 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
             image::ExtendedColorType::Rgba8,
         )
         .unwrap();
-        let out = bin()
-            .args(["eval", "face", "--json", "--models"])
-            .arg(&models)
-            .arg(&turned)
-            .output()
-            .unwrap();
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-        let line: serde_json::Value = serde_json::from_str(String::from_utf8_lossy(&out.stdout).trim()).unwrap();
+        let line = eval_one(&turned);
         let turned_face = &line["faces"][0];
         for side in ["left_eye", "right_eye"] {
             let d = eye(&turned_face[side]).distance(eye(&lines[0]["faces"][0][side]));
