@@ -4,11 +4,9 @@
 //! them, so that the discs overlap into a closed skin. The renderer then lights, shadows and
 //! draws it in stereo like any mesh.
 //!
-//! * **Points kept**: at most [`MAX_SURFELS`] (or fewer where the budget is smaller), chosen at
-//!   random ([`kept`]): every k-th in the file's order would keep a scanner's lines whole and
-//!   thin each, leaving gaps across them wider than the discs that the nearest neighbours along
-//!   them size (seen on a Fibonacci sphere: a ring of holes where its spiral arms alias). The
-//!   discs of a thinned cloud grow with the gaps, so it stays closed.
+//! * **Points kept**: at most [`MAX_SURFELS`] (or fewer where the budget is smaller), thinned
+//!   evenly in space ([`kept`]: one point per cell of a grid), each kept point's disc wide enough
+//!   to cover the points dropped beside it, so that a thinned cloud stays closed.
 //! * **Size**: a disc's radius is the distance to its 6th nearest neighbour / √3 × 1.25. On a
 //!   hexagonal lattice of spacing `s` six neighbours lie at `s` and discs of radius `s/√3` just
 //!   cover the plane; the quarter more covers irregular sampling.
@@ -157,8 +155,8 @@ pub fn discs(kept: &[Vertex], cell_m: Option<f64>) -> Mesh {
         normals.push(normal);
         radii.push(found.last().map(|&(d2, _)| d2.sqrt()));
     }
-    // A point with no neighbour in reach (a lone outlier, or a cloud of one) takes the median
-    // radius; a cloud where none has one takes a hundredth of its size.
+    // A point whose neighbours all lie on it (or the one point of a cloud of one) takes the
+    // median radius; a cloud where none has another beside it takes a hundredth of its size.
     let mut known: Vec<f64> = radii.iter().flatten().copied().filter(|r| *r > 0.0).collect();
     let fallback = if known.is_empty() {
         tree.extent * 0.01
