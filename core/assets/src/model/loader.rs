@@ -1594,7 +1594,8 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                 if points {
                     let count = (attributes.positions.len() / 3) as u32;
                     let sequence = attributes.indices.take().unwrap_or_else(|| (0..count).collect());
-                    discs = point_cloud::affordable(sequence.len(), ctx.spending.borrow().bytes_left());
+                    // At least one: with no room even for that, the charge names the budget.
+                    discs = point_cloud::affordable(sequence.len(), ctx.spending.borrow().bytes_left()).max(1);
                     ctx.spending
                         .borrow_mut()
                         .charge_bytes(

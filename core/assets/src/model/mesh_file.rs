@@ -128,7 +128,8 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     let cloud = soup.indices.is_empty() && !soup.positions.is_empty();
     let mut mesh = if cloud {
         // As many discs as the budget holds, up to the cap, then charged like any mesh.
-        let discs = point_cloud::affordable(soup.positions.len(), spending.bytes_left());
+        // At least one: with no room even for that, the charge names the budget.
+        let discs = point_cloud::affordable(soup.positions.len(), spending.bytes_left()).max(1);
         spending
             .charge_primitive(|| "the point cloud".to_owned())
             .and_then(|()| {
