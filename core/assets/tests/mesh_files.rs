@@ -249,4 +249,17 @@ fn a_point_cloud_over_the_budget_is_thinned_to_fit() {
     let model = phantogram_assets::model::load_model_within(&path, small).expect("loads thinned");
     let discs = model.primitives[0].mesh.vertices.len() / 6;
     assert!((500..=1001).contains(&discs), "{discs} discs");
+    // A budget with room for a small file but not for one disc (528 bytes): the budget is
+    // named, not an empty model.
+    let small_file = dir.join("four.ply");
+    std::fs::write(&small_file, point_cloud_ply(4)).expect("write");
+    let tiny = ResourceBudget {
+        memory_bytes: std::fs::metadata(&small_file).expect("size").len(),
+        ..ResourceBudget::default()
+    };
+    assert!(tiny.memory_bytes < 528);
+    match phantogram_assets::model::load_model_within(&small_file, tiny) {
+        Err(ModelError::OverBudget { error, .. }) => assert!(error.what.contains("point cloud"), "{error}"),
+        other => panic!("{other:?}"),
+    }
 }
