@@ -163,3 +163,34 @@ fn an_obj_zip_opened_from_bytes_is_kept_with_its_texture() {
         .expect("imported");
     assert_eq!(bare.model.triangle_count(), 3);
 }
+
+/// A scan with vertex colours (`v x y z r g b`, 0–1, sRGB as MeshLab writes a PLY's 8-bit ones),
+/// no MTL: the colours linear, as the PLY loader makes them.
+#[test]
+fn vertex_colours_are_read_as_srgb_like_a_plys() {
+    let dir = folder(
+        "vertex-colours",
+        &[(
+            "scan.obj",
+            b"v 0 0 0 0.5 0.5 0.5\nv 1 0 0 1 0 0\nv 0 1 0 0 0 1\nf 1 2 3\n",
+        )],
+    );
+    let model = load(&dir).expect("loads");
+    let vertices = &model.primitives[0].mesh.vertices;
+    let grey = vertices
+        .iter()
+        .find(|v| v.position == [0.0, 0.0, 0.0])
+        .expect("first corner");
+    assert!(
+        (grey.color[0] - 0.2140).abs() < 1e-3,
+        "sRGB 0.5 is linear 0.214: {:?}",
+        grey.color
+    );
+    let red = vertices
+        .iter()
+        .find(|v| v.position == [1.0, 0.0, 0.0])
+        .expect("second corner");
+    assert_eq!(red.color, [1.0, 0.0, 0.0, 1.0]);
+    // Over a white material, so they show as they are (not tinted by plaster's grey).
+    assert_eq!(model.materials[model.primitives[0].material].base_color, [1.0; 4]);
+}

@@ -6,6 +6,7 @@
 //! diffuse colour `Kd` (taken as linear, as glTF converters do; white where a `map_Kd` texture
 //! gives the colour), `map_Kd`, and the dissolve `d` (blended below 1). Bump and specular maps
 //! are not read; the surface is a matte dielectric (scans bake their look into the colour).
+//! Vertex colours (`v x y z r g b`, as scanners and MeshLab write them) are sRGB, like a PLY's.
 //! Texture coordinates are flipped to glTF's top-left origin.
 //!
 //! **Files**: the MTL libraries and textures are opened only inside the OBJ's folder
@@ -76,6 +77,15 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
         .collect::<Result<_, _>>()?;
     let plain = model_materials.len();
     model_materials.push(Material::plaster());
+    // Without a material, a scan with vertex colours shows them as they are (white, matte),
+    // as a coloured PLY does; without either, plaster.
+    let coloured = model_materials.len();
+    model_materials.push(Material {
+        name: "vertex colours".into(),
+        metallic: 0.0,
+        roughness: 0.8,
+        ..Material::default()
+    });
     progress.step(0.6).map_err(cancelled)?;
 
     let mut primitives = Vec::new();
@@ -110,7 +120,12 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
                 tangent: [1.0, 0.0, 0.0, 1.0],
                 // OBJ's v runs up from the image's bottom; glTF's down from its top.
                 uv: get(&mesh.texcoords, i, 2).map_or([0.0; 4], |t| [t[0], 1.0 - t[1], 0.0, 0.0]),
-                color: get(&mesh.vertex_color, i, 3).map_or([1.0; 4], |c| [c[0], c[1], c[2], 1.0]),
+                // `v x y z r g b`: a scan's colours, sRGB-encoded like a PLY's (MeshLab and
+                // photogrammetry tools write the same 8-bit values, as 0–1).
+                color: get(&mesh.vertex_color, i, 3).map_or([1.0; 4], |c| {
+                    let linear = phantogram_geometry::srgb::to_linear;
+                    [linear(c[0]), linear(c[1]), linear(c[2]), 1.0]
+                }),
                 material: [1.0, 1.0],
             })
             .collect();
@@ -134,7 +149,10 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
         }
         primitives.push(Primitive {
             mesh: built,
-            material: mesh.material_id.filter(|&i| i < plain).unwrap_or(plain),
+            material: mesh
+                .material_id
+                .filter(|&i| i < plain)
+                .unwrap_or(if mesh.vertex_color.is_empty() { plain } else { coloured }),
             is_floor: false,
             lods: Vec::new(),
         });
