@@ -227,6 +227,18 @@ fn a_point_cloud_ply_is_drawn_as_discs_that_close_its_surface() {
         let centre = disc.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
         assert!(Vec3::from(disc[0].normal).dot(centre.normalize()) > 0.98);
     }
+    // Opened on a phone (a share of its bytes): kept in the library and loaded the same.
+    let dir = Scratch::new("mesh-files-cloud-library");
+    let lib = Library::new(Some(dir.to_path_buf()), None);
+    let imported = lib
+        .import(
+            "scan.ply",
+            point_cloud_ply(3000).as_bytes(),
+            ResourceBudget::PHONE,
+            &Progress::new(),
+        )
+        .expect("imported");
+    assert_eq!(imported.model.triangle_count(), 3000 * 4);
     // The bounds are the sphere's, grown by at most a disc.
     let bounds = mesh.bounds().expect("bounds");
     assert!(
