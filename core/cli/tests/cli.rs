@@ -524,7 +524,7 @@ fn eval_face_prints_json_per_image_and_names_the_missing_models() {
         err.contains("60000×60000 pixels is more than this tool decodes"),
         "{err}"
     );
-    assert!(err.contains("not a PNG or JPEG photo (Hdr)"), "{err}");
+    assert!(err.contains("not a PNG, JPEG or WebP photo (Hdr)"), "{err}");
     assert_eq!(String::from_utf8_lossy(&out.stdout).lines().count(), 1, "{err}");
 }
 

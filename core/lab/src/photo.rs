@@ -12,7 +12,7 @@
 //! to the long side).
 //!
 //! Panics: none on any input; a damaged EXIF block gives no turn and no focal length, as if
-//! absent. Only PNG and JPEG are read (the HDR and EXR decoders are built in for
+//! absent. Only PNG, JPEG and WebP are read (the HDR and EXR decoders are built in for
 //! environments). A header claiming more than `image`'s default limit (512 MiB decoded) is
 //! refused before anything is allocated for it.
 
@@ -38,7 +38,7 @@ pub struct Photo {
 pub enum PhotoError {
     #[error("{0}")]
     Io(#[from] std::io::Error),
-    #[error("not a PNG or JPEG photo ({0})")]
+    #[error("not a PNG, JPEG or WebP photo ({0})")]
     NotAPhoto(String),
     #[error("{width}×{height} pixels is more than this tool decodes (512 MiB)")]
     TooLarge { width: u32, height: u32 },
@@ -46,13 +46,13 @@ pub enum PhotoError {
     Decode(#[from] image::ImageError),
 }
 
-/// Reads a PNG or JPEG photo upright (its EXIF orientation applied) as RGBA8.
+/// Reads a PNG, JPEG or WebP photo upright (its EXIF orientation applied) as RGBA8.
 pub fn open_photo(path: &Path) -> Result<Photo, PhotoError> {
     // Regular files only: a pipe would block, a device never end.
     let file = phantogram_files::open_regular_file(path)?;
     let reader = image::ImageReader::new(std::io::BufReader::new(file)).with_guessed_format()?;
     match reader.format() {
-        Some(ImageFormat::Png | ImageFormat::Jpeg) => {}
+        Some(ImageFormat::Png | ImageFormat::Jpeg | ImageFormat::WebP) => {}
         other => {
             return Err(PhotoError::NotAPhoto(
                 other.map_or("unrecognised data".to_owned(), |f| format!("{f:?}")),
@@ -248,6 +248,21 @@ mod tests {
         }
     }
 
+    /// WebP (some phones' and messengers' format) carries EXIF too.
+    #[test]
+    fn a_webp_photo_is_turned_upright_too() {
+        let path = scratch("o8.webp");
+        let file = std::fs::File::create(&path).unwrap();
+        let mut enc = image::codecs::webp::WebPEncoder::new_lossless(file);
+        enc.set_exif_metadata(block(true, Some(8), None)).unwrap();
+        let img = stored(8);
+        enc.write_image(img.as_raw(), img.width(), img.height(), image::ExtendedColorType::Rgba8)
+            .unwrap();
+        let photo = open_photo(&path).unwrap();
+        assert_eq!(photo.orientation, Orientation::Rotate270);
+        assert!(photo.rgba == upright());
+    }
+
     #[test]
     fn a_portrait_jpeg_from_a_phone_is_read_upright_with_its_focal_length() {
         // Large flat blocks so that JPEG's loss cannot swap them: a red top half and a blue
@@ -308,7 +323,7 @@ mod tests {
         std::fs::write(&path, b"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 1 +X 1\n\0\0\0\0").unwrap();
         let e = open_photo(&path).unwrap_err();
         assert!(matches!(e, PhotoError::NotAPhoto(_)), "{e}");
-        assert!(e.to_string().contains("not a PNG or JPEG"), "{e}");
+        assert!(e.to_string().contains("not a PNG, JPEG or WebP"), "{e}");
         let e = open_photo(&std::env::temp_dir()).unwrap_err();
         assert!(matches!(e, PhotoError::Io(_)), "{e}");
     }
