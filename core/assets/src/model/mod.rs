@@ -722,6 +722,7 @@ mod instancing;
 mod loader;
 mod mesh_file;
 mod meshopt_views;
+mod nearest;
 mod obj;
 mod ply;
 mod point_cloud;

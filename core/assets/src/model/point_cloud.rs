@@ -14,13 +14,14 @@
 //!   and its neighbours spread least (the covariance's smallest eigenvector, Hoppe et al.,
 //!   SIGGRAPH 1992), turned away from the cloud's centre, as a scanned object is seen from
 //!   outside. Draw the discs double-sided, so that one turned the wrong way still shows.
-//! * **Neighbours** come from a k-d tree: O(n log n) for any spread of points.
+//! * **Neighbours** come from a k-d tree (`nearest`): O(n log n) for any spread of points.
 //! * Every corner of a disc carries its point's colour, texture coordinates and material values.
 //!
 //! Panics: none. Cost: O(n log n) for n points, whatever their spread.
 
 use glam::{DMat3, DVec3};
 
+use super::nearest::KdTree;
 use super::{Mesh, Vertex};
 
 /// Most points drawn: 150 k discs are 600 k triangles and 72 MB of vertices, a fifth of a
@@ -144,7 +145,7 @@ pub fn discs(kept: &[Vertex], cell_m: Option<f64>) -> Mesh {
     let mut radii = Vec::with_capacity(points.len());
     let mut normals = Vec::with_capacity(points.len());
     for (k, &p) in points.iter().enumerate() {
-        tree.nearest(&points, k, &mut found);
+        tree.nearest(&points, k, NEIGHBOURS, &mut found);
         let given = Some(DVec3::from(kept[k].normal.map(f64::from)))
             .filter(|v| v.is_finite() && v.length_squared() > 0.0)
             .map(DVec3::normalize);
@@ -254,120 +255,6 @@ fn smallest_eigenvector(m: DMat3) -> DVec3 {
     let smallest = (0..3).min_by(|&i, &j| a[i][i].total_cmp(&a[j][j])).unwrap_or(2);
     let e = DVec3::new(v[0][smallest], v[1][smallest], v[2][smallest]);
     e.try_normalize().unwrap_or(DVec3::Z)
-}
-
-/// A k-d tree over the points (an index array split at the median of its widest axis, leaves of
-/// at most [`LEAF`] points), for nearest neighbours. Balanced whatever the points' spread, so a
-/// dense clump beside a few far-off points costs O(log n) a query like an even scan (a uniform
-/// grid would put the clump in one cell and look at all of it for each of its points).
-struct KdTree {
-    /// Point indices, each node's points a contiguous run.
-    order: Vec<u32>,
-    nodes: Vec<Node>,
-    /// The bounding box's diagonal.
-    extent: f64,
-}
-
-/// Points per leaf: a leaf is searched whole.
-const LEAF: usize = 8;
-
-enum Node {
-    Leaf {
-        start: usize,
-        end: usize,
-    },
-    Split {
-        axis: usize,
-        at: f64,
-        below: usize,
-        above: usize,
-    },
-}
-
-impl KdTree {
-    fn new(points: &[DVec3]) -> KdTree {
-        let (lo, hi) = points
-            .iter()
-            .fold((points[0], points[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
-        let mut tree = KdTree {
-            order: (0..points.len() as u32).collect(),
-            nodes: Vec::with_capacity(2 * points.len() / LEAF + 1),
-            extent: (hi - lo).length(),
-        };
-        // Built iteratively (an explicit stack): a recursion's depth is fine at log₂ n, but the
-        // stack needs no argument.
-        tree.nodes.push(Node::Leaf { start: 0, end: 0 });
-        let mut pending = vec![(0usize, 0usize, points.len())];
-        while let Some((node, start, end)) = pending.pop() {
-            if end - start <= LEAF {
-                tree.nodes[node] = Node::Leaf { start, end };
-                continue;
-            }
-            let run = &mut tree.order[start..end];
-            let (lo, hi) = run.iter().fold(
-                (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
-                |(lo, hi), &i| (lo.min(points[i as usize]), hi.max(points[i as usize])),
-            );
-            let size = hi - lo;
-            let axis = if size.x >= size.y && size.x >= size.z {
-                0
-            } else if size.y >= size.z {
-                1
-            } else {
-                2
-            };
-            let mid = run.len() / 2;
-            run.select_nth_unstable_by(mid, |&a, &b| {
-                points[a as usize][axis].total_cmp(&points[b as usize][axis])
-            });
-            let at = points[run[mid] as usize][axis];
-            let below = tree.nodes.len();
-            tree.nodes.push(Node::Leaf { start: 0, end: 0 });
-            let above = tree.nodes.len();
-            tree.nodes.push(Node::Leaf { start: 0, end: 0 });
-            tree.nodes[node] = Node::Split { axis, at, below, above };
-            pending.push((below, start, start + mid));
-            pending.push((above, start + mid, end));
-        }
-        tree
-    }
-
-    /// The [`NEIGHBOURS`] nearest other points of `points[k]` (squared distance, index), nearest
-    /// first; fewer in a cloud of fewer points.
-    fn nearest(&self, points: &[DVec3], k: usize, found: &mut Vec<(f64, usize)>) {
-        let p = points[k];
-        found.clear();
-        let mut pending = vec![(0usize, 0.0f64)];
-        while let Some((node, plane_d2)) = pending.pop() {
-            // A side no nearer than the worst kept neighbour holds nothing better.
-            if found.len() == NEIGHBOURS && plane_d2 >= found[NEIGHBOURS - 1].0 {
-                continue;
-            }
-            match self.nodes[node] {
-                Node::Leaf { start, end } => {
-                    for &j in &self.order[start..end] {
-                        let j = j as usize;
-                        if j == k {
-                            continue;
-                        }
-                        let d2 = points[j].distance_squared(p);
-                        if found.len() < NEIGHBOURS || d2 < found[NEIGHBOURS - 1].0 {
-                            let at = found.partition_point(|&(e, _)| e <= d2);
-                            found.insert(at, (d2, j));
-                            found.truncate(NEIGHBOURS);
-                        }
-                    }
-                }
-                Node::Split { axis, at, below, above } => {
-                    let d = p[axis] - at;
-                    let (near, far) = if d < 0.0 { (below, above) } else { (above, below) };
-                    // The far side first onto the stack, so the near side is searched first.
-                    pending.push((far, d * d));
-                    pending.push((near, 0.0));
-                }
-            }
-        }
-    }
 }
 
 #[cfg(test)]
@@ -531,34 +418,6 @@ mod tests {
         }
         // Coincident points: a few kept, no panic.
         assert!(kept(&vec![[1.0, 2.0, 3.0]; 50], 10).indices.len() <= 10);
-    }
-
-    /// Against a brute-force search, on a cloud a uniform grid handles worst: a dense clump
-    /// (with exact duplicates) beside a few far-off points.
-    #[test]
-    fn the_tree_finds_the_same_neighbours_as_brute_force() {
-        let mut state = 12345u64;
-        let mut next = || {
-            state = state
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (state >> 11) as f64 / (1u64 << 53) as f64
-        };
-        let mut points: Vec<DVec3> = (0..3000).map(|_| DVec3::new(next(), next(), next()) * 1e-3).collect();
-        points.extend([DVec3::splat(100.0), DVec3::new(-50.0, 3.0, 0.0)]);
-        points.extend(std::iter::repeat_n(DVec3::splat(5e-4), 20));
-        let tree = KdTree::new(&points);
-        let mut found = Vec::new();
-        for k in (0..points.len()).step_by(7) {
-            tree.nearest(&points, k, &mut found);
-            let mut all: Vec<f64> = (0..points.len())
-                .filter(|&j| j != k)
-                .map(|j| points[j].distance_squared(points[k]))
-                .collect();
-            all.sort_by(f64::total_cmp);
-            let got: Vec<f64> = found.iter().map(|&(d2, _)| d2).collect();
-            assert_eq!(got, all[..NEIGHBOURS], "point {k}");
-        }
     }
 
     #[test]
