@@ -2,9 +2,11 @@
 //! scanners and photogrammetry tools write, often with a colour per vertex.
 //!
 //! Read: the `vertex` element's `x y z`, `nx ny nz` (when all three are there) and
-//! `red green blue [alpha]` (8-bit, or 0–1 floats), and the `face` element's index list
-//! (`vertex_indices` or `vertex_index`; polygons become fans). Every other element and property is
-//! skipped, list properties included. Texture coordinates and `TextureFile` comments are not
+//! `red green blue [alpha]` (8-bit, or 0–1 floats; a Gaussian-splat file's `f_dc_0..2` colour
+//! where these are absent), and the `face` element's index list (`vertex_indices` or
+//! `vertex_index`; polygons become fans; without faces the file is a point cloud). Every other
+//! element and property is skipped, list properties included (a splat's opacity, scales and
+//! rotation too: its points are drawn as `point_cloud`'s discs). Texture coordinates and `TextureFile` comments are not
 //! read: such a scan shows its vertex colours, or none.
 //! **Panics**: none; an element's count is held to what the rest of the file can hold (at least a
 //! byte an element in binary, two characters in ASCII) before it sizes anything.
@@ -289,6 +291,13 @@ fn read_vertices(body: &mut Body, element: &Element, soup: &mut Soup) -> Result<
         [Some(r), Some(g), Some(b)] => Some([r, g, b, find("alpha").unwrap_or(usize::MAX)]),
         _ => None,
     };
+    // A Gaussian-splat PLY (3D Gaussian Splatting's layout) has no red/green/blue: its colour is
+    // the spherical-harmonic DC term, shown as 0.5 + Y₀₀·f_dc per channel (Y₀₀ = 1/(2√π)), on
+    // the scale of the photographs it was fitted to (sRGB).
+    let dc = match (colour, [find("f_dc_0"), find("f_dc_1"), find("f_dc_2")]) {
+        (None, [Some(r), Some(g), Some(b)]) => Some([r, g, b]),
+        _ => None,
+    };
     soup.positions.reserve(element.count);
     let mut values = vec![0.0f64; element.properties.len()];
     for _ in 0..element.count {
@@ -316,6 +325,11 @@ fn read_vertices(body: &mut Body, element: &Element, soup: &mut Soup) -> Result<
             };
             let channel = |k: usize| values.get(k).map_or(1.0, |v| (v * scale(k)).clamp(0.0, 1.0) as f32);
             soup.colors.get_or_insert_with(Vec::new).push(channels.map(channel));
+        }
+        if let Some(channels) = dc {
+            const Y00: f64 = 0.282_094_791_773_878_14;
+            let [r, g, b] = channels.map(|k| (0.5 + Y00 * values[k]).clamp(0.0, 1.0) as f32);
+            soup.colors.get_or_insert_with(Vec::new).push([r, g, b, 1.0]);
         }
     }
     Ok(())
@@ -365,6 +379,24 @@ mod tests {
         assert_eq!(soup.indices, [0, 1, 2, 0, 2, 3]);
         assert_eq!(soup.colors.as_ref().map(|c| c[1]), Some([0.0, 1.0, 0.0, 1.0]));
         assert!(soup.normals.is_none());
+    }
+
+    /// A Gaussian-splat PLY's points (3D Gaussian Splatting's layout: normals of zero, colour as
+    /// the SH DC term, opacity, scales and rotation): coloured by the DC term.
+    #[test]
+    fn a_gaussian_splat_ply_is_coloured_by_its_dc_term() {
+        let text = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float f_dc_0\nproperty float f_dc_1\nproperty float f_dc_2\nproperty float opacity\nproperty float scale_0\nproperty float rot_0\nend_header\n0 0 0 0 0 0 0 1.7724539 -1.7724539 2.0 -4 1\n1 0 0 0 0 0 10 -10 0.5 -1.0 -4 1\n";
+        let soup = parse(text.as_bytes()).expect("parses");
+        assert!(soup.indices.is_empty(), "a point cloud");
+        let colors = soup.colors.expect("coloured");
+        // 0.5 + f/(2√π): 0 → 0.5, √π → 1, −√π → 0; beyond the range clamped.
+        let expected = [[0.5, 1.0, 0.0, 1.0], [1.0, 0.0, 0.641, 1.0]];
+        for (c, e) in colors.iter().zip(expected) {
+            assert!(
+                c.iter().zip(e).all(|(a, b)| (a - b).abs() < 1e-3),
+                "{c:?} against {e:?}"
+            );
+        }
     }
 
     /// The same quad, binary, with a skipped element and a skipped list property before the faces.
