@@ -1594,18 +1594,10 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                 if points {
                     let count = (attributes.positions.len() / 3) as u32;
                     let sequence = attributes.indices.take().unwrap_or_else(|| (0..count).collect());
-                    // At least one: with no room even for that, the charge names the budget.
-                    discs = point_cloud::affordable(sequence.len(), ctx.spending.borrow().bytes_left()).max(1);
-                    ctx.spending
-                        .borrow_mut()
-                        .charge_bytes(
-                            || format!("{what}'s discs (in node {})", node.index()),
-                            ResourceBudget::mesh_bytes(
-                                discs as u64 * point_cloud::VERTICES_PER_SURFEL,
-                                discs as u64 * point_cloud::INDICES_PER_SURFEL,
-                            ),
-                        )
-                        .map_err(|e| over_budget(path, e))?;
+                    discs = point_cloud::charge_discs(&mut ctx.spending.borrow_mut(), sequence.len(), || {
+                        format!("{what}'s discs (in node {})", node.index())
+                    })
+                    .map_err(|e| over_budget(path, e))?;
                     attributes.indices = Some(sequence.iter().flat_map(|&i| [i, i, i]).collect());
                 } else if prim.mode() != gltf::mesh::Mode::Triangles {
                     let count = (attributes.positions.len() / 3) as u32;

@@ -127,33 +127,19 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     }
     let cloud = soup.indices.is_empty() && !soup.positions.is_empty();
     let mut mesh = if cloud {
-        // As many discs as the budget holds, up to the cap, then charged like any mesh.
-        // At least one: with no room even for that, the charge names the budget.
-        let discs = point_cloud::affordable(soup.positions.len(), spending.bytes_left()).max(1);
-        spending
+        let discs = spending
             .charge_primitive(|| "the point cloud".to_owned())
             .and_then(|()| {
-                spending.charge_bytes(
-                    || "the point cloud".to_owned(),
-                    ResourceBudget::mesh_bytes(
-                        discs as u64 * point_cloud::VERTICES_PER_SURFEL,
-                        discs as u64 * point_cloud::INDICES_PER_SURFEL,
-                    ),
-                )
+                point_cloud::charge_discs(&mut spending, soup.positions.len(), || "the point cloud".to_owned())
             })
             .map_err(|e| over_budget(path, e))?;
         // Thinned before the points become vertices (80 bytes each, against the file's 12 or
         // so): only the kept ones are made.
         let thinned = point_cloud::kept(&soup.positions, discs);
-        let chosen = &thinned.indices;
-        let pick = |v: &[[f32; 3]]| chosen.iter().filter_map(|&i| v.get(i).copied()).collect::<Vec<_>>();
         let kept = Soup {
-            positions: pick(&soup.positions),
-            normals: soup.normals.as_deref().map(pick),
-            colors: soup
-                .colors
-                .as_deref()
-                .map(|c| chosen.iter().filter_map(|&i| c.get(i).copied()).collect()),
+            positions: pick(&soup.positions, &thinned.indices),
+            normals: soup.normals.as_deref().map(|n| pick(n, &thinned.indices)),
+            colors: soup.colors.as_deref().map(|c| pick(c, &thinned.indices)),
             indices: Vec::new(),
         };
         point_cloud::discs(&vertices(&kept), thinned.cell_m)
@@ -191,12 +177,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     progress.step(0.9).map_err(cancelled)?;
     let coloured = mesh.vertices.iter().any(|v| v.color != [1.0; 4]);
     let mut material = if coloured {
-        Material {
-            name: "vertex colours".into(),
-            metallic: 0.0,
-            roughness: 0.8,
-            ..Material::default()
-        }
+        Material::vertex_coloured_scan()
     } else {
         Material::plaster()
     };
@@ -259,6 +240,17 @@ fn build(soup: Soup) -> Mesh {
     mesh
 }
 
+/// The entries of `values` at `indices`, in that order (indices past the end left out).
+fn pick<T: Copy>(values: &[T], indices: &[usize]) -> Vec<T> {
+    indices.iter().filter_map(|&i| values.get(i).copied()).collect()
+}
+
+/// A scan's vertex colour, sRGB-encoded as scanners write it (0–1, alpha linear), made linear.
+pub(super) fn scan_colour(c: [f32; 4]) -> [f32; 4] {
+    let linear = phantogram_geometry::srgb::to_linear;
+    [linear(c[0]), linear(c[1]), linear(c[2]), c[3]]
+}
+
 /// A soup's vertices: its normals where given (else zero), its sRGB colours linearised (else
 /// white).
 fn vertices(soup: &Soup) -> Vec<Vertex> {
@@ -274,10 +266,11 @@ fn vertices(soup: &Soup) -> Vec<Vertex> {
                 .map_or([0.0; 3], |n| Vec3::from(*n).normalize_or_zero().to_array()),
             tangent: [1.0, 0.0, 0.0, 1.0],
             uv: [0.0; 4],
-            color: soup.colors.as_ref().and_then(|c| c.get(i)).map_or([1.0; 4], |c| {
-                let linear = phantogram_geometry::srgb::to_linear;
-                [linear(c[0]), linear(c[1]), linear(c[2]), c[3]]
-            }),
+            color: soup
+                .colors
+                .as_ref()
+                .and_then(|c| c.get(i))
+                .map_or([1.0; 4], |&c| scan_colour(c)),
             material: [1.0, 1.0],
         })
         .collect()

@@ -314,7 +314,6 @@ impl Default for Material {
 }
 
 impl Material {
-    /// For meshes that paint colour and metallic/roughness per vertex (the procedural artifact).
     /// A scan without a colour of its own (STL, PLY without colours, OBJ without materials):
     /// a light, warm grey (linear), matte, a cast's colour, not a claim about the object.
     pub fn plaster() -> Self {
@@ -327,6 +326,18 @@ impl Material {
         }
     }
 
+    /// A scan whose colour is in its vertices (a coloured PLY, an OBJ's `v x y z r g b`) and
+    /// that has no material of its own: white, so the colours show as they are, and matte.
+    pub fn vertex_coloured_scan() -> Self {
+        Self {
+            name: "vertex colours".into(),
+            metallic: 0.0,
+            roughness: 0.8,
+            ..Self::default()
+        }
+    }
+
+    /// For meshes that paint colour and metallic/roughness per vertex (the procedural artifact).
     pub fn vertex_painted() -> Self {
         Self {
             name: "vertex painted".into(),

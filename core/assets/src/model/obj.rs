@@ -20,6 +20,7 @@ use std::path::Path;
 
 use super::encoded_image::Encoded;
 use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file, resolve_inside};
+use super::mesh_file::scan_colour;
 use super::{AlphaMode, Image, Material, Mesh, Model, Primitive, TextureRef, Vertex};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
@@ -80,12 +81,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
     // Without a material, a scan with vertex colours shows them as they are (white, matte),
     // as a coloured PLY does; without either, plaster.
     let coloured = model_materials.len();
-    model_materials.push(Material {
-        name: "vertex colours".into(),
-        metallic: 0.0,
-        roughness: 0.8,
-        ..Material::default()
-    });
+    model_materials.push(Material::vertex_coloured_scan());
     progress.step(0.6).map_err(cancelled)?;
 
     let mut primitives = Vec::new();
@@ -122,10 +118,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
                 uv: get(&mesh.texcoords, i, 2).map_or([0.0; 4], |t| [t[0], 1.0 - t[1], 0.0, 0.0]),
                 // `v x y z r g b`: a scan's colours, sRGB-encoded like a PLY's (MeshLab and
                 // photogrammetry tools write the same 8-bit values, as 0–1).
-                color: get(&mesh.vertex_color, i, 3).map_or([1.0; 4], |c| {
-                    let linear = phantogram_geometry::srgb::to_linear;
-                    [linear(c[0]), linear(c[1]), linear(c[2]), 1.0]
-                }),
+                color: get(&mesh.vertex_color, i, 3).map_or([1.0; 4], |c| scan_colour([c[0], c[1], c[2], 1.0])),
                 material: [1.0, 1.0],
             })
             .collect();

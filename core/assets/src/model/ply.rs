@@ -6,8 +6,8 @@
 //! where these are absent), and the `face` element's index list (`vertex_indices` or
 //! `vertex_index`; polygons become fans; without faces the file is a point cloud). Every other
 //! element and property is skipped, list properties included (a splat's opacity, scales and
-//! rotation too: its points are drawn as `point_cloud`'s discs). Texture coordinates and `TextureFile` comments are not
-//! read: such a scan shows its vertex colours, or none.
+//! rotation too: its points are drawn as `point_cloud`'s discs). Texture coordinates and
+//! `TextureFile` comments are not read: such a scan shows its vertex colours, or none.
 //! **Panics**: none; an element's count is held to what the rest of the file can hold (at least a
 //! byte an element in binary, two characters in ASCII) before it sizes anything.
 
@@ -327,8 +327,8 @@ fn read_vertices(body: &mut Body, element: &Element, soup: &mut Soup) -> Result<
             soup.colors.get_or_insert_with(Vec::new).push(channels.map(channel));
         }
         if let Some(channels) = dc {
-            const Y00: f64 = 0.282_094_791_773_878_14;
-            let [r, g, b] = channels.map(|k| (0.5 + Y00 * values[k]).clamp(0.0, 1.0) as f32);
+            let y00 = 0.5 / std::f64::consts::PI.sqrt();
+            let [r, g, b] = channels.map(|k| (0.5 + y00 * values[k]).clamp(0.0, 1.0) as f32);
             soup.colors.get_or_insert_with(Vec::new).push([r, g, b, 1.0]);
         }
     }

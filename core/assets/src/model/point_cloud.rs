@@ -23,23 +23,35 @@ use glam::{DMat3, DVec3};
 
 use super::nearest::KdTree;
 use super::{Mesh, Vertex};
+use crate::budget::{OverBudget, ResourceBudget, Spending};
 
 /// Most points drawn: 150 k discs are 600 k triangles and 72 MB of vertices, a fifth of a
 /// phone's memory budget for one artifact; a denser cloud is thinned.
 pub const MAX_SURFELS: usize = 150_000;
 
 /// Vertices and indices of one disc (a hexagon as four triangles).
-pub const VERTICES_PER_SURFEL: u64 = 6;
-pub const INDICES_PER_SURFEL: u64 = 12;
+const VERTICES_PER_SURFEL: u64 = 6;
+const INDICES_PER_SURFEL: u64 = 12;
 
 /// Neighbours that set a disc's radius and plane.
 const NEIGHBOURS: usize = 6;
 
-/// How many discs [`surfels`] makes of `points` within `bytes` of mesh memory.
-pub fn affordable(points: usize, bytes: u64) -> usize {
-    let per_point = crate::budget::ResourceBudget::mesh_bytes(VERTICES_PER_SURFEL, INDICES_PER_SURFEL);
-    let affordable = usize::try_from(bytes / per_point).unwrap_or(usize::MAX);
-    points.min(MAX_SURFELS).min(affordable)
+/// Charges `spending` for the discs of a cloud of `points` and says how many to make: as many
+/// as the budget left holds, up to [`MAX_SURFELS`], and at least one (with no room even for
+/// that, the error names the budget rather than the model coming out empty).
+pub fn charge_discs(
+    spending: &mut Spending,
+    points: usize,
+    what: impl FnOnce() -> String,
+) -> Result<usize, OverBudget> {
+    let per_point = ResourceBudget::mesh_bytes(VERTICES_PER_SURFEL, INDICES_PER_SURFEL);
+    let affordable = usize::try_from(spending.bytes_left() / per_point).unwrap_or(usize::MAX);
+    let discs = points.min(MAX_SURFELS).min(affordable).max(1);
+    spending.charge_bytes(
+        what,
+        ResourceBudget::mesh_bytes(discs as u64 * VERTICES_PER_SURFEL, discs as u64 * INDICES_PER_SURFEL),
+    )?;
+    Ok(discs)
 }
 
 /// Which points to keep, at most `max`, in their order: all of them, or one per cell of the
