@@ -87,7 +87,7 @@ fn orientation_of(exif: &[u8]) -> Orientation {
 
 /// FocalLengthIn35mmFilm from a TIFF-structured EXIF block (optionally after "Exif\0\0").
 /// Every offset is checked: a malformed block gives `None`.
-pub fn focal_length_35mm(exif: &[u8]) -> Option<f32> {
+fn focal_length_35mm(exif: &[u8]) -> Option<f32> {
     let tiff = exif.strip_prefix(b"Exif\0\0").unwrap_or(exif);
     let little = match tiff.get(0..2)? {
         b"II" => true,

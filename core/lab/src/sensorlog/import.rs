@@ -253,8 +253,13 @@ fn column_index(names: &[String], wanted: &str) -> Result<usize, String> {
 /// (`0,5` read as two fields): it is an error naming its line, never data shifted into the next
 /// column. A line longer than [`MAX_LINE_BYTES`] is an error before it is held in memory.
 fn read_csv(path: &Path, wanted: &[&str], mut row: impl FnMut(&[&str]) -> Result<(), String>) -> Result<(), LogError> {
-    let delimiter = sniff_delimiter(&first_line(path)?);
-    let reader = LineLengthGuard::new(super::open_maybe_gz(path)?);
+    let mut input = super::open_maybe_gz(path)?;
+    // The header as far as the first read holds it (a header is far shorter), peeked, not
+    // consumed: the file is opened once.
+    let head = input.fill_buf().map_err(|e| LogError::io(path, e))?;
+    let header = head.split(|&b| b == b'\n').next().unwrap_or_default();
+    let delimiter = sniff_delimiter(&String::from_utf8_lossy(header));
+    let reader = LineLengthGuard::new(input);
     let mut csv = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(false)
