@@ -449,6 +449,16 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                     .replace(r#""nodes":[{"mesh":0}]"#, r#""nodes":[{"mesh":0,"weights":[0.5]}]"#)
                     .as_bytes(),
             )?;
+            // The triangle in amber glass: every material extension `model::layers` reads.
+            put(
+                "glass.gltf",
+                tri_gltf
+                    .replace(
+                        r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}]"#,
+                        r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},"extensions":{"KHR_materials_transmission":{"transmissionFactor":1},"KHR_materials_volume":{"thicknessFactor":0.1,"attenuationDistance":0.2,"attenuationColor":[0.9,0.5,0.1]},"KHR_materials_ior":{"ior":1.54},"KHR_materials_specular":{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]},"KHR_materials_clearcoat":{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1}}}]"#,
+                    )
+                    .as_bytes(),
+            )?;
             // A skinned triangle over the target's `tri.bin` (joints and weights read from its
             // bytes).
             put(

@@ -208,15 +208,15 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
 
     let needs = tiny_gltf(
         &dir,
-        "volume.gltf",
-        r#","extensionsUsed":["KHR_materials_volume"],"extensionsRequired":["KHR_materials_volume"]"#,
+        "sheen.gltf",
+        r#","extensionsUsed":["KHR_materials_sheen"],"extensionsRequired":["KHR_materials_sheen"]"#,
     );
     match load_gltf(&needs) {
-        Err(ModelError::UnsupportedExtension { name, .. }) => assert_eq!(name, "KHR_materials_volume"),
+        Err(ModelError::UnsupportedExtension { name, .. }) => assert_eq!(name, "KHR_materials_sheen"),
         other => panic!("expected an unsupported-extension error, got {other:?}"),
     }
     // Merely *used* (optional) extensions are fine.
-    let optional = tiny_gltf(&dir, "optional.gltf", r#","extensionsUsed":["KHR_materials_volume"]"#);
+    let optional = tiny_gltf(&dir, "optional.gltf", r#","extensionsUsed":["KHR_materials_sheen"]"#);
     assert!(load_gltf(&optional).is_ok());
 
     let broken = dir.join("broken.gltf");
@@ -228,8 +228,70 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
     ));
     let text = load_gltf(&needs).unwrap_err().to_string();
     assert!(
-        text.contains("volume.gltf") && text.contains("KHR_materials_volume"),
+        text.contains("sheen.gltf") && text.contains("KHR_materials_sheen"),
         "{text}"
+    );
+}
+
+/// Glass, gems and varnish: each material extension's factors reach the material, the
+/// transmission texture too, another texture they name is reported (not read), and a file
+/// requiring them loads.
+#[test]
+fn material_extensions_reach_the_material() {
+    let dir = scratch("gltf-layers");
+    let image = png_data_uri(1, [255, 0, 0, 255]);
+    let path = tiny_gltf(
+        &dir,
+        "amber.gltf",
+        &format!(
+            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat"],
+        "extensionsRequired":["KHR_materials_transmission"],
+        "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
+        "materials":[{{"name":"amber","extensions":{{
+          "KHR_materials_transmission":{{"transmissionFactor":0.9,"transmissionTexture":{{"index":0,"texCoord":1}}}},
+          "KHR_materials_volume":{{"thicknessFactor":0.02,"thicknessTexture":{{"index":0}},"attenuationDistance":0.05,"attenuationColor":[0.9,0.5,0.1]}},
+          "KHR_materials_ior":{{"ior":1.54}},
+          "KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]}},
+          "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1}}}}}}]"#
+        ),
+    );
+    let model = load_gltf(&path).unwrap();
+    let amber = model
+        .materials
+        .iter()
+        .find(|m| m.name == "amber")
+        .expect("the amber material");
+    let l = amber.layers;
+    assert_eq!(
+        (
+            l.transmission,
+            l.thickness,
+            l.attenuation_distance,
+            l.ior,
+            l.specular,
+            l.clear_coat,
+            l.clear_coat_roughness
+        ),
+        (0.9, 0.02, 0.05, 1.54, 0.8, 0.5, 0.1)
+    );
+    assert_eq!(l.attenuation_color, [0.9, 0.5, 0.1]);
+    assert_eq!(l.specular_color, [1.0, 0.9, 0.8]);
+    // The transmission texture is read (which parts are glass); the thickness texture is named.
+    let texture = amber.transmission_texture.expect("the transmission texture");
+    assert_eq!((texture.image, texture.tex_coord), (0, 1));
+    let named: Vec<&String> = model.warnings.iter().filter(|w| w.contains("amber")).collect();
+    assert!(
+        named.len() == 1 && named[0].contains("thicknessTexture"),
+        "{:?}",
+        model.warnings
+    );
+    // The plain triangle's default material has none of them.
+    assert!(
+        model
+            .materials
+            .iter()
+            .filter(|m| m.name != "amber")
+            .all(|m| m.layers == Default::default())
     );
 }
 

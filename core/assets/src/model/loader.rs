@@ -15,6 +15,7 @@ use super::meshopt_views::{self, DecodedViews};
 use super::point_cloud;
 use super::skin;
 use super::spec_gloss::{self, SpecGloss};
+use super::texture_info::TextureInfo;
 use super::topology;
 use super::*;
 use crate::budget::{OverBudget, ResourceBudget, Spending};
@@ -30,7 +31,7 @@ pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load, one merely
 /// using another loads with a warning naming it.
-pub const SUPPORTED_EXTENSIONS: [&str; 11] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 16] = [
     "KHR_draco_mesh_compression",
     "EXT_mesh_gpu_instancing",
     "EXT_meshopt_compression",
@@ -42,6 +43,11 @@ pub const SUPPORTED_EXTENSIONS: [&str; 11] = [
     "EXT_texture_webp",
     "KHR_texture_basisu",
     "KHR_materials_pbrSpecularGlossiness",
+    super::layers::EXTENSIONS[0],
+    super::layers::EXTENSIONS[1],
+    super::layers::EXTENSIONS[2],
+    super::layers::EXTENSIONS[3],
+    super::layers::EXTENSIONS[4],
 ];
 
 #[derive(Debug, Error)]
@@ -564,6 +570,7 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
     });
     let strength = m.emissive_strength().unwrap_or(1.0);
     let e = m.emissive_factor();
+    let layers = Layers::from_extensions(|name| m.extension_value(name), &format!("material {name}"), warnings);
     Material {
         name: name.to_owned(),
         // glTF colour factors are linear already.
@@ -583,7 +590,10 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
         normal_texture,
         occlusion_texture,
         emissive_texture,
+        // Read with the document's textures (`transmission_texture`).
+        transmission_texture: None,
         scenery: false,
+        layers,
     }
 }
 
@@ -610,14 +620,14 @@ fn with_spec_gloss(
         }
     };
     let image_count = images.len();
-    let mut texture = |info: &spec_gloss::TextureInfo, slot: &str| {
-        let what = format!("material {name}, {slot} texture");
-        let Some(t) = doc.textures().nth(info.index) else {
-            warnings.push(format!("{what}: texture {} does not exist; left out", info.index));
-            return None;
-        };
-        let transform = raw_transform(info.transform.as_ref(), &what, warnings);
-        texture_ref(&t, info.tex_coord, transform, &what, warnings).filter(|r| r.image < image_count)
+    let mut texture = |info: &TextureInfo, slot: &str| {
+        texture_of_info(
+            doc,
+            info,
+            &format!("material {name}, {slot} texture"),
+            image_count,
+            warnings,
+        )
     };
     let diffuse_texture = sg.diffuse_texture.as_ref().and_then(|i| texture(i, "diffuse"));
     let sg_texture = sg
@@ -662,6 +672,42 @@ fn with_spec_gloss(
         }
     }
     Ok(())
+}
+
+/// The texture a `textureInfo` of an extension's JSON names (`what` names it in warnings); `None`
+/// (and a warning) where the texture or its image does not exist.
+fn texture_of_info(
+    doc: &gltf::Document,
+    info: &TextureInfo,
+    what: &str,
+    image_count: usize,
+    warnings: &mut Vec<String>,
+) -> Option<TextureRef> {
+    let Some(t) = doc.textures().nth(info.index) else {
+        warnings.push(format!("{what}: texture {} does not exist; left out", info.index));
+        return None;
+    };
+    let transform = raw_transform(info.transform.as_ref(), what, warnings);
+    texture_ref(&t, info.tex_coord, transform, what, warnings).filter(|r| r.image < image_count)
+}
+
+/// `KHR_materials_transmission`'s texture (`value`, the extension's object) of `material`; a
+/// malformed one is left out with a warning.
+fn transmission_texture(
+    material: &Material,
+    value: &serde_json::Value,
+    doc: &gltf::Document,
+    image_count: usize,
+    warnings: &mut Vec<String>,
+) -> Option<TextureRef> {
+    let what = format!("material {}, transmission texture", material.name);
+    match TextureInfo::read(value, "transmissionTexture") {
+        Ok(info) => texture_of_info(doc, &info?, &what, image_count, warnings),
+        Err(e) => {
+            warnings.push(format!("{what}: {e}; left out"));
+            None
+        }
+    }
 }
 
 /// Each joint's world matrix times its inverse bind matrix (identity where the skin gives
@@ -1473,6 +1519,9 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     let mut materials = Vec::with_capacity(doc.materials().len() + 1);
     for m in doc.materials() {
         let mut material = material_of(&m, &mut warnings);
+        if let Some(value) = m.extension_value("KHR_materials_transmission") {
+            material.transmission_texture = transmission_texture(&material, value, doc, images.len(), &mut warnings);
+        }
         if let Some(value) = m.extension_value("KHR_materials_pbrSpecularGlossiness") {
             with_spec_gloss(&mut material, value, doc, &mut images, &ctx.spending, &mut warnings)
                 .map_err(|e| over_budget(path, e))?;

@@ -30,6 +30,9 @@
 //!   `KHR_texture_basisu` (ETC1S or UASTC, gltfpack's `-tc`; the pure-Rust `basisu` transcoder).
 //!   Where a texture names both, the core `source` (the lossless fallback) is used. A texture
 //!   whose image comes only from an extension we do not read is left out with a warning.
+//! * Glass, gems and varnish by their factors: `KHR_materials_ior`, `_specular`, `_clearcoat`,
+//!   `_transmission` and `_volume` ([`Layers`]; of their textures the transmission texture is
+//!   read, the others are left out with a warning each).
 //! * `KHR_materials_pbrSpecularGlossiness` (archived by Khronos, but found in older exports) is
 //!   converted to metallic–roughness as Khronos published, texel by texel where it has a texture
 //!   (`spec_gloss`).
@@ -283,12 +286,18 @@ pub struct Material {
     pub normal_texture: Option<(TextureRef, f32)>,
     pub occlusion_texture: Option<(TextureRef, f32)>,
     pub emissive_texture: Option<TextureRef>,
+    /// `KHR_materials_transmission`'s texture: its red channel scales [`Layers::transmission`]
+    /// (linear), saying which parts of the surface let light through.
+    pub transmission_texture: Option<TextureRef>,
     /// `KHR_materials_unlit`: shown in its base colour, without lighting (scans whose lighting
     /// is baked into their colour).
     pub unlit: bool,
     /// Part of the scene the artifact stands in (the diorama's floor), not of the artifact: the
     /// material screen's changes leave it as it is.
     pub scenery: bool,
+    /// Index of refraction, specular strength, varnish, transmission and absorption (glTF's
+    /// material extensions); the core material has none.
+    pub layers: Layers,
 }
 
 impl Default for Material {
@@ -307,8 +316,10 @@ impl Default for Material {
             normal_texture: None,
             occlusion_texture: None,
             emissive_texture: None,
+            transmission_texture: None,
             unlit: false,
             scenery: false,
+            layers: Layers::default(),
         }
     }
 }
@@ -354,6 +365,7 @@ impl Material {
             self.normal_texture.map(|(t, _)| (t, false)),
             self.occlusion_texture.map(|(t, _)| (t, false)),
             self.emissive_texture.map(|t| (t, true)),
+            self.transmission_texture.map(|t| (t, false)),
         ]
         .into_iter()
         .flatten()
@@ -721,6 +733,7 @@ fn push_ball(mesh: &mut Mesh, centre: Vec3, radius: f32, segments: u32, rings: u
     }
 }
 
+pub use layers::Layers;
 pub use loader::{
     MAX_COORDINATE, ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with, load_gltf_within, load_model,
     load_model_with, load_model_within, resolve_inside, voyager_annotations, voyager_preview, voyager_rotation,
@@ -730,6 +743,7 @@ pub use mesh_file::MeshFormat;
 
 mod encoded_image;
 mod instancing;
+pub mod layers;
 mod loader;
 mod mesh_file;
 mod meshopt_views;
@@ -741,6 +755,7 @@ mod skin;
 mod spec_gloss;
 mod split;
 mod stl;
+mod texture_info;
 mod topology;
 
 #[cfg(test)]

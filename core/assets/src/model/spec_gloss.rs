@@ -24,18 +24,10 @@ use phantogram_geometry::srgb::{code_to_linear, linear_to_code};
 use serde_json::Value;
 
 use super::Image;
+use super::texture_info::TextureInfo;
 
 /// What a dielectric reflects at normal incidence (the metallic–roughness model's assumption).
 pub(super) const DIELECTRIC_SPECULAR: f32 = 0.04;
-
-/// A texture reference as the extension writes it: texture index, texture coordinate set and
-/// the `KHR_texture_transform` object, if any.
-#[derive(Clone, Debug, PartialEq)]
-pub(super) struct TextureInfo {
-    pub index: usize,
-    pub tex_coord: u32,
-    pub transform: Option<Value>,
-}
 
 /// The extension's properties, with its defaults.
 #[derive(Clone, Debug, PartialEq)]
@@ -64,32 +56,7 @@ pub(super) fn read(value: &Value) -> Result<SpecGloss, String> {
             Some(_) => Err(format!("{key} is not an array of {n} numbers")),
         }
     };
-    let texture = |key: &str| -> Result<Option<TextureInfo>, String> {
-        let Some(info) = value.get(key) else {
-            return Ok(None);
-        };
-        let index = info
-            .get("index")
-            .and_then(Value::as_u64)
-            .and_then(|i| usize::try_from(i).ok())
-            .ok_or_else(|| format!("{key}.index is missing or not an index"))?;
-        let tex_coord = match info.get("texCoord") {
-            None => 0,
-            Some(t) => t
-                .as_u64()
-                .and_then(|t| u32::try_from(t).ok())
-                .ok_or_else(|| format!("{key}.texCoord is not a set number"))?,
-        };
-        let transform = info
-            .get("extensions")
-            .and_then(|e| e.get("KHR_texture_transform"))
-            .cloned();
-        Ok(Some(TextureInfo {
-            index,
-            tex_coord,
-            transform,
-        }))
-    };
+    let texture = |key: &str| TextureInfo::read(value, key);
     let d = numbers("diffuseFactor", 4, &[1.0; 4])?;
     let s = numbers("specularFactor", 3, &[1.0; 3])?;
     let glossiness = match value.get("glossinessFactor") {

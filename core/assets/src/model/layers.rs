@@ -1,0 +1,344 @@
+//! What glTF's material extensions add to a metallic–roughness surface, by the factors they give:
+//! the dielectric's index of refraction (`KHR_materials_ior`) and specular strength and colour
+//! (`KHR_materials_specular`), a varnish over it (`KHR_materials_clearcoat`), light passing
+//! through it as through glass (`KHR_materials_transmission`) and absorbed inside it
+//! (`KHR_materials_volume`).
+//!
+//! Invariants of a [`Layers`] made by [`Layers::from_extensions`]: every value finite and in the
+//! range its extension allows (a value outside it is clamped, with a warning). The defaults are
+//! glTF's core material: none of the layers, an index of 1.5.
+//!
+//! Of their textures only `transmissionTexture` is read (by the loader, into
+//! [`super::Material::transmission_texture`]): it says which parts of a surface are glass, and
+//! without it a lantern's frame would be as clear as its panes. The others are named in a
+//! warning and left out: their factors alone give a varnish its gloss and a volume its colour,
+//! which is what those textures modulate.
+//!
+//! Pure data; no panics.
+
+use serde_json::Value;
+
+/// The extensions [`Layers::from_extensions`] reads, for the loader's list of supported ones.
+pub const EXTENSIONS: [&str; 5] = [
+    "KHR_materials_ior",
+    "KHR_materials_specular",
+    "KHR_materials_clearcoat",
+    "KHR_materials_transmission",
+    "KHR_materials_volume",
+];
+
+/// The layers over, in and through a material's base (see the module docs). Lengths are in the
+/// model's units (glTF's metres), colours linear.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Layers {
+    /// Index of refraction of the dielectric: its reflectance at normal incidence is
+    /// ((ior − 1)/(ior + 1))², 4 % at glTF's 1.5; 1 reflects nothing. Infinite: the file's 0,
+    /// `KHR_materials_ior`'s specular–glossiness mode, where the reflectance is the specular
+    /// colour at every angle ([`Self::fresnel_rises`] is false).
+    pub ior: f32,
+    /// Strength of the dielectric's specular reflection, 0–1 (it scales the reflectance at every
+    /// angle, grazing included).
+    pub specular: f32,
+    /// Colour of the dielectric's reflectance at normal incidence, a factor on the one `ior`
+    /// gives (the product is kept at most 1); may exceed 1.
+    pub specular_color: [f32; 3],
+    /// Share of the surface under a clear varnish (a dielectric of index 1.5), 0–1, and the
+    /// varnish's roughness.
+    pub clear_coat: f32,
+    pub clear_coat_roughness: f32,
+    /// Share of the light entering the dielectric that passes through instead of being scattered
+    /// back (glass: 1), 0–1. The base colour tints it.
+    pub transmission: f32,
+    /// Thickness of the volume under the surface (0: a thin wall, as glTF has it without
+    /// `KHR_materials_volume`).
+    pub thickness: f32,
+    /// The colour white light becomes after [`Self::attenuation_distance`] inside the volume.
+    pub attenuation_color: [f32; 3],
+    /// Distance over which the volume absorbs light to [`Self::attenuation_color`]; infinite:
+    /// nothing is absorbed.
+    pub attenuation_distance: f32,
+}
+
+impl Default for Layers {
+    fn default() -> Self {
+        Self {
+            ior: 1.5,
+            specular: 1.0,
+            specular_color: [1.0; 3],
+            clear_coat: 0.0,
+            clear_coat_roughness: 0.0,
+            transmission: 0.0,
+            thickness: 0.0,
+            attenuation_color: [1.0; 3],
+            attenuation_distance: f32::INFINITY,
+        }
+    }
+}
+
+impl Layers {
+    /// The dielectric's reflectance at normal incidence, per channel: ((ior − 1)/(ior + 1))² times
+    /// the specular colour, at most 1 (`KHR_materials_specular`'s definition). Not scaled by
+    /// [`Self::specular`], which scales the whole lobe.
+    pub fn dielectric_f0(&self) -> [f32; 3] {
+        let r = if self.ior.is_finite() {
+            (self.ior - 1.0) / (self.ior + 1.0)
+        } else {
+            1.0
+        };
+        self.specular_color.map(|c| (r * r * c).min(1.0))
+    }
+
+    /// Whether the dielectric's reflectance rises towards 1 at grazing angles (Fresnel), as every
+    /// finite index has it; with an infinite one it is [`Self::dielectric_f0`] at every angle.
+    pub fn fresnel_rises(&self) -> bool {
+        self.ior.is_finite()
+    }
+
+    /// Optical depth per unit of path length in the volume, per channel: −ln(attenuation colour)
+    /// / attenuation distance (Beer–Lambert; 0 where nothing is absorbed, and for a thin wall).
+    pub fn absorption_per_unit(&self) -> [f32; 3] {
+        if self.thickness <= 0.0 || !self.attenuation_distance.is_finite() {
+            return [0.0; 3];
+        }
+        // A colour of 0 would absorb everything at once: kept finite, far past visible.
+        self.attenuation_color
+            .map(|c| -(c.max(1e-6)).ln() / self.attenuation_distance)
+    }
+
+    /// Whether light passes through the surface: drawn over what is behind it, filtering it.
+    pub fn transmits(&self) -> bool {
+        self.transmission > 0.0
+    }
+
+    /// The layers a material's extensions give; `extension` returns an extension's object by
+    /// name. `what` names the material in warnings; values out of range are clamped, malformed
+    /// ones ignored, textures left out, each with a warning.
+    pub fn from_extensions<'a>(
+        extension: impl Fn(&str) -> Option<&'a Value>,
+        what: &str,
+        warnings: &mut Vec<String>,
+    ) -> Self {
+        let mut layers = Self::default();
+        let mut reader = Reader { what, warnings };
+        if let Some(e) = extension("KHR_materials_ior") {
+            let ior = reader.number(e, "KHR_materials_ior", "ior", 1.5);
+            // The schema allows 0 besides ≥ 1: an infinite index, the mode for materials
+            // converted from specular–glossiness (the specular colour is the reflectance).
+            layers.ior = if ior == 0.0 {
+                f32::INFINITY
+            } else {
+                reader.clamped("KHR_materials_ior", "ior", ior, 1.0, f32::MAX)
+            };
+        }
+        if let Some(e) = extension("KHR_materials_specular") {
+            let name = "KHR_materials_specular";
+            let s = reader.number(e, name, "specularFactor", 1.0);
+            layers.specular = reader.clamped(name, "specularFactor", s, 0.0, 1.0);
+            if let Some(c) = reader.color(e, name, "specularColorFactor") {
+                layers.specular_color = c.map(|c| reader.clamped(name, "specularColorFactor", c, 0.0, f32::MAX));
+            }
+            reader.textures(e, name, &["specularTexture", "specularColorTexture"]);
+        }
+        if let Some(e) = extension("KHR_materials_clearcoat") {
+            let name = "KHR_materials_clearcoat";
+            let c = reader.number(e, name, "clearcoatFactor", 0.0);
+            layers.clear_coat = reader.clamped(name, "clearcoatFactor", c, 0.0, 1.0);
+            let r = reader.number(e, name, "clearcoatRoughnessFactor", 0.0);
+            layers.clear_coat_roughness = reader.clamped(name, "clearcoatRoughnessFactor", r, 0.0, 1.0);
+            reader.textures(
+                e,
+                name,
+                &[
+                    "clearcoatTexture",
+                    "clearcoatRoughnessTexture",
+                    "clearcoatNormalTexture",
+                ],
+            );
+        }
+        if let Some(e) = extension("KHR_materials_transmission") {
+            let name = "KHR_materials_transmission";
+            let t = reader.number(e, name, "transmissionFactor", 0.0);
+            layers.transmission = reader.clamped(name, "transmissionFactor", t, 0.0, 1.0);
+        }
+        if let Some(e) = extension("KHR_materials_volume") {
+            let name = "KHR_materials_volume";
+            let t = reader.number(e, name, "thicknessFactor", 0.0);
+            layers.thickness = reader.clamped(name, "thicknessFactor", t, 0.0, f32::MAX);
+            let d = reader.number(e, name, "attenuationDistance", f32::INFINITY);
+            layers.attenuation_distance = if d > 0.0 {
+                d
+            } else {
+                reader.warn(name, "attenuationDistance", "must be positive: no absorption");
+                f32::INFINITY
+            };
+            if let Some(c) = reader.color(e, name, "attenuationColor") {
+                layers.attenuation_color = c.map(|c| reader.clamped(name, "attenuationColor", c, 0.0, 1.0));
+            }
+            reader.textures(e, name, &["thicknessTexture"]);
+        }
+        layers
+    }
+}
+
+/// Reads an extension object's fields into warnings where they are not what its schema says.
+struct Reader<'w> {
+    what: &'w str,
+    warnings: &'w mut Vec<String>,
+}
+
+impl Reader<'_> {
+    fn warn(&mut self, extension: &str, field: &str, message: &str) {
+        self.warnings
+            .push(format!("{}: {extension} {field} {message}", self.what));
+    }
+
+    /// A number field, `default` where it is absent or not a finite number (with a warning).
+    fn number(&mut self, object: &Value, extension: &str, field: &str, default: f32) -> f32 {
+        match object.get(field) {
+            None => default,
+            Some(v) => match v.as_f64().map(|x| x as f32).filter(|x| x.is_finite()) {
+                Some(x) => x,
+                None => {
+                    self.warn(extension, field, "is not a number: its default used");
+                    default
+                }
+            },
+        }
+    }
+
+    fn clamped(&mut self, extension: &str, field: &str, x: f32, lo: f32, hi: f32) -> f32 {
+        if x < lo || x > hi {
+            self.warn(
+                extension,
+                field,
+                &format!("{x} is out of its range: kept within {lo}–{hi}"),
+            );
+        }
+        x.clamp(lo, hi)
+    }
+
+    /// An RGB array field; `None` where it is absent or malformed (with a warning).
+    fn color(&mut self, object: &Value, extension: &str, field: &str) -> Option<[f32; 3]> {
+        let v = object.get(field)?;
+        let c = v.as_array().filter(|a| a.len() == 3).and_then(|a| {
+            let c: Vec<f32> = a
+                .iter()
+                .filter_map(|x| x.as_f64().map(|x| x as f32).filter(|x| x.is_finite()))
+                .collect();
+            <[f32; 3]>::try_from(c).ok()
+        });
+        if c.is_none() {
+            self.warn(extension, field, "is not three numbers: its default used");
+        }
+        c
+    }
+
+    fn textures(&mut self, object: &Value, extension: &str, fields: &[&str]) {
+        for field in fields {
+            if object.get(*field).is_some() {
+                self.warn(extension, field, "is not read: its factor alone is used");
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn read(extensions: Value) -> (Layers, Vec<String>) {
+        let mut warnings = Vec::new();
+        let layers = Layers::from_extensions(|name| extensions.get(name), "material glass", &mut warnings);
+        (layers, warnings)
+    }
+
+    #[test]
+    fn without_extensions_the_layers_are_the_core_material() {
+        let (layers, warnings) = read(json!({}));
+        assert_eq!(layers, Layers::default());
+        assert!(warnings.is_empty());
+        // ((1.5 − 1)/(1.5 + 1))² = 0.04, the core material's dielectric reflectance.
+        for f0 in layers.dielectric_f0() {
+            assert!((f0 - 0.04).abs() < 1e-7, "{f0}");
+        }
+        assert_eq!(layers.absorption_per_unit(), [0.0; 3]);
+        assert!(!layers.transmits());
+    }
+
+    #[test]
+    fn each_extension_sets_its_factors() {
+        let (layers, warnings) = read(json!({
+            "KHR_materials_ior": { "ior": 2.42 },
+            "KHR_materials_specular": { "specularFactor": 0.5, "specularColorFactor": [1.0, 0.5, 0.25] },
+            "KHR_materials_clearcoat": { "clearcoatFactor": 0.8, "clearcoatRoughnessFactor": 0.2 },
+            "KHR_materials_transmission": { "transmissionFactor": 1.0 },
+            "KHR_materials_volume": { "thicknessFactor": 0.01, "attenuationDistance": 0.02, "attenuationColor": [0.9, 0.5, 0.1] }
+        }));
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(layers.ior, 2.42);
+        assert_eq!(layers.specular, 0.5);
+        assert_eq!((layers.clear_coat, layers.clear_coat_roughness), (0.8, 0.2));
+        assert_eq!(layers.transmission, 1.0);
+        // Diamond's ((2.42 − 1)/(2.42 + 1))² ≈ 0.1724, times the colour.
+        let f0 = layers.dielectric_f0();
+        let diamond = (1.42f32 / 3.42).powi(2);
+        for (got, c) in f0.iter().zip([1.0, 0.5, 0.25]) {
+            assert!((got - diamond * c).abs() < 1e-6, "{f0:?}");
+        }
+        // After the attenuation distance, white light has become the attenuation colour.
+        let sigma = layers.absorption_per_unit();
+        for (s, c) in sigma.iter().zip([0.9f32, 0.5, 0.1]) {
+            assert!(((-s * 0.02).exp() - c).abs() < 1e-6, "{sigma:?}");
+        }
+    }
+
+    #[test]
+    fn values_out_of_range_are_clamped_and_named() {
+        let (layers, warnings) = read(json!({
+            "KHR_materials_ior": { "ior": 0.5 },
+            "KHR_materials_transmission": { "transmissionFactor": 3.0 },
+            "KHR_materials_clearcoat": { "clearcoatFactor": "lots" },
+            "KHR_materials_specular": { "specularColorFactor": [1.0, 2.0] },
+            "KHR_materials_volume": { "thicknessFactor": 1.0, "attenuationDistance": -1.0 }
+        }));
+        assert_eq!(layers.ior, 1.0);
+        assert_eq!(layers.dielectric_f0(), [0.0; 3]);
+        assert_eq!(layers.transmission, 1.0);
+        assert_eq!(layers.clear_coat, 0.0);
+        assert_eq!(layers.specular_color, [1.0; 3]);
+        assert_eq!(layers.attenuation_distance, f32::INFINITY);
+        assert_eq!(layers.absorption_per_unit(), [0.0; 3]);
+        for field in [
+            "ior",
+            "transmissionFactor",
+            "clearcoatFactor",
+            "specularColorFactor",
+            "attenuationDistance",
+        ] {
+            assert!(
+                warnings
+                    .iter()
+                    .any(|w| w.contains(field) && w.starts_with("material glass")),
+                "{field}: {warnings:?}"
+            );
+        }
+        assert_eq!(warnings.len(), 5, "{warnings:?}");
+    }
+
+    #[test]
+    fn an_ior_of_zero_makes_the_specular_colour_the_reflectance_and_textures_are_named() {
+        let (layers, warnings) = read(json!({
+            "KHR_materials_ior": { "ior": 0 },
+            "KHR_materials_specular": { "specularColorFactor": [0.5, 0.25, 2.0] },
+            "KHR_materials_transmission": { "transmissionFactor": 0.5, "transmissionTexture": { "index": 0 } },
+            "KHR_materials_volume": { "thicknessFactor": 0.5, "thicknessTexture": { "index": 0 } }
+        }));
+        assert_eq!(layers.dielectric_f0(), [0.5, 0.25, 1.0]);
+        assert!(!layers.fresnel_rises());
+        assert!(Layers::default().fresnel_rises());
+        // The transmission texture is the loader's to read; the thickness texture is named.
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
+        assert!(warnings[0].contains("thicknessTexture"), "{warnings:?}");
+    }
+}
