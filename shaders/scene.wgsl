@@ -65,10 +65,20 @@ struct Material {
     // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended; w: 1 if
     // unlit (KHR_materials_unlit).
     flags: vec4<f32>,
-    // KHR_texture_transform rows for the five slots, in the order above plus emissive.
-    transforms: array<vec4<f32>, 10>,
-    // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is.
+    // KHR_texture_transform rows for the six slots, in the order above plus emissive and
+    // transmission.
+    transforms: array<vec4<f32>, 12>,
+    // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is; y: UV set
+    // of the transmission texture.
     scene: vec4<f32>,
+    // glTF's material extensions (assets crate, `model::layers`). x: transmission; y: specular
+    // strength; z: clear coat; w: its roughness.
+    layers: vec4<f32>,
+    // rgb: the dielectric's reflectance at normal incidence (index of refraction × specular
+    // colour); w: 1 where it rises to 1 at grazing angles (0: an infinite index).
+    dielectric: vec4<f32>,
+    // rgb: optical depth of the volume's thickness at normal incidence; w: 1 / index of refraction.
+    volume: vec4<f32>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -80,9 +90,13 @@ override HAS_METALLIC_ROUGHNESS_TEXTURE: bool = true;
 override HAS_NORMAL_TEXTURE: bool = true;
 override HAS_OCCLUSION_TEXTURE: bool = true;
 override HAS_EMISSIVE_TEXTURE: bool = true;
+override HAS_TRANSMISSION_TEXTURE: bool = true;
 override ALPHA_MASK: bool = true;
 // A pipeline for the draws of a cross-fade between levels (`vs_fade`; render crate, `fades`).
 override FADE: bool = false;
+// What the draw writes (render crate, `DrawLayer`): 0 the whole surface; for a surface light
+// passes through, 1 the factor what is behind it is multiplied by, 2 the light it adds.
+override TRANSMIT_LAYER: u32 = 0u;
 
 @group(0) @binding(0) var<uniform> eye: Eye;
 @group(0) @binding(1) var shadow_map: texture_depth_2d;
@@ -112,6 +126,9 @@ override FADE: bool = false;
 @group(1) @binding(8) var occlusion_sampler: sampler;
 @group(1) @binding(9) var emissive_texture: texture_2d<f32>;
 @group(1) @binding(10) var emissive_sampler: sampler;
+// KHR_materials_transmission: red scales the share of light let through.
+@group(1) @binding(11) var transmission_texture: texture_2d<f32>;
+@group(1) @binding(12) var transmission_sampler: sampler;
 
 struct VsIn {
     @location(0) position: vec3<f32>,
@@ -404,7 +421,33 @@ struct Surface {
     unlit: bool,
     // Scenery (the floor) keeps its own material under the visitor's `Appearance`.
     scenery: bool,
+    // The dielectric's reflectance at normal incidence, whether it rises to 1 at grazing angles
+    // (not for an infinite index), and the strength of its specular lobe (glTF core: 0.04, yes, 1).
+    f0_dielectric: vec3<f32>,
+    fresnel_rises: bool,
+    specular_weight: f32,
+    // A varnish over it (its share, its roughness).
+    coat: f32,
+    coat_roughness: f32,
+    // Share of the light entering it that passes through; the optical depth of its volume at
+    // normal incidence; 1 / its index of refraction.
+    transmission: f32,
+    optical_depth: vec3<f32>,
+    inv_ior: f32,
 };
+
+// glTF's core dielectric, no varnish, nothing passing through (for surfaces without a material
+// of their own: impostors).
+fn core_layers(s: ptr<function, Surface>) {
+    (*s).f0_dielectric = vec3<f32>(0.04);
+    (*s).fresnel_rises = true;
+    (*s).specular_weight = 1.0;
+    (*s).coat = 0.0;
+    (*s).coat_roughness = 0.0;
+    (*s).transmission = 0.0;
+    (*s).optical_depth = vec3<f32>(0.0);
+    (*s).inv_ior = 1.0 / 1.5;
+}
 
 // The material's surface at a fragment of the scene pass. Samples every texture first:
 // derivatives need uniform control flow (the pipeline constants are uniform). A missing slot
@@ -430,6 +473,10 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     var emissive_sample = vec4<f32>(1.0);
     if (HAS_EMISSIVE_TEXTURE) {
         emissive_sample = textureSample(emissive_texture, emissive_sampler, slot_uv(4u, material.flags.x, in.uv));
+    }
+    var transmission_sample = vec4<f32>(1.0);
+    if (HAS_TRANSMISSION_TEXTURE) {
+        transmission_sample = textureSample(transmission_texture, transmission_sampler, slot_uv(5u, material.scene.y, in.uv));
     }
 
     var s: Surface;
@@ -460,6 +507,14 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     s.emissive = material.emissive.rgb * emissive_sample.rgb;
     s.unlit = material.flags.w > 0.5;
     s.scenery = material.scene.x > 0.5;
+    s.f0_dielectric = material.dielectric.rgb;
+    s.fresnel_rises = material.dielectric.w > 0.5;
+    s.specular_weight = material.layers.y;
+    s.coat = material.layers.z;
+    s.coat_roughness = material.layers.w;
+    s.transmission = material.layers.x * transmission_sample.r;
+    s.optical_depth = material.volume.rgb;
+    s.inv_ior = material.volume.w;
     return s;
 }
 
@@ -478,14 +533,35 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     if (material.flags.z > 0.5) {
         out_alpha = s.alpha;
     }
-    return vec4<f32>(shade(in.world, s), out_alpha);
+    let shaded = shade_surface(in.world, s);
+    // A surface light passes through (`DrawLayer`), over a pixel behind it: what is behind is
+    // filtered where the surface covers it (alpha as coverage), then the surface's light added.
+    if (TRANSMIT_LAYER == 1u) {
+        return vec4<f32>(vec3<f32>(1.0 - out_alpha) + out_alpha * shaded.through, 1.0);
+    }
+    if (TRANSMIT_LAYER == 2u) {
+        return vec4<f32>(out_alpha * shaded.radiance, 0.0);
+    }
+    return vec4<f32>(shaded.radiance, out_alpha);
 }
 
-// Outgoing radiance towards the eye from surface `s` at `world` (mesh coordinates), under the
-// light, the lamp, the environment and the visitor's `Appearance`.
+struct Shaded {
+    // Radiance leaving the surface towards the eye: reflected and emitted.
+    radiance: vec3<f32>,
+    // The factor on the radiance from behind the surface that passes through it to the eye.
+    through: vec3<f32>,
+};
+
+// Outgoing radiance towards the eye from surface `s` at `world` (mesh coordinates).
 fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
+    return shade_surface(world, s).radiance;
+}
+
+// What surface `s` at `world` (mesh coordinates) sends towards the eye, under the light, the
+// lamp, the environment and the visitor's `Appearance`, and what it lets through from behind.
+fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     if (s.unlit) {
-        return s.base;
+        return Shaded(s.base, vec3<f32>(0.0));
     }
     let n = s.n;
     let t = s.t;
@@ -528,6 +604,20 @@ fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));
     var direct = vec3<f32>(0.0);
     var ambient_light = vec3<f32>(0.0);
+    // The dielectric's reflectance (Schlick, glTF's `fresnel_mix`), the visitor's specular scale
+    // on it: towards the light's half vector, and averaged over the environment's directions
+    // at this roughness (the grazing rise tempered by roughness, Fdez-Agüera's fit).
+    let f0_d = s.f0_dielectric * look.tint.w;
+    let f90_d = select(f0_d, vec3<f32>(1.0), s.fresnel_rises);
+    let fresnel_d = s.specular_weight * (f0_d + (f90_d - f0_d) * pow(1.0 - v_dot_h, 5.0));
+    let f90_ambient_d = select(f0_d, max(vec3<f32>(1.0 - roughness), f0_d), s.fresnel_rises);
+    let fresnel_ambient_d = s.specular_weight * (f0_d + (f90_ambient_d - f0_d) * pow(1.0 - n_dot_v, 5.0));
+    // What the base does not scatter back passes through (glTF's transmission: a thin wall,
+    // tinted by the base colour; through a volume, absorbed along the refracted path).
+    let transmission = s.transmission * (1.0 - metallic);
+    let sin2_t = (1.0 - n_dot_v * n_dot_v) * s.inv_ior * s.inv_ior;
+    let cos_t = sqrt(max(1.0 - sin2_t, 1e-4));
+    var through = transmission * (vec3<f32>(1.0) - fresnel_ambient_d) * base * exp(-s.optical_depth / cos_t);
     if (look.ward_rho_d.w > 0.5) {
         // Ward: ρd (times the base colour) / π + ρs · lobe along the tangent frame (any frame
         // about n where the mesh has no tangents: the lobe is then isotropic in effect only if
@@ -559,6 +649,7 @@ fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
             ward_alpha = mix(ward_alpha, ward_alpha.yx, m.b) * (2.0 * m.g);
             ward_alpha = clamp(ward_alpha, vec2<f32>(0.01), vec2<f32>(1.0));
         }
+        rho_d = rho_d * (1.0 - transmission);
         let lobe = ward_lobe(l, v, tw, bw, n, ward_alpha);
         direct = (rho_d / PI + rho_s * lobe) * light_in;
         let rough_eq = clamp(sqrt(sqrt(ward_alpha.x * ward_alpha.y)), 0.045, 1.0);
@@ -567,30 +658,38 @@ fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
         let prefiltered = ward_image_light(v, n, tw, bw, ward_alpha);
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * (scale_bias.x + scale_bias.y);
     } else {
-        let f0 = mix(vec3<f32>(0.04 * look.tint.w), base, metallic);
-        let fresnel = f0 + (vec3<f32>(1.0) - f0) * pow(1.0 - v_dot_h, 5.0);
+        let fresnel_m = base + (vec3<f32>(1.0) - base) * pow(1.0 - v_dot_h, 5.0);
+        let fresnel = mix(fresnel_d, fresnel_m, metallic);
         let specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
-        let diffuse = (vec3<f32>(1.0) - fresnel) * (1.0 - metallic) * base / PI;
+        let diffuse = (vec3<f32>(1.0) - fresnel) * (1.0 - metallic) * (1.0 - s.transmission) * base / PI;
         direct = (diffuse + specular) * light_in;
 
         // Image-based light, world-fixed: diffuse from the environment's irradiance (ρ/π·E),
         // specular by the split sum: the prefiltered radiance around the reflection direction at
         // this roughness, times F0·scale + bias from the BRDF table (Karis 2013). Explicit
         // levels: no derivatives, so the azimuth seam of the equirectangular map leaves no line.
-        let fresnel_ambient = f0 + (max(vec3<f32>(1.0 - roughness), f0) - f0) * pow(1.0 - n_dot_v, 5.0);
-        let diffuse_ambient = irradiance(to_world(n)) / PI * base * (1.0 - metallic) * (vec3<f32>(1.0) - fresnel_ambient);
+        let fresnel_ambient_m = base + (max(vec3<f32>(1.0 - roughness), base) - base) * pow(1.0 - n_dot_v, 5.0);
+        let fresnel_ambient = mix(fresnel_ambient_d, fresnel_ambient_m, metallic);
+        let diffuse_ambient = irradiance(to_world(n)) / PI * base * (1.0 - metallic) * (1.0 - s.transmission) * (vec3<f32>(1.0) - fresnel_ambient);
         let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), roughness * PREFILTERED_MAX_LEVEL).rgb;
-        let specular_ambient = prefiltered * (f0 * scale_bias.x + vec3<f32>(scale_bias.y));
+        let albedo_d = s.specular_weight * (f0_d * scale_bias.x + f90_d * scale_bias.y);
+        let albedo_m = base * scale_bias.x + vec3<f32>(scale_bias.y);
+        let specular_ambient = prefiltered * mix(albedo_d, albedo_m, metallic);
         ambient_light = diffuse_ambient + specular_ambient;
     }
 
     // Clear coat: a smooth dielectric layer (4 %) over everything; what it reflects the layer
-    // below does not receive.
-    let coat = look.params.z;
+    // below does not receive, nor what is behind it. The visitor's varnish where it is the
+    // stronger, else the material's own.
+    var coat = look.params.z;
+    var coat_rough = clamp(look.params.w, 0.045, 1.0);
+    if (s.coat > coat) {
+        coat = s.coat;
+        coat_rough = clamp(s.coat_roughness, 0.045, 1.0);
+    }
     if (coat > 0.0) {
-        let coat_rough = clamp(look.params.w, 0.045, 1.0);
         let coat_alpha = coat_rough * coat_rough;
         let fc = (0.04 + 0.96 * pow(1.0 - v_dot_h, 5.0)) * coat;
         let coat_direct = fc * ggx(n_dot_h, coat_alpha) * smith_visibility(n_dot_l, n_dot_v, coat_alpha) * light_in;
@@ -600,9 +699,10 @@ fn shade(world: vec3<f32>, s: Surface) -> vec3<f32> {
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), coat_rough * PREFILTERED_MAX_LEVEL).rgb;
         ambient_light = ambient_light * (1.0 - fc_ambient) + prefiltered * (0.04 * scale_bias.x + scale_bias.y) * coat;
+        through = through * (1.0 - fc_ambient);
     }
     let ambient = eye.light.w * occlusion * ambient_light;
-    return direct + ambient + s.emissive;
+    return Shaded(direct + ambient + s.emissive, through);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -853,6 +953,7 @@ fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
     s.emissive = vec3<f32>(0.0);
     s.unlit = normal.z < 0.0;
     s.scenery = false;
+    core_layers(&s);
     var out: ImpostorFsOut;
     out.radiance = vec4<f32>(shade(p, s), 1.0);
     let clip = eye.view_proj * vec4<f32>(p, 1.0);

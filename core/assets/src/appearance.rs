@@ -18,9 +18,12 @@ pub struct Appearance {
     pub roughness: Option<f32>,
     /// Replaces the materials' metalness (0–1), or keeps it (`None`).
     pub metalness: Option<f32>,
-    /// Scales the dielectric reflectance at normal incidence (glTF's 4 %), 0–2.
+    /// Scales the dielectric reflectance at normal incidence (glTF's 4 %, or what the material's
+    /// index of refraction and specular colour make it), 0–2.
     pub specular: f32,
     /// Strength of a clear lacquer layer over the material (0 none – 1 full; 4 % reflectance).
+    /// Where the material has a varnish of its own (`KHR_materials_clearcoat`), the stronger of
+    /// the two shows, with its roughness.
     pub clear_coat: f32,
     /// Roughness of that layer (0–1).
     pub clear_coat_roughness: f32,

@@ -546,15 +546,17 @@ impl Renderer {
 
     pub(crate) fn draw_primitive(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive, levels: &[u8]) {
         let m = &self.model.materials[p.material];
-        // Every material's variant was prepared with its model; a miss would be our bug, and
-        // skipping the primitive beats a panic in the middle of a frame.
-        let Some(pipeline) = self.scene.get(&m.variant) else {
-            debug_assert!(false, "no pipeline for {:?}", m.variant);
-            return;
-        };
-        pass.set_pipeline(pipeline);
         pass.set_bind_group(1, &m.bind, &[]);
-        p.draw(pass, levels);
+        for variant in m.variant.draws() {
+            // Every material's variants were prepared with its model; a miss would be our bug,
+            // and skipping the draw beats a panic in the middle of a frame.
+            let Some(pipeline) = self.scene.get(&variant) else {
+                debug_assert!(false, "no pipeline for {variant:?}");
+                continue;
+            };
+            pass.set_pipeline(pipeline);
+            p.draw(pass, levels);
+        }
     }
 }
 

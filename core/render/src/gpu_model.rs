@@ -90,16 +90,82 @@ impl GpuModel {
 pub(crate) struct MaterialVariant {
     pub(crate) double_sided: bool,
     pub(crate) blend: bool,
-    /// Base colour, metallic-roughness, normal, occlusion, emissive: sampled or not.
-    pub(crate) textures: [bool; 5],
+    /// Base colour, metallic-roughness, normal, occlusion, emissive, transmission: sampled or
+    /// not.
+    pub(crate) textures: [bool; 6],
     /// Alpha mask: the shader may discard (which also costs early depth testing).
     pub(crate) mask: bool,
     /// The pipeline of a cross-fade's draws (`vs_fade`, the per-instance fade, and a
     /// screen-door discard); made for the materials of primitives with levels of detail.
     pub(crate) fade: bool,
+    /// What the draw writes: the whole surface, or one of the two layers of a surface that
+    /// light passes through (`KHR_materials_transmission`).
+    pub(crate) layer: DrawLayer,
+}
+
+/// A surface that transmits light changes what is behind it in two ways, which one blend
+/// operation cannot do: it filters it (a colour factor: tinted glass) and adds its own light
+/// (reflections, emission). So it is drawn twice, [`DrawLayer::Filter`] then
+/// [`DrawLayer::Light`]: the pixel becomes behind × filter + light. Every other surface is drawn
+/// once, [`DrawLayer::Whole`]. The `TRANSMIT_LAYER` constant of `scene.wgsl`, in this order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub(crate) enum DrawLayer {
+    Whole,
+    Filter,
+    Light,
+}
+
+impl DrawLayer {
+    pub(crate) fn shader_constant(self) -> f64 {
+        match self {
+            Self::Whole => 0.0,
+            Self::Filter => 1.0,
+            Self::Light => 2.0,
+        }
+    }
+
+    /// The colour target's blending: alpha blending for a blended whole surface, none for an
+    /// opaque one; the destination times the source for the filter, their sum for the light.
+    /// The layers leave the target's alpha as it is.
+    pub(crate) fn blend(self, blended: bool) -> Option<wgpu::BlendState> {
+        let keep_alpha = wgpu::BlendComponent {
+            src_factor: wgpu::BlendFactor::Zero,
+            dst_factor: wgpu::BlendFactor::One,
+            operation: wgpu::BlendOperation::Add,
+        };
+        match self {
+            Self::Whole => blended.then_some(wgpu::BlendState::ALPHA_BLENDING),
+            Self::Filter => Some(wgpu::BlendState {
+                color: wgpu::BlendComponent {
+                    src_factor: wgpu::BlendFactor::Zero,
+                    dst_factor: wgpu::BlendFactor::Src,
+                    operation: wgpu::BlendOperation::Add,
+                },
+                alpha: keep_alpha,
+            }),
+            Self::Light => Some(wgpu::BlendState {
+                color: wgpu::BlendComponent {
+                    src_factor: wgpu::BlendFactor::One,
+                    dst_factor: wgpu::BlendFactor::One,
+                    operation: wgpu::BlendOperation::Add,
+                },
+                alpha: keep_alpha,
+            }),
+        }
+    }
 }
 
 impl MaterialVariant {
+    /// The draws that make a primitive of this material, in order: itself, or for a surface that
+    /// transmits light its filter, then itself (its light).
+    pub(crate) fn draws(self) -> impl Iterator<Item = MaterialVariant> {
+        let filter = (self.layer == DrawLayer::Light).then_some(MaterialVariant {
+            layer: DrawLayer::Filter,
+            ..self
+        });
+        filter.into_iter().chain(std::iter::once(self))
+    }
+
     /// Casts its shadow through the alpha-masked shadow pipeline (blended surfaces cast none).
     pub(crate) fn casts_masked_shadow(&self) -> bool {
         self.mask && !self.blend
@@ -107,10 +173,11 @@ impl MaterialVariant {
 }
 
 /// Names of the `override` constants in `scene.wgsl`, in [`MaterialVariant::textures`] order.
-pub(crate) const TEXTURE_OVERRIDES: [&str; 5] = [
+pub(crate) const TEXTURE_OVERRIDES: [&str; 6] = [
     "HAS_BASE_TEXTURE",
     "HAS_METALLIC_ROUGHNESS_TEXTURE",
     "HAS_NORMAL_TEXTURE",
     "HAS_OCCLUSION_TEXTURE",
     "HAS_EMISSIVE_TEXTURE",
+    "HAS_TRANSMISSION_TEXTURE",
 ];

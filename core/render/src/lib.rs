@@ -12,14 +12,19 @@
 //! ## Passes per frame
 //! 1. Shadow pass, once for both eyes: depth from the world-fixed light (orthographic over the
 //!    model without its floor, which only receives unless the light is below it), both faces of
-//!    every surface; alpha-masked materials are cut out as in the scene pass
-//!    (their shadows have the holes they have), blended ones cast none. A [`Lamp`] in its place
-//!    is seen from one perspective view, or, standing among what it shadows, from the six faces
-//!    of a cube ([`point_shadow`]: six passes of 512² texels).
+//!    every surface; alpha-masked materials are cut out as in the scene pass (their shadows have
+//!    the holes they have), blended and transmissive ones cast none. A [`Lamp`] in its place is
+//!    seen from one perspective view, or, standing among what it shadows, from the six faces of
+//!    a cube ([`point_shadow`]: six passes of 512² texels).
 //! 2. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
 //!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
 //!    Opaque and masked primitives first, then blended ones back to front (depth test, no depth
-//!    write). Mono renders only the cyclopean eye. Light, materials and textures are shared by
+//!    write), among them those light passes through (glass: `KHR_materials_transmission`), each
+//!    drawn twice: a filter that multiplies what is behind by its transmittance (base colour,
+//!    Fresnel, the volume's absorption), then its own light added (`DrawLayer`). What is behind
+//!    glass shows sharp whatever its roughness (no copy of the frame to blur is made), and the
+//!    reflections of a glass primitive's far side are not filtered by its near side (one draw
+//!    each). Mono renders only the cyclopean eye. Light, materials and textures are shared by
 //!    both eyes; only the small per-eye uniform differs. A primitive whose level is
 //!    [`IMPOSTOR_LEVEL`] and that has one baked is drawn as its relief-texture impostor
 //!    ([`impostor`]; it casts the shadow of its polygon level as exact as it is); a primitive in
@@ -405,7 +410,7 @@ impl Renderer {
             }],
         });
         let mut material_entries = vec![uniform_entry(0, wgpu::ShaderStages::FRAGMENT)];
-        for slot in 0..5u32 {
+        for slot in 0..TEXTURE_OVERRIDES.len() as u32 {
             material_entries.push(wgpu::BindGroupLayoutEntry {
                 binding: 1 + 2 * slot,
                 visibility: wgpu::ShaderStages::FRAGMENT,
@@ -860,7 +865,7 @@ mod tests {
 
     #[test]
     fn a_broken_shader_fails_validation() {
-        let good = "return direct + ambient + s.emissive;";
+        let good = "return Shaded(direct + ambient + s.emissive, through);";
         assert!(SCENE_WGSL.contains(good), "the sabotage below must apply");
         let bad = SCENE_WGSL.replace(good, "return vec4<f32>(direct, 1.0);");
         let parsed = naga::front::wgsl::parse_str(&bad);

@@ -35,7 +35,12 @@ impl ScenePipelines {
             .map(|p| model.materials[p.material].variant)
             .filter(|v| !v.blend)
             .map(|v| MaterialVariant { fade: true, ..v });
-        let variants: Vec<MaterialVariant> = model.materials.iter().map(|m| m.variant).chain(fading).collect();
+        let variants: Vec<MaterialVariant> = model
+            .materials
+            .iter()
+            .flat_map(|m| m.variant.draws())
+            .chain(fading)
+            .collect();
         for v in variants {
             if !self.variants.contains_key(&v) {
                 let pipeline = self.create(device, &v);
@@ -101,6 +106,7 @@ impl ScenePipelines {
             .collect();
         constants.push(("ALPHA_MASK", flag(v.mask)));
         constants.push(("FADE", flag(v.fade)));
+        constants.push(("TRANSMIT_LAYER", v.layer.shader_constant()));
         let fade_attributes = FADE_ATTRIBUTES;
         let plain = [Some(vertex_buffer(&vertex_attributes))];
         let fading = [
@@ -141,7 +147,7 @@ impl ScenePipelines {
                 },
                 targets: &[Some(wgpu::ColorTargetState {
                     format: HDR_FORMAT,
-                    blend: v.blend.then_some(wgpu::BlendState::ALPHA_BLENDING),
+                    blend: v.layer.blend(v.blend),
                     write_mask: wgpu::ColorWrites::ALL,
                 })],
             }),

@@ -68,8 +68,11 @@ pub(crate) struct MaterialUniform {
     pub(crate) params: [f32; 4],
     pub(crate) uv_sets: [f32; 4],
     pub(crate) flags: [f32; 4],
-    pub(crate) transforms: [[f32; 4]; 10],
+    pub(crate) transforms: [[f32; 4]; 12],
     pub(crate) scene: [f32; 4],
+    pub(crate) layers: [f32; 4],
+    pub(crate) dielectric: [f32; 4],
+    pub(crate) volume: [f32; 4],
 }
 
 impl MaterialUniform {
@@ -80,14 +83,19 @@ impl MaterialUniform {
             m.normal_texture.map(|(t, _)| t),
             m.occlusion_texture.map(|(t, _)| t),
             m.emissive_texture,
+            m.transmission_texture,
         ];
-        let mut transforms = [[0.0; 4]; 10];
+        let mut transforms = [[0.0; 4]; 12];
         for (i, slot) in slots.iter().enumerate() {
             let rows = slot.map(|t| t.transform).unwrap_or_default().rows();
             transforms[2 * i] = [rows[0][0], rows[0][1], rows[0][2], 0.0];
             transforms[2 * i + 1] = [rows[1][0], rows[1][1], rows[1][2], 0.0];
         }
         let set = |t: Option<TextureRef>| t.map_or(0.0, |t| t.tex_coord as f32);
+        let l = &m.layers;
+        let f0 = l.dielectric_f0();
+        // Optical depth across the volume's thickness, at normal incidence.
+        let depth = l.absorption_per_unit().map(|a| (a * l.thickness).min(1e4));
         Self {
             base_color: m.base_color,
             emissive: [
@@ -113,7 +121,21 @@ impl MaterialUniform {
                 f32::from(u8::from(m.unlit)),
             ],
             transforms,
-            scene: [f32::from(u8::from(m.scenery)), 0.0, 0.0, 0.0],
+            scene: [f32::from(u8::from(m.scenery)), set(slots[5]), 0.0, 0.0],
+            layers: [
+                if m.unlit { 0.0 } else { l.transmission },
+                l.specular,
+                l.clear_coat,
+                l.clear_coat_roughness,
+            ],
+            dielectric: [f0[0], f0[1], f0[2], f32::from(u8::from(l.fresnel_rises()))],
+            volume: [
+                depth[0],
+                depth[1],
+                depth[2],
+                // 1/ior, for the angle of the refracted path (0 for an infinite index).
+                1.0 / l.ior,
+            ],
         }
     }
 }

@@ -163,6 +163,8 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
         .materials
         .iter()
         .map(|m| {
+            // An unlit surface shows its colour as it is; glTF forbids transmission on one.
+            let transmits = m.layers.transmits() && !m.unlit;
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),
                 contents: bytemuck::bytes_of(&MaterialUniform::new(m)),
@@ -174,6 +176,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                 (m.normal_texture.map(|(t, _)| t), false, &flat_normal),
                 (m.occlusion_texture.map(|(t, _)| t), false, &white),
                 (m.emissive_texture, true, &white),
+                (m.transmission_texture, false, &white),
             ];
             let samplers: Vec<wgpu::Sampler> = slots
                 .iter()
@@ -183,7 +186,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                 binding: 0,
                 resource: uniform.as_entire_binding(),
             }];
-            let mut textures = [false; 5];
+            let mut textures = [false; 6];
             for (i, (t, srgb, fallback)) in slots.iter().enumerate() {
                 let found = t.and_then(|t| views.get(&(t.image, *srgb)));
                 textures[i] = found.is_some();
@@ -204,11 +207,16 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     entries: &entries,
                 }),
                 variant: MaterialVariant {
-                    double_sided: m.double_sided,
-                    blend: m.alpha == AlphaMode::Blend,
+                    // A volume's front faces carry its whole absorption (`scene.wgsl`): its back
+                    // faces would filter what is behind it a second time.
+                    double_sided: m.double_sided && !(transmits && m.layers.thickness > 0.0),
+                    // What light passes through is drawn with the blended surfaces: after the
+                    // opaque ones, back to front, hiding nothing.
+                    blend: m.alpha == AlphaMode::Blend || transmits,
                     textures,
                     mask: matches!(m.alpha, AlphaMode::Mask(_)),
                     fade: false,
+                    layer: if transmits { DrawLayer::Light } else { DrawLayer::Whole },
                 },
                 _uniform: uniform,
             }

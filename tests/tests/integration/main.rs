@@ -30,4 +30,5 @@ mod render;
 mod room_light;
 mod shared_data;
 mod surface;
+mod transmission;
 mod viewpoint_and_light;

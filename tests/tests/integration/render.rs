@@ -267,15 +267,19 @@ fn shadow_scene(cube_centre: Vec3, half: f32, shadows: bool) -> Option<(Vec<u8>,
     render_over_floor(Model::from_painted_mesh("shadow test", mesh), shadows, OBLIQUE_LIGHT)
 }
 
-const OBLIQUE_LIGHT: Vec3 = Vec3::new(0.5, 0.0, 1.0);
+pub(crate) const OBLIQUE_LIGHT: Vec3 = Vec3::new(0.5, 0.0, 1.0);
 
 /// A tiny cube whose bottom is at z = −31 mm, so that `add_floor` puts the floor there.
-fn push_floor_marker(mesh: &mut Mesh) {
+pub(crate) fn push_floor_marker(mesh: &mut Mesh) {
     mesh.push_cube(Vec3::new(0.03, 0.06, -0.0305), 0.0005, [0.5, 0.5, 0.5, 1.0]);
 }
 
 /// `model` on its floor seen straight on from 30 cm, lit from `toward_light`, in mono.
-fn render_over_floor(model: Model, shadows: bool, toward_light: Vec3) -> Option<(Vec<u8>, OffAxisProjection)> {
+pub(crate) fn render_over_floor(
+    model: Model,
+    shadows: bool,
+    toward_light: Vec3,
+) -> Option<(Vec<u8>, OffAxisProjection)> {
     render_over_floor_lit(model, shadows, toward_light, None).map(|(px, proj, _)| (px, proj))
 }
 
@@ -310,9 +314,14 @@ fn render_over_floor_lit(
 }
 
 fn luminance_at(pixels: &[u8], proj: &OffAxisProjection, p: Vec3) -> f32 {
+    luminance(&pixel_at(pixels, proj, p))
+}
+
+/// The pixel (RGBA) of a [`render_over_floor`] frame where `p` (device frame) projects.
+pub(crate) fn pixel_at(pixels: &[u8], proj: &OffAxisProjection, p: Vec3) -> [u8; 4] {
     let px = proj.project(p).unwrap().pixel * (W as f32 / Screen::default().width_px() as f32);
     let i = (px.y as u32 * W + px.x as u32) as usize * 4;
-    luminance(&pixels[i..i + 4])
+    [pixels[i], pixels[i + 1], pixels[i + 2], pixels[i + 3]]
 }
 
 #[test]

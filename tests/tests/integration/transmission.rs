@@ -1,0 +1,254 @@
+//! glTF's material extensions on the GPU (the assets crate's `model::layers`, `scene.wgsl`'s
+//! `shade_surface` and the render crate's `DrawLayer`): glass shows what is behind it, filtered by
+//! its base colour or absorbed by its volume, an index of refraction of 1 reflects nothing, and a
+//! material's own varnish and specular strength change its reflection.
+//!
+//! Each scene: a block on the floor, seen straight on from 30 cm, and a second block of the
+//! material under test floating over it; the pixel at the centre looks through the upper block's
+//! top face onto the lower block's.
+
+use crate::render::{OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_over_floor};
+use phantogram::glam::Vec3;
+use phantogram::model::{Image, Layers, Material, Mesh, Model, Primitive, TextureRef};
+use phantogram::projection::OffAxisProjection;
+
+/// The centre of the lower block's top face, which the upper block hides from the eye.
+const BEHIND: Vec3 = Vec3::new(0.0, 0.0, -0.022);
+
+/// A block of `colour` standing on the floor under `over`'s block (none: nothing over it).
+fn render_under(colour: [f32; 4], over: Option<Material>) -> Option<(Vec<u8>, OffAxisProjection)> {
+    render_under_with(colour, over, Vec::new())
+}
+
+/// [`render_under`], with `images` for `over`'s textures.
+fn render_under_with(
+    colour: [f32; 4],
+    over: Option<Material>,
+    images: Vec<Image>,
+) -> Option<(Vec<u8>, OffAxisProjection)> {
+    let mut mesh = Mesh::default();
+    mesh.push_cube(Vec3::new(0.0, 0.0, -0.026), 0.004, colour);
+    push_floor_marker(&mut mesh);
+    let mut model = Model::from_painted_mesh("under glass", mesh);
+    model.images = images;
+    if let Some(material) = over {
+        let mut block = Mesh::default();
+        block.push_cube(Vec3::new(0.0, 0.0, -0.012), 0.004, [1.0; 4]);
+        model.materials.push(material);
+        model.primitives.push(Primitive {
+            mesh: block,
+            material: model.materials.len() - 1,
+            is_floor: false,
+            lods: Vec::new(),
+        });
+    }
+    render_over_floor(model, true, OBLIQUE_LIGHT)
+}
+
+/// The pixel at [`BEHIND`] with `over` floating above the block of `colour`.
+fn seen(colour: [f32; 4], over: Option<Material>) -> Option<[f32; 3]> {
+    let (pixels, proj) = render_under(colour, over)?;
+    let p = pixel_at(&pixels, &proj, BEHIND);
+    Some([p[0] as f32, p[1] as f32, p[2] as f32])
+}
+
+/// Smooth glass: a dielectric that lets through what it does not reflect.
+fn glass(base: [f32; 3], layers: Layers) -> Material {
+    Material {
+        name: "glass".into(),
+        base_color: [base[0], base[1], base[2], 1.0],
+        metallic: 0.0,
+        roughness: 0.05,
+        layers: Layers {
+            transmission: 1.0,
+            ..layers
+        },
+        ..Material::default()
+    }
+}
+
+fn largest_difference(a: [f32; 3], b: [f32; 3]) -> f32 {
+    a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f32::max)
+}
+
+const RED: [f32; 4] = [0.6, 0.05, 0.05, 1.0];
+const GREY: [f32; 4] = [0.7, 0.7, 0.7, 1.0];
+
+#[test]
+fn clear_glass_shows_what_is_behind_it() {
+    let Some(bare) = seen(RED, None) else {
+        return;
+    };
+    let through = seen(RED, Some(glass([1.0; 3], Layers::default()))).expect("a frame");
+    let opaque_white = Material {
+        layers: Layers::default(),
+        ..glass([1.0; 3], Layers::default())
+    };
+    let opaque = seen(RED, Some(opaque_white)).expect("a frame");
+    println!("the red block: bare {bare:?}, through clear glass {through:?}, under an opaque white block {opaque:?}");
+    assert!(bare[0] > 2.0 * bare[1], "the block is red: {bare:?}");
+    // Through the glass: the red block, less the ~4 % the glass reflects, plus the room that
+    // reflection shows.
+    assert!(
+        largest_difference(through, bare) <= 16.0,
+        "through clear glass {through:?} vs bare {bare:?}"
+    );
+    assert!(through[0] > 2.0 * through[1], "red through the glass: {through:?}");
+    // The same block without transmission hides it.
+    assert!(
+        opaque[1] > 0.8 * opaque[0],
+        "an opaque white block is not red: {opaque:?}"
+    );
+}
+
+#[test]
+fn glass_filters_by_its_base_colour_and_a_volume_by_its_attenuation() {
+    let amber = [1.0, 0.4, 0.1];
+    let Some(bare) = seen(GREY, None) else {
+        return;
+    };
+    let tinted = seen(GREY, Some(glass(amber, Layers::default()))).expect("a frame");
+    // A clear volume whose thickness is its attenuation distance: at normal incidence its light
+    // leaves tinted by exactly the attenuation colour (Beer–Lambert), as the thin tinted wall's.
+    let volume = Layers {
+        thickness: 0.01,
+        attenuation_distance: 0.01,
+        attenuation_color: amber,
+        ..Layers::default()
+    };
+    let absorbed = seen(GREY, Some(glass([1.0; 3], volume))).expect("a frame");
+    println!("the grey block: bare {bare:?}, through amber glass {tinted:?}, through an amber volume {absorbed:?}");
+    assert!(
+        tinted[0] > tinted[1] + 20.0 && tinted[1] > tinted[2] + 20.0,
+        "amber: {tinted:?}"
+    );
+    assert!(
+        (tinted[0] - bare[0]).abs() <= 16.0,
+        "red passes: {tinted:?} vs {bare:?}"
+    );
+    assert!(
+        largest_difference(tinted, absorbed) <= 3.0,
+        "thin amber {tinted:?} vs amber volume {absorbed:?}"
+    );
+}
+
+#[test]
+fn an_index_of_refraction_of_one_reflects_nothing() {
+    let Some(bare) = seen(RED, None) else {
+        return;
+    };
+    let air = Layers {
+        ior: 1.0,
+        ..Layers::default()
+    };
+    let diamond = Layers {
+        ior: 2.42,
+        ..Layers::default()
+    };
+    let through_air = seen(RED, Some(glass([1.0; 3], air))).expect("a frame");
+    let through_diamond = seen(RED, Some(glass([1.0; 3], diamond))).expect("a frame");
+    println!("the red block: bare {bare:?}, through ior 1 {through_air:?}, through ior 2.42 {through_diamond:?}");
+    assert!(
+        largest_difference(through_air, bare) <= 1.0,
+        "an index of 1: {through_air:?} vs bare {bare:?}"
+    );
+    // Diamond reflects 17 % at normal incidence: the red block dims and the room shows.
+    assert!(
+        largest_difference(through_diamond, bare) >= 4.0,
+        "an index of 2.42: {through_diamond:?} vs bare {bare:?}"
+    );
+}
+
+#[test]
+fn a_materials_own_varnish_and_specular_strength_change_its_reflection() {
+    // Dark, rough plastic: its reflection of the room is most of what it shows.
+    let plastic = |layers: Layers| Material {
+        name: "plastic".into(),
+        base_color: [0.02, 0.02, 0.02, 1.0],
+        metallic: 0.0,
+        roughness: 0.6,
+        layers,
+        ..Material::default()
+    };
+    let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let Some(plain) = seen(GREY, Some(plastic(Layers::default()))) else {
+        return;
+    };
+    let varnished = seen(
+        GREY,
+        Some(plastic(Layers {
+            clear_coat: 1.0,
+            clear_coat_roughness: 0.0,
+            ..Layers::default()
+        })),
+    )
+    .expect("a frame");
+    let unreflecting = seen(
+        GREY,
+        Some(plastic(Layers {
+            specular: 0.0,
+            ..Layers::default()
+        })),
+    )
+    .expect("a frame");
+    println!("dark plastic {plain:?}, varnished {varnished:?}, with no specular {unreflecting:?}");
+    assert!(
+        luminance(varnished) >= luminance(plain) + 2.0,
+        "varnish: {varnished:?} vs {plain:?}"
+    );
+    assert!(
+        luminance(unreflecting) + 2.0 <= luminance(plain),
+        "no specular: {unreflecting:?} vs {plain:?}"
+    );
+}
+
+#[test]
+fn a_transmission_texture_says_where_the_glass_is() {
+    // One texel, as a transmission texture: its red channel scales the factor (linear).
+    let texture = |red: u8| {
+        let image = Image {
+            name: format!("transmission {red}"),
+            width: 1,
+            height: 1,
+            rgba8: vec![red, 0, 0, 255],
+        };
+        let reference = TextureRef {
+            image: 0,
+            tex_coord: 0,
+            transform: Default::default(),
+            sampler: Default::default(),
+        };
+        (image, reference)
+    };
+    let textured = |red: u8| {
+        let (image, reference) = texture(red);
+        let material = Material {
+            transmission_texture: Some(reference),
+            ..glass([1.0; 3], Layers::default())
+        };
+        let (pixels, proj) = render_under_with(RED, Some(material), vec![image])?;
+        let p = pixel_at(&pixels, &proj, BEHIND);
+        Some([p[0] as f32, p[1] as f32, p[2] as f32])
+    };
+    let Some(stopped) = textured(0) else {
+        return;
+    };
+    let passed = textured(255).expect("a frame");
+    let clear = seen(RED, Some(glass([1.0; 3], Layers::default()))).expect("a frame");
+    let opaque_white = Material {
+        layers: Layers::default(),
+        ..glass([1.0; 3], Layers::default())
+    };
+    let opaque = seen(RED, Some(opaque_white)).expect("a frame");
+    println!(
+        "red block under glass: texture 0 {stopped:?} (opaque {opaque:?}), texture 1 {passed:?} (clear {clear:?})"
+    );
+    assert!(
+        largest_difference(stopped, opaque) <= 2.0,
+        "where the texture says 0 the glass is opaque: {stopped:?} vs {opaque:?}"
+    );
+    assert!(
+        largest_difference(passed, clear) <= 1.0,
+        "where it says 1, clear: {passed:?} vs {clear:?}"
+    );
+}
