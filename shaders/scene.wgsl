@@ -65,11 +65,11 @@ struct Material {
     // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended; w: 1 if
     // unlit (KHR_materials_unlit).
     flags: vec4<f32>,
-    // KHR_texture_transform rows for the six slots, in the order above plus emissive and
-    // transmission.
-    transforms: array<vec4<f32>, 12>,
-    // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is; y: UV set
-    // of the transmission texture.
+    // KHR_texture_transform rows for the seven slots, in the order above plus emissive,
+    // transmission and thickness.
+    transforms: array<vec4<f32>, 14>,
+    // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is; y, z: UV
+    // sets of the transmission and thickness textures.
     scene: vec4<f32>,
     // glTF's material extensions (assets crate, `model::layers`). x: transmission; y: specular
     // strength; z: clear coat; w: its roughness.
@@ -91,6 +91,7 @@ override HAS_NORMAL_TEXTURE: bool = true;
 override HAS_OCCLUSION_TEXTURE: bool = true;
 override HAS_EMISSIVE_TEXTURE: bool = true;
 override HAS_TRANSMISSION_TEXTURE: bool = true;
+override HAS_THICKNESS_TEXTURE: bool = true;
 override ALPHA_MASK: bool = true;
 // A pipeline for the draws of a cross-fade between levels (`vs_fade`; render crate, `fades`).
 override FADE: bool = false;
@@ -129,6 +130,9 @@ override TRANSMIT_LAYER: u32 = 0u;
 // KHR_materials_transmission: red scales the share of light let through.
 @group(1) @binding(11) var transmission_texture: texture_2d<f32>;
 @group(1) @binding(12) var transmission_sampler: sampler;
+// KHR_materials_volume: green scales the volume's thickness.
+@group(1) @binding(13) var thickness_texture: texture_2d<f32>;
+@group(1) @binding(14) var thickness_sampler: sampler;
 
 struct VsIn {
     @location(0) position: vec3<f32>,
@@ -478,6 +482,10 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     if (HAS_TRANSMISSION_TEXTURE) {
         transmission_sample = textureSample(transmission_texture, transmission_sampler, slot_uv(5u, material.scene.y, in.uv));
     }
+    var thickness_sample = vec4<f32>(1.0);
+    if (HAS_THICKNESS_TEXTURE) {
+        thickness_sample = textureSample(thickness_texture, thickness_sampler, slot_uv(6u, material.scene.z, in.uv));
+    }
 
     var s: Surface;
     let base_rgba = in.color * material.base_color * base_sample;
@@ -513,7 +521,7 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     s.coat = material.layers.z;
     s.coat_roughness = material.layers.w;
     s.transmission = material.layers.x * transmission_sample.r;
-    s.optical_depth = material.volume.rgb;
+    s.optical_depth = material.volume.rgb * thickness_sample.g;
     s.inv_ior = material.volume.w;
     return s;
 }

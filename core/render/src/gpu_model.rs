@@ -90,9 +90,9 @@ impl GpuModel {
 pub(crate) struct MaterialVariant {
     pub(crate) double_sided: bool,
     pub(crate) blend: bool,
-    /// Base colour, metallic-roughness, normal, occlusion, emissive, transmission: sampled or
-    /// not.
-    pub(crate) textures: [bool; 6],
+    /// Base colour, metallic-roughness, normal, occlusion, emissive, transmission, thickness:
+    /// sampled or not.
+    pub(crate) textures: [bool; 7],
     /// Alpha mask: the shader may discard (which also costs early depth testing).
     pub(crate) mask: bool,
     /// The pipeline of a cross-fade's draws (`vs_fade`, the per-instance fade, and a
@@ -173,11 +173,12 @@ impl MaterialVariant {
 }
 
 /// Names of the `override` constants in `scene.wgsl`, in [`MaterialVariant::textures`] order.
-pub(crate) const TEXTURE_OVERRIDES: [&str; 6] = [
+pub(crate) const TEXTURE_OVERRIDES: [&str; 7] = [
     "HAS_BASE_TEXTURE",
     "HAS_METALLIC_ROUGHNESS_TEXTURE",
     "HAS_NORMAL_TEXTURE",
     "HAS_OCCLUSION_TEXTURE",
     "HAS_EMISSIVE_TEXTURE",
     "HAS_TRANSMISSION_TEXTURE",
+    "HAS_THICKNESS_TEXTURE",
 ];

@@ -68,7 +68,7 @@ pub(crate) struct MaterialUniform {
     pub(crate) params: [f32; 4],
     pub(crate) uv_sets: [f32; 4],
     pub(crate) flags: [f32; 4],
-    pub(crate) transforms: [[f32; 4]; 12],
+    pub(crate) transforms: [[f32; 4]; 14],
     pub(crate) scene: [f32; 4],
     pub(crate) layers: [f32; 4],
     pub(crate) dielectric: [f32; 4],
@@ -84,8 +84,9 @@ impl MaterialUniform {
             m.occlusion_texture.map(|(t, _)| t),
             m.emissive_texture,
             m.transmission_texture,
+            m.thickness_texture,
         ];
-        let mut transforms = [[0.0; 4]; 12];
+        let mut transforms = [[0.0; 4]; 14];
         for (i, slot) in slots.iter().enumerate() {
             let rows = slot.map(|t| t.transform).unwrap_or_default().rows();
             transforms[2 * i] = [rows[0][0], rows[0][1], rows[0][2], 0.0];
@@ -121,7 +122,7 @@ impl MaterialUniform {
                 f32::from(u8::from(m.unlit)),
             ],
             transforms,
-            scene: [f32::from(u8::from(m.scenery)), set(slots[5]), 0.0, 0.0],
+            scene: [f32::from(u8::from(m.scenery)), set(slots[5]), set(slots[6]), 0.0],
             layers: [
                 if m.unlit { 0.0 } else { l.transmission },
                 l.specular,

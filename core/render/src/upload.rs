@@ -177,6 +177,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                 (m.occlusion_texture.map(|(t, _)| t), false, &white),
                 (m.emissive_texture, true, &white),
                 (m.transmission_texture, false, &white),
+                (m.thickness_texture, false, &white),
             ];
             let samplers: Vec<wgpu::Sampler> = slots
                 .iter()
@@ -186,7 +187,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                 binding: 0,
                 resource: uniform.as_entire_binding(),
             }];
-            let mut textures = [false; 6];
+            let mut textures = [false; 7];
             for (i, (t, srgb, fallback)) in slots.iter().enumerate() {
                 let found = t.and_then(|t| views.get(&(t.image, *srgb)));
                 textures[i] = found.is_some();

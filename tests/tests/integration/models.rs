@@ -234,8 +234,8 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
 }
 
 /// Glass, gems and varnish: each material extension's factors reach the material, the
-/// transmission texture too, another texture they name is reported (not read), and a file
-/// requiring them loads.
+/// transmission and thickness textures too, another texture they name is reported (not read),
+/// and a file requiring them loads.
 #[test]
 fn material_extensions_reach_the_material() {
     let dir = scratch("gltf-layers");
@@ -252,7 +252,7 @@ fn material_extensions_reach_the_material() {
           "KHR_materials_volume":{{"thicknessFactor":0.02,"thicknessTexture":{{"index":0}},"attenuationDistance":0.05,"attenuationColor":[0.9,0.5,0.1]}},
           "KHR_materials_ior":{{"ior":1.54}},
           "KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]}},
-          "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1}}}}}}]"#
+          "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}}}}}}}}]"#
         ),
     );
     let model = load_gltf(&path).unwrap();
@@ -276,12 +276,15 @@ fn material_extensions_reach_the_material() {
     );
     assert_eq!(l.attenuation_color, [0.9, 0.5, 0.1]);
     assert_eq!(l.specular_color, [1.0, 0.9, 0.8]);
-    // The transmission texture is read (which parts are glass); the thickness texture is named.
+    // The transmission and thickness textures are read (which parts are glass, how thick); the
+    // varnish's texture is named.
     let texture = amber.transmission_texture.expect("the transmission texture");
     assert_eq!((texture.image, texture.tex_coord), (0, 1));
+    let thickness = amber.thickness_texture.expect("the thickness texture");
+    assert_eq!((thickness.image, thickness.tex_coord), (0, 0));
     let named: Vec<&String> = model.warnings.iter().filter(|w| w.contains("amber")).collect();
     assert!(
-        named.len() == 1 && named[0].contains("thicknessTexture"),
+        named.len() == 1 && named[0].contains("clearcoatTexture"),
         "{:?}",
         model.warnings
     );

@@ -252,3 +252,52 @@ fn a_transmission_texture_says_where_the_glass_is() {
         "where it says 1, clear: {passed:?} vs {clear:?}"
     );
 }
+
+#[test]
+fn a_thickness_texture_thins_the_volume() {
+    let amber = [1.0, 0.4, 0.1];
+    let volume = Layers {
+        thickness: 0.01,
+        attenuation_distance: 0.01,
+        attenuation_color: amber,
+        ..Layers::default()
+    };
+    // One texel, as a thickness texture: its green channel scales the thickness (linear).
+    let thinned = |green: u8| {
+        let image = Image {
+            name: format!("thickness {green}"),
+            width: 1,
+            height: 1,
+            rgba8: vec![0, green, 0, 255],
+        };
+        let material = Material {
+            thickness_texture: Some(TextureRef {
+                image: 0,
+                tex_coord: 0,
+                transform: Default::default(),
+                sampler: Default::default(),
+            }),
+            ..glass([1.0; 3], volume)
+        };
+        let (pixels, proj) = render_under_with(GREY, Some(material), vec![image])?;
+        let p = pixel_at(&pixels, &proj, BEHIND);
+        Some([p[0] as f32, p[1] as f32, p[2] as f32])
+    };
+    let Some(none) = thinned(0) else {
+        return;
+    };
+    let whole = thinned(255).expect("a frame");
+    let clear = seen(GREY, Some(glass([1.0; 3], Layers::default()))).expect("a frame");
+    let absorbed = seen(GREY, Some(glass([1.0; 3], volume))).expect("a frame");
+    println!(
+        "grey block under a volume: texture 0 {none:?} (clear {clear:?}), texture 1 {whole:?} (full thickness {absorbed:?})"
+    );
+    assert!(
+        largest_difference(none, clear) <= 1.0,
+        "no thickness absorbs nothing: {none:?} vs {clear:?}"
+    );
+    assert!(
+        largest_difference(whole, absorbed) <= 1.0,
+        "the full thickness: {whole:?} vs {absorbed:?}"
+    );
+}

@@ -8,10 +8,12 @@
 //! range its extension allows (a value outside it is clamped, with a warning). The defaults are
 //! glTF's core material: none of the layers, an index of 1.5.
 //!
-//! Of their textures only `transmissionTexture` is read (by the loader, into
-//! [`super::Material::transmission_texture`]): it says which parts of a surface are glass, and
-//! without it a lantern's frame would be as clear as its panes. The others are named in a
-//! warning and left out: their factors alone give a varnish its gloss and a volume its colour,
+//! Of their textures, `transmissionTexture` and `thicknessTexture` are read (by the loader, into
+//! [`super::Material::transmission_texture`] and [`super::Material::thickness_texture`]): the
+//! first says which parts of a surface are glass (without it a lantern's frame would be as clear
+//! as its panes), the second where a volume is thinner than its factor (without it a glass
+//! figure's thin fingers would be as dark as its body). The others are named in a warning and
+//! left out: their factors alone give a varnish its gloss and a specular layer its strength,
 //! which is what those textures modulate.
 //!
 //! Pure data; no panics.
@@ -174,7 +176,6 @@ impl Layers {
             if let Some(c) = reader.color(e, name, "attenuationColor") {
                 layers.attenuation_color = c.map(|c| reader.clamped(name, "attenuationColor", c, 0.0, 1.0));
             }
-            reader.textures(e, name, &["thicknessTexture"]);
         }
         layers
     }
@@ -332,13 +333,15 @@ mod tests {
             "KHR_materials_ior": { "ior": 0 },
             "KHR_materials_specular": { "specularColorFactor": [0.5, 0.25, 2.0] },
             "KHR_materials_transmission": { "transmissionFactor": 0.5, "transmissionTexture": { "index": 0 } },
-            "KHR_materials_volume": { "thicknessFactor": 0.5, "thicknessTexture": { "index": 0 } }
+            "KHR_materials_volume": { "thicknessFactor": 0.5, "thicknessTexture": { "index": 0 } },
+            "KHR_materials_clearcoat": { "clearcoatFactor": 0.5, "clearcoatNormalTexture": { "index": 0 } }
         }));
         assert_eq!(layers.dielectric_f0(), [0.5, 0.25, 1.0]);
         assert!(!layers.fresnel_rises());
         assert!(Layers::default().fresnel_rises());
-        // The transmission texture is the loader's to read; the thickness texture is named.
+        // The transmission and thickness textures are the loader's to read; the varnish's
+        // normal map is named.
         assert_eq!(warnings.len(), 1, "{warnings:?}");
-        assert!(warnings[0].contains("thicknessTexture"), "{warnings:?}");
+        assert!(warnings[0].contains("clearcoatNormalTexture"), "{warnings:?}");
     }
 }

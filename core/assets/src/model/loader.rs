@@ -590,8 +590,9 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
         normal_texture,
         occlusion_texture,
         emissive_texture,
-        // Read with the document's textures (`transmission_texture`).
+        // Read with the document's textures (`extension_texture`).
         transmission_texture: None,
+        thickness_texture: None,
         scenery: false,
         layers,
     }
@@ -691,17 +692,19 @@ fn texture_of_info(
     texture_ref(&t, info.tex_coord, transform, what, warnings).filter(|r| r.image < image_count)
 }
 
-/// `KHR_materials_transmission`'s texture (`value`, the extension's object) of `material`; a
-/// malformed one is left out with a warning.
-fn transmission_texture(
+/// The texture under `key` in a material extension's object (`value`) of `material` (`slot`
+/// names it in warnings); a malformed one is left out with a warning.
+fn extension_texture(
     material: &Material,
     value: &serde_json::Value,
+    key: &str,
+    slot: &str,
     doc: &gltf::Document,
     image_count: usize,
     warnings: &mut Vec<String>,
 ) -> Option<TextureRef> {
-    let what = format!("material {}, transmission texture", material.name);
-    match TextureInfo::read(value, "transmissionTexture") {
+    let what = format!("material {}, {slot} texture", material.name);
+    match TextureInfo::read(value, key) {
         Ok(info) => texture_of_info(doc, &info?, &what, image_count, warnings),
         Err(e) => {
             warnings.push(format!("{what}: {e}; left out"));
@@ -1520,7 +1523,26 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     for m in doc.materials() {
         let mut material = material_of(&m, &mut warnings);
         if let Some(value) = m.extension_value("KHR_materials_transmission") {
-            material.transmission_texture = transmission_texture(&material, value, doc, images.len(), &mut warnings);
+            material.transmission_texture = extension_texture(
+                &material,
+                value,
+                "transmissionTexture",
+                "transmission",
+                doc,
+                images.len(),
+                &mut warnings,
+            );
+        }
+        if let Some(value) = m.extension_value("KHR_materials_volume") {
+            material.thickness_texture = extension_texture(
+                &material,
+                value,
+                "thicknessTexture",
+                "thickness",
+                doc,
+                images.len(),
+                &mut warnings,
+            );
         }
         if let Some(value) = m.extension_value("KHR_materials_pbrSpecularGlossiness") {
             with_spec_gloss(&mut material, value, doc, &mut images, &ctx.spending, &mut warnings)

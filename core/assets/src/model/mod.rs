@@ -31,8 +31,8 @@
 //!   Where a texture names both, the core `source` (the lossless fallback) is used. A texture
 //!   whose image comes only from an extension we do not read is left out with a warning.
 //! * Glass, gems and varnish by their factors: `KHR_materials_ior`, `_specular`, `_clearcoat`,
-//!   `_transmission` and `_volume` ([`Layers`]; of their textures the transmission texture is
-//!   read, the others are left out with a warning each).
+//!   `_transmission` and `_volume` ([`Layers`]; of their textures the transmission and thickness
+//!   textures are read, the others are left out with a warning each).
 //! * `KHR_materials_pbrSpecularGlossiness` (archived by Khronos, but found in older exports) is
 //!   converted to metallic–roughness as Khronos published, texel by texel where it has a texture
 //!   (`spec_gloss`).
@@ -289,6 +289,9 @@ pub struct Material {
     /// `KHR_materials_transmission`'s texture: its red channel scales [`Layers::transmission`]
     /// (linear), saying which parts of the surface let light through.
     pub transmission_texture: Option<TextureRef>,
+    /// `KHR_materials_volume`'s texture: its green channel scales [`Layers::thickness`]
+    /// (linear), where the volume is thinner than its thickest.
+    pub thickness_texture: Option<TextureRef>,
     /// `KHR_materials_unlit`: shown in its base colour, without lighting (scans whose lighting
     /// is baked into their colour).
     pub unlit: bool,
@@ -317,6 +320,7 @@ impl Default for Material {
             occlusion_texture: None,
             emissive_texture: None,
             transmission_texture: None,
+            thickness_texture: None,
             unlit: false,
             scenery: false,
             layers: Layers::default(),
@@ -366,6 +370,7 @@ impl Material {
             self.occlusion_texture.map(|(t, _)| (t, false)),
             self.emissive_texture.map(|t| (t, true)),
             self.transmission_texture.map(|t| (t, false)),
+            self.thickness_texture.map(|t| (t, false)),
         ]
         .into_iter()
         .flatten()
