@@ -95,6 +95,9 @@ override HAS_THICKNESS_TEXTURE: bool = true;
 override ALPHA_MASK: bool = true;
 // A pipeline for the draws of a cross-fade between levels (`vs_fade`; render crate, `fades`).
 override FADE: bool = false;
+// Whether the material has any of glTF's extension layers (index, specular, varnish,
+// transmission, volume); without, the core material's constants.
+override HAS_LAYERS: bool = true;
 // What the draw writes (render crate, `DrawLayer`): 0 the whole surface; for a surface light
 // passes through, 1 the factor what is behind it is multiplied by, 2 the light it adds.
 override TRANSMIT_LAYER: u32 = 0u;
@@ -515,14 +518,20 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     s.emissive = material.emissive.rgb * emissive_sample.rgb;
     s.unlit = material.flags.w > 0.5;
     s.scenery = material.scene.x > 0.5;
-    s.f0_dielectric = material.dielectric.rgb;
-    s.fresnel_rises = material.dielectric.w > 0.5;
-    s.specular_weight = material.layers.y;
-    s.coat = material.layers.z;
-    s.coat_roughness = material.layers.w;
-    s.transmission = material.layers.x * transmission_sample.r;
-    s.optical_depth = material.volume.rgb * thickness_sample.g;
-    s.inv_ior = material.volume.w;
+    if (HAS_LAYERS) {
+        s.f0_dielectric = material.dielectric.rgb;
+        s.fresnel_rises = material.dielectric.w > 0.5;
+        s.specular_weight = material.layers.y;
+        s.coat = material.layers.z;
+        s.coat_roughness = material.layers.w;
+        s.transmission = material.layers.x * transmission_sample.r;
+        s.optical_depth = material.volume.rgb * thickness_sample.g;
+        s.inv_ior = material.volume.w;
+    } else {
+        // Constants the compiler folds into the shading: the core material costs what it did
+        // before the extensions.
+        core_layers(&s);
+    }
     return s;
 }
 

@@ -101,6 +101,9 @@ pub(crate) struct MaterialVariant {
     /// What the draw writes: the whole surface, or one of the two layers of a surface that
     /// light passes through (`KHR_materials_transmission`).
     pub(crate) layer: DrawLayer,
+    /// Whether the material has any of glTF's extension layers; without, the shader uses the
+    /// core material's constants (`HAS_LAYERS`), which its compiler folds away.
+    pub(crate) layers: bool,
 }
 
 /// A surface that transmits light changes what is behind it in two ways, which one blend

@@ -68,7 +68,7 @@ use wgpu::util::DeviceExt;
 
 pub use phantogram_assets::appearance::Appearance;
 pub use phantogram_assets::model::LevelFade;
-use phantogram_assets::model::{AlphaMode, Model, Sampler, Wrap};
+use phantogram_assets::model::{AlphaMode, Layers, Model, Sampler, Wrap};
 pub use phantogram_assets::ward;
 use phantogram_assets::ward::WardMap;
 use phantogram_geometry::anaglyph::Method;

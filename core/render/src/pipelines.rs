@@ -107,6 +107,7 @@ impl ScenePipelines {
         constants.push(("ALPHA_MASK", flag(v.mask)));
         constants.push(("FADE", flag(v.fade)));
         constants.push(("TRANSMIT_LAYER", v.layer.shader_constant()));
+        constants.push(("HAS_LAYERS", flag(v.layers)));
         let fade_attributes = FADE_ATTRIBUTES;
         let plain = [Some(vertex_buffer(&vertex_attributes))];
         let fading = [

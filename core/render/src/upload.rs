@@ -218,6 +218,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     mask: matches!(m.alpha, AlphaMode::Mask(_)),
                     fade: false,
                     layer: if transmits { DrawLayer::Light } else { DrawLayer::Whole },
+                    layers: m.layers != Layers::default(),
                 },
                 _uniform: uniform,
             }
