@@ -118,6 +118,10 @@ override TRANSMIT_LAYER: u32 = 0u;
 // the scale of ρd over 2 (a); tiled along the tangent frame, repeating sampler.
 @group(0) @binding(7) var ward_map: texture_2d<f32>;
 @group(0) @binding(8) var ward_sampler: sampler;
+// What glass between the light and a surface leaves of the light (render crate,
+// `shadow_filter`): rgb the share passed, alpha the light-space depth of the nearest glass. Read
+// only where `eye.shadow.w` says it holds this frame's glass.
+@group(0) @binding(9) var shadow_filter: texture_2d<f32>;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_texture: texture_2d<f32>;
@@ -203,6 +207,31 @@ fn fs_shadow_masked(in: ShadowMaskedOut) {
     }
 }
 
+// The shadow filter of a surface that lets light through (render crate, `shadow_filter`): the
+// share of the light it passes at normal incidence (its transmission, less what its dielectric
+// and varnish reflect, tinted by its base colour and absorbed across its volume's thickness;
+// where alpha is coverage, the light passes beside it), multiplied into the map by the blend;
+// and its light-space depth, of which the blend keeps the nearest.
+@fragment
+fn fs_shadow_filter(in: ShadowMaskedOut) -> @location(0) vec4<f32> {
+    let base = in.color * material.base_color
+        * textureSample(base_texture, base_sampler, slot_uv(0u, material.uv_sets.x, in.uv));
+    let mr = textureSample(mr_texture, mr_sampler, slot_uv(1u, material.uv_sets.y, in.uv));
+    let transmitted = textureSample(transmission_texture, transmission_sampler, slot_uv(5u, material.scene.y, in.uv));
+    let thickness = textureSample(thickness_texture, thickness_sampler, slot_uv(6u, material.scene.z, in.uv));
+    if (material.params.z >= 0.0 && base.a < material.params.z) {
+        discard;
+    }
+    let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
+    let transmission = material.layers.x * transmitted.r * (1.0 - metallic);
+    let reflected = material.layers.y * material.dielectric.rgb;
+    let coat = 0.04 * material.layers.z;
+    let through = transmission * (vec3<f32>(1.0) - reflected) * (1.0 - coat) * base.rgb
+        * exp(-material.volume.rgb * thickness.g);
+    let coverage = select(1.0, base.a, material.flags.z > 0.5);
+    return vec4<f32>(vec3<f32>(1.0 - coverage) + coverage * through, in.clip.z);
+}
+
 @vertex
 fn vs_main(v: VsIn) -> VsOut {
     return vertex_out(v);
@@ -277,24 +306,50 @@ fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     if (eye.shadow.y < 0.5) {
         return 1.0;
     }
+    let p = shadow_map_point(world, n, l);
+    // The map covers the casters only (render.rs, `shadow_casters`): a receiver outside it is lit,
+    // and one beyond its far plane (the floor under a long shadow) lies behind every caster there,
+    // so it is compared at the far plane.
+    if (p.w < 0.5) {
+        return 1.0;
+    }
+    return shadow_pcf(p.xy, min(p.z, 1.0));
+}
+
+// Where `world` (with normal `n`, lit from `l`) falls in the light's shadow map: uv in xy, its
+// depth in z, w 1 when inside the map. Offset along the normal by a texel and more at grazing
+// light, against acne.
+fn shadow_map_point(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec4<f32> {
     let texel = eye.shadow.x;
     let n_dot_l = clamp(dot(n, l), 0.05, 1.0);
     let offset = n * texel * (1.5 + 2.0 * sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l);
     let clip = eye.light_view_proj * vec4<f32>(world + offset, 1.0);
     // Behind a lamp's shadow view: outside its cone, lit by nothing it could shadow.
     if (clip.w <= 1e-6) {
-        return 1.0;
+        return vec4<f32>(0.0);
     }
     // The directional light's view is orthographic (w = 1), a lamp's perspective.
     let p = clip.xyz / clip.w;
     let uv = vec2<f32>(p.x * 0.5 + 0.5, 0.5 - p.y * 0.5);
-    // The map covers the casters only (render.rs, `shadow_casters`): a receiver outside it is lit,
-    // and one beyond its far plane (the floor under a long shadow) lies behind every caster there,
-    // so it is compared at the far plane.
-    if (any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0))) {
-        return 1.0;
+    let inside = all(uv >= vec2<f32>(0.0)) && all(uv <= vec2<f32>(1.0));
+    return vec4<f32>(uv, p.z, select(0.0, 1.0, inside));
+}
+
+// The share of the light that the glass between the light and `world` leaves (render crate,
+// `shadow_filter`): 1 where none stands nearer the light than the surface (the glass's own
+// surface facing the light included), or where the frame has no filter.
+fn light_filter(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    if (eye.shadow.w < 0.5) {
+        return vec3<f32>(1.0);
     }
-    return shadow_pcf(uv, min(p.z, 1.0));
+    let p = shadow_map_point(world, n, l);
+    if (p.w < 0.5) {
+        return vec3<f32>(1.0);
+    }
+    let size = vec2<f32>(textureDimensions(shadow_filter));
+    let texel = vec2<i32>(clamp(p.xy * size, vec2<f32>(0.0), size - vec2<f32>(1.0)));
+    let f = textureLoad(shadow_filter, texel, 0);
+    return select(vec3<f32>(1.0), f.rgb, p.z > f.a);
 }
 
 // The depth a cube face stores for a point `major` metres along its axis (point_shadow.rs,
@@ -615,7 +670,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let n_dot_v = max(dot(n, v), 1e-4);
     let n_dot_h = max(dot(n, h), 0.0);
     let v_dot_h = max(dot(v, h), 0.0);
-    let light_in = light_rgb * n_dot_l * light_visibility(world, s.geometric_n, l);
+    let light_in = light_rgb * n_dot_l * light_visibility(world, s.geometric_n, l) * light_filter(world, s.geometric_n, l);
     let occlusion = s.occlusion;
     let reflected = to_world(reflect(-v, n));
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));

@@ -33,6 +33,8 @@ pub(crate) struct EyeViews<'a> {
     pub(crate) shadow: &'a wgpu::TextureView,
     pub(crate) shadow_sampler: &'a wgpu::Sampler,
     pub(crate) shadow_cube: &'a wgpu::TextureView,
+    /// What glass leaves of the light (`shadow_filter`).
+    pub(crate) shadow_filter: &'a wgpu::TextureView,
     pub(crate) ward_map: &'a wgpu::TextureView,
     pub(crate) ward_sampler: &'a wgpu::Sampler,
 }
@@ -100,6 +102,10 @@ pub(crate) fn eye_bind_group(
             wgpu::BindGroupEntry {
                 binding: 8,
                 resource: wgpu::BindingResource::Sampler(views.ward_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 9,
+                resource: wgpu::BindingResource::TextureView(views.shadow_filter),
             },
         ],
     })

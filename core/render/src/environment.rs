@@ -145,6 +145,7 @@ impl Renderer {
             shadow: &self.shadow_view,
             shadow_sampler: &self.shadow_sampler,
             shadow_cube: &self.point_shadow.cube_view,
+            shadow_filter: &self.shadow_filter.view,
             ward_map: &self.ward_map.1,
             ward_sampler: &self.ward_sampler,
         }

@@ -2,13 +2,13 @@
 //! composition, and the ways to ask for a frame (offscreen, side by side, into a view).
 
 use crate::{
-    CLEAR_RADIANCE, FrameInput, OUTPUT_FORMAT, RenderError, Renderer, checked,
+    CLEAR_RADIANCE, FrameInput, OUTPUT_FORMAT, RenderError, Renderer, SHADOW_SIZE, checked,
     gpu::Gpu,
-    gpu_model::{GpuPrimitive, MaterialVariant},
+    gpu_model::{DrawLayer, GpuPrimitive, MaterialVariant},
     impostor::{self, IMPOSTOR_LEVEL},
     lights::{Lamp, lamp_view_proj, light_view_proj},
     pipelines::create_compose_pipeline,
-    point_shadow,
+    point_shadow, shadow_filter,
     targets::{Offscreen, read_back},
     uniforms::{ComposeUniform, EyeUniform},
 };
@@ -242,6 +242,41 @@ impl Renderer {
                 faces = Some(views);
             }
         }
+        // Glass filters the light of one view (not a lamp's cube): drawn after the shadows.
+        let mut filter_pass = self.lighting.shadows
+            && cube.is_none()
+            && self
+                .model
+                .primitives
+                .iter()
+                .any(|p| self.model.materials[p.material].variant.layer == DrawLayer::Light);
+        if filter_pass && self.shadow_filter.size < SHADOW_SIZE {
+            let device = self.gpu.device.clone();
+            // A device that cannot make it: glass casts no shadow (as before the filter) and the
+            // frames go on.
+            match checked(&device, "the shadow filter of glass", || {
+                shadow_filter::ShadowFilter::new(&device, SHADOW_SIZE)
+            }) {
+                Ok(made) => {
+                    self.shadow_filter = made;
+                    self.remake_eye_binds();
+                }
+                Err(_) => filter_pass = false,
+            }
+        }
+        if filter_pass {
+            let device = self.gpu.device.clone();
+            let (module, layout) = (&self.scene.module, &self.scene.shadow_masked_layout);
+            filter_pass = checked(&device, "the shadow filter's pipeline", || {
+                self.shadow_filter.prepare(&device, module, layout)
+            })
+            .is_ok();
+        }
+        if filter_pass {
+            for u in &mut uniforms {
+                u.shadow[3] = 1.0;
+            }
+        }
         let (lm, rm) = method.matrices();
         let row = |m: [f32; 3]| [m[0], m[1], m[2], 0.0];
         let compose = ComposeUniform {
@@ -296,6 +331,30 @@ impl Renderer {
                 });
                 shadow_triangles +=
                     self.draw_shadow_casters(&mut pass, bind, &shadow_levels, floor_casts, cull.as_ref());
+            }
+            if let Some(pipeline) = self.shadow_filter.pipeline().filter(|_| filter_pass) {
+                let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("shadow filter"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &self.shadow_filter.view,
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Clear(shadow_filter::NOTHING_FILTERED),
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    ..Default::default()
+                });
+                pass.set_pipeline(pipeline);
+                pass.set_bind_group(0, &self.shadow_bind, &[]);
+                for p in &self.model.primitives {
+                    let m = &self.model.materials[p.material];
+                    if m.variant.layer == DrawLayer::Light {
+                        pass.set_bind_group(1, &m.bind, &[]);
+                        p.draw(&mut pass, &shadow_levels);
+                    }
+                }
             }
         }
         self.shadow_triangles = shadow_triangles;

@@ -15,7 +15,10 @@
 //!    every surface; alpha-masked materials are cut out as in the scene pass (their shadows have
 //!    the holes they have), blended and transmissive ones cast none. A [`Lamp`] in its place is
 //!    seen from one perspective view, or, standing among what it shadows, from the six faces of
-//!    a cube ([`point_shadow`]: six passes of 512² texels).
+//!    a cube ([`point_shadow`]: six passes of 512² texels). Then, where the model has glass and
+//!    the light one view, the shadow filter: the transmissive surfaces drawn from the light into
+//!    a colour map of the share of the light they pass and the depth of the nearest
+//!    (`shadow_filter`), so that glass casts a pale shadow and tinted glass a coloured one.
 //! 2. Scene pass per eye into a linear HDR target (`Rgba16Float`) with reverse-Z depth
 //!    (`Depth32Float`, cleared to 0, compare `Greater`): the core's projections map near to 1.
 //!    Opaque and masked primitives first, then blended ones back to front (depth test, no depth
@@ -86,6 +89,7 @@ mod lights;
 mod pipelines;
 pub mod point_shadow;
 pub mod prefilter_gpu;
+mod shadow_filter;
 pub mod surface;
 mod targets;
 mod uniforms;
@@ -215,6 +219,8 @@ pub struct Renderer {
     shadow_layout: wgpu::BindGroupLayout,
     /// The shadows of a lamp among its casters ([`point_shadow`]).
     point_shadow: point_shadow::PointShadowMap,
+    /// What glass between the light and a surface leaves of the light (`shadow_filter`).
+    shadow_filter: shadow_filter::ShadowFilter,
     /// Triangles the last frame's shadow passes drew (all faces of a lamp's cube together).
     shadow_triangles: u64,
     /// Why the lamp's cube could not be made, if it could not ([`Renderer::lamp_cube_error`]).
@@ -344,6 +350,7 @@ impl Renderer {
                     ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
                     count: None,
                 },
+                texture_entry(9),
             ],
         });
         let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -378,6 +385,8 @@ impl Renderer {
         });
         // 1×1 a face until a lamp stands among its casters (see `point_shadow`).
         let point_shadow = point_shadow::PointShadowMap::new(device, &shadow_layout, 1);
+        // 1×1 until a model with glass is drawn with shadows.
+        let shadow_filter = shadow_filter::ShadowFilter::new(device, 1);
         let ward_map = (WardMap::Uniform, upload_ward_map(&gpu, WardMap::Uniform));
         let ward_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("Ward map"),
@@ -396,6 +405,7 @@ impl Renderer {
                 shadow: &shadow_view,
                 shadow_sampler: &shadow_sampler,
                 shadow_cube: &point_shadow.cube_view,
+                shadow_filter: &shadow_filter.view,
                 ward_map: &ward_map.1,
                 ward_sampler: &ward_sampler,
             },
@@ -523,6 +533,7 @@ impl Renderer {
             shadow_view,
             shadow_layout,
             point_shadow,
+            shadow_filter,
             shadow_triangles: 0,
             lamp_cube_error: None,
             ward_map,

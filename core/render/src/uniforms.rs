@@ -16,7 +16,8 @@ pub(crate) struct EyeUniform {
     pub(crate) light: [f32; 4],
     pub(crate) world_from_device: [[f32; 4]; 3],
     pub(crate) light_view_proj: [[f32; 4]; 4],
-    /// Texel size (metres) and on/off of the shadow map; the angle a pixel subtends (radians).
+    /// Texel size (metres) and on/off of the shadow map; the angle a pixel subtends (radians);
+    /// 1 when the shadow filter holds this frame's glass (`shadow_filter`).
     pub(crate) shadow: [f32; 4],
     pub(crate) sh: [[f32; 4]; 9],
     /// The artifact's [`Appearance`], as `Appearance` in `scene.wgsl` lays it out.

@@ -1,7 +1,8 @@
 //! glTF's material extensions on the GPU (the assets crate's `model::layers`, `scene.wgsl`'s
 //! `shade_surface` and the render crate's `DrawLayer`): glass shows what is behind it, filtered by
-//! its base colour or absorbed by its volume, an index of refraction of 1 reflects nothing, and a
-//! material's own varnish and specular strength change its reflection.
+//! its base colour or absorbed by its volume, an index of refraction of 1 reflects nothing, a
+//! material's own varnish and specular strength change its reflection, and glass casts the
+//! shadow it should: pale when clear, coloured when tinted (the render crate's `shadow_filter`).
 //!
 //! Each scene: a block on the floor, seen straight on from 30 cm, and a second block of the
 //! material under test floating over it; the pixel at the centre looks through the upper block's
@@ -299,5 +300,60 @@ fn a_thickness_texture_thins_the_volume() {
     assert!(
         largest_difference(whole, absorbed) <= 1.0,
         "the full thickness: {whole:?} vs {absorbed:?}"
+    );
+}
+
+/// The floor's pixels (RGB) in the shadow of a block of `material` 15 mm above it and at the
+/// mirror point across the block, lit: the oblique light puts the shadow's centre 7.5 mm
+/// towards −x.
+fn shadow_and_lit(material: Material) -> Option<([f32; 3], [f32; 3])> {
+    let mut marker = Mesh::default();
+    push_floor_marker(&mut marker);
+    let mut model = Model::from_painted_mesh("glass shadow", marker);
+    let mut block = Mesh::default();
+    block.push_cube(Vec3::new(0.0, 0.0, -0.015), 0.004, [1.0; 4]);
+    model.materials.push(material);
+    model.primitives.push(Primitive {
+        mesh: block,
+        material: model.materials.len() - 1,
+        is_floor: false,
+        lods: Vec::new(),
+    });
+    let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
+    let rgb = |p: Vec3| {
+        let c = pixel_at(&pixels, &proj, p);
+        [c[0] as f32, c[1] as f32, c[2] as f32]
+    };
+    Some((rgb(Vec3::new(-0.0075, 0.0, -0.03)), rgb(Vec3::new(0.0075, 0.0, -0.03))))
+}
+
+#[test]
+fn glass_casts_a_pale_shadow_and_tinted_glass_a_coloured_one() {
+    let opaque_white = Material {
+        layers: Layers::default(),
+        ..glass([1.0; 3], Layers::default())
+    };
+    let Some((opaque_shadow, opaque_lit)) = shadow_and_lit(opaque_white) else {
+        return;
+    };
+    let (clear_shadow, clear_lit) = shadow_and_lit(glass([1.0; 3], Layers::default())).expect("a frame");
+    let (red_shadow, red_lit) = shadow_and_lit(glass([1.0, 0.1, 0.1], Layers::default())).expect("a frame");
+    println!(
+        "floor in the shadow / lit: opaque {opaque_shadow:?} / {opaque_lit:?}, clear glass {clear_shadow:?} / {clear_lit:?}, red glass {red_shadow:?} / {red_lit:?}"
+    );
+    let luminance = |c: [f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    assert!(
+        luminance(opaque_shadow) < 0.6 * luminance(opaque_lit),
+        "an opaque block's shadow: {opaque_shadow:?} vs {opaque_lit:?}"
+    );
+    // Clear glass passes most of the light: its shadow is pale, but there.
+    assert!(
+        luminance(clear_shadow) > 0.8 * luminance(clear_lit) && luminance(clear_shadow) < luminance(clear_lit) - 1.0,
+        "clear glass's shadow: {clear_shadow:?} vs {clear_lit:?}"
+    );
+    // Red glass passes red: the shadow keeps the lit floor's red and loses its green and blue.
+    assert!(
+        red_shadow[0] > 0.85 * red_lit[0] && red_shadow[1] < 0.8 * red_lit[1] && red_shadow[2] < 0.8 * red_lit[2],
+        "red glass's shadow: {red_shadow:?} vs {red_lit:?}"
     );
 }

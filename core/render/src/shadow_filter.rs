@@ -1,0 +1,134 @@
+//! What glass does to the light on its way to what stands behind it: a light-space map, beside
+//! the shadow map, of the share of the light the surfaces that let light through
+//! (`KHR_materials_transmission`) pass, per colour, multiplied over all of them, and in alpha the
+//! light-space depth of the nearest, so that what lies between the light and the glass is not
+//! tinted by it. A glass vase then casts a pale shadow, tinted glass a coloured one, where the
+//! depth-only shadow map would give none (transmissive surfaces do not cast there) or a black one.
+//!
+//! Drawn when the frame has transmissive primitives and one view of the light (the directional
+//! light's, or a lamp's single perspective view; a lamp among its casters, seen from a cube, has
+//! no filter: its light passes glass unfiltered). The scene shader reads it by `light_filter`
+//! when the eye block's `shadow.w` says it holds this frame's glass. The share is taken at
+//! normal incidence (the Fresnel loss at the light's angle and the refracted path's length are
+//! not modelled, nor caustics).
+//!
+//! Made 1×1 and grown to the shadow map's size with the first model that needs it (the eyes'
+//! bind groups are remade then). Render thread only, like the renderer; no panics.
+
+use crate::pipelines::{SHADOW_PRIMITIVE, vertex_buffer};
+use phantogram_assets::model::Vertex;
+
+/// Colour: the share of the light passed; alpha: the nearest glass's depth (float for the depth,
+/// and a format every device blends).
+pub(crate) const FILTER_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// Cleared to: all the light passes, and no glass nearer than the far plane.
+pub(crate) const NOTHING_FILTERED: wgpu::Color = wgpu::Color {
+    r: 1.0,
+    g: 1.0,
+    b: 1.0,
+    a: 1.0,
+};
+
+pub(crate) struct ShadowFilter {
+    pub(crate) view: wgpu::TextureView,
+    pub(crate) size: u32,
+    pipeline: Option<wgpu::RenderPipeline>,
+}
+
+impl ShadowFilter {
+    pub(crate) fn new(device: &wgpu::Device, size: u32) -> Self {
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("shadow filter"),
+            size: wgpu::Extent3d {
+                width: size,
+                height: size,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: FILTER_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        Self {
+            view: texture.create_view(&Default::default()),
+            size,
+            pipeline: None,
+        }
+    }
+
+    /// The pipeline that draws a transmissive primitive into the filter, once [`Self::prepare`]
+    /// has made it.
+    pub(crate) fn pipeline(&self) -> Option<&wgpu::RenderPipeline> {
+        self.pipeline.as_ref()
+    }
+
+    /// Makes the pipeline that draws a transmissive primitive into the filter
+    /// (`fs_shadow_filter`), if it is not made yet. `layout`: the light's matrix and a material,
+    /// as the alpha-masked shadow pass has them.
+    pub(crate) fn prepare(
+        &mut self,
+        device: &wgpu::Device,
+        module: &wgpu::ShaderModule,
+        layout: &wgpu::PipelineLayout,
+    ) {
+        self.pipeline.get_or_insert_with(|| {
+            let attributes = [
+                wgpu::VertexAttribute {
+                    format: wgpu::VertexFormat::Float32x3,
+                    offset: std::mem::offset_of!(Vertex, position) as u64,
+                    shader_location: 0,
+                },
+                wgpu::VertexAttribute {
+                    format: wgpu::VertexFormat::Float32x4,
+                    offset: std::mem::offset_of!(Vertex, uv) as u64,
+                    shader_location: 3,
+                },
+                wgpu::VertexAttribute {
+                    format: wgpu::VertexFormat::Float32x4,
+                    offset: std::mem::offset_of!(Vertex, color) as u64,
+                    shader_location: 4,
+                },
+            ];
+            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+                label: Some("shadow filter"),
+                layout: Some(layout),
+                vertex: wgpu::VertexState {
+                    module,
+                    entry_point: Some("vs_shadow_masked"),
+                    compilation_options: Default::default(),
+                    buffers: &[Some(vertex_buffer(&attributes))],
+                },
+                primitive: SHADOW_PRIMITIVE,
+                depth_stencil: None,
+                multisample: Default::default(),
+                fragment: Some(wgpu::FragmentState {
+                    module,
+                    entry_point: Some("fs_shadow_filter"),
+                    compilation_options: Default::default(),
+                    targets: &[Some(wgpu::ColorTargetState {
+                        format: FILTER_FORMAT,
+                        // The shares multiply; the depth keeps the nearest.
+                        blend: Some(wgpu::BlendState {
+                            color: wgpu::BlendComponent {
+                                src_factor: wgpu::BlendFactor::Zero,
+                                dst_factor: wgpu::BlendFactor::Src,
+                                operation: wgpu::BlendOperation::Add,
+                            },
+                            alpha: wgpu::BlendComponent {
+                                src_factor: wgpu::BlendFactor::One,
+                                dst_factor: wgpu::BlendFactor::One,
+                                operation: wgpu::BlendOperation::Min,
+                            },
+                        }),
+                        write_mask: wgpu::ColorWrites::ALL,
+                    })],
+                }),
+                multiview_mask: None,
+                cache: None,
+            })
+        });
+    }
+}
