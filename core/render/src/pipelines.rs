@@ -54,23 +54,7 @@ impl ScenePipelines {
     }
 
     pub(crate) fn create_shadow_masked(&self, device: &wgpu::Device) -> wgpu::RenderPipeline {
-        let attributes = [
-            wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x3,
-                offset: std::mem::offset_of!(Vertex, position) as u64,
-                shader_location: 0,
-            },
-            wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x4,
-                offset: std::mem::offset_of!(Vertex, uv) as u64,
-                shader_location: 3,
-            },
-            wgpu::VertexAttribute {
-                format: wgpu::VertexFormat::Float32x4,
-                offset: std::mem::offset_of!(Vertex, color) as u64,
-                shader_location: 4,
-            },
-        ];
+        let attributes = SHADOW_MASKED_ATTRIBUTES;
         device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("shadow (alpha-masked)"),
             layout: Some(&self.shadow_masked_layout),
@@ -157,6 +141,26 @@ impl ScenePipelines {
         })
     }
 }
+
+/// What `vs_shadow_masked` reads of a [`Vertex`]: position, texture coordinates and colour (the
+/// alpha-masked shadow pass and the shadow filter of glass).
+pub(crate) const SHADOW_MASKED_ATTRIBUTES: [wgpu::VertexAttribute; 3] = [
+    wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x3,
+        offset: std::mem::offset_of!(Vertex, position) as u64,
+        shader_location: 0,
+    },
+    wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x4,
+        offset: std::mem::offset_of!(Vertex, uv) as u64,
+        shader_location: 3,
+    },
+    wgpu::VertexAttribute {
+        format: wgpu::VertexFormat::Float32x4,
+        offset: std::mem::offset_of!(Vertex, color) as u64,
+        shader_location: 4,
+    },
+];
 
 /// The per-instance cross-fade (`vs_fade`, `vs_impostor`): fraction shown and side.
 pub(crate) const FADE_ATTRIBUTES: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![6 => Float32x2];

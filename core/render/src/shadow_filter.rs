@@ -15,8 +15,7 @@
 //! Made 1×1 and grown to the shadow map's size with the first model that needs it (the eyes'
 //! bind groups are remade then). Render thread only, like the renderer; no panics.
 
-use crate::pipelines::{SHADOW_PRIMITIVE, vertex_buffer};
-use phantogram_assets::model::Vertex;
+use crate::pipelines::{SHADOW_MASKED_ATTRIBUTES, SHADOW_PRIMITIVE, vertex_buffer};
 
 /// Colour: the share of the light passed; alpha: the nearest glass's depth (float for the depth,
 /// and a format every device blends).
@@ -75,23 +74,7 @@ impl ShadowFilter {
         layout: &wgpu::PipelineLayout,
     ) {
         self.pipeline.get_or_insert_with(|| {
-            let attributes = [
-                wgpu::VertexAttribute {
-                    format: wgpu::VertexFormat::Float32x3,
-                    offset: std::mem::offset_of!(Vertex, position) as u64,
-                    shader_location: 0,
-                },
-                wgpu::VertexAttribute {
-                    format: wgpu::VertexFormat::Float32x4,
-                    offset: std::mem::offset_of!(Vertex, uv) as u64,
-                    shader_location: 3,
-                },
-                wgpu::VertexAttribute {
-                    format: wgpu::VertexFormat::Float32x4,
-                    offset: std::mem::offset_of!(Vertex, color) as u64,
-                    shader_location: 4,
-                },
-            ];
+            let attributes = SHADOW_MASKED_ATTRIBUTES;
             device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
                 label: Some("shadow filter"),
                 layout: Some(layout),

@@ -16,12 +16,8 @@ use phantogram::projection::OffAxisProjection;
 /// The centre of the lower block's top face, which the upper block hides from the eye.
 const BEHIND: Vec3 = Vec3::new(0.0, 0.0, -0.022);
 
-/// A block of `colour` standing on the floor under `over`'s block (none: nothing over it).
-fn render_under(colour: [f32; 4], over: Option<Material>) -> Option<(Vec<u8>, OffAxisProjection)> {
-    render_under_with(colour, over, Vec::new())
-}
-
-/// [`render_under`], with `images` for `over`'s textures.
+/// A block of `colour` standing on the floor under `over`'s block (none: nothing over it), with
+/// `images` for `over`'s textures.
 fn render_under_with(
     colour: [f32; 4],
     over: Option<Material>,
@@ -48,9 +44,40 @@ fn render_under_with(
 
 /// The pixel at [`BEHIND`] with `over` floating above the block of `colour`.
 fn seen(colour: [f32; 4], over: Option<Material>) -> Option<[f32; 3]> {
-    let (pixels, proj) = render_under(colour, over)?;
+    seen_with(colour, over, Vec::new())
+}
+
+/// [`seen`], with `images` for `over`'s textures.
+fn seen_with(colour: [f32; 4], over: Option<Material>, images: Vec<Image>) -> Option<[f32; 3]> {
+    let (pixels, proj) = render_under_with(colour, over, images)?;
     let p = pixel_at(&pixels, &proj, BEHIND);
     Some([p[0] as f32, p[1] as f32, p[2] as f32])
+}
+
+/// A one-texel image of `rgba` (linear data, as the layers' textures are), and a reference to it
+/// as the model's first image.
+fn one_texel(rgba: [u8; 4]) -> (Image, TextureRef) {
+    let image = Image {
+        name: format!("texel {rgba:?}"),
+        width: 1,
+        height: 1,
+        rgba8: rgba.to_vec(),
+    };
+    let reference = TextureRef {
+        image: 0,
+        tex_coord: 0,
+        transform: Default::default(),
+        sampler: Default::default(),
+    };
+    (image, reference)
+}
+
+/// [`glass`] without transmission: a white dielectric block.
+fn opaque_white() -> Material {
+    Material {
+        layers: Layers::default(),
+        ..glass([1.0; 3], Layers::default())
+    }
 }
 
 /// Smooth glass: a dielectric that lets through what it does not reflect.
@@ -81,11 +108,7 @@ fn clear_glass_shows_what_is_behind_it() {
         return;
     };
     let through = seen(RED, Some(glass([1.0; 3], Layers::default()))).expect("a frame");
-    let opaque_white = Material {
-        layers: Layers::default(),
-        ..glass([1.0; 3], Layers::default())
-    };
-    let opaque = seen(RED, Some(opaque_white)).expect("a frame");
+    let opaque = seen(RED, Some(opaque_white())).expect("a frame");
     println!("the red block: bare {bare:?}, through clear glass {through:?}, under an opaque white block {opaque:?}");
     assert!(bare[0] > 2.0 * bare[1], "the block is red: {bare:?}");
     // Through the glass: the red block, less the ~4 % the glass reflects, plus the room that
@@ -206,41 +229,20 @@ fn a_materials_own_varnish_and_specular_strength_change_its_reflection() {
 #[test]
 fn a_transmission_texture_says_where_the_glass_is() {
     // One texel, as a transmission texture: its red channel scales the factor (linear).
-    let texture = |red: u8| {
-        let image = Image {
-            name: format!("transmission {red}"),
-            width: 1,
-            height: 1,
-            rgba8: vec![red, 0, 0, 255],
-        };
-        let reference = TextureRef {
-            image: 0,
-            tex_coord: 0,
-            transform: Default::default(),
-            sampler: Default::default(),
-        };
-        (image, reference)
-    };
     let textured = |red: u8| {
-        let (image, reference) = texture(red);
+        let (image, reference) = one_texel([red, 0, 0, 255]);
         let material = Material {
             transmission_texture: Some(reference),
             ..glass([1.0; 3], Layers::default())
         };
-        let (pixels, proj) = render_under_with(RED, Some(material), vec![image])?;
-        let p = pixel_at(&pixels, &proj, BEHIND);
-        Some([p[0] as f32, p[1] as f32, p[2] as f32])
+        seen_with(RED, Some(material), vec![image])
     };
     let Some(stopped) = textured(0) else {
         return;
     };
     let passed = textured(255).expect("a frame");
     let clear = seen(RED, Some(glass([1.0; 3], Layers::default()))).expect("a frame");
-    let opaque_white = Material {
-        layers: Layers::default(),
-        ..glass([1.0; 3], Layers::default())
-    };
-    let opaque = seen(RED, Some(opaque_white)).expect("a frame");
+    let opaque = seen(RED, Some(opaque_white())).expect("a frame");
     println!(
         "red block under glass: texture 0 {stopped:?} (opaque {opaque:?}), texture 1 {passed:?} (clear {clear:?})"
     );
@@ -265,24 +267,12 @@ fn a_thickness_texture_thins_the_volume() {
     };
     // One texel, as a thickness texture: its green channel scales the thickness (linear).
     let thinned = |green: u8| {
-        let image = Image {
-            name: format!("thickness {green}"),
-            width: 1,
-            height: 1,
-            rgba8: vec![0, green, 0, 255],
-        };
+        let (image, reference) = one_texel([0, green, 0, 255]);
         let material = Material {
-            thickness_texture: Some(TextureRef {
-                image: 0,
-                tex_coord: 0,
-                transform: Default::default(),
-                sampler: Default::default(),
-            }),
+            thickness_texture: Some(reference),
             ..glass([1.0; 3], volume)
         };
-        let (pixels, proj) = render_under_with(GREY, Some(material), vec![image])?;
-        let p = pixel_at(&pixels, &proj, BEHIND);
-        Some([p[0] as f32, p[1] as f32, p[2] as f32])
+        seen_with(GREY, Some(material), vec![image])
     };
     let Some(none) = thinned(0) else {
         return;
@@ -329,11 +319,7 @@ fn shadow_and_lit(material: Material) -> Option<([f32; 3], [f32; 3])> {
 
 #[test]
 fn glass_casts_a_pale_shadow_and_tinted_glass_a_coloured_one() {
-    let opaque_white = Material {
-        layers: Layers::default(),
-        ..glass([1.0; 3], Layers::default())
-    };
-    let Some((opaque_shadow, opaque_lit)) = shadow_and_lit(opaque_white) else {
+    let Some((opaque_shadow, opaque_lit)) = shadow_and_lit(opaque_white()) else {
         return;
     };
     let (clear_shadow, clear_lit) = shadow_and_lit(glass([1.0; 3], Layers::default())).expect("a frame");
