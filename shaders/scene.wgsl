@@ -98,6 +98,9 @@ override FADE: bool = false;
 // Whether the material has any of glTF's extension layers (index, specular, varnish,
 // transmission, volume); without, the core material's constants.
 override HAS_LAYERS: bool = true;
+// Whether the model has glass, whose shadow filter the direct light may pass through
+// (`light_filter`); without (and in the impostors' pipelines), the filter is compiled out.
+override GLASS_SHADOWS: bool = false;
 // What the draw writes (render crate, `DrawLayer`): 0 the whole surface; for a surface light
 // passes through, 1 the factor what is behind it is multiplied by, 2 the light it adds.
 override TRANSMIT_LAYER: u32 = 0u;
@@ -339,7 +342,7 @@ fn shadow_map_point(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec4<f32> {
 // `shadow_filter`): 1 where none stands nearer the light than the surface (the glass's own
 // surface facing the light included), or where the frame has no filter.
 fn light_filter(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
-    if (eye.shadow.w < 0.5) {
+    if (!GLASS_SHADOWS || eye.shadow.w < 0.5) {
         return vec3<f32>(1.0);
     }
     let p = shadow_map_point(world, n, l);

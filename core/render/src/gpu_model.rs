@@ -104,6 +104,9 @@ pub(crate) struct MaterialVariant {
     /// Whether the material has any of glTF's extension layers; without, the shader uses the
     /// core material's constants (`HAS_LAYERS`), which its compiler folds away.
     pub(crate) layers: bool,
+    /// Whether the model has glass, whose coloured shadow the surface may receive
+    /// (`GLASS_SHADOWS`, `shadow_filter`); without, the shader leaves the filter out, at no cost.
+    pub(crate) glass_shadows: bool,
 }
 
 /// A surface that transmits light changes what is behind it in two ways, which one blend

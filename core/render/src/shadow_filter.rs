@@ -8,7 +8,10 @@
 //! Drawn when the frame has transmissive primitives and one view of the light (the directional
 //! light's, or a lamp's single perspective view; a lamp among its casters, seen from a cube, has
 //! no filter: its light passes glass unfiltered). The scene shader reads it by `light_filter`
-//! when the eye block's `shadow.w` says it holds this frame's glass. The share is taken at
+//! when the eye block's `shadow.w` says it holds this frame's glass; the pipelines of a model
+//! without glass are made with that read compiled out (`GLASS_SHADOWS`: read behind the branch
+//! alone, it cost such frames 4–7 % on lavapipe, `benchmarks/render.md`), and so are the
+//! impostors' (a big scan's far parts receive glass's light unfiltered). The share is taken at
 //! normal incidence (the Fresnel loss at the light's angle and the refracted path's length are
 //! not modelled, nor caustics).
 //!

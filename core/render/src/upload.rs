@@ -159,12 +159,14 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());
+    // An unlit surface shows its colour as it is; glTF forbids transmission on one.
+    let transmits = |m: &phantogram_assets::model::Material| m.layers.transmits() && !m.unlit;
+    let glass_shadows = model.materials.iter().any(transmits);
     let materials = model
         .materials
         .iter()
         .map(|m| {
-            // An unlit surface shows its colour as it is; glTF forbids transmission on one.
-            let transmits = m.layers.transmits() && !m.unlit;
+            let transmits = transmits(m);
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),
                 contents: bytemuck::bytes_of(&MaterialUniform::new(m)),
@@ -219,6 +221,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     fade: false,
                     layer: if transmits { DrawLayer::Light } else { DrawLayer::Whole },
                     layers: m.layers != Layers::default(),
+                    glass_shadows,
                 },
                 _uniform: uniform,
             }
