@@ -210,6 +210,15 @@ fn fs_shadow_masked(in: ShadowMaskedOut) {
     }
 }
 
+// The share of the light from behind a surface that passes through it (glTF's transmission):
+// what enters (not reflected by the dielectric, `fresnel_d`, nor by a varnish over it,
+// `fresnel_coat`) and is transmitted rather than scattered (`transmission`, metalness already
+// taken out), tinted by the base colour and absorbed along the path (`optical_depth`, Beer–
+// Lambert). The eye's view (`shade_surface`) and the light's (`fs_shadow_filter`) both use it.
+fn transmittance(transmission: f32, fresnel_d: vec3<f32>, fresnel_coat: f32, base: vec3<f32>, optical_depth: vec3<f32>) -> vec3<f32> {
+    return transmission * (vec3<f32>(1.0) - fresnel_d) * (1.0 - fresnel_coat) * base * exp(-optical_depth);
+}
+
 // The shadow filter of a surface that lets light through (render crate, `shadow_filter`): the
 // share of the light it passes at normal incidence (its transmission, less what its dielectric
 // and varnish reflect, tinted by its base colour and absorbed across its volume's thickness;
@@ -226,11 +235,15 @@ fn fs_shadow_filter(in: ShadowMaskedOut) -> @location(0) vec4<f32> {
         discard;
     }
     let metallic = clamp(material.params.x * mr.b, 0.0, 1.0);
-    let transmission = material.layers.x * transmitted.r * (1.0 - metallic);
-    let reflected = material.layers.y * material.dielectric.rgb;
-    let coat = 0.04 * material.layers.z;
-    let through = transmission * (vec3<f32>(1.0) - reflected) * (1.0 - coat) * base.rgb
-        * exp(-material.volume.rgb * thickness.g);
+    // At normal incidence: the dielectric reflects its F0 (times the specular strength), the
+    // varnish 4 % of its share, and the path across the volume is its thickness.
+    let through = transmittance(
+        material.layers.x * transmitted.r * (1.0 - metallic),
+        material.layers.y * material.dielectric.rgb,
+        0.04 * material.layers.z,
+        base.rgb,
+        material.volume.rgb * thickness.g,
+    );
     let coverage = select(1.0, base.a, material.flags.z > 0.5);
     return vec4<f32>(vec3<f32>(1.0 - coverage) + coverage * through, in.clip.z);
 }
@@ -690,9 +703,6 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     // What the base does not scatter back passes through (glTF's transmission: a thin wall,
     // tinted by the base colour; through a volume, absorbed along the refracted path).
     let transmission = s.transmission * (1.0 - metallic);
-    let sin2_t = (1.0 - n_dot_v * n_dot_v) * s.inv_ior * s.inv_ior;
-    let cos_t = sqrt(max(1.0 - sin2_t, 1e-4));
-    var through = transmission * (vec3<f32>(1.0) - fresnel_ambient_d) * base * exp(-s.optical_depth / cos_t);
     if (look.ward_rho_d.w > 0.5) {
         // Ward: ρd (times the base colour) / π + ρs · lobe along the tangent frame (any frame
         // about n where the mesh has no tangents: the lobe is then isotropic in effect only if
@@ -764,6 +774,8 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         coat = s.coat;
         coat_rough = clamp(s.coat_roughness, 0.045, 1.0);
     }
+    // What the varnish reflects of the view's light, and so keeps from what is behind.
+    var coat_reflects = 0.0;
     if (coat > 0.0) {
         let coat_alpha = coat_rough * coat_rough;
         let fc = (0.04 + 0.96 * pow(1.0 - v_dot_h, 5.0)) * coat;
@@ -774,9 +786,12 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), coat_rough * PREFILTERED_MAX_LEVEL).rgb;
         ambient_light = ambient_light * (1.0 - fc_ambient) + prefiltered * (0.04 * scale_bias.x + scale_bias.y) * coat;
-        through = through * (1.0 - fc_ambient);
+        coat_reflects = fc_ambient;
     }
     let ambient = eye.light.w * occlusion * ambient_light;
+    let sin2_t = (1.0 - n_dot_v * n_dot_v) * s.inv_ior * s.inv_ior;
+    let cos_t = sqrt(max(1.0 - sin2_t, 1e-4));
+    let through = transmittance(transmission, fresnel_ambient_d, coat_reflects, base, s.optical_depth / cos_t);
     return Shaded(direct + ambient + s.emissive, through);
 }
 

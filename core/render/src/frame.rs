@@ -4,7 +4,7 @@
 use crate::{
     CLEAR_RADIANCE, FrameInput, OUTPUT_FORMAT, RenderError, Renderer, SHADOW_SIZE, checked,
     gpu::Gpu,
-    gpu_model::{DrawLayer, GpuPrimitive, MaterialVariant},
+    gpu_model::{GpuPrimitive, MaterialVariant},
     impostor::{self, IMPOSTOR_LEVEL},
     lights::{Lamp, lamp_view_proj, light_view_proj},
     pipelines::create_compose_pipeline,
@@ -243,13 +243,7 @@ impl Renderer {
             }
         }
         // Glass filters the light of one view (not a lamp's cube): drawn after the shadows.
-        let mut filter_pass = self.lighting.shadows
-            && cube.is_none()
-            && self
-                .model
-                .primitives
-                .iter()
-                .any(|p| self.model.materials[p.material].variant.layer == DrawLayer::Light);
+        let mut filter_pass = self.lighting.shadows && cube.is_none() && self.model.glass().next().is_some();
         if filter_pass && self.shadow_filter.size < SHADOW_SIZE {
             let device = self.gpu.device.clone();
             // A device that cannot make it: glass casts no shadow (as before the filter) and the
@@ -348,12 +342,9 @@ impl Renderer {
                 });
                 pass.set_pipeline(pipeline);
                 pass.set_bind_group(0, &self.shadow_bind, &[]);
-                for p in &self.model.primitives {
-                    let m = &self.model.materials[p.material];
-                    if m.variant.layer == DrawLayer::Light {
-                        pass.set_bind_group(1, &m.bind, &[]);
-                        p.draw(&mut pass, &shadow_levels);
-                    }
+                for p in self.model.glass() {
+                    pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
+                    p.draw(&mut pass, &shadow_levels);
                 }
             }
         }

@@ -70,6 +70,14 @@ pub(crate) struct GpuModel {
 }
 
 impl GpuModel {
+    /// The primitives light passes through (drawn as [`DrawLayer::Filter`] then
+    /// [`DrawLayer::Light`]): what the shadow filter of glass draws.
+    pub(crate) fn glass(&self) -> impl Iterator<Item = &GpuPrimitive> {
+        self.primitives
+            .iter()
+            .filter(|p| self.materials[p.material].variant.layer == DrawLayer::Light)
+    }
+
     /// What casts shadows this frame, and the bounds the shadow map must cover. The floor is a
     /// plane under everything that faces +z: lit from above it shadows nothing, so the map covers
     /// only what stands on it, at the resolution that detail needs (with the floor, 2.5 screens

@@ -125,7 +125,7 @@ impl MaterialUniform {
             transforms,
             scene: [f32::from(u8::from(m.scenery)), set(slots[5]), set(slots[6]), 0.0],
             layers: [
-                if m.unlit { 0.0 } else { l.transmission },
+                if m.transmits() { l.transmission } else { 0.0 },
                 l.specular,
                 l.clear_coat,
                 l.clear_coat_roughness,

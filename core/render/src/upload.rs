@@ -159,14 +159,12 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());
-    // An unlit surface shows its colour as it is; glTF forbids transmission on one.
-    let transmits = |m: &phantogram_assets::model::Material| m.layers.transmits() && !m.unlit;
-    let glass_shadows = model.materials.iter().any(transmits);
+    let glass_shadows = model.materials.iter().any(|m| m.transmits());
     let materials = model
         .materials
         .iter()
         .map(|m| {
-            let transmits = transmits(m);
+            let transmits = m.transmits();
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),
                 contents: bytemuck::bytes_of(&MaterialUniform::new(m)),

@@ -361,6 +361,12 @@ impl Material {
         }
     }
 
+    /// Whether light passes through the surface ([`Layers::transmits`]): never for an unlit one,
+    /// which shows its colour as it is (glTF forbids transmission on it).
+    pub fn transmits(&self) -> bool {
+        self.layers.transmits() && !self.unlit
+    }
+
     /// Every texture the material uses, with whether it holds colour (sRGB-encoded) data.
     pub fn textures(&self) -> impl Iterator<Item = (TextureRef, bool)> + '_ {
         [
