@@ -14,11 +14,14 @@
 //!   frames with the progress banner meanwhile as the app does, and how many frames showed
 //!   progress before the turtle; also the best scan's load waited for without drawing (load,
 //!   fit, upload and one frame);
+//! * the amphora as amber glass on its floor (drawn twice per eye, and a shadow filter);
 //! * the raking lamp over the amphora on its floor (`LampSetting::raking`, at the screen's left
 //!   edge 2 cm above the glass: inside the amphora's bounding sphere, so its shadows come from a
 //!   cube of six views, `phantogram_render::point_shadow`), with shadows and without, and the
 //!   triangles the shadow passes drew;
 //! * peak resident memory of the process (VmHWM).
+//!
+//! With `PHANTOGRAM_BENCH_FRAMES=DIR` each model's mono frame is also written to `DIR` as a PNG.
 //!
 //! Frame times include reading the frame back to the CPU, as `phantogram render` does.
 
@@ -66,6 +69,7 @@ fn frame_times(renderer: &mut Renderer, input: &FrameInput, frames: usize) -> (f
 fn main() {
     let quick = std::env::args().any(|a| a == "--test" || a == "--list");
     let frames = if quick { 1 } else { 11 };
+    let frames_dir = std::env::var_os("PHANTOGRAM_BENCH_FRAMES").map(std::path::PathBuf::from);
     let gpu = match Gpu::headless() {
         Ok(g) => g,
         Err(e) => {
@@ -93,6 +97,7 @@ fn main() {
     let mut models: Vec<(String, Model)> = vec![
         ("amphora".into(), phantogram::artifact::default_model()),
         ("amphora on the floor".into(), on_floor),
+        ("amber glass amphora on the floor".into(), glass_amphora_on_floor()),
     ];
     let mut renderer = None;
     let mut gpu = Some(gpu);
@@ -130,6 +135,9 @@ fn main() {
             "{name}, {W}x{H}: mono {mono:.1} ms, stereo {stereo:.1} ms, stereo/mono {:.2}x",
             stereo / mono
         );
+        if let Some(dir) = &frames_dir {
+            save_frame(&mut renderer, &input, dir, name);
+        }
     }
     lamp_among_the_artifact(&mut renderer, &models[1].1, &input, frames);
     if let Some(data) = std::env::var_os("PHANTOGRAM_DATA") {
@@ -138,6 +146,33 @@ fn main() {
     if let Some(mib) = peak_rss_mib() {
         println!("peak resident memory: {mib:.0} MiB");
     }
+}
+
+/// Writes `name`'s mono frame as a PNG into `dir`, to look at what was timed (on another machine's
+/// GPU, say).
+fn save_frame(renderer: &mut Renderer, input: &FrameInput, dir: &std::path::Path, name: &str) {
+    let rgba = renderer.render(input, Method::Mono, W, H).expect("frame");
+    let image = image::RgbaImage::from_raw(W, H, rgba).expect("a whole frame");
+    let path = dir.join(format!("{}.png", name.replace(' ', "_")));
+    image.save(&path).expect("the frame is written");
+    println!("  frame written to {}", path.display());
+}
+
+/// The amphora as tinted glass on its floor: every one of its materials transmits, through an
+/// amber volume, so each eye draws it twice (filter and light) and the light's view draws the
+/// shadow filter.
+fn glass_amphora_on_floor() -> Model {
+    let mut glass = phantogram::artifact::default_model();
+    for material in &mut glass.materials {
+        material.layers.transmission = 1.0;
+        material.layers.thickness = 0.004;
+        material.layers.attenuation_distance = 0.01;
+        material.layers.attenuation_color = [0.95, 0.6, 0.2];
+        // The painted amphora's material is metallic, and metal lets no light through.
+        material.metallic = 0.0;
+    }
+    glass.add_floor(&SessionConfig::default().screen, Model::FLOOR_REACH);
+    glass
 }
 
 /// The raking lamp over the amphora on its floor, with its cube shadows and without (see the
