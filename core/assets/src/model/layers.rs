@@ -112,6 +112,22 @@ impl Layers {
         self.transmission > 0.0
     }
 
+    /// Whether a ray crossing the surface changes direction: a volume of an index other than 1
+    /// (thin walls, as glTF has them, leave the ray where it was).
+    pub fn refracts(&self) -> bool {
+        self.thickness > 0.0 && self.ior != 1.0
+    }
+
+    /// The layers of the model scaled by `scale` (every length grows by it): the volume's
+    /// thickness and attenuation distance, whose ratio, the absorption, stays as it was. A scale
+    /// that is not a positive finite number changes nothing.
+    pub fn scale_lengths(&mut self, scale: f32) {
+        if scale.is_finite() && scale > 0.0 {
+            self.thickness *= scale;
+            self.attenuation_distance *= scale;
+        }
+    }
+
     /// The layers a material's extensions give; `extension` returns an extension's object by
     /// name. `what` names the material in warnings; values out of range are clamped, malformed
     /// ones ignored, textures left out, each with a warning.

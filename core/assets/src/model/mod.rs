@@ -367,6 +367,20 @@ impl Material {
         self.layers.transmits() && !self.unlit
     }
 
+    /// Whether what is seen through the surface is blurred (rough glass: frosted) or displaced
+    /// (a refracting volume), which needs the picture behind it rather than a filter over it
+    /// (the render crate's backdrop). Smooth thin glass needs neither.
+    pub fn blurs_or_bends(&self) -> bool {
+        self.blurs() || (self.transmits() && self.layers.refracts())
+    }
+
+    /// Whether what is seen through the surface is blurred: it lets light through, is rough
+    /// somewhere (its factor scales the texture's), and its index differs from the air's (a rough
+    /// boundary between media of one index turns no ray).
+    pub fn blurs(&self) -> bool {
+        self.transmits() && self.roughness > 0.0 && self.layers.ior != 1.0
+    }
+
     /// Every texture the material uses, with whether it holds colour (sRGB-encoded) data.
     pub fn textures(&self) -> impl Iterator<Item = (TextureRef, bool)> + '_ {
         [
@@ -607,6 +621,9 @@ impl Model {
         self.primitives.iter().map(|p| p.mesh.indices.len() / 3).sum()
     }
 
+    /// Moves every primitive, level and annotation by `m` (a similarity: rotation, uniform scale,
+    /// translation, perhaps a mirror), and scales the materials' volume lengths with the mesh,
+    /// so that a glass's thickness stays that of its walls.
     pub fn transform(&mut self, m: Mat4) {
         let linear = Mat3::from_mat4(m);
         // A length grows by at most the largest singular value; the columns' largest length is
@@ -627,6 +644,9 @@ impl Model {
                     }
                 }
             }
+        }
+        for m in &mut self.materials {
+            m.layers.scale_lengths(scale);
         }
         let normal_m = linear.inverse().transpose();
         for a in &mut self.annotations {
@@ -810,6 +830,84 @@ mod tests {
             "{scale}"
         );
         assert!(b.max.z.abs() < 1e-6);
+    }
+
+    #[test]
+    fn only_rough_or_refracting_glass_needs_what_is_behind_it() {
+        let glass = |roughness: f32, ior: f32, thickness: f32| Material {
+            roughness,
+            metallic: 0.0,
+            layers: Layers {
+                transmission: 1.0,
+                ior,
+                thickness,
+                ..Layers::default()
+            },
+            ..Material::default()
+        };
+        assert!(!glass(0.0, 1.5, 0.0).blurs_or_bends(), "smooth thin glass filters");
+        assert!(glass(0.3, 1.5, 0.0).blurs_or_bends(), "frosted");
+        assert!(glass(0.0, 1.5, 0.01).blurs_or_bends(), "a refracting volume");
+        assert!(
+            !glass(0.0, 1.0, 0.01).blurs_or_bends(),
+            "a volume of index 1 bends nothing"
+        );
+        assert!(
+            glass(0.0, f32::INFINITY, 0.01).blurs_or_bends(),
+            "an infinite index bends"
+        );
+        assert!(!glass(0.0, 1.5, 0.01).blurs(), "it bends but does not blur");
+        assert!(
+            !glass(0.7, 1.0, 0.0).blurs_or_bends(),
+            "rough, of index 1: nothing turns"
+        );
+        let opaque = Material {
+            layers: Layers {
+                transmission: 0.0,
+                ..glass(0.5, 1.5, 0.01).layers
+            },
+            ..glass(0.5, 1.5, 0.01)
+        };
+        assert!(!opaque.blurs_or_bends(), "nothing passes: nothing to blur");
+        let unlit = Material {
+            unlit: true,
+            ..glass(0.5, 1.5, 0.01)
+        };
+        assert!(!unlit.blurs_or_bends(), "an unlit surface lets nothing through");
+    }
+
+    #[test]
+    fn a_fit_scales_the_volume_of_glass_with_its_mesh() {
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::ZERO, 0.5, [1.0; 4]);
+        let mut m = Model::from_painted_mesh("paperweight", mesh);
+        m.materials[0].layers.thickness = 0.5;
+        m.materials[0].layers.attenuation_distance = 2.0;
+        let absorbed = m.materials[0].layers.absorption_per_unit();
+        let scale = m.fit_to_diorama(&Screen::default(), &DioramaFit::default());
+        assert!(scale < 0.1, "a metre cube is shrunk: {scale}");
+        let l = m.materials[0].layers;
+        assert!(
+            (l.thickness - 0.5 * scale).abs() < 1e-7,
+            "{} vs {}",
+            l.thickness,
+            0.5 * scale
+        );
+        assert!((l.attenuation_distance - 2.0 * scale).abs() < 1e-6);
+        // The absorption over the wall is the same.
+        let after = l.absorption_per_unit();
+        for (a, b) in absorbed.iter().zip(after) {
+            assert!((a * 0.5 - b * l.thickness).abs() < 1e-5, "{absorbed:?} vs {after:?}");
+        }
+        // An infinite distance (nothing absorbed) stays infinite; a bad scale changes nothing.
+        let mut clear = Layers::default();
+        clear.scale_lengths(0.5);
+        assert!(clear.attenuation_distance.is_infinite());
+        clear.thickness = 1.0;
+        for bad in [0.0, -1.0, f32::NAN, f32::INFINITY] {
+            clear.scale_lengths(bad);
+        }
+        assert_eq!(clear.thickness, 1.0);
     }
 
     #[test]
