@@ -102,7 +102,8 @@ override HAS_LAYERS: bool = true;
 // (`light_filter`); without (and in the impostors' pipelines), the filter is compiled out.
 override GLASS_SHADOWS: bool = false;
 // What the draw writes (render crate, `DrawLayer`): 0 the whole surface; for a surface light
-// passes through, 1 the factor what is behind it is multiplied by, 2 the light it adds.
+// passes through, 1 the factor what is behind it is multiplied by, 2 the light it adds, 3 (glass
+// that blurs or bends) what the backdrop shows behind it, filtered, over the pixel by coverage.
 override TRANSMIT_LAYER: u32 = 0u;
 
 @group(0) @binding(0) var<uniform> eye: Eye;
@@ -125,6 +126,11 @@ override TRANSMIT_LAYER: u32 = 0u;
 // `shadow_filter`): rgb the share passed, alpha the light-space depth of the nearest glass. Read
 // only where `eye.shadow.w` says it holds this frame's glass.
 @group(0) @binding(9) var shadow_filter: texture_2d<f32>;
+// What the opaque scene shows this eye, with its halvings (render crate, `backdrop`): glass that
+// blurs or bends the view through it reads what is behind it here (`TRANSMIT_LAYER` 3). A 1×1
+// placeholder while the model has no such glass.
+@group(0) @binding(10) var backdrop: texture_2d<f32>;
+@group(0) @binding(11) var backdrop_sampler: sampler;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_texture: texture_2d<f32>;
@@ -512,6 +518,11 @@ struct Surface {
     transmission: f32,
     optical_depth: vec3<f32>,
     inv_ior: f32,
+    // The length of a refracted ray's path across the volume (0: no bend), and the roughness
+    // that blurs what is seen through the surface (the material's, before the lower bound the
+    // shading keeps).
+    refracted_path: f32,
+    transmission_roughness: f32,
 };
 
 // glTF's core dielectric, no varnish, nothing passing through (for surfaces without a material
@@ -525,6 +536,8 @@ fn core_layers(s: ptr<function, Surface>) {
     (*s).transmission = 0.0;
     (*s).optical_depth = vec3<f32>(0.0);
     (*s).inv_ior = 1.0 / 1.5;
+    (*s).refracted_path = 0.0;
+    (*s).transmission_roughness = 0.0;
 }
 
 // The material's surface at a fragment of the scene pass. Samples every texture first:
@@ -584,7 +597,8 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     s.n = n;
     s.t = t;
     s.metallic = clamp(material.params.x * mr_sample.b * in.material.x, 0.0, 1.0);
-    s.roughness = clamp(material.params.y * mr_sample.g * in.material.y, 0.045, 1.0);
+    let roughness = clamp(material.params.y * mr_sample.g * in.material.y, 0.0, 1.0);
+    s.roughness = max(roughness, 0.045);
     s.occlusion = 1.0 + material.params.w * (occlusion_sample.r - 1.0);
     s.emissive = material.emissive.rgb * emissive_sample.rgb;
     s.unlit = material.flags.w > 0.5;
@@ -598,6 +612,8 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
         s.transmission = material.layers.x * transmission_sample.r;
         s.optical_depth = material.volume.rgb * thickness_sample.g;
         s.inv_ior = material.volume.w;
+        s.refracted_path = material.scene.w * thickness_sample.g;
+        s.transmission_roughness = roughness;
     } else {
         // Constants the compiler folds into the shading: the core material costs what it did
         // before the extensions.
@@ -630,7 +646,37 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     if (TRANSMIT_LAYER == 2u) {
         return vec4<f32>(out_alpha * shaded.radiance, 0.0);
     }
+    if (TRANSMIT_LAYER == 3u) {
+        return vec4<f32>(seen_through(in.world, in.clip.xy, s) * shaded.through, out_alpha);
+    }
     return vec4<f32>(shaded.radiance, out_alpha);
+}
+
+// What the opaque scene shows through a surface at `world` (mesh coordinates; pixel `pixel`):
+// where a ray refracted into its volume leaves it, projected into this eye's backdrop, blurred by
+// its roughness. The ray's exit is taken one path length straight along the refracted direction
+// and what is behind is read where that point falls on the screen: the thick-slab approximation of
+// the glTF sample viewer, which is exact for a flat slab of that thickness with the background far
+// behind it. The blur too is that viewer's: a level log2(width) × roughness × clamp(2·ior − 2, 0, 1)
+// of the backdrop's halvings, so a fully rough surface of index 1.5 shows the scene's mean and
+// one of index 1 (no change of medium) shows it sharp.
+fn seen_through(world: vec3<f32>, pixel: vec2<f32>, s: Surface) -> vec3<f32> {
+    let size = vec2<f32>(textureDimensions(backdrop, 0));
+    var uv = pixel / size;
+    if (s.refracted_path > 0.0) {
+        let v = normalize(eye.eye_pos.xyz - world);
+        let bent = refract(-v, s.n, s.inv_ior);
+        if (dot(bent, bent) > 0.0) {
+            let exit = eye.view_proj * vec4<f32>(world + normalize(bent) * s.refracted_path, 1.0);
+            if (exit.w > 0.0) {
+                let ndc = exit.xy / exit.w;
+                uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
+            }
+        }
+    }
+    let index_change = clamp(2.0 / max(s.inv_ior, 1e-3) - 2.0, 0.0, 1.0);
+    let level = log2(max(size.x, size.y)) * s.transmission_roughness * index_change;
+    return textureSampleLevel(backdrop, backdrop_sampler, uv, level).rgb;
 }
 
 struct Shaded {

@@ -37,6 +37,10 @@ pub(crate) struct EyeViews<'a> {
     pub(crate) shadow_filter: &'a wgpu::TextureView,
     pub(crate) ward_map: &'a wgpu::TextureView,
     pub(crate) ward_sampler: &'a wgpu::Sampler,
+    /// Each eye's copy of its opaque scene (`backdrop`; a placeholder without one) and its
+    /// sampler.
+    pub(crate) backdrop: [&'a wgpu::TextureView; 2],
+    pub(crate) backdrop_sampler: &'a wgpu::Sampler,
 }
 
 /// A Ward map's texels as a mipmapped linear texture (the mips average the scales, so a distant
@@ -53,14 +57,16 @@ pub(crate) fn eye_bind_groups(
     views: &EyeViews<'_>,
     ibl: &IblTextures,
 ) -> [wgpu::BindGroup; 2] {
-    [0, 1].map(|i| eye_bind_group(device, layout, &buffers[i], views, ibl))
+    [0, 1].map(|i| eye_bind_group(device, layout, &buffers[i], views, i, ibl))
 }
 
+/// The bind group of a view drawn from `buffer`'s block with eye `eye`'s backdrop.
 pub(crate) fn eye_bind_group(
     device: &wgpu::Device,
     layout: &wgpu::BindGroupLayout,
     buffer: &wgpu::Buffer,
     views: &EyeViews<'_>,
+    eye: usize,
     ibl: &IblTextures,
 ) -> wgpu::BindGroup {
     device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -106,6 +112,14 @@ pub(crate) fn eye_bind_group(
             wgpu::BindGroupEntry {
                 binding: 9,
                 resource: wgpu::BindingResource::TextureView(views.shadow_filter),
+            },
+            wgpu::BindGroupEntry {
+                binding: 10,
+                resource: wgpu::BindingResource::TextureView(views.backdrop[eye]),
+            },
+            wgpu::BindGroupEntry {
+                binding: 11,
+                resource: wgpu::BindingResource::Sampler(views.backdrop_sampler),
             },
         ],
     })

@@ -137,6 +137,12 @@ impl Renderer {
             &self.eye_views(),
             &self.ibl,
         );
+        self.backdrop_bound = self.backdrop().map_or(0, |b| b.id);
+    }
+
+    /// The frame targets' backdrop, if they have one.
+    pub(crate) fn backdrop(&self) -> Option<&crate::backdrop::Backdrop> {
+        self.targets.as_ref().and_then(|t| t.backdrop.as_ref())
     }
 
     /// What the eyes' bind groups hold besides their uniforms and the image light.
@@ -148,6 +154,11 @@ impl Renderer {
             shadow_filter: &self.shadow_filter.view,
             ward_map: &self.ward_map.1,
             ward_sampler: &self.ward_sampler,
+            backdrop: match self.backdrop() {
+                Some(b) => [&b.views[0], &b.views[1]],
+                None => [&self.backdrop_placeholder; 2],
+            },
+            backdrop_sampler: &self.backdrop_sampler,
         }
     }
 

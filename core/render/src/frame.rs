@@ -271,6 +271,7 @@ impl Renderer {
                 u.shadow[3] = 1.0;
             }
         }
+        let with_backdrop = self.prepare_backdrop();
         let (lm, rm) = method.matrices();
         let row = |m: [f32; 3]| [m[0], m[1], m[2], 0.0];
         let compose = ComposeUniform {
@@ -349,6 +350,7 @@ impl Renderer {
             }
         }
         self.shadow_triangles = shadow_triangles;
+        let backdrop = targets.backdrop.as_ref().filter(|_| with_backdrop);
         for (i, u) in uniforms.iter().enumerate() {
             let first = i == 0 && !shadow_pass;
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -365,10 +367,15 @@ impl Renderer {
                 })],
                 depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
                     view: &targets.depth,
-                    // Reverse-Z: 0 is infinitely far.
+                    // Reverse-Z: 0 is infinitely far. Kept for the blended draws' own pass
+                    // where a backdrop is made between.
                     depth_ops: Some(wgpu::Operations {
                         load: wgpu::LoadOp::Clear(0.0),
-                        store: wgpu::StoreOp::Discard,
+                        store: if backdrop.is_some() {
+                            wgpu::StoreOp::Store
+                        } else {
+                            wgpu::StoreOp::Discard
+                        },
                     }),
                     stencil_ops: None,
                 }),
@@ -404,7 +411,7 @@ impl Renderer {
                         self.draw_impostor(&mut pass, imp, 0);
                     }
                 } else {
-                    self.draw_primitive(&mut pass, p, input.levels);
+                    self.draw_primitive(&mut pass, p, input.levels, false);
                 }
             }
             blended.sort_by(|a, b| {
@@ -412,8 +419,36 @@ impl Renderer {
                     .distance_squared(eye_at)
                     .total_cmp(&a.centre.distance_squared(eye_at))
             });
+            // Glass that blurs or bends reads the opaque scene from the eye's backdrop, made
+            // between the opaque draws and the blended ones, each in a pass of its own.
+            if let (Some(backdrop), Some(halver)) = (backdrop, &self.backdrop_halver) {
+                drop(pass);
+                backdrop.record(&mut encoder, halver, i);
+                pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                    label: Some("scene, blended"),
+                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                        view: &targets.hdr[i],
+                        depth_slice: None,
+                        resolve_target: None,
+                        ops: wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Store,
+                        },
+                    })],
+                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                        view: &targets.depth,
+                        depth_ops: Some(wgpu::Operations {
+                            load: wgpu::LoadOp::Load,
+                            store: wgpu::StoreOp::Discard,
+                        }),
+                        stencil_ops: None,
+                    }),
+                    ..Default::default()
+                });
+                pass.set_bind_group(0, &self.eye_bind[i], &[]);
+            }
             for p in blended {
-                self.draw_primitive(&mut pass, p, input.levels);
+                self.draw_primitive(&mut pass, p, input.levels, backdrop.is_some());
             }
         }
         {
@@ -444,6 +479,56 @@ impl Renderer {
 }
 
 impl Renderer {
+    /// Makes the eyes' backdrops for the current targets if the model has glass that blurs or
+    /// bends (`backdrop`), drops them if it has none, and points the eyes' bind groups at what is
+    /// there. Whether this frame draws with a backdrop: not where the device could not make one
+    /// (such glass is then drawn with the plain filter; not tried again at that size).
+    pub(crate) fn prepare_backdrop(&mut self) -> bool {
+        let needed = self.model.backdrop_needed();
+        let halvings = needed == crate::gpu_model::BackdropNeeded::Blurred;
+        let Some(targets) = self.targets.as_mut() else {
+            return false;
+        };
+        let size = (targets.width, targets.height);
+        let full = crate::backdrop::level_count(size.0, size.1);
+        // None needed: the memory goes when the eyes' bind groups let go of it (below). One made
+        // without the halvings now needed, or with those no longer needed, is made again.
+        if needed == crate::gpu_model::BackdropNeeded::None
+            || targets
+                .backdrop
+                .as_ref()
+                .is_some_and(|b| (b.level_count == full) != halvings)
+        {
+            targets.backdrop = None;
+        }
+        if needed != crate::gpu_model::BackdropNeeded::None
+            && targets.backdrop.is_none()
+            && self.backdrop_failed != Some(size)
+        {
+            let device = self.gpu.device.clone();
+            if self.backdrop_halver.is_none() {
+                self.backdrop_halver = checked(&device, "the backdrop's pipeline", || {
+                    crate::backdrop::Halver::new(&device)
+                })
+                .ok();
+            }
+            if let Some(halver) = &self.backdrop_halver {
+                let hdr = &targets.hdr;
+                match checked(&device, "the eyes' backdrops", || {
+                    crate::backdrop::Backdrop::new(&device, halver, hdr, size, halvings)
+                }) {
+                    Ok(b) => targets.backdrop = Some(b),
+                    Err(_) => self.backdrop_failed = Some(size),
+                }
+            }
+        }
+        let current = self.backdrop().map_or(0, |b| b.id);
+        if current != self.backdrop_bound {
+            self.remake_eye_binds();
+        }
+        current != 0
+    }
+
     /// Draws what casts shadows into a shadow pass whose light matrix `bind` holds: opaque
     /// materials, then masked ones cut out (blended ones cast none); the floor only when
     /// `floor_casts`; with `cull` (that matrix), only pieces whose bounds reach its frustum.
@@ -584,7 +669,7 @@ impl Renderer {
             // Made with the model for every primitive with levels; without it, the new level
             // alone (a switch without the fade).
             if instance % 2 == 1 {
-                self.draw_primitive(pass, p, &[level]);
+                self.draw_primitive(pass, p, &[level], false);
             }
             return;
         };
@@ -594,10 +679,18 @@ impl Renderer {
         p.draw_at(pass, level, instance);
     }
 
-    pub(crate) fn draw_primitive(&self, pass: &mut wgpu::RenderPass<'_>, p: &GpuPrimitive, levels: &[u8]) {
+    /// Draws `p` (each of its material's draws, `MaterialVariant::draws`); `with_backdrop`: the
+    /// eye's backdrop is made this frame.
+    pub(crate) fn draw_primitive(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        p: &GpuPrimitive,
+        levels: &[u8],
+        with_backdrop: bool,
+    ) {
         let m = &self.model.materials[p.material];
         pass.set_bind_group(1, &m.bind, &[]);
-        for variant in m.variant.draws() {
+        for variant in m.variant.draws(with_backdrop) {
             // Every material's variants were prepared with its model; a miss would be our bug,
             // and skipping the draw beats a panic in the middle of a frame.
             let Some(pipeline) = self.scene.get(&variant) else {

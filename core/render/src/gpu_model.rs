@@ -50,9 +50,22 @@ impl GpuPrimitive {
     }
 }
 
+/// What a frame's glass needs of the eyes' backdrops ([`GpuModel::backdrop_needed`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum BackdropNeeded {
+    None,
+    /// The opaque scene's copy (level 0) alone.
+    Sharp,
+    /// The copy and its halvings.
+    Blurred,
+}
+
 pub(crate) struct GpuMaterial {
     pub(crate) bind: wgpu::BindGroup,
     pub(crate) variant: MaterialVariant,
+    /// Glass that blurs what is seen through it (`Material::blurs`): its backdrop needs the
+    /// halvings.
+    pub(crate) blurs: bool,
     // Kept alive for the bind group.
     pub(crate) _uniform: wgpu::Buffer,
 }
@@ -76,6 +89,20 @@ impl GpuModel {
         self.primitives
             .iter()
             .filter(|p| self.materials[p.material].variant.layer == DrawLayer::Light)
+    }
+
+    /// The backdrop the model's glass needs ([`DrawLayer::Backdrop`], `backdrop`): none without
+    /// glass that blurs or bends what is seen through it; the copy of the opaque scene alone
+    /// where such glass only bends; the copy and its halvings where any blurs.
+    pub(crate) fn backdrop_needed(&self) -> BackdropNeeded {
+        let drawn = || self.primitives.iter().map(|p| &self.materials[p.material]);
+        if drawn().any(|m| m.variant.backdrop && m.blurs) {
+            BackdropNeeded::Blurred
+        } else if drawn().any(|m| m.variant.backdrop) {
+            BackdropNeeded::Sharp
+        } else {
+            BackdropNeeded::None
+        }
     }
 
     /// What casts shadows this frame, and the bounds the shadow map must cover. The floor is a
@@ -109,6 +136,9 @@ pub(crate) struct MaterialVariant {
     /// What the draw writes: the whole surface, or one of the two layers of a surface that
     /// light passes through (`KHR_materials_transmission`).
     pub(crate) layer: DrawLayer,
+    /// Whether what is seen through it is blurred (rough glass) or displaced (a refracting
+    /// volume): its filter is then [`DrawLayer::Backdrop`] instead of [`DrawLayer::Filter`].
+    pub(crate) backdrop: bool,
     /// Whether the material has any of glTF's extension layers; without, the shader uses the
     /// core material's constants (`HAS_LAYERS`), which its compiler folds away.
     pub(crate) layers: bool,
@@ -121,12 +151,17 @@ pub(crate) struct MaterialVariant {
 /// operation cannot do: it filters it (a colour factor: tinted glass) and adds its own light
 /// (reflections, emission). So it is drawn twice, [`DrawLayer::Filter`] then
 /// [`DrawLayer::Light`]: the pixel becomes behind × filter + light. Every other surface is drawn
-/// once, [`DrawLayer::Whole`]. The `TRANSMIT_LAYER` constant of `scene.wgsl`, in this order.
+/// once, [`DrawLayer::Whole`]. Glass that blurs or bends what is behind it cannot filter the
+/// pixel under it: its first draw is [`DrawLayer::Backdrop`], which reads what the opaque scene
+/// showed elsewhere behind it (the eye's `backdrop`: blurred by its roughness, shifted by
+/// refraction), filters that, and blends it over the pixel by the surface's coverage. The
+/// `TRANSMIT_LAYER` constant of `scene.wgsl`, in this order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum DrawLayer {
     Whole,
     Filter,
     Light,
+    Backdrop,
 }
 
 impl DrawLayer {
@@ -135,12 +170,14 @@ impl DrawLayer {
             Self::Whole => 0.0,
             Self::Filter => 1.0,
             Self::Light => 2.0,
+            Self::Backdrop => 3.0,
         }
     }
 
     /// The colour target's blending: alpha blending for a blended whole surface, none for an
-    /// opaque one; the destination times the source for the filter, their sum for the light.
-    /// The layers leave the target's alpha as it is.
+    /// opaque one; the destination times the source for the filter, their sum for the light,
+    /// the source over the destination by its coverage for the backdrop. The layers leave the
+    /// target's alpha as it is.
     pub(crate) fn blend(self, blended: bool) -> Option<wgpu::BlendState> {
         let keep_alpha = wgpu::BlendComponent {
             src_factor: wgpu::BlendFactor::Zero,
@@ -165,16 +202,26 @@ impl DrawLayer {
                 },
                 alpha: keep_alpha,
             }),
+            Self::Backdrop => Some(wgpu::BlendState {
+                color: wgpu::BlendState::ALPHA_BLENDING.color,
+                alpha: keep_alpha,
+            }),
         }
     }
 }
 
 impl MaterialVariant {
     /// The draws that make a primitive of this material, in order: itself, or for a surface that
-    /// transmits light its filter, then itself (its light).
-    pub(crate) fn draws(self) -> impl Iterator<Item = MaterialVariant> {
+    /// transmits light its filter, then itself (its light). The filter of glass that blurs or
+    /// bends is its backdrop where the frame has one (`with_backdrop`); without (a device that
+    /// could not make it), the plain filter: sharp and straight, but what is behind still shows.
+    pub(crate) fn draws(self, with_backdrop: bool) -> impl Iterator<Item = MaterialVariant> {
         let filter = (self.layer == DrawLayer::Light).then_some(MaterialVariant {
-            layer: DrawLayer::Filter,
+            layer: if self.backdrop && with_backdrop {
+                DrawLayer::Backdrop
+            } else {
+                DrawLayer::Filter
+            },
             ..self
         });
         filter.into_iter().chain(std::iter::once(self))

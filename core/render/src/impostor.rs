@@ -342,7 +342,7 @@ impl crate::Renderer {
                 .collect();
             let face_binds = face_buffers
                 .iter()
-                .map(|b| crate::eye_bind_group(device, &self.eye_layout, b, &self.eye_views(), &self.ibl))
+                .map(|b| crate::eye_bind_group(device, &self.eye_layout, b, &self.eye_views(), 0, &self.ibl))
                 .collect();
             self.impostor_pipelines = Some(ImpostorPipelines {
                 bake,

@@ -24,10 +24,13 @@
 //!    Opaque and masked primitives first, then blended ones back to front (depth test, no depth
 //!    write), among them those light passes through (glass: `KHR_materials_transmission`), each
 //!    drawn twice: a filter that multiplies what is behind by its transmittance (base colour,
-//!    Fresnel, the volume's absorption), then its own light added (`DrawLayer`). What is behind
-//!    glass shows sharp whatever its roughness (no copy of the frame to blur is made), and the
-//!    reflections of a glass primitive's far side are not filtered by its near side (one draw
-//!    each). Mono renders only the cyclopean eye. Light, materials and textures are shared by
+//!    Fresnel, the volume's absorption), then its own light added (`DrawLayer`). Glass that
+//!    blurs (rough: frosted) or bends (a refracting volume) what is seen through it is drawn
+//!    over the eye's backdrop instead (`backdrop`): the opaque draws end a first pass, a copy of
+//!    the eye's target and its halvings are made, and the blended draws follow in a second pass,
+//!    such glass reading what is behind it from the copy (at a level by its roughness, where its
+//!    refracted ray lands); blended surfaces behind it are not in the copy. The reflections of a
+//!    glass primitive's far side are not filtered by its near side (one draw each). Mono renders only the cyclopean eye. Light, materials and textures are shared by
 //!    both eyes; only the small per-eye uniform differs. A primitive whose level is
 //!    [`IMPOSTOR_LEVEL`] and that has one baked is drawn as its relief-texture impostor
 //!    ([`impostor`]; it casts the shadow of its polygon level as exact as it is); a primitive in
@@ -77,6 +80,7 @@ use phantogram_assets::ward::WardMap;
 use phantogram_geometry::anaglyph::Method;
 use phantogram_geometry::projection::OffAxisProjection;
 
+mod backdrop;
 mod bindings;
 mod environment;
 mod frame;
@@ -221,6 +225,15 @@ pub struct Renderer {
     point_shadow: point_shadow::PointShadowMap,
     /// What glass between the light and a surface leaves of the light (`shadow_filter`).
     shadow_filter: shadow_filter::ShadowFilter,
+    /// Draws the levels of the eyes' backdrops (`backdrop`), made with the first that is needed.
+    backdrop_halver: Option<backdrop::Halver>,
+    /// What the eyes' bind groups hold without a backdrop, and how backdrops are sampled.
+    backdrop_placeholder: wgpu::TextureView,
+    backdrop_sampler: wgpu::Sampler,
+    /// Which backdrop the eyes' bind groups hold (`Backdrop::id`; 0: the placeholder).
+    backdrop_bound: u64,
+    /// The target size at which the device could not make the backdrops, if it could not.
+    backdrop_failed: Option<(u32, u32)>,
     /// Triangles the last frame's shadow passes drew (all faces of a lamp's cube together).
     shadow_triangles: u64,
     /// Why the lamp's cube could not be made, if it could not ([`Renderer::lamp_cube_error`]).
@@ -351,6 +364,13 @@ impl Renderer {
                     count: None,
                 },
                 texture_entry(9),
+                filterable_texture_entry(10),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 11,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
             ],
         });
         let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -397,6 +417,8 @@ impl Renderer {
             mipmap_filter: wgpu::MipmapFilterMode::Linear,
             ..Default::default()
         });
+        let backdrop_placeholder = backdrop::placeholder(device);
+        let backdrop_sampler = backdrop::sampler(device);
         let eye_bind = eye_bind_groups(
             device,
             &eye_layout,
@@ -408,6 +430,8 @@ impl Renderer {
                 shadow_filter: &shadow_filter.view,
                 ward_map: &ward_map.1,
                 ward_sampler: &ward_sampler,
+                backdrop: [&backdrop_placeholder; 2],
+                backdrop_sampler: &backdrop_sampler,
             },
             &ibl,
         );
@@ -534,6 +558,11 @@ impl Renderer {
             shadow_layout,
             point_shadow,
             shadow_filter,
+            backdrop_halver: None,
+            backdrop_placeholder,
+            backdrop_sampler,
+            backdrop_bound: 0,
+            backdrop_failed: None,
             shadow_triangles: 0,
             lamp_cube_error: None,
             ward_map,
@@ -729,6 +758,7 @@ impl Renderer {
             hdr,
             depth,
             offscreen: None,
+            backdrop: None,
             compose_bind,
         }
     }

@@ -38,7 +38,7 @@ impl ScenePipelines {
         let variants: Vec<MaterialVariant> = model
             .materials
             .iter()
-            .flat_map(|m| m.variant.draws())
+            .flat_map(|m| m.variant.draws(true).chain(m.variant.draws(false)))
             .chain(fading)
             .collect();
         for v in variants {

@@ -11,6 +11,8 @@ pub(crate) struct Targets {
     pub(crate) compose_bind: [wgpu::BindGroup; 2],
     /// Only when rendering headless: drawing to a window composes into its swapchain image.
     pub(crate) offscreen: Option<Offscreen>,
+    /// Only while the model has glass that blurs or bends what is behind it.
+    pub(crate) backdrop: Option<crate::backdrop::Backdrop>,
 }
 
 /// The composed frame's texture and the buffer it is read back through.

@@ -123,7 +123,13 @@ impl MaterialUniform {
                 f32::from(u8::from(m.unlit)),
             ],
             transforms,
-            scene: [f32::from(u8::from(m.scenery)), set(slots[5]), set(slots[6]), 0.0],
+            scene: [
+                f32::from(u8::from(m.scenery)),
+                set(slots[5]),
+                set(slots[6]),
+                // The path a ray refracted into the volume takes across it (none without a bend).
+                if l.refracts() { l.thickness } else { 0.0 },
+            ],
             layers: [
                 if m.transmits() { l.transmission } else { 0.0 },
                 l.specular,

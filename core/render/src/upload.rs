@@ -218,9 +218,11 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     mask: matches!(m.alpha, AlphaMode::Mask(_)),
                     fade: false,
                     layer: if transmits { DrawLayer::Light } else { DrawLayer::Whole },
+                    backdrop: m.blurs_or_bends(),
                     layers: m.layers != Layers::default(),
                     glass_shadows,
                 },
+                blurs: m.blurs(),
                 _uniform: uniform,
             }
         })

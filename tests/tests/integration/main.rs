@@ -28,6 +28,7 @@ mod prefilter_gpu;
 mod projection_ground_truth;
 mod render;
 mod room_light;
+mod seen_through;
 mod shared_data;
 mod surface;
 mod transmission;

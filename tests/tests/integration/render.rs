@@ -313,6 +313,39 @@ fn render_over_floor_lit(
     Some((pixels, mono, renderer.shadow_triangles_last_frame()))
 }
 
+/// Each of `models` on its floor as [`render_over_floor`] draws it (with shadows, lit from
+/// `toward_light`), one after the other by one renderer (`Renderer::set_model` between).
+pub(crate) fn render_in_turn_over_floor(models: Vec<Model>, toward_light: Vec3) -> Option<Vec<Vec<u8>>> {
+    let gpu = gpu()?;
+    let screen = Screen::default();
+    let models: Vec<Model> = models
+        .into_iter()
+        .map(|mut m| {
+            m.add_floor(&screen, 2.0);
+            m
+        })
+        .collect();
+    let mono = OffAxisProjection::new(&screen, Vec3::new(0.0, 0.0, 0.3), DepthRange::default()).unwrap();
+    let mut renderer = Renderer::new(gpu, models.first()?).unwrap();
+    renderer.lighting.shadows = true;
+    let input = FrameInput {
+        left: &mono,
+        right: &mono,
+        mono: &mono,
+        toward_light,
+        device_to_world: phantogram::glam::Quat::IDENTITY,
+        offset: Vec3::ZERO,
+        levels: &[],
+        fades: &[],
+    };
+    let mut frames = Vec::new();
+    for model in &models {
+        renderer.set_model(model).unwrap();
+        frames.push(renderer.render(&input, Method::Mono, W, H).unwrap());
+    }
+    Some(frames)
+}
+
 fn luminance_at(pixels: &[u8], proj: &OffAxisProjection, p: Vec3) -> f32 {
     luminance(&pixel_at(pixels, proj, p))
 }

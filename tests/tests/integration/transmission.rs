@@ -43,7 +43,7 @@ fn render_under_with(
 }
 
 /// The pixel at [`BEHIND`] with `over` floating above the block of `colour`.
-fn seen(colour: [f32; 4], over: Option<Material>) -> Option<[f32; 3]> {
+pub(crate) fn seen(colour: [f32; 4], over: Option<Material>) -> Option<[f32; 3]> {
     seen_with(colour, over, Vec::new())
 }
 
@@ -81,7 +81,7 @@ fn opaque_white() -> Material {
 }
 
 /// Smooth glass: a dielectric that lets through what it does not reflect.
-fn glass(base: [f32; 3], layers: Layers) -> Material {
+pub(crate) fn glass(base: [f32; 3], layers: Layers) -> Material {
     Material {
         name: "glass".into(),
         base_color: [base[0], base[1], base[2], 1.0],
@@ -95,11 +95,11 @@ fn glass(base: [f32; 3], layers: Layers) -> Material {
     }
 }
 
-fn largest_difference(a: [f32; 3], b: [f32; 3]) -> f32 {
+pub(crate) fn largest_difference(a: [f32; 3], b: [f32; 3]) -> f32 {
     a.iter().zip(b).map(|(x, y)| (x - y).abs()).fold(0.0, f32::max)
 }
 
-const RED: [f32; 4] = [0.6, 0.05, 0.05, 1.0];
+pub(crate) const RED: [f32; 4] = [0.6, 0.05, 0.05, 1.0];
 const GREY: [f32; 4] = [0.7, 0.7, 0.7, 1.0];
 
 #[test]

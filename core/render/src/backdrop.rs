@@ -1,0 +1,244 @@
+//! What glass that blurs or bends the view through it shows: per eye, a copy of the opaque scene
+//! as that eye sees it (linear HDR, the eye's target format) with its chain of halvings down to
+//! one texel, made between the eye's opaque and blended draws.
+//!
+//! Smooth thin glass filters the pixel under it (`DrawLayer::Filter`), which is exact for any
+//! number of layers. Frosted glass shows a blur of what is behind it and a refracting volume
+//! shows what is behind it displaced: neither is the pixel under it, so such glass
+//! (`Material::blurs_or_bends`) reads the backdrop instead (`DrawLayer::Backdrop`, `seen_through`
+//! in `scene.wgsl`: a level by its roughness, a place by its refracted ray). The backdrop holds
+//! the opaque scene only: what is blended (other glass, blended surfaces) behind such glass is
+//! not seen through it, as in the glTF sample viewer, whose transmission pass this follows.
+//!
+//! Made with the frame's targets, only while the model has such glass (a 1080×2400 eye costs
+//! 21 MB, 28 MB with its halvings), and with the halvings only while some of it is rough (glass
+//! that only bends reads the copy itself); the eyes' bind groups are remade when the backdrop
+//! they hold is not the current one. Each level is one draw of `backdrop.wgsl` reading the level
+//! above: two passes of the eye's scene instead of one, plus one small one per level. Render
+//! thread only, like the renderer; no panics.
+
+use std::sync::atomic::{AtomicU64, Ordering};
+
+use crate::HDR_FORMAT;
+use crate::bindings::filterable_texture_entry;
+
+pub(crate) const BACKDROP_WGSL: &str = include_str!("../../../shaders/backdrop.wgsl");
+
+/// Draws one level of a backdrop from the one above (or from the eye's target).
+pub(crate) struct Halver {
+    pipeline: wgpu::RenderPipeline,
+    layout: wgpu::BindGroupLayout,
+    sampler: wgpu::Sampler,
+}
+
+impl Halver {
+    pub(crate) fn new(device: &wgpu::Device) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("backdrop.wgsl"),
+            source: wgpu::ShaderSource::Wgsl(BACKDROP_WGSL.into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("backdrop level"),
+            entries: &[
+                filterable_texture_entry(0),
+                wgpu::BindGroupLayoutEntry {
+                    binding: 1,
+                    visibility: wgpu::ShaderStages::FRAGMENT,
+                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                    count: None,
+                },
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("backdrop level"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("backdrop level"),
+            layout: Some(&pipeline_layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_main"),
+                compilation_options: Default::default(),
+                buffers: &[],
+            },
+            primitive: Default::default(),
+            depth_stencil: None,
+            multisample: Default::default(),
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_main"),
+                compilation_options: Default::default(),
+                targets: &[Some(HDR_FORMAT.into())],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        Self {
+            pipeline,
+            layout,
+            sampler: sampler(device),
+        }
+    }
+}
+
+/// The sampler the scene shader reads a backdrop with, and levels are drawn with: bilinear within
+/// and between levels, clamped at the screen's edges (a ray bent off the screen reads its edge).
+pub(crate) fn sampler(device: &wgpu::Device) -> wgpu::Sampler {
+    device.create_sampler(&wgpu::SamplerDescriptor {
+        label: Some("backdrop"),
+        mag_filter: wgpu::FilterMode::Linear,
+        min_filter: wgpu::FilterMode::Linear,
+        mipmap_filter: wgpu::MipmapFilterMode::Linear,
+        ..Default::default()
+    })
+}
+
+/// What the eyes' bind groups hold while no backdrop is made: one black texel.
+pub(crate) fn placeholder(device: &wgpu::Device) -> wgpu::TextureView {
+    device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("no backdrop"),
+            size: wgpu::Extent3d {
+                width: 1,
+                height: 1,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: HDR_FORMAT,
+            usage: wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        })
+        .create_view(&Default::default())
+}
+
+/// Levels of a chain of halvings of `width × height` down to one texel.
+pub(crate) fn level_count(width: u32, height: u32) -> u32 {
+    32 - width.max(height).max(1).leading_zeros()
+}
+
+/// Each backdrop made gets its own number, so that the eyes' bind groups can tell whether they
+/// hold the current one (0: the placeholder).
+static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+
+/// Both eyes' backdrops for targets of one size.
+pub(crate) struct Backdrop {
+    pub(crate) id: u64,
+    /// Levels made: 1 (the copy alone, for glass that only bends) or the whole chain.
+    pub(crate) level_count: u32,
+    /// Each eye's levels together, as the scene shader samples them.
+    pub(crate) views: [wgpu::TextureView; 2],
+    /// Each eye's levels, one view each, drawn into in order.
+    levels: [Vec<wgpu::TextureView>; 2],
+    /// What each eye's level k is drawn from: the eye's target for level 0, then level k − 1.
+    sources: [Vec<wgpu::BindGroup>; 2],
+}
+
+impl Backdrop {
+    /// Backdrops for the eyes' targets `eyes`, of `width × height`: the copy alone, or with
+    /// `halvings` the whole chain.
+    pub(crate) fn new(
+        device: &wgpu::Device,
+        halver: &Halver,
+        eyes: &[wgpu::TextureView; 2],
+        (width, height): (u32, u32),
+        halvings: bool,
+    ) -> Self {
+        let count = if halvings { level_count(width, height) } else { 1 };
+        let made = [0, 1].map(|eye| {
+            let texture = device.create_texture(&wgpu::TextureDescriptor {
+                label: Some(if eye == 0 { "backdrop left" } else { "backdrop right" }),
+                size: wgpu::Extent3d {
+                    width,
+                    height,
+                    depth_or_array_layers: 1,
+                },
+                mip_level_count: count,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: HDR_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+                view_formats: &[],
+            });
+            let levels: Vec<wgpu::TextureView> = (0..count)
+                .map(|k| {
+                    texture.create_view(&wgpu::TextureViewDescriptor {
+                        label: Some("backdrop level"),
+                        base_mip_level: k,
+                        mip_level_count: Some(1),
+                        ..Default::default()
+                    })
+                })
+                .collect();
+            let sources = (0..count as usize)
+                .map(|k| {
+                    let source = if k == 0 { &eyes[eye] } else { &levels[k - 1] };
+                    device.create_bind_group(&wgpu::BindGroupDescriptor {
+                        label: Some("backdrop level"),
+                        layout: &halver.layout,
+                        entries: &[
+                            wgpu::BindGroupEntry {
+                                binding: 0,
+                                resource: wgpu::BindingResource::TextureView(source),
+                            },
+                            wgpu::BindGroupEntry {
+                                binding: 1,
+                                resource: wgpu::BindingResource::Sampler(&halver.sampler),
+                            },
+                        ],
+                    })
+                })
+                .collect();
+            (texture.create_view(&Default::default()), levels, sources)
+        });
+        let [(view_l, levels_l, sources_l), (view_r, levels_r, sources_r)] = made;
+        Self {
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
+            level_count: count,
+            views: [view_l, view_r],
+            levels: [levels_l, levels_r],
+            sources: [sources_l, sources_r],
+        }
+    }
+
+    /// Records eye `eye`'s copy of its target and the halvings, after its opaque draws.
+    pub(crate) fn record(&self, encoder: &mut wgpu::CommandEncoder, halver: &Halver, eye: usize) {
+        for (level, source) in self.levels[eye].iter().zip(&self.sources[eye]) {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("backdrop level"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: level,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                ..Default::default()
+            });
+            pass.set_pipeline(&halver.pipeline);
+            pass.set_bind_group(0, source, &[]);
+            pass.draw(0..3, 0..1);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_chain_ends_at_one_texel() {
+        assert_eq!(level_count(1, 1), 1);
+        assert_eq!(level_count(2, 1), 2);
+        assert_eq!(level_count(1080, 2400), 12);
+        assert_eq!(level_count(2048, 2048), 12);
+        assert_eq!(level_count(2049, 3), 12);
+        assert_eq!(level_count(3, 4096), 13);
+        assert_eq!(level_count(0, 0), 1);
+    }
+}

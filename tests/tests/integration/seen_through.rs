@@ -1,0 +1,184 @@
+//! Glass that blurs or bends what is seen through it (the render crate's `backdrop`,
+//! `seen_through` in `scene.wgsl`): frosted glass shows a blur of what is behind it, as much as its
+//! roughness and index say, and what it shows agrees with the plain filter's picture where it
+//! is smooth; a refracting volume shows what is behind it displaced the way Snell's law bends
+//! the ray, and not at normal incidence.
+
+use crate::render::{OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_in_turn_over_floor, render_over_floor};
+use crate::transmission::{RED, glass, largest_difference, seen};
+use phantogram::glam::{Mat4, Vec3};
+use phantogram::model::{Layers, Material, Mesh, Model, Primitive};
+
+const GREEN: [f32; 4] = [0.05, 0.6, 0.05, 1.0];
+
+/// Red over green: how much the pixel still shows the red block.
+fn redness(c: [f32; 3]) -> f32 {
+    c[0] / c[1].max(1.0)
+}
+
+/// Glass of `roughness` and index `ior` over the red block.
+fn rough_glass(roughness: f32, ior: f32) -> Material {
+    Material {
+        roughness,
+        ..glass(
+            [1.0; 3],
+            Layers {
+                ior,
+                ..Layers::default()
+            },
+        )
+    }
+}
+
+#[test]
+fn frosted_glass_blurs_what_is_behind_it_by_its_roughness() {
+    // Roughness 0 is drawn with the plain filter; any other through the backdrop.
+    let Some(smooth) = seen(RED, Some(rough_glass(0.0, 1.5))) else {
+        return;
+    };
+    let barely = seen(RED, Some(rough_glass(1e-4, 1.5))).expect("a frame");
+    let half = seen(RED, Some(rough_glass(0.4, 1.5))).expect("a frame");
+    let frosted = seen(RED, Some(rough_glass(1.0, 1.5))).expect("a frame");
+    let same_index_smooth = seen(RED, Some(rough_glass(0.0, 1.0))).expect("a frame");
+    let same_index_rough = seen(RED, Some(rough_glass(1.0, 1.0))).expect("a frame");
+    println!(
+        "the red block through glass of roughness 0 {smooth:?}, 1e-4 {barely:?}, 0.4 {half:?}, 1 {frosted:?}; of index 1, smooth {same_index_smooth:?}, rough {same_index_rough:?}"
+    );
+    // The backdrop is the opaque scene as the eye saw it: at the sharpest level the two ways of
+    // drawing glass agree.
+    assert!(
+        largest_difference(barely, smooth) <= 2.0,
+        "backdrop {barely:?} vs filter {smooth:?}"
+    );
+    assert!(redness(smooth) > 2.0, "smooth glass shows the red block: {smooth:?}");
+    // Fully rough: the whole scene's mean, mostly the grey floor.
+    assert!(redness(frosted) < 1.3, "frosted glass shows a blur: {frosted:?}");
+    assert!(
+        redness(half) < 0.95 * redness(smooth) && redness(half) > 1.05 * redness(frosted),
+        "half as rough, half as blurred: {half:?} between {smooth:?} and {frosted:?}"
+    );
+    // A rough boundary between media of one index turns no ray: sharp, as the smooth one.
+    assert!(
+        largest_difference(same_index_rough, same_index_smooth) <= 2.0,
+        "index 1: rough {same_index_rough:?} vs smooth {same_index_smooth:?}"
+    );
+}
+
+/// Where a ray from the eye straight down onto the screen's centre lands through a 12 mm gem
+/// (diamond's index) tilted 30° about x: refracted towards the face's inward normal, it leaves
+/// the gem 18° off the vertical, 3.7 mm towards +y, and meets the plane 24 mm under the glass
+/// 3.8 mm out (a slab's exit ray, parallel to the entering one, lands 3.8 mm out too).
+const BENT_TO: Vec3 = Vec3::new(0.0, 0.0038, -0.024);
+
+/// A 12 mm block of `layers` over the floor, tilted by `tilt_deg` about x, with a 4 mm block of
+/// `under` standing where [`BENT_TO`] is.
+fn gem_scene(layers: Layers, roughness: f32, tilt_deg: f32, under: [f32; 4]) -> Model {
+    let mut mesh = Mesh::default();
+    mesh.push_cube(BENT_TO - Vec3::new(0.0, 0.0, 0.002), 0.002, under);
+    push_floor_marker(&mut mesh);
+    let mut model = Model::from_painted_mesh("under a gem", mesh);
+    let mut gem = Mesh::default();
+    gem.push_cube(Vec3::ZERO, 0.006, [1.0; 4]);
+    gem.transform(Mat4::from_translation(Vec3::new(0.0, 0.0, -0.012)) * Mat4::from_rotation_x(tilt_deg.to_radians()));
+    model.materials.push(Material {
+        roughness,
+        ..glass([1.0; 3], layers)
+    });
+    model.primitives.push(Primitive {
+        mesh: gem,
+        material: model.materials.len() - 1,
+        is_floor: false,
+        lods: Vec::new(),
+    });
+    model
+}
+
+/// The pixel at the screen's centre through [`gem_scene`]'s smooth block.
+fn through_a_gem(layers: Layers, tilt_deg: f32) -> Option<[f32; 3]> {
+    let (pixels, proj) = render_over_floor(gem_scene(layers, 0.0, tilt_deg, RED), true, OBLIQUE_LIGHT)?;
+    let p = pixel_at(&pixels, &proj, Vec3::new(0.0, 0.0, BENT_TO.z));
+    Some([p[0] as f32, p[1] as f32, p[2] as f32])
+}
+
+#[test]
+fn a_refracting_volume_shows_what_is_behind_it_where_the_ray_bends() {
+    let diamond = Layers {
+        ior: 2.42,
+        thickness: 0.012,
+        ..Layers::default()
+    };
+    let Some(bent) = through_a_gem(diamond, 30.0) else {
+        return;
+    };
+    let thin = through_a_gem(
+        Layers {
+            ior: 2.42,
+            ..Layers::default()
+        },
+        30.0,
+    )
+    .expect("a frame");
+    let straight_on = through_a_gem(diamond, 0.0).expect("a frame");
+    println!(
+        "the screen's centre through a tilted gem {bent:?}, a tilted thin wall {thin:?}, the gem face on {straight_on:?}"
+    );
+    // The red block is 3.8 mm off the straight line of sight, under the floor's grey.
+    assert!(redness(thin) < 1.3, "a thin wall does not bend the ray: {thin:?}");
+    assert!(
+        redness(straight_on) < 1.3,
+        "at normal incidence the ray goes straight on: {straight_on:?}"
+    );
+    assert!(
+        redness(bent) > 2.0,
+        "the gem bends the ray onto the red block: {bent:?}"
+    );
+}
+
+#[test]
+fn one_renderer_draws_each_kind_of_glass_as_a_fresh_one_does() {
+    // Frosted (a backdrop with its halvings), only bending (the copy alone), no glass (none),
+    // and frosted again: the backdrop is made, remade and dropped as each model needs. The block
+    // under the gem changes colour from one to the next, so that a backdrop left over from the
+    // model before shows.
+    let diamond = Layers {
+        ior: 2.42,
+        thickness: 0.012,
+        ..Layers::default()
+    };
+    let scenes = || {
+        vec![
+            gem_scene(diamond, 0.6, 30.0, RED),
+            gem_scene(diamond, 0.0, 30.0, GREEN),
+            gem_scene(
+                Layers {
+                    transmission: 0.0,
+                    ..diamond
+                },
+                0.0,
+                30.0,
+                RED,
+            ),
+            gem_scene(diamond, 0.6, 30.0, GREEN),
+        ]
+    };
+    let Some(in_turn) = render_in_turn_over_floor(scenes(), OBLIQUE_LIGHT) else {
+        return;
+    };
+    for (k, (model, drawn)) in scenes().into_iter().zip(&in_turn).enumerate() {
+        let fresh = render_in_turn_over_floor(vec![model], OBLIQUE_LIGHT).expect("a frame");
+        let worst = fresh[0]
+            .iter()
+            .zip(drawn)
+            .map(|(a, b)| a.abs_diff(*b))
+            .max()
+            .unwrap_or(0);
+        assert!(worst <= 1, "scene {k}: a channel differs by {worst}");
+    }
+    // And the frames differ where they should: the frosted gem is not the sharp one.
+    let differs = in_turn[0]
+        .iter()
+        .zip(&in_turn[1])
+        .filter(|(a, b)| a.abs_diff(**b) > 8)
+        .count();
+    assert!(differs > 1000, "frosted and sharp differ at {differs} channels");
+}
