@@ -14,7 +14,10 @@
 //!   frames with the progress banner meanwhile as the app does, and how many frames showed
 //!   progress before the turtle; also the best scan's load waited for without drawing (load,
 //!   fit, upload and one frame);
-//! * the amphora as amber glass on its floor (drawn twice per eye, and a shadow filter);
+//! * the amphora as smooth glass on its floor (drawn twice per eye, and a shadow filter), and as
+//!   amber glass of index 1 (the same, back faces culled) and 1.5 (it bends what is seen
+//!   through it: drawn over each eye's backdrop, the copy alone), and frosted (blurred: the
+//!   backdrop's halvings too);
 //! * the raking lamp over the amphora on its floor (`LampSetting::raking`, at the screen's left
 //!   edge 2 cm above the glass: inside the amphora's bounding sphere, so its shadows come from a
 //!   cube of six views, `phantogram_render::point_shadow`), with shadows and without, and the
@@ -48,22 +51,31 @@ fn peak_rss_mib() -> Option<f64> {
     Some(kib / 1024.0)
 }
 
-/// Median mono and stereo frame times, ms. The two are measured alternately, frame by frame, so
-/// that the load of this shared machine weighs on both alike.
-fn frame_times(renderer: &mut Renderer, input: &FrameInput, frames: usize) -> (f64, f64) {
+/// Median mono and stereo frame times, ms, and where the device has timestamp queries the median
+/// GPU times of the same frames (first pass to composition). The two are measured alternately,
+/// frame by frame, so that the load of this shared machine weighs on both alike.
+fn frame_times(renderer: &mut Renderer, input: &FrameInput, frames: usize) -> ((f64, f64), Option<(f64, f64)>) {
+    // Each frame is read back, which waits for its timestamps too: its reading is there at once.
     let mut time = |method: Method| {
         let start = Instant::now();
         std::hint::black_box(renderer.render(input, method, W, H).expect("frame"));
-        start.elapsed().as_secs_f64() * 1e3
+        let wall = start.elapsed().as_secs_f64() * 1e3;
+        (wall, renderer.take_gpu_time_s().map(|s| s * 1e3))
     };
     time(Method::Mono);
     time(Method::DuboisRedCyan);
     let (mut mono, mut stereo) = (Vec::new(), Vec::new());
+    let (mut mono_gpu, mut stereo_gpu) = (Vec::new(), Vec::new());
     for _ in 0..frames {
-        mono.push(time(Method::Mono));
-        stereo.push(time(Method::DuboisRedCyan));
+        let (wall, gpu) = time(Method::Mono);
+        mono.push(wall);
+        mono_gpu.extend(gpu);
+        let (wall, gpu) = time(Method::DuboisRedCyan);
+        stereo.push(wall);
+        stereo_gpu.extend(gpu);
     }
-    (median_ms(mono), median_ms(stereo))
+    let gpu = (!mono_gpu.is_empty() && !stereo_gpu.is_empty()).then(|| (median_ms(mono_gpu), median_ms(stereo_gpu)));
+    ((median_ms(mono), median_ms(stereo)), gpu)
 }
 
 fn main() {
@@ -97,7 +109,19 @@ fn main() {
     let mut models: Vec<(String, Model)> = vec![
         ("amphora".into(), phantogram::artifact::default_model()),
         ("amphora on the floor".into(), on_floor),
-        ("amber glass amphora on the floor".into(), glass_amphora_on_floor()),
+        ("glass amphora on the floor".into(), glass_amphora_on_floor(None)),
+        (
+            "amber glass amphora on the floor, index 1".into(),
+            glass_amphora_on_floor(Some(1.0)),
+        ),
+        (
+            "amber glass amphora on the floor, index 1.5".into(),
+            glass_amphora_on_floor(Some(1.5)),
+        ),
+        (
+            "frosted amber glass amphora on the floor, index 1.5".into(),
+            frosted(glass_amphora_on_floor(Some(1.5))),
+        ),
     ];
     let mut renderer = None;
     let mut gpu = Some(gpu);
@@ -130,9 +154,12 @@ fn main() {
     };
     for (name, model) in &models {
         renderer.set_model(model).expect("model");
-        let (mono, stereo) = frame_times(&mut renderer, &input, frames);
+        let ((mono, stereo), gpu) = frame_times(&mut renderer, &input, frames);
+        let on_gpu = gpu.map_or(String::new(), |(m, s)| {
+            format!("; on the GPU mono {m:.2} ms, stereo {s:.2} ms")
+        });
         println!(
-            "{name}, {W}x{H}: mono {mono:.1} ms, stereo {stereo:.1} ms, stereo/mono {:.2}x",
+            "{name}, {W}x{H}: mono {mono:.1} ms, stereo {stereo:.1} ms, stereo/mono {:.2}x{on_gpu}",
             stereo / mono
         );
         if let Some(dir) = &frames_dir {
@@ -153,25 +180,44 @@ fn main() {
 fn save_frame(renderer: &mut Renderer, input: &FrameInput, dir: &std::path::Path, name: &str) {
     let rgba = renderer.render(input, Method::Mono, W, H).expect("frame");
     let image = image::RgbaImage::from_raw(W, H, rgba).expect("a whole frame");
-    let path = dir.join(format!("{}.png", name.replace(' ', "_")));
+    let file: String = name
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    let path = dir.join(format!("{file}.png"));
     image.save(&path).expect("the frame is written");
     println!("  frame written to {}", path.display());
 }
 
-/// The amphora as tinted glass on its floor: every one of its materials transmits, through an
-/// amber volume, so each eye draws it twice (filter and light) and the light's view draws the
-/// shadow filter.
-fn glass_amphora_on_floor() -> Model {
+/// The amphora as glass on its floor: every one of its materials transmits, smooth, so each eye
+/// draws it twice (filter and light) and the light's view draws the shadow filter. With a
+/// volume's index, its walls are 4 mm of amber glass (back faces culled); of index 1 it bends
+/// nothing and is drawn with the filter, of any other over each eye's backdrop (a copy of the
+/// opaque scene and its halvings): the two differ by the backdrop's cost alone.
+fn glass_amphora_on_floor(volume_ior: Option<f32>) -> Model {
     let mut glass = phantogram::artifact::default_model();
     for material in &mut glass.materials {
         material.layers.transmission = 1.0;
-        material.layers.thickness = 0.004;
-        material.layers.attenuation_distance = 0.01;
-        material.layers.attenuation_color = [0.95, 0.6, 0.2];
+        material.roughness = 0.0;
+        if let Some(ior) = volume_ior {
+            material.layers.ior = ior;
+            material.layers.thickness = 0.004;
+            material.layers.attenuation_distance = 0.01;
+            material.layers.attenuation_color = [0.95, 0.6, 0.2];
+        }
         // The painted amphora's material is metallic, and metal lets no light through.
         material.metallic = 0.0;
     }
     glass.add_floor(&SessionConfig::default().screen, Model::FLOOR_REACH);
+    glass
+}
+
+/// `glass` made rough (0.5), so that what is seen through it is blurred: the backdrop with its
+/// halvings.
+fn frosted(mut glass: Model) -> Model {
+    for material in glass.materials.iter_mut().filter(|m| m.transmits()) {
+        material.roughness = 0.5;
+    }
     glass
 }
 
@@ -186,10 +232,10 @@ fn lamp_among_the_artifact(renderer: &mut Renderer, on_floor: &Model, input: &Fr
         .map_or(Vec3::ZERO, |b| (b.min + b.max) * 0.5);
     renderer.set_model(on_floor).expect("model");
     renderer.lamp = Some(placed.lamp(None, target));
-    let (mono, stereo) = frame_times(renderer, input, frames);
+    let ((mono, stereo), _) = frame_times(renderer, input, frames);
     let triangles = renderer.shadow_triangles_last_frame();
     renderer.lighting.shadows = false;
-    let (mono_plain, stereo_plain) = frame_times(renderer, input, frames);
+    let ((mono_plain, stereo_plain), _) = frame_times(renderer, input, frames);
     renderer.lighting.shadows = true;
     renderer.lamp = None;
     println!(
