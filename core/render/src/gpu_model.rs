@@ -124,6 +124,9 @@ impl GpuModel {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) struct MaterialVariant {
     pub(crate) double_sided: bool,
+    /// Draws the back faces alone (the far side of double-sided glass, drawn before its near
+    /// side: [`MaterialVariant::draws`]); overrides `double_sided`.
+    pub(crate) cull_front: bool,
     pub(crate) blend: bool,
     /// Base colour, metallic-roughness, normal, occlusion, emissive, transmission, thickness:
     /// sampled or not.
@@ -215,16 +218,41 @@ impl MaterialVariant {
     /// transmits light its filter, then itself (its light). The filter of glass that blurs or
     /// bends is its backdrop where the frame has one (`with_backdrop`); without (a device that
     /// could not make it), the plain filter: sharp and straight, but what is behind still shows.
+    /// Double-sided glass is drawn in two halves, its back faces (the far side of a closed
+    /// shape) and then its front faces, each filter then light: the near side filters the far
+    /// side's light, whatever the order of the triangles in the mesh.
     pub(crate) fn draws(self, with_backdrop: bool) -> impl Iterator<Item = MaterialVariant> {
-        let filter = (self.layer == DrawLayer::Light).then_some(MaterialVariant {
-            layer: if self.backdrop && with_backdrop {
-                DrawLayer::Backdrop
-            } else {
-                DrawLayer::Filter
-            },
+        let filter_layer = if self.backdrop && with_backdrop {
+            DrawLayer::Backdrop
+        } else {
+            DrawLayer::Filter
+        };
+        let side = |cull_front: bool| MaterialVariant {
+            double_sided: false,
+            cull_front,
             ..self
-        });
-        filter.into_iter().chain(std::iter::once(self))
+        };
+        let layers = |light: MaterialVariant| {
+            [
+                Some(MaterialVariant {
+                    layer: filter_layer,
+                    ..light
+                }),
+                Some(light),
+            ]
+        };
+        let draws: [Option<MaterialVariant>; 4] = match (self.layer, self.double_sided) {
+            (DrawLayer::Light, true) => {
+                let ([far_filter, far], [near_filter, near]) = (layers(side(true)), layers(side(false)));
+                [far_filter, far, near_filter, near]
+            }
+            (DrawLayer::Light, false) => {
+                let [filter, light] = layers(self);
+                [filter, light, None, None]
+            }
+            _ => [Some(self), None, None, None],
+        };
+        draws.into_iter().flatten()
     }
 
     /// Casts its shadow through the alpha-masked shadow pipeline (blended surfaces cast none).
@@ -243,3 +271,55 @@ pub(crate) const TEXTURE_OVERRIDES: [&str; 7] = [
     "HAS_TRANSMISSION_TEXTURE",
     "HAS_THICKNESS_TEXTURE",
 ];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn variant(layer: DrawLayer, double_sided: bool, backdrop: bool) -> MaterialVariant {
+        MaterialVariant {
+            double_sided,
+            cull_front: false,
+            blend: layer != DrawLayer::Whole,
+            textures: [false; 7],
+            mask: false,
+            fade: false,
+            layer,
+            backdrop,
+            layers: true,
+            glass_shadows: true,
+        }
+    }
+
+    #[test]
+    fn double_sided_glass_is_drawn_far_side_first() {
+        let draws: Vec<_> = variant(DrawLayer::Light, true, false).draws(true).collect();
+        let shape: Vec<_> = draws.iter().map(|v| (v.layer, v.cull_front, v.double_sided)).collect();
+        assert_eq!(
+            shape,
+            [
+                (DrawLayer::Filter, true, false),
+                (DrawLayer::Light, true, false),
+                (DrawLayer::Filter, false, false),
+                (DrawLayer::Light, false, false),
+            ]
+        );
+        // One-sided glass: its filter, then its light; anything else once, as it is.
+        let one_sided: Vec<_> = variant(DrawLayer::Light, false, false)
+            .draws(true)
+            .map(|v| v.layer)
+            .collect();
+        assert_eq!(one_sided, [DrawLayer::Filter, DrawLayer::Light]);
+        let whole = variant(DrawLayer::Whole, true, false);
+        assert_eq!(whole.draws(true).collect::<Vec<_>>(), [whole]);
+    }
+
+    #[test]
+    fn glass_that_blurs_or_bends_filters_through_the_backdrop_when_there_is_one() {
+        let frosted = variant(DrawLayer::Light, false, true);
+        let with: Vec<_> = frosted.draws(true).map(|v| v.layer).collect();
+        assert_eq!(with, [DrawLayer::Backdrop, DrawLayer::Light]);
+        let without: Vec<_> = frosted.draws(false).map(|v| v.layer).collect();
+        assert_eq!(without, [DrawLayer::Filter, DrawLayer::Light]);
+    }
+}

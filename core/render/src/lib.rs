@@ -29,9 +29,12 @@
 //!    over the eye's backdrop instead (`backdrop`): the opaque draws end a first pass, a copy of
 //!    the eye's target and its halvings are made, and the blended draws follow in a second pass,
 //!    such glass reading what is behind it from the copy (at a level by its roughness, where its
-//!    refracted ray lands); blended surfaces behind it are not in the copy. The reflections of a
-//!    glass primitive's far side are not filtered by its near side (one draw each). Mono renders only the cyclopean eye. Light, materials and textures are shared by
-//!    both eyes; only the small per-eye uniform differs. A primitive whose level is
+//!    refracted ray lands); blended surfaces behind it are not in the copy. Double-sided glass is
+//!    drawn in two halves, its back faces (the far side) before its front faces, so that its
+//!    near side filters its far side's light; within one half, triangles that overlap on screen
+//!    (a shape folded over itself) are drawn in the mesh's order. Mono renders only the
+//!    cyclopean eye. Light, materials and textures are shared by both eyes; only the small
+//!    per-eye uniform differs. A primitive whose level is
 //!    [`IMPOSTOR_LEVEL`] and that has one baked is drawn as its relief-texture impostor
 //!    ([`impostor`]; it casts the shadow of its polygon level as exact as it is); a primitive in
 //!    [`FrameInput::fades`] is drawn at both its levels, each on its share of the pixels

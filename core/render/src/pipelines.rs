@@ -111,7 +111,11 @@ impl ScenePipelines {
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
                 front_face: wgpu::FrontFace::Ccw,
-                cull_mode: (!v.double_sided).then_some(wgpu::Face::Back),
+                cull_mode: if v.cull_front {
+                    Some(wgpu::Face::Front)
+                } else {
+                    (!v.double_sided).then_some(wgpu::Face::Back)
+                },
                 ..Default::default()
             },
             depth_stencil: Some(wgpu::DepthStencilState {

@@ -211,6 +211,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     // A volume's front faces carry its whole absorption (`scene.wgsl`): its back
                     // faces would filter what is behind it a second time.
                     double_sided: m.double_sided && !(transmits && m.layers.thickness > 0.0),
+                    cull_front: false,
                     // What light passes through is drawn with the blended surfaces: after the
                     // opaque ones, back to front, hiding nothing.
                     blend: m.alpha == AlphaMode::Blend || transmits,

@@ -10,7 +10,7 @@
 
 use crate::render::{OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_over_floor};
 use phantogram::glam::Vec3;
-use phantogram::model::{Image, Layers, Material, Mesh, Model, Primitive, TextureRef};
+use phantogram::model::{Image, Layers, Material, Mesh, Model, Primitive, TextureRef, Vertex};
 use phantogram::projection::OffAxisProjection;
 
 /// The centre of the lower block's top face, which the upper block hides from the eye.
@@ -341,5 +341,65 @@ fn glass_casts_a_pale_shadow_and_tinted_glass_a_coloured_one() {
     assert!(
         red_shadow[0] > 0.85 * red_lit[0] && red_shadow[1] < 0.8 * red_lit[1] && red_shadow[2] < 0.8 * red_lit[2],
         "red glass's shadow: {red_shadow:?} vs {red_lit:?}"
+    );
+}
+
+/// A square 10 mm across at height `z`, facing up (+z) or down, in `colour`.
+fn square(mesh: &mut Mesh, z: f32, up: bool, colour: [f32; 4]) {
+    let base = mesh.vertices.len() as u32;
+    let normal = if up { [0.0, 0.0, 1.0] } else { [0.0, 0.0, -1.0] };
+    for (x, y) in [(-0.005, -0.005), (0.005, -0.005), (0.005, 0.005), (-0.005, 0.005)] {
+        mesh.vertices.push(Vertex {
+            position: [x, y, z],
+            normal,
+            tangent: [1.0, 0.0, 0.0, 1.0],
+            uv: [0.0; 4],
+            color: colour,
+            material: [1.0, 1.0],
+        });
+    }
+    // Counter-clockwise as seen from the side it faces.
+    let order = if up { [0, 1, 2, 0, 2, 3] } else { [0, 2, 1, 0, 3, 2] };
+    mesh.indices.extend(order.map(|i| base + i));
+}
+
+#[test]
+fn the_near_side_of_double_sided_glass_filters_the_far_sides_light() {
+    // One primitive, half-transmissive and double-sided: the top of a thin box tinted red, its
+    // bottom tinted blue, the top's triangles first in the mesh. Looking down, the red top's own
+    // light and, through it, the blue bottom's light filtered red: mostly red. Drawn in the
+    // mesh's order, the blue bottom would filter the red top's light instead: mostly blue.
+    let mut glass_box = Mesh::default();
+    square(&mut glass_box, -0.010, true, [1.0, 0.1, 0.1, 1.0]);
+    square(&mut glass_box, -0.020, false, [0.1, 0.1, 1.0, 1.0]);
+    let mut floor = Mesh::default();
+    push_floor_marker(&mut floor);
+    let mut model = Model::from_painted_mesh("under a glass box", floor);
+    model.materials.push(Material {
+        name: "half-clear".into(),
+        base_color: [1.0; 4],
+        metallic: 0.0,
+        roughness: 0.0,
+        double_sided: true,
+        layers: Layers {
+            transmission: 0.5,
+            ..Layers::default()
+        },
+        ..Material::default()
+    });
+    model.primitives.push(Primitive {
+        mesh: glass_box,
+        material: model.materials.len() - 1,
+        is_floor: false,
+        lods: Vec::new(),
+    });
+    let Some((pixels, proj)) = render_over_floor(model, false, OBLIQUE_LIGHT) else {
+        return;
+    };
+    let p = pixel_at(&pixels, &proj, Vec3::new(0.0, 0.0, -0.010));
+    println!("looking down through the red top onto the blue bottom: {p:?}");
+    assert!(
+        f32::from(p[0]) > 1.5 * f32::from(p[2]),
+        "the near (red) side's light over the far (blue) side's: {p:?}"
     );
 }
