@@ -10,8 +10,8 @@
 //! the opaque scene only: what is blended (other glass, blended surfaces) behind such glass is
 //! not seen through it, as in the glTF sample viewer, whose transmission pass this follows.
 //!
-//! Made with the frame's targets, only while the model has such glass (a 1080×2400 eye costs
-//! 21 MB, 28 MB with its halvings), and with the halvings only while some of it is rough (glass
+//! Made with the frame's targets, only while the model has such glass, and for an eye only once
+//! a frame draws it (a 1080×2400 eye costs 21 MB, 28 MB with its halvings), and with the halvings only while some of it is rough (glass
 //! that only bends reads the copy itself); the eyes' bind groups are remade when the backdrop
 //! they hold is not the current one. Each level is one draw of `backdrop.wgsl` reading the level
 //! above: two passes of the eye's scene instead of one, plus one small one per level. Render
@@ -124,89 +124,109 @@ pub(crate) fn level_count(width: u32, height: u32) -> u32 {
 /// hold the current one (0: the placeholder).
 static NEXT_ID: AtomicU64 = AtomicU64::new(1);
 
-/// Both eyes' backdrops for targets of one size.
+/// One eye's backdrop.
+struct EyeBackdrop {
+    /// Its levels together, as the scene shader samples them.
+    view: wgpu::TextureView,
+    /// Its levels, one view each, drawn into in order.
+    levels: Vec<wgpu::TextureView>,
+    /// What level k is drawn from: the eye's target for level 0, then level k − 1.
+    sources: Vec<wgpu::BindGroup>,
+}
+
+/// The eyes' backdrops for targets of one size, each made when a frame first draws that eye (a
+/// mono frame only the first).
 pub(crate) struct Backdrop {
+    /// Changes whenever an eye's backdrop is made.
     pub(crate) id: u64,
     /// Levels made: 1 (the copy alone, for glass that only bends) or the whole chain.
     pub(crate) level_count: u32,
-    /// Each eye's levels together, as the scene shader samples them.
-    pub(crate) views: [wgpu::TextureView; 2],
-    /// Each eye's levels, one view each, drawn into in order.
-    levels: [Vec<wgpu::TextureView>; 2],
-    /// What each eye's level k is drawn from: the eye's target for level 0, then level k − 1.
-    sources: [Vec<wgpu::BindGroup>; 2],
+    size: (u32, u32),
+    eyes: [Option<EyeBackdrop>; 2],
 }
 
 impl Backdrop {
-    /// Backdrops for the eyes' targets `eyes`, of `width × height`: the copy alone, or with
-    /// `halvings` the whole chain.
-    pub(crate) fn new(
-        device: &wgpu::Device,
-        halver: &Halver,
-        eyes: &[wgpu::TextureView; 2],
-        (width, height): (u32, u32),
-        halvings: bool,
-    ) -> Self {
-        let count = if halvings { level_count(width, height) } else { 1 };
-        let made = [0, 1].map(|eye| {
-            let texture = device.create_texture(&wgpu::TextureDescriptor {
-                label: Some(if eye == 0 { "backdrop left" } else { "backdrop right" }),
-                size: wgpu::Extent3d {
-                    width,
-                    height,
-                    depth_or_array_layers: 1,
-                },
-                mip_level_count: count,
-                sample_count: 1,
-                dimension: wgpu::TextureDimension::D2,
-                format: HDR_FORMAT,
-                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
-                view_formats: &[],
-            });
-            let levels: Vec<wgpu::TextureView> = (0..count)
-                .map(|k| {
-                    texture.create_view(&wgpu::TextureViewDescriptor {
-                        label: Some("backdrop level"),
-                        base_mip_level: k,
-                        mip_level_count: Some(1),
-                        ..Default::default()
-                    })
-                })
-                .collect();
-            let sources = (0..count as usize)
-                .map(|k| {
-                    let source = if k == 0 { &eyes[eye] } else { &levels[k - 1] };
-                    device.create_bind_group(&wgpu::BindGroupDescriptor {
-                        label: Some("backdrop level"),
-                        layout: &halver.layout,
-                        entries: &[
-                            wgpu::BindGroupEntry {
-                                binding: 0,
-                                resource: wgpu::BindingResource::TextureView(source),
-                            },
-                            wgpu::BindGroupEntry {
-                                binding: 1,
-                                resource: wgpu::BindingResource::Sampler(&halver.sampler),
-                            },
-                        ],
-                    })
-                })
-                .collect();
-            (texture.create_view(&Default::default()), levels, sources)
-        });
-        let [(view_l, levels_l, sources_l), (view_r, levels_r, sources_r)] = made;
+    /// Backdrops of `width × height` (none made yet): the copy alone, or with `halvings` the
+    /// whole chain.
+    pub(crate) fn new((width, height): (u32, u32), halvings: bool) -> Self {
         Self {
             id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
-            level_count: count,
-            views: [view_l, view_r],
-            levels: [levels_l, levels_r],
-            sources: [sources_l, sources_r],
+            level_count: if halvings { level_count(width, height) } else { 1 },
+            size: (width, height),
+            eyes: [None, None],
         }
     }
 
+    /// Eye `eye`'s levels together, once made.
+    pub(crate) fn view(&self, eye: usize) -> Option<&wgpu::TextureView> {
+        self.eyes.get(eye)?.as_ref().map(|e| &e.view)
+    }
+
+    /// Makes eye `eye`'s backdrop from its target `target`, if not made yet (a new [`Self::id`]).
+    pub(crate) fn make_eye(&mut self, device: &wgpu::Device, halver: &Halver, target: &wgpu::TextureView, eye: usize) {
+        if eye >= 2 || self.eyes[eye].is_some() {
+            return;
+        }
+        let (width, height) = self.size;
+        let count = self.level_count;
+        let texture = device.create_texture(&wgpu::TextureDescriptor {
+            label: Some(if eye == 0 { "backdrop left" } else { "backdrop right" }),
+            size: wgpu::Extent3d {
+                width,
+                height,
+                depth_or_array_layers: 1,
+            },
+            mip_level_count: count,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: HDR_FORMAT,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+            view_formats: &[],
+        });
+        let levels: Vec<wgpu::TextureView> = (0..count)
+            .map(|k| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    label: Some("backdrop level"),
+                    base_mip_level: k,
+                    mip_level_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
+        let sources = (0..count as usize)
+            .map(|k| {
+                let source = if k == 0 { target } else { &levels[k - 1] };
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("backdrop level"),
+                    layout: &halver.layout,
+                    entries: &[
+                        wgpu::BindGroupEntry {
+                            binding: 0,
+                            resource: wgpu::BindingResource::TextureView(source),
+                        },
+                        wgpu::BindGroupEntry {
+                            binding: 1,
+                            resource: wgpu::BindingResource::Sampler(&halver.sampler),
+                        },
+                    ],
+                })
+            })
+            .collect();
+        self.eyes[eye] = Some(EyeBackdrop {
+            view: texture.create_view(&Default::default()),
+            levels,
+            sources,
+        });
+        self.id = NEXT_ID.fetch_add(1, Ordering::Relaxed);
+    }
+
     /// Records eye `eye`'s copy of its target and the halvings, after its opaque draws.
+    /// Nothing where that eye's backdrop is not made.
     pub(crate) fn record(&self, encoder: &mut wgpu::CommandEncoder, halver: &Halver, eye: usize) {
-        for (level, source) in self.levels[eye].iter().zip(&self.sources[eye]) {
+        let Some(Some(made)) = self.eyes.get(eye) else {
+            return;
+        };
+        for (level, source) in made.levels.iter().zip(&made.sources) {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("backdrop level"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {

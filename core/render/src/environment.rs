@@ -154,10 +154,11 @@ impl Renderer {
             shadow_filter: &self.shadow_filter.view,
             ward_map: &self.ward_map.1,
             ward_sampler: &self.ward_sampler,
-            backdrop: match self.backdrop() {
-                Some(b) => [&b.views[0], &b.views[1]],
-                None => [&self.backdrop_placeholder; 2],
-            },
+            backdrop: [0, 1].map(|eye| {
+                self.backdrop()
+                    .and_then(|b| b.view(eye))
+                    .unwrap_or(&self.backdrop_placeholder)
+            }),
             backdrop_sampler: &self.backdrop_sampler,
         }
     }

@@ -271,7 +271,7 @@ impl Renderer {
                 u.shadow[3] = 1.0;
             }
         }
-        let with_backdrop = self.prepare_backdrop();
+        let with_backdrop = self.prepare_backdrop(eyes.len());
         let (lm, rm) = method.matrices();
         let row = |m: [f32; 3]| [m[0], m[1], m[2], 0.0];
         let compose = ComposeUniform {
@@ -483,7 +483,7 @@ impl Renderer {
     /// bends (`backdrop`), drops them if it has none, and points the eyes' bind groups at what is
     /// there. Whether this frame draws with a backdrop: not where the device could not make one
     /// (such glass is then drawn with the plain filter; not tried again at that size).
-    pub(crate) fn prepare_backdrop(&mut self) -> bool {
+    pub(crate) fn prepare_backdrop(&mut self, eyes: usize) -> bool {
         let needed = self.model.backdrop_needed();
         let halvings = needed == crate::gpu_model::BackdropNeeded::Blurred;
         let Some(targets) = self.targets.as_mut() else {
@@ -501,8 +501,11 @@ impl Renderer {
         {
             targets.backdrop = None;
         }
+        let missing = |b: &Option<crate::backdrop::Backdrop>| {
+            b.as_ref().is_none_or(|b| (0..eyes).any(|eye| b.view(eye).is_none()))
+        };
         if needed != crate::gpu_model::BackdropNeeded::None
-            && targets.backdrop.is_none()
+            && missing(&targets.backdrop)
             && self.backdrop_failed != Some(size)
         {
             let device = self.gpu.device.clone();
@@ -514,19 +517,25 @@ impl Renderer {
             }
             if let Some(halver) = &self.backdrop_halver {
                 let hdr = &targets.hdr;
-                match checked(&device, "the eyes' backdrops", || {
-                    crate::backdrop::Backdrop::new(&device, halver, hdr, size, halvings)
-                }) {
-                    Ok(b) => targets.backdrop = Some(b),
-                    Err(_) => self.backdrop_failed = Some(size),
+                let backdrop = targets
+                    .backdrop
+                    .get_or_insert_with(|| crate::backdrop::Backdrop::new(size, halvings));
+                let made = checked(&device, "the eyes' backdrops", || {
+                    for (eye, target) in hdr.iter().enumerate().take(eyes) {
+                        backdrop.make_eye(&device, halver, target, eye);
+                    }
+                });
+                if made.is_err() {
+                    targets.backdrop = None;
+                    self.backdrop_failed = Some(size);
                 }
             }
         }
-        let current = self.backdrop().map_or(0, |b| b.id);
-        if current != self.backdrop_bound {
+        if self.backdrop().map_or(0, |b| b.id) != self.backdrop_bound {
             self.remake_eye_binds();
         }
-        current != 0
+        self.backdrop()
+            .is_some_and(|b| (0..eyes).all(|eye| b.view(eye).is_some()))
     }
 
     /// Draws what casts shadows into a shadow pass whose light matrix `bind` holds: opaque

@@ -346,6 +346,34 @@ pub(crate) fn render_in_turn_over_floor(models: Vec<Model>, toward_light: Vec3) 
     Some(frames)
 }
 
+/// `model` on its floor as [`render_over_floor`] draws it (with shadows), by one renderer in
+/// each of `methods` in turn; stereo with the eyes 64 mm apart.
+pub(crate) fn render_methods_over_floor(mut model: Model, methods: &[Method]) -> Option<Vec<Vec<u8>>> {
+    let gpu = gpu()?;
+    let screen = Screen::default();
+    model.add_floor(&screen, 2.0);
+    let at = |x: f32| OffAxisProjection::new(&screen, Vec3::new(x, 0.0, 0.3), DepthRange::default()).unwrap();
+    let (left, right, mono) = (at(-0.032), at(0.032), at(0.0));
+    let mut renderer = Renderer::new(gpu, &model).unwrap();
+    renderer.lighting.shadows = true;
+    let input = FrameInput {
+        left: &left,
+        right: &right,
+        mono: &mono,
+        toward_light: OBLIQUE_LIGHT,
+        device_to_world: phantogram::glam::Quat::IDENTITY,
+        offset: Vec3::ZERO,
+        levels: &[],
+        fades: &[],
+    };
+    Some(
+        methods
+            .iter()
+            .map(|m| renderer.render(&input, *m, W, H).unwrap())
+            .collect(),
+    )
+}
+
 fn luminance_at(pixels: &[u8], proj: &OffAxisProjection, p: Vec3) -> f32 {
     luminance(&pixel_at(pixels, proj, p))
 }

@@ -4,8 +4,11 @@
 //! is smooth; a refracting volume shows what is behind it displaced the way Snell's law bends
 //! the ray, and not at normal incidence.
 
-use crate::render::{OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_in_turn_over_floor, render_over_floor};
+use crate::render::{
+    OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_in_turn_over_floor, render_methods_over_floor, render_over_floor,
+};
 use crate::transmission::{RED, glass, largest_difference, seen};
+use phantogram::anaglyph::Method;
 use phantogram::glam::{Mat4, Vec3};
 use phantogram::model::{Layers, Material, Mesh, Model, Primitive};
 
@@ -181,4 +184,36 @@ fn one_renderer_draws_each_kind_of_glass_as_a_fresh_one_does() {
         .filter(|(a, b)| a.abs_diff(**b) > 8)
         .count();
     assert!(differs > 1000, "frosted and sharp differ at {differs} channels");
+}
+
+#[test]
+fn a_stereo_frame_after_mono_ones_sees_through_frosted_glass_with_both_eyes() {
+    // A mono frame makes the first eye's backdrop alone; the stereo frame after it needs the
+    // second's too.
+    let diamond = Layers {
+        ior: 2.42,
+        thickness: 0.012,
+        ..Layers::default()
+    };
+    let scene = || gem_scene(diamond, 0.6, 30.0, RED);
+    let Some(frames) = render_methods_over_floor(scene(), &[Method::Mono, Method::DuboisRedCyan]) else {
+        return;
+    };
+    let fresh = render_methods_over_floor(scene(), &[Method::DuboisRedCyan]).expect("a frame");
+    let worst = fresh[0]
+        .iter()
+        .zip(&frames[1])
+        .map(|(a, b)| a.abs_diff(*b))
+        .max()
+        .unwrap_or(0);
+    assert!(
+        worst <= 1,
+        "the stereo frame after a mono one: a channel differs by {worst}"
+    );
+    let differs = frames[0]
+        .iter()
+        .zip(&frames[1])
+        .filter(|(a, b)| a.abs_diff(**b) > 8)
+        .count();
+    assert!(differs > 1000, "mono and stereo differ at {differs} channels");
 }
