@@ -126,9 +126,9 @@ override TRANSMIT_LAYER: u32 = 0u;
 // `shadow_filter`): rgb the share passed, alpha the light-space depth of the nearest glass. Read
 // only where `eye.shadow.w` says it holds this frame's glass.
 @group(0) @binding(9) var shadow_filter: texture_2d<f32>;
-// What the opaque scene shows this eye, with its halvings (render crate, `backdrop`): glass that
-// blurs or bends the view through it reads what is behind it here (`TRANSMIT_LAYER` 3). A 1×1
-// placeholder while the model has no such glass.
+// What this eye drew before its farthest glass that blurs or bends the view through it, with its
+// halvings (render crate, `backdrop`): such glass reads what is behind it here (`TRANSMIT_LAYER`
+// 3). A 1×1 placeholder while the model has no such glass.
 @group(0) @binding(10) var backdrop: texture_2d<f32>;
 @group(0) @binding(11) var backdrop_sampler: sampler;
 
@@ -652,7 +652,7 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     return vec4<f32>(shaded.radiance, out_alpha);
 }
 
-// What the opaque scene shows through a surface at `world` (mesh coordinates; pixel `pixel`):
+// What the backdrop shows through a surface at `world` (mesh coordinates; pixel `pixel`):
 // where a ray refracted into its volume leaves it, projected into this eye's backdrop, blurred by
 // its roughness. The ray's exit is taken one path length straight along the refracted direction
 // and what is behind is read where that point falls on the screen: the thick-slab approximation of

@@ -1,19 +1,21 @@
-//! What glass that blurs or bends the view through it shows: per eye, a copy of the opaque scene
-//! as that eye sees it (linear HDR, the eye's target format) with its chain of halvings down to
-//! one texel, made between the eye's opaque and blended draws.
+//! What glass that blurs or bends the view through it shows: per eye, a copy of what the eye has
+//! drawn so far (linear HDR, the eye's target format) with its chain of halvings down to one
+//! texel, made just before the eye's farthest such glass is drawn.
 //!
 //! Smooth thin glass filters the pixel under it (`DrawLayer::Filter`), which is exact for any
 //! number of layers. Frosted glass shows a blur of what is behind it and a refracting volume
 //! shows what is behind it displaced: neither is the pixel under it, so such glass
 //! (`Material::blurs_or_bends`) reads the backdrop instead (`DrawLayer::Backdrop`, `seen_through`
-//! in `scene.wgsl`: a level by its roughness, a place by its refracted ray). The backdrop holds
-//! the opaque scene only: what is blended (other glass, blended surfaces) behind such glass is
-//! not seen through it, as in the glTF sample viewer, whose transmission pass this follows.
+//! in `scene.wgsl`: a level by its roughness, a place by its refracted ray). The copy holds the
+//! opaque scene and the blended surfaces drawn before it (those farther than the farthest such
+//! glass, by the blended surfaces' back-to-front order): what is blended between two such glasses
+//! is not seen through the nearer one. The glTF sample viewer, whose transmission pass this
+//! follows, copies the opaque scene alone.
 //!
-//! Made with the frame's targets, only while the model has such glass, and for an eye only once
-//! a frame draws it (a 1080×2400 eye costs 21 MB, 28 MB with its halvings), and with the halvings only while some of it is rough (glass
-//! that only bends reads the copy itself); the eyes' bind groups are remade when the backdrop
-//! they hold is not the current one. Each level is one draw of `backdrop.wgsl` reading the level
+//! Made with the frame's targets, only while the model has such glass, for an eye only once a
+//! frame draws it (a 1080×2400 eye costs 21 MB, 28 MB with its halvings), and with the halvings
+//! only while some of that glass is rough (glass that only bends reads the copy itself); the
+//! eyes' bind groups are remade when the backdrop they hold is not the current one. Each level is one draw of `backdrop.wgsl` reading the level
 //! above: two passes of the eye's scene instead of one, plus one small one per level. Render
 //! thread only, like the renderer; no panics.
 

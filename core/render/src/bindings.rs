@@ -37,7 +37,7 @@ pub(crate) struct EyeViews<'a> {
     pub(crate) shadow_filter: &'a wgpu::TextureView,
     pub(crate) ward_map: &'a wgpu::TextureView,
     pub(crate) ward_sampler: &'a wgpu::Sampler,
-    /// Each eye's copy of its opaque scene (`backdrop`; a placeholder without one) and its
+    /// Each eye's copy of what lies behind its glass (`backdrop`; a placeholder without one) and its
     /// sampler.
     pub(crate) backdrop: [&'a wgpu::TextureView; 2],
     pub(crate) backdrop_sampler: &'a wgpu::Sampler,

@@ -419,36 +419,42 @@ impl Renderer {
                     .distance_squared(eye_at)
                     .total_cmp(&a.centre.distance_squared(eye_at))
             });
-            // Glass that blurs or bends reads the opaque scene from the eye's backdrop, made
-            // between the opaque draws and the blended ones, each in a pass of its own.
-            if let (Some(backdrop), Some(halver)) = (backdrop, &self.backdrop_halver) {
-                drop(pass);
-                backdrop.record(&mut encoder, halver, i);
-                pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                    label: Some("scene, blended"),
-                    color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &targets.hdr[i],
-                        depth_slice: None,
-                        resolve_target: None,
-                        ops: wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Store,
-                        },
-                    })],
-                    depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                        view: &targets.depth,
-                        depth_ops: Some(wgpu::Operations {
-                            load: wgpu::LoadOp::Load,
-                            store: wgpu::StoreOp::Discard,
-                        }),
-                        stencil_ops: None,
-                    }),
-                    ..Default::default()
-                });
-                pass.set_bind_group(0, &self.eye_bind[i], &[]);
-            }
+            // Glass that blurs or bends reads what is behind it from the eye's backdrop, made
+            // just before the farthest such glass is drawn: of everything drawn until then (the
+            // opaque scene and the blended surfaces farther away), in a pass of its own between
+            // two of the scene's.
+            let over_backdrop = backdrop.zip(self.backdrop_halver.as_ref());
+            let mut backdrop_to_make = over_backdrop;
             for p in blended {
-                self.draw_primitive(&mut pass, p, input.levels, backdrop.is_some());
+                if let Some((made, halver)) =
+                    backdrop_to_make.take_if(|_| self.model.materials[p.material].variant.backdrop)
+                {
+                    drop(pass);
+                    made.record(&mut encoder, halver, i);
+                    pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                        label: Some("scene, over the backdrop"),
+                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                            view: &targets.hdr[i],
+                            depth_slice: None,
+                            resolve_target: None,
+                            ops: wgpu::Operations {
+                                load: wgpu::LoadOp::Load,
+                                store: wgpu::StoreOp::Store,
+                            },
+                        })],
+                        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                            view: &targets.depth,
+                            depth_ops: Some(wgpu::Operations {
+                                load: wgpu::LoadOp::Load,
+                                store: wgpu::StoreOp::Discard,
+                            }),
+                            stencil_ops: None,
+                        }),
+                        ..Default::default()
+                    });
+                    pass.set_bind_group(0, &self.eye_bind[i], &[]);
+                }
+                self.draw_primitive(&mut pass, p, input.levels, over_backdrop.is_some());
             }
         }
         {

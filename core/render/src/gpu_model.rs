@@ -54,7 +54,7 @@ impl GpuPrimitive {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum BackdropNeeded {
     None,
-    /// The opaque scene's copy (level 0) alone.
+    /// The copy (level 0) alone.
     Sharp,
     /// The copy and its halvings.
     Blurred,

@@ -26,10 +26,11 @@
 //!    drawn twice: a filter that multiplies what is behind by its transmittance (base colour,
 //!    Fresnel, the volume's absorption), then its own light added (`DrawLayer`). Glass that
 //!    blurs (rough: frosted) or bends (a refracting volume) what is seen through it is drawn
-//!    over the eye's backdrop instead (`backdrop`): the opaque draws end a first pass, a copy of
-//!    the eye's target and its halvings are made, and the blended draws follow in a second pass,
-//!    such glass reading what is behind it from the copy (at a level by its roughness, where its
-//!    refracted ray lands); blended surfaces behind it are not in the copy. Double-sided glass is
+//!    over the eye's backdrop instead (`backdrop`): just before the farthest such glass, the
+//!    pass ends, a copy of the eye's target and its halvings are made, and the rest follows in a
+//!    second pass, such glass reading what is behind it from the copy (at a level by its
+//!    roughness, where its refracted ray lands); blended surfaces between two such glasses are
+//!    not in the copy the nearer one reads. Double-sided glass is
 //!    drawn in two halves, its back faces (the far side) before its front faces, so that its
 //!    near side filters its far side's light; within one half, triangles that overlap on screen
 //!    (a shape folded over itself) are drawn in the mesh's order. Mono renders only the

@@ -7,7 +7,7 @@
 use crate::render::{
     OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_in_turn_over_floor, render_methods_over_floor, render_over_floor,
 };
-use crate::transmission::{RED, glass, largest_difference, seen};
+use crate::transmission::{RED, glass, largest_difference, seen, square};
 use phantogram::anaglyph::Method;
 use phantogram::glam::{Mat4, Vec3};
 use phantogram::model::{Layers, Material, Mesh, Model, Primitive};
@@ -216,4 +216,52 @@ fn a_stereo_frame_after_mono_ones_sees_through_frosted_glass_with_both_eyes() {
         .filter(|(a, b)| a.abs_diff(**b) > 8)
         .count();
     assert!(differs > 1000, "mono and stereo differ at {differs} channels");
+}
+
+/// The pixel looking down through a frosted block onto the red block, with `between` (if any) a
+/// square of glass halfway between them.
+fn through_frost_onto_red(between: Option<Material>) -> Option<[f32; 3]> {
+    let mut mesh = Mesh::default();
+    mesh.push_cube(Vec3::new(0.0, 0.0, -0.026), 0.004, RED);
+    push_floor_marker(&mut mesh);
+    let mut model = Model::from_painted_mesh("under glass", mesh);
+    let mut add = |mesh: Mesh, material: Material| {
+        model.materials.push(material);
+        model.primitives.push(Primitive {
+            mesh,
+            material: model.materials.len() - 1,
+            is_floor: false,
+            lods: Vec::new(),
+        });
+    };
+    if let Some(material) = between {
+        let mut pane = Mesh::default();
+        square(&mut pane, -0.019, true, [1.0; 4]);
+        add(pane, material);
+    }
+    let mut frosted = Mesh::default();
+    frosted.push_cube(Vec3::new(0.0, 0.0, -0.012), 0.004, [1.0; 4]);
+    add(frosted, rough_glass(0.1, 1.5));
+    let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
+    let p = pixel_at(&pixels, &proj, Vec3::new(0.0, 0.0, -0.022));
+    Some([p[0] as f32, p[1] as f32, p[2] as f32])
+}
+
+#[test]
+fn frosted_glass_shows_the_glass_behind_it() {
+    let Some(alone) = through_frost_onto_red(None) else {
+        return;
+    };
+    let green = Material {
+        roughness: 0.0,
+        ..glass([0.1, 1.0, 0.1], Layers::default())
+    };
+    let behind_green = through_frost_onto_red(Some(green)).expect("a frame");
+    println!("the red block through frosted glass {alone:?}, and through green glass under it too {behind_green:?}");
+    assert!(redness(alone) > 2.0, "through the frost alone, red: {alone:?}");
+    // Green glass passes a tenth of the red: the frost must show it, not the bare block.
+    assert!(
+        behind_green[0] < 0.5 * alone[0],
+        "the green glass under the frost filters the red: {behind_green:?} vs {alone:?}"
+    );
 }

@@ -345,7 +345,7 @@ fn glass_casts_a_pale_shadow_and_tinted_glass_a_coloured_one() {
 }
 
 /// A square 10 mm across at height `z`, facing up (+z) or down, in `colour`.
-fn square(mesh: &mut Mesh, z: f32, up: bool, colour: [f32; 4]) {
+pub(crate) fn square(mesh: &mut Mesh, z: f32, up: bool, colour: [f32; 4]) {
     let base = mesh.vertices.len() as u32;
     let normal = if up { [0.0, 0.0, 1.0] } else { [0.0, 0.0, -1.0] };
     for (x, y) in [(-0.005, -0.005), (0.005, -0.005), (0.005, 0.005), (-0.005, 0.005)] {
