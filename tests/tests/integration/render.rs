@@ -347,8 +347,14 @@ pub(crate) fn render_in_turn_over_floor(models: Vec<Model>, toward_light: Vec3) 
 }
 
 /// `model` on its floor as [`render_over_floor`] draws it (with shadows), by one renderer in
-/// each of `methods` in turn; stereo with the eyes 64 mm apart.
-pub(crate) fn render_methods_over_floor(mut model: Model, methods: &[Method]) -> Option<Vec<Vec<u8>>> {
+/// each of `methods` in turn, `size` pixels (default: the tests' size); stereo with the eyes
+/// 64 mm apart.
+pub(crate) fn render_methods_over_floor(
+    mut model: Model,
+    methods: &[Method],
+    size: Option<(u32, u32)>,
+) -> Option<Vec<Vec<u8>>> {
+    let (w, h) = size.unwrap_or((W, H));
     let gpu = gpu()?;
     let screen = Screen::default();
     model.add_floor(&screen, 2.0);
@@ -369,7 +375,7 @@ pub(crate) fn render_methods_over_floor(mut model: Model, methods: &[Method]) ->
     Some(
         methods
             .iter()
-            .map(|m| renderer.render(&input, *m, W, H).unwrap())
+            .map(|m| renderer.render(&input, *m, w, h).unwrap())
             .collect(),
     )
 }

@@ -4,6 +4,7 @@
 //! is smooth; a refracting volume shows what is behind it displaced the way Snell's law bends
 //! the ray, and not at normal incidence.
 
+use crate::golden;
 use crate::render::{
     OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_in_turn_over_floor, render_methods_over_floor, render_over_floor,
 };
@@ -196,10 +197,10 @@ fn a_stereo_frame_after_mono_ones_sees_through_frosted_glass_with_both_eyes() {
         ..Layers::default()
     };
     let scene = || gem_scene(diamond, 0.6, 30.0, RED);
-    let Some(frames) = render_methods_over_floor(scene(), &[Method::Mono, Method::DuboisRedCyan]) else {
+    let Some(frames) = render_methods_over_floor(scene(), &[Method::Mono, Method::DuboisRedCyan], None) else {
         return;
     };
-    let fresh = render_methods_over_floor(scene(), &[Method::DuboisRedCyan]).expect("a frame");
+    let fresh = render_methods_over_floor(scene(), &[Method::DuboisRedCyan], None).expect("a frame");
     let worst = fresh[0]
         .iter()
         .zip(&frames[1])
@@ -264,4 +265,64 @@ fn frosted_glass_shows_the_glass_behind_it() {
         behind_green[0] < 0.5 * alone[0],
         "the green glass under the frost filters the red: {behind_green:?} vs {alone:?}"
     );
+}
+
+#[test]
+fn four_kinds_of_glass_match_their_golden_frame() {
+    // Over red and white bars on the floor, left to right: clear thin glass (the filter), an
+    // amber volume (absorbs; of index 1.5 it bends too), frosted glass, and a tilted diamond.
+    let mut mesh = Mesh::default();
+    for i in -9..=9 {
+        let colour = if i % 2 == 0 { RED } else { [0.9, 0.9, 0.9, 1.0] };
+        for y in [-0.004, 0.0, 0.004] {
+            mesh.push_cube(Vec3::new(i as f32 * 0.002, y, -0.028), 0.001, colour);
+        }
+    }
+    push_floor_marker(&mut mesh);
+    let mut model = Model::from_painted_mesh("four glasses", mesh);
+    let clear = rough_glass(0.0, 1.5);
+    let amber = Material {
+        roughness: 0.0,
+        ..glass(
+            [1.0; 3],
+            Layers {
+                thickness: 0.007,
+                attenuation_distance: 0.007,
+                attenuation_color: [0.95, 0.55, 0.15],
+                ..Layers::default()
+            },
+        )
+    };
+    let frosted = rough_glass(0.35, 1.5);
+    let diamond = Material {
+        roughness: 0.0,
+        ..glass(
+            [1.0; 3],
+            Layers {
+                ior: 2.42,
+                thickness: 0.007,
+                ..Layers::default()
+            },
+        )
+    };
+    for (k, material) in [clear, amber, frosted, diamond].into_iter().enumerate() {
+        let mut block = Mesh::default();
+        block.push_cube(Vec3::ZERO, 0.0035, [1.0; 4]);
+        let tilt = if k == 3 { 30f32.to_radians() } else { 0.0 };
+        block.transform(
+            Mat4::from_translation(Vec3::new(-0.0135 + 0.009 * k as f32, 0.0, -0.014)) * Mat4::from_rotation_x(tilt),
+        );
+        model.materials.push(material);
+        model.primitives.push(Primitive {
+            mesh: block,
+            material: model.materials.len() - 1,
+            is_floor: false,
+            lods: Vec::new(),
+        });
+    }
+    let size = (360, 800);
+    let Some(frames) = render_methods_over_floor(model, &[Method::Mono], Some(size)) else {
+        return;
+    };
+    golden::check("glass-four-kinds-mono", size.0, size.1, &frames[0], 3, 0.003);
 }
