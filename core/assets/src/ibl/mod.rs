@@ -33,6 +33,7 @@ pub mod accuracy;
 pub mod anisotropic;
 pub mod prefilter;
 pub mod sh;
+pub mod sheen;
 
 pub use anisotropic::{WARD_IMAGE_LIGHT_TAPS, WARD_TAP_NODES, WardImageLight, sample_levels};
 pub use prefilter::{
@@ -40,6 +41,7 @@ pub use prefilter::{
     prefiltered_levels,
 };
 pub use sh::IrradianceSh;
+pub use sheen::sheen_albedo_table;
 
 /// Widest environment [`Environment::load`] reads: 4096 × 2048 (128 MiB as RGBA floats while
 /// decoding). The image-based light is prefiltered down to a few hundred texels a side.

@@ -2,7 +2,8 @@
 //! the dielectric's index of refraction (`KHR_materials_ior`) and specular strength and colour
 //! (`KHR_materials_specular`), a varnish over it (`KHR_materials_clearcoat`), light passing
 //! through it as through glass (`KHR_materials_transmission`) and absorbed inside it
-//! (`KHR_materials_volume`).
+//! (`KHR_materials_volume`), and the sheen of cloth's fibres over it (`KHR_materials_sheen`:
+//! velvet, silk, felt).
 //!
 //! Invariants of a [`Layers`] made by [`Layers::from_extensions`]: every value finite and in the
 //! range its extension allows (a value outside it is clamped, with a warning). The defaults are
@@ -21,12 +22,13 @@
 use serde_json::Value;
 
 /// The extensions [`Layers::from_extensions`] reads, for the loader's list of supported ones.
-pub const EXTENSIONS: [&str; 5] = [
+pub const EXTENSIONS: [&str; 6] = [
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
     "KHR_materials_transmission",
     "KHR_materials_volume",
+    "KHR_materials_sheen",
 ];
 
 /// The layers over, in and through a material's base (see the module docs). Lengths are in the
@@ -59,6 +61,11 @@ pub struct Layers {
     /// Distance over which the volume absorbs light to [`Self::attenuation_color`]; infinite:
     /// nothing is absorbed.
     pub attenuation_distance: f32,
+    /// Colour of the sheen of fibres standing from the surface (cloth), linear, 0–1 (black: no
+    /// sheen), and their roughness, 0–1 (the spread of the sheen: low, a rim light at grazing
+    /// angles like velvet's; high, a soft glow).
+    pub sheen_color: [f32; 3],
+    pub sheen_roughness: f32,
 }
 
 impl Default for Layers {
@@ -73,6 +80,8 @@ impl Default for Layers {
             thickness: 0.0,
             attenuation_color: [1.0; 3],
             attenuation_distance: f32::INFINITY,
+            sheen_color: [0.0; 3],
+            sheen_roughness: 0.0,
         }
     }
 }
@@ -105,6 +114,11 @@ impl Layers {
         // A colour of 0 would absorb everything at once: kept finite, far past visible.
         self.attenuation_color
             .map(|c| -(c.max(1e-6)).ln() / self.attenuation_distance)
+    }
+
+    /// Whether the surface has a sheen (a sheen colour other than black).
+    pub fn has_sheen(&self) -> bool {
+        self.sheen_color.iter().any(|c| *c > 0.0)
     }
 
     /// Whether light passes through the surface: drawn over what is behind it, filtering it.
@@ -192,6 +206,15 @@ impl Layers {
             if let Some(c) = reader.color(e, name, "attenuationColor") {
                 layers.attenuation_color = c.map(|c| reader.clamped(name, "attenuationColor", c, 0.0, 1.0));
             }
+        }
+        if let Some(e) = extension("KHR_materials_sheen") {
+            let name = "KHR_materials_sheen";
+            if let Some(c) = reader.color(e, name, "sheenColorFactor") {
+                layers.sheen_color = c.map(|c| reader.clamped(name, "sheenColorFactor", c, 0.0, 1.0));
+            }
+            let r = reader.number(e, name, "sheenRoughnessFactor", 0.0);
+            layers.sheen_roughness = reader.clamped(name, "sheenRoughnessFactor", r, 0.0, 1.0);
+            reader.textures(e, name, &["sheenColorTexture", "sheenRoughnessTexture"]);
         }
         layers
     }
@@ -341,6 +364,31 @@ mod tests {
             );
         }
         assert_eq!(warnings.len(), 5, "{warnings:?}");
+    }
+
+    #[test]
+    fn a_sheen_is_read_clamped_and_its_textures_named() {
+        let (velvet, warnings) = read(json!({
+            "KHR_materials_sheen": { "sheenColorFactor": [0.6, 0.1, 0.2], "sheenRoughnessFactor": 0.3 }
+        }));
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(velvet.sheen_color, [0.6, 0.1, 0.2]);
+        assert_eq!(velvet.sheen_roughness, 0.3);
+        assert!(velvet.has_sheen());
+        // The extension's defaults: black, which is no sheen.
+        let (none, _) = read(json!({ "KHR_materials_sheen": {} }));
+        assert!(!none.has_sheen());
+        let (bad, warnings) = read(json!({
+            "KHR_materials_sheen": {
+                "sheenColorFactor": [1.5, -0.5, 0.5],
+                "sheenRoughnessFactor": 2.0,
+                "sheenColorTexture": { "index": 0 }
+            }
+        }));
+        assert_eq!(bad.sheen_color, [1.0, 0.0, 0.5]);
+        assert_eq!(bad.sheen_roughness, 1.0);
+        assert_eq!(warnings.len(), 4, "{warnings:?}");
+        assert!(warnings.iter().any(|w| w.contains("sheenColorTexture")), "{warnings:?}");
     }
 
     #[test]
