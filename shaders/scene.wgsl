@@ -79,6 +79,8 @@ struct Material {
     dielectric: vec4<f32>,
     // rgb: optical depth of the volume's thickness at normal incidence; w: 1 / index of refraction.
     volume: vec4<f32>,
+    // KHR_materials_sheen: rgb the sheen's colour (black: none), w its roughness.
+    sheen: vec4<f32>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -480,6 +482,36 @@ fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
 }
 
 // Smith visibility (height-correlated, including the 1 / (4 n·l n·v) term).
+// The sheen of cloth (KHR_materials_sheen; assets crate, `ibl::sheen`, which this mirrors and
+// tests): the Charlie distribution of fibre directions at α = roughness², and its visibility
+// G / (4 n·l n·v) with G = 1 / (1 + Λ(l) + Λ(v)), Λ from Estevez and Kulla's fitted profile.
+fn charlie(n_dot_h: f32, alpha: f32) -> f32 {
+    let sin2 = max(1.0 - n_dot_h * n_dot_h, 0.0);
+    return (2.0 + 1.0 / alpha) * pow(sin2, 0.5 / alpha) / (2.0 * PI);
+}
+
+fn sheen_lambda_profile(x: f32, alpha: f32) -> f32 {
+    let t = (1.0 - alpha) * (1.0 - alpha);
+    let a = mix(21.5473, 25.3245, t);
+    let b = mix(3.82987, 3.32435, t);
+    let c = mix(0.19823, 0.16801, t);
+    let d = mix(-1.97760, -1.27393, t);
+    let e = mix(-4.32054, -4.85967, t);
+    return a / (1.0 + b * pow(x, c)) + d * x + e;
+}
+
+fn sheen_lambda(cos_theta: f32, alpha: f32) -> f32 {
+    if (cos_theta < 0.5) {
+        return exp(sheen_lambda_profile(cos_theta, alpha));
+    }
+    return exp(2.0 * sheen_lambda_profile(0.5, alpha) - sheen_lambda_profile(1.0 - cos_theta, alpha));
+}
+
+fn sheen_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
+    let g = 1.0 / (1.0 + sheen_lambda(n_dot_l, alpha) + sheen_lambda(n_dot_v, alpha));
+    return clamp(g / max(4.0 * n_dot_l * n_dot_v, 1e-6), 0.0, 1.0);
+}
+
 fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
@@ -523,6 +555,9 @@ struct Surface {
     // shading keeps).
     refracted_path: f32,
     transmission_roughness: f32,
+    // The sheen of fibres over it (cloth; black: none) and their roughness.
+    sheen_color: vec3<f32>,
+    sheen_roughness: f32,
 };
 
 // glTF's core dielectric, no varnish, nothing passing through (for surfaces without a material
@@ -538,6 +573,8 @@ fn core_layers(s: ptr<function, Surface>) {
     (*s).inv_ior = 1.0 / 1.5;
     (*s).refracted_path = 0.0;
     (*s).transmission_roughness = 0.0;
+    (*s).sheen_color = vec3<f32>(0.0);
+    (*s).sheen_roughness = 0.0;
 }
 
 // The material's surface at a fragment of the scene pass. Samples every texture first:
@@ -614,6 +651,8 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
         s.inv_ior = material.volume.w;
         s.refracted_path = material.scene.w * thickness_sample.g;
         s.transmission_roughness = roughness;
+        s.sheen_color = material.sheen.rgb;
+        s.sheen_roughness = material.sheen.w;
     } else {
         // Constants the compiler folds into the shading: the core material costs what it did
         // before the extensions.
@@ -809,6 +848,23 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let albedo_m = base * scale_bias.x + vec3<f32>(scale_bias.y);
         let specular_ambient = prefiltered * mix(albedo_d, albedo_m, metallic);
         ambient_light = diffuse_ambient + specular_ambient;
+
+        // Sheen over it (cloth): the fibres' lobe added, the layer below dimmed by what they
+        // reflect of a white light (the table's albedo), so the two reflect no more than comes
+        // in. Its image light: the environment prefiltered at the sheen's roughness (the GGX
+        // levels, as Filament takes them) times that albedo.
+        let sheen_strength = max(s.sheen_color.r, max(s.sheen_color.g, s.sheen_color.b));
+        if (sheen_strength > 0.0) {
+            let sheen_rough = clamp(s.sheen_roughness, 0.07, 1.0);
+            let sheen_alpha = sheen_rough * sheen_rough;
+            let sheen_uv = clamp(vec2<f32>(n_dot_v, sheen_rough), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+            let sheen_albedo = textureSampleLevel(brdf_lut, env_sampler, sheen_uv, 0.0).b;
+            let below = 1.0 - sheen_strength * sheen_albedo;
+            let sheen_direct = s.sheen_color * charlie(n_dot_h, sheen_alpha) * sheen_visibility(max(n_dot_l, 1e-4), n_dot_v, sheen_alpha) * light_in;
+            direct = direct * below + sheen_direct;
+            let sheen_env = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), sheen_rough * PREFILTERED_MAX_LEVEL).rgb;
+            ambient_light = ambient_light * below + sheen_env * s.sheen_color * sheen_albedo;
+        }
     }
 
     // Clear coat: a smooth dielectric layer (4 %) over everything; what it reflects the layer

@@ -41,13 +41,17 @@ pub(super) fn default_prefiltered_environment() -> &'static [phantogram_assets::
     })
 }
 
-/// The split-sum table as `Rg16Float` texels, computed once per process (it depends on nothing).
+/// The split-sum table (scale and bias on F0) and the sheen's directional albedo
+/// ([`phantogram_assets::ibl::sheen`]) as `Rgba16Float` texels, read at the same (n·v, roughness),
+/// computed once per process (they depend on nothing).
 pub(super) fn brdf_lut_texels() -> &'static [u8] {
     static TEXELS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
     TEXELS.get_or_init(|| {
+        let sheen = phantogram_assets::ibl::sheen_albedo_table(BRDF_LUT_SIZE);
         phantogram_assets::ibl::brdf_lut(BRDF_LUT_SIZE)
             .into_iter()
-            .flat_map(|[a, b]| [half::f16::from_f32(a), half::f16::from_f32(b)])
+            .zip(sheen)
+            .flat_map(|([a, b], e)| [a, b, e, 0.0].map(half::f16::from_f32))
             .flat_map(|h| h.to_le_bytes())
             .collect()
     })
@@ -92,7 +96,7 @@ impl IblTextures {
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: wgpu::TextureFormat::Rg16Float,
+            format: wgpu::TextureFormat::Rgba16Float,
             usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
             view_formats: &[],
         });
@@ -106,7 +110,7 @@ impl IblTextures {
             brdf_lut_texels(),
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
-                bytes_per_row: Some(4 * BRDF_LUT_SIZE as u32),
+                bytes_per_row: Some(8 * BRDF_LUT_SIZE as u32),
                 rows_per_image: Some(BRDF_LUT_SIZE as u32),
             },
             wgpu::Extent3d {

@@ -74,6 +74,7 @@ pub(crate) struct MaterialUniform {
     pub(crate) layers: [f32; 4],
     pub(crate) dielectric: [f32; 4],
     pub(crate) volume: [f32; 4],
+    pub(crate) sheen: [f32; 4],
 }
 
 impl MaterialUniform {
@@ -144,6 +145,7 @@ impl MaterialUniform {
                 // 1/ior, for the angle of the refracted path (0 for an infinite index).
                 1.0 / l.ior,
             ],
+            sheen: [l.sheen_color[0], l.sheen_color[1], l.sheen_color[2], l.sheen_roughness],
         }
     }
 }

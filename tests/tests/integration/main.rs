@@ -30,6 +30,7 @@ mod render;
 mod room_light;
 mod seen_through;
 mod shared_data;
+mod sheen;
 mod surface;
 mod transmission;
 mod viewpoint_and_light;

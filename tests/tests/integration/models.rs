@@ -208,15 +208,19 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
 
     let needs = tiny_gltf(
         &dir,
-        "sheen.gltf",
-        r#","extensionsUsed":["KHR_materials_sheen"],"extensionsRequired":["KHR_materials_sheen"]"#,
+        "iridescence.gltf",
+        r#","extensionsUsed":["KHR_materials_iridescence"],"extensionsRequired":["KHR_materials_iridescence"]"#,
     );
     match load_gltf(&needs) {
-        Err(ModelError::UnsupportedExtension { name, .. }) => assert_eq!(name, "KHR_materials_sheen"),
+        Err(ModelError::UnsupportedExtension { name, .. }) => assert_eq!(name, "KHR_materials_iridescence"),
         other => panic!("expected an unsupported-extension error, got {other:?}"),
     }
     // Merely *used* (optional) extensions are fine.
-    let optional = tiny_gltf(&dir, "optional.gltf", r#","extensionsUsed":["KHR_materials_sheen"]"#);
+    let optional = tiny_gltf(
+        &dir,
+        "optional.gltf",
+        r#","extensionsUsed":["KHR_materials_iridescence"]"#,
+    );
     assert!(load_gltf(&optional).is_ok());
 
     let broken = dir.join("broken.gltf");
@@ -228,12 +232,12 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
     ));
     let text = load_gltf(&needs).unwrap_err().to_string();
     assert!(
-        text.contains("sheen.gltf") && text.contains("KHR_materials_sheen"),
+        text.contains("iridescence.gltf") && text.contains("KHR_materials_iridescence"),
         "{text}"
     );
 }
 
-/// Glass, gems and varnish: each material extension's factors reach the material, the
+/// Glass, gems, varnish and cloth: each material extension's factors reach the material, the
 /// transmission and thickness textures too, another texture they name is reported (not read),
 /// and a file requiring them loads.
 #[test]
@@ -244,15 +248,16 @@ fn material_extensions_reach_the_material() {
         &dir,
         "amber.gltf",
         &format!(
-            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat"],
-        "extensionsRequired":["KHR_materials_transmission"],
+            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen"],
+        "extensionsRequired":["KHR_materials_transmission","KHR_materials_sheen"],
         "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
         "materials":[{{"name":"amber","extensions":{{
           "KHR_materials_transmission":{{"transmissionFactor":0.9,"transmissionTexture":{{"index":0,"texCoord":1}}}},
           "KHR_materials_volume":{{"thicknessFactor":0.02,"thicknessTexture":{{"index":0}},"attenuationDistance":0.05,"attenuationColor":[0.9,0.5,0.1]}},
           "KHR_materials_ior":{{"ior":1.54}},
           "KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]}},
-          "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}}}}}}}}]"#
+          "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}}}},
+          "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6}}}}}}]"#
         ),
     );
     let model = load_gltf(&path).unwrap();
@@ -276,6 +281,7 @@ fn material_extensions_reach_the_material() {
     );
     assert_eq!(l.attenuation_color, [0.9, 0.5, 0.1]);
     assert_eq!(l.specular_color, [1.0, 0.9, 0.8]);
+    assert_eq!((l.sheen_color, l.sheen_roughness), ([0.3, 0.2, 0.1], 0.6));
     // The transmission and thickness textures are read (which parts are glass, how thick); the
     // varnish's texture is named.
     let texture = amber.transmission_texture.expect("the transmission texture");
