@@ -23,6 +23,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::HDR_FORMAT;
 use crate::bindings::filterable_texture_entry;
+use crate::pipelines::{create_fullscreen_pipeline, draw_fullscreen};
 
 pub(crate) const BACKDROP_WGSL: &str = include_str!("../../../shaders/backdrop.wgsl");
 
@@ -56,27 +57,7 @@ impl Halver {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-            label: Some("backdrop level"),
-            layout: Some(&pipeline_layout),
-            vertex: wgpu::VertexState {
-                module: &module,
-                entry_point: Some("vs_main"),
-                compilation_options: Default::default(),
-                buffers: &[],
-            },
-            primitive: Default::default(),
-            depth_stencil: None,
-            multisample: Default::default(),
-            fragment: Some(wgpu::FragmentState {
-                module: &module,
-                entry_point: Some("fs_main"),
-                compilation_options: Default::default(),
-                targets: &[Some(HDR_FORMAT.into())],
-            }),
-            multiview_mask: None,
-            cache: None,
-        });
+        let pipeline = create_fullscreen_pipeline(device, "backdrop level", &module, &pipeline_layout, HDR_FORMAT);
         Self {
             pipeline,
             layout,
@@ -229,22 +210,7 @@ impl Backdrop {
             return;
         };
         for (level, source) in made.levels.iter().zip(&made.sources) {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("backdrop level"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: level,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            });
-            pass.set_pipeline(&halver.pipeline);
-            pass.set_bind_group(0, source, &[]);
-            pass.draw(0..3, 0..1);
+            draw_fullscreen(encoder, "backdrop level", level, &halver.pipeline, source, None);
         }
     }
 }

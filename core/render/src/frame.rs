@@ -457,26 +457,16 @@ impl Renderer {
                 self.draw_primitive(&mut pass, p, input.levels, over_backdrop.is_some());
             }
         }
-        {
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("compose"),
-                timestamp_writes: timer.map(|t| t.writes(false, true)),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            });
-            pass.set_pipeline(&self.compose_pipelines[&format]);
-            let bind = if uniforms.len() == 2 { 0 } else { 1 };
-            pass.set_bind_group(0, &targets.compose_bind[bind], &[]);
-            pass.draw(0..3, 0..1);
-        }
+        // Bind group 0 composes the two eyes, 1 the first alone (mono).
+        let bind = if uniforms.len() == 2 { 0 } else { 1 };
+        crate::pipelines::draw_fullscreen(
+            &mut encoder,
+            "compose",
+            target,
+            &self.compose_pipelines[&format],
+            &targets.compose_bind[bind],
+            timer.map(|t| t.writes(false, true)),
+        );
         if let Some(t) = timer {
             t.resolve(&mut encoder);
         }

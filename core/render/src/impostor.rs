@@ -512,22 +512,14 @@ impl crate::Renderer {
                     resource: wgpu::BindingResource::TextureView(&raw),
                 }],
             });
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("impostor depth (conservative)"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                ..Default::default()
-            });
-            pass.set_pipeline(&pipelines.dilate);
-            pass.set_bind_group(0, &bind, &[]);
-            pass.draw(0..3, 0..1);
+            crate::pipelines::draw_fullscreen(
+                &mut encoder,
+                "impostor depth (conservative)",
+                &target,
+                &pipelines.dilate,
+                &bind,
+                None,
+            );
         }
         queue.submit([encoder.finish()]);
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {

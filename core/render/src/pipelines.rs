@@ -221,8 +221,49 @@ pub(crate) fn create_compose_pipeline(
     layout: &wgpu::PipelineLayout,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    create_fullscreen_pipeline(device, "compose", module, layout, format)
+}
+
+/// Records a pass that clears `target` to black and draws one triangle over it with `pipeline`
+/// (made by [`create_fullscreen_pipeline`]) and `bind` as its group 0.
+pub(crate) fn draw_fullscreen(
+    encoder: &mut wgpu::CommandEncoder,
+    label: &str,
+    target: &wgpu::TextureView,
+    pipeline: &wgpu::RenderPipeline,
+    bind: &wgpu::BindGroup,
+    timestamp_writes: Option<wgpu::RenderPassTimestampWrites<'_>>,
+) {
+    let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        timestamp_writes,
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: target,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        ..Default::default()
+    });
+    pass.set_pipeline(pipeline);
+    pass.set_bind_group(0, bind, &[]);
+    pass.draw(0..3, 0..1);
+}
+
+/// A pipeline that draws one triangle over its whole target (`module`'s `vs_main`, three
+/// vertices, no buffers) with `module`'s `fs_main` into `format`, without depth or blending.
+pub(crate) fn create_fullscreen_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    format: wgpu::TextureFormat,
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-        label: Some("compose"),
+        label: Some(label),
         layout: Some(layout),
         vertex: wgpu::VertexState {
             module,

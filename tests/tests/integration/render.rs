@@ -299,18 +299,40 @@ fn render_over_floor_lit(
     let mut renderer = Renderer::new(gpu, &model).unwrap();
     renderer.lighting.shadows = shadows;
     renderer.lamp = lamp;
-    let input = FrameInput {
-        left: &mono,
-        right: &mono,
-        mono: &mono,
+    let input = still_input(&mono, &mono, &mono, toward_light);
+    let pixels = renderer.render(&input, Method::Mono, W, H).unwrap();
+    Some((pixels, mono, renderer.shadow_triangles_last_frame()))
+}
+
+/// A frame's input for the eyes `left`, `right` and `mono`, lit from `toward_light`: the device
+/// upright in the world, the mesh where it is, every part at its full level, nothing fading.
+pub(crate) fn still_input<'a>(
+    left: &'a OffAxisProjection,
+    right: &'a OffAxisProjection,
+    mono: &'a OffAxisProjection,
+    toward_light: Vec3,
+) -> FrameInput<'a> {
+    FrameInput {
+        left,
+        right,
+        mono,
         toward_light,
         device_to_world: phantogram::glam::Quat::IDENTITY,
         offset: Vec3::ZERO,
         levels: &[],
         fades: &[],
-    };
-    let pixels = renderer.render(&input, Method::Mono, W, H).unwrap();
-    Some((pixels, mono, renderer.shadow_triangles_last_frame()))
+    }
+}
+
+/// `mesh` added to `model` as a part of its own, in `material`.
+pub(crate) fn add_part(model: &mut Model, mesh: Mesh, material: phantogram::model::Material) {
+    model.materials.push(material);
+    model.primitives.push(phantogram::model::Primitive {
+        mesh,
+        material: model.materials.len() - 1,
+        is_floor: false,
+        lods: Vec::new(),
+    });
 }
 
 /// Each of `models` on its floor as [`render_over_floor`] draws it (with shadows, lit from
@@ -328,16 +350,7 @@ pub(crate) fn render_in_turn_over_floor(models: Vec<Model>, toward_light: Vec3) 
     let mono = OffAxisProjection::new(&screen, Vec3::new(0.0, 0.0, 0.3), DepthRange::default()).unwrap();
     let mut renderer = Renderer::new(gpu, models.first()?).unwrap();
     renderer.lighting.shadows = true;
-    let input = FrameInput {
-        left: &mono,
-        right: &mono,
-        mono: &mono,
-        toward_light,
-        device_to_world: phantogram::glam::Quat::IDENTITY,
-        offset: Vec3::ZERO,
-        levels: &[],
-        fades: &[],
-    };
+    let input = still_input(&mono, &mono, &mono, toward_light);
     let mut frames = Vec::new();
     for model in &models {
         renderer.set_model(model).unwrap();
@@ -362,16 +375,7 @@ pub(crate) fn render_methods_over_floor(
     let (left, right, mono) = (at(-0.032), at(0.032), at(0.0));
     let mut renderer = Renderer::new(gpu, &model).unwrap();
     renderer.lighting.shadows = true;
-    let input = FrameInput {
-        left: &left,
-        right: &right,
-        mono: &mono,
-        toward_light: OBLIQUE_LIGHT,
-        device_to_world: phantogram::glam::Quat::IDENTITY,
-        offset: Vec3::ZERO,
-        levels: &[],
-        fades: &[],
-    };
+    let input = still_input(&left, &right, &mono, OBLIQUE_LIGHT);
     Some(
         methods
             .iter()

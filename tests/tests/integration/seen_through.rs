@@ -6,12 +6,13 @@
 
 use crate::golden;
 use crate::render::{
-    OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_in_turn_over_floor, render_methods_over_floor, render_over_floor,
+    OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_in_turn_over_floor, render_methods_over_floor,
+    render_over_floor,
 };
 use crate::transmission::{RED, glass, largest_difference, seen, square};
 use phantogram::anaglyph::Method;
 use phantogram::glam::{Mat4, Vec3};
-use phantogram::model::{Layers, Material, Mesh, Model, Primitive};
+use phantogram::model::{Layers, Material, Mesh, Model};
 
 const GREEN: [f32; 4] = [0.05, 0.6, 0.05, 1.0];
 
@@ -84,16 +85,14 @@ fn gem_scene(layers: Layers, roughness: f32, tilt_deg: f32, under: [f32; 4]) -> 
     let mut gem = Mesh::default();
     gem.push_cube(Vec3::ZERO, 0.006, [1.0; 4]);
     gem.transform(Mat4::from_translation(Vec3::new(0.0, 0.0, -0.012)) * Mat4::from_rotation_x(tilt_deg.to_radians()));
-    model.materials.push(Material {
-        roughness,
-        ..glass([1.0; 3], layers)
-    });
-    model.primitives.push(Primitive {
-        mesh: gem,
-        material: model.materials.len() - 1,
-        is_floor: false,
-        lods: Vec::new(),
-    });
+    add_part(
+        &mut model,
+        gem,
+        Material {
+            roughness,
+            ..glass([1.0; 3], layers)
+        },
+    );
     model
 }
 
@@ -106,11 +105,7 @@ fn through_a_gem(layers: Layers, tilt_deg: f32) -> Option<[f32; 3]> {
 
 #[test]
 fn a_refracting_volume_shows_what_is_behind_it_where_the_ray_bends() {
-    let diamond = Layers {
-        ior: 2.42,
-        thickness: 0.012,
-        ..Layers::default()
-    };
+    let diamond = diamond();
     let Some(bent) = through_a_gem(diamond, 30.0) else {
         return;
     };
@@ -138,17 +133,32 @@ fn a_refracting_volume_shows_what_is_behind_it_where_the_ray_bends() {
     );
 }
 
+/// Diamond 12 mm thick: the gem blocks' volume.
+fn diamond() -> Layers {
+    Layers {
+        ior: 2.42,
+        thickness: 0.012,
+        ..Layers::default()
+    }
+}
+
+/// The largest difference of one channel between two frames, and how many channels differ by
+/// more than 8.
+fn compare_frames(a: &[u8], b: &[u8]) -> (u8, usize) {
+    let differences = || a.iter().zip(b).map(|(x, y)| x.abs_diff(*y));
+    (
+        differences().max().unwrap_or(0),
+        differences().filter(|d| *d > 8).count(),
+    )
+}
+
 #[test]
 fn one_renderer_draws_each_kind_of_glass_as_a_fresh_one_does() {
     // Frosted (a backdrop with its halvings), only bending (the copy alone), no glass (none),
     // and frosted again: the backdrop is made, remade and dropped as each model needs. The block
     // under the gem changes colour from one to the next, so that a backdrop left over from the
     // model before shows.
-    let diamond = Layers {
-        ior: 2.42,
-        thickness: 0.012,
-        ..Layers::default()
-    };
+    let diamond = diamond();
     let scenes = || {
         vec![
             gem_scene(diamond, 0.6, 30.0, RED),
@@ -170,20 +180,11 @@ fn one_renderer_draws_each_kind_of_glass_as_a_fresh_one_does() {
     };
     for (k, (model, drawn)) in scenes().into_iter().zip(&in_turn).enumerate() {
         let fresh = render_in_turn_over_floor(vec![model], OBLIQUE_LIGHT).expect("a frame");
-        let worst = fresh[0]
-            .iter()
-            .zip(drawn)
-            .map(|(a, b)| a.abs_diff(*b))
-            .max()
-            .unwrap_or(0);
+        let (worst, _) = compare_frames(&fresh[0], drawn);
         assert!(worst <= 1, "scene {k}: a channel differs by {worst}");
     }
     // And the frames differ where they should: the frosted gem is not the sharp one.
-    let differs = in_turn[0]
-        .iter()
-        .zip(&in_turn[1])
-        .filter(|(a, b)| a.abs_diff(**b) > 8)
-        .count();
+    let (_, differs) = compare_frames(&in_turn[0], &in_turn[1]);
     assert!(differs > 1000, "frosted and sharp differ at {differs} channels");
 }
 
@@ -191,31 +192,18 @@ fn one_renderer_draws_each_kind_of_glass_as_a_fresh_one_does() {
 fn a_stereo_frame_after_mono_ones_sees_through_frosted_glass_with_both_eyes() {
     // A mono frame makes the first eye's backdrop alone; the stereo frame after it needs the
     // second's too.
-    let diamond = Layers {
-        ior: 2.42,
-        thickness: 0.012,
-        ..Layers::default()
-    };
+    let diamond = diamond();
     let scene = || gem_scene(diamond, 0.6, 30.0, RED);
     let Some(frames) = render_methods_over_floor(scene(), &[Method::Mono, Method::DuboisRedCyan], None) else {
         return;
     };
     let fresh = render_methods_over_floor(scene(), &[Method::DuboisRedCyan], None).expect("a frame");
-    let worst = fresh[0]
-        .iter()
-        .zip(&frames[1])
-        .map(|(a, b)| a.abs_diff(*b))
-        .max()
-        .unwrap_or(0);
+    let (worst, _) = compare_frames(&fresh[0], &frames[1]);
     assert!(
         worst <= 1,
         "the stereo frame after a mono one: a channel differs by {worst}"
     );
-    let differs = frames[0]
-        .iter()
-        .zip(&frames[1])
-        .filter(|(a, b)| a.abs_diff(**b) > 8)
-        .count();
+    let (_, differs) = compare_frames(&frames[0], &frames[1]);
     assert!(differs > 1000, "mono and stereo differ at {differs} channels");
 }
 
@@ -226,23 +214,14 @@ fn through_frost_onto_red(between: Option<Material>) -> Option<[f32; 3]> {
     mesh.push_cube(Vec3::new(0.0, 0.0, -0.026), 0.004, RED);
     push_floor_marker(&mut mesh);
     let mut model = Model::from_painted_mesh("under glass", mesh);
-    let mut add = |mesh: Mesh, material: Material| {
-        model.materials.push(material);
-        model.primitives.push(Primitive {
-            mesh,
-            material: model.materials.len() - 1,
-            is_floor: false,
-            lods: Vec::new(),
-        });
-    };
     if let Some(material) = between {
         let mut pane = Mesh::default();
         square(&mut pane, -0.019, true, [1.0; 4]);
-        add(pane, material);
+        add_part(&mut model, pane, material);
     }
     let mut frosted = Mesh::default();
     frosted.push_cube(Vec3::new(0.0, 0.0, -0.012), 0.004, [1.0; 4]);
-    add(frosted, rough_glass(0.1, 1.5));
+    add_part(&mut model, frosted, rough_glass(0.1, 1.5));
     let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
     let p = pixel_at(&pixels, &proj, Vec3::new(0.0, 0.0, -0.022));
     Some([p[0] as f32, p[1] as f32, p[2] as f32])
@@ -312,13 +291,7 @@ fn four_kinds_of_glass_match_their_golden_frame() {
         block.transform(
             Mat4::from_translation(Vec3::new(-0.0135 + 0.009 * k as f32, 0.0, -0.014)) * Mat4::from_rotation_x(tilt),
         );
-        model.materials.push(material);
-        model.primitives.push(Primitive {
-            mesh: block,
-            material: model.materials.len() - 1,
-            is_floor: false,
-            lods: Vec::new(),
-        });
+        add_part(&mut model, block, material);
     }
     let size = (360, 800);
     let Some(frames) = render_methods_over_floor(model, &[Method::Mono], Some(size)) else {

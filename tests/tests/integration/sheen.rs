@@ -2,9 +2,9 @@
 //! `charlie`): velvet's fibres catch the light where the surface turns away from the eye, and
 //! hardly where it faces it.
 
-use crate::render::{OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_over_floor};
+use crate::render::{OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_over_floor};
 use phantogram::glam::{Mat4, Vec3};
-use phantogram::model::{Layers, Material, Mesh, Model, Primitive};
+use phantogram::model::{Layers, Material, Mesh, Model};
 
 const CENTRE: Vec3 = Vec3::new(0.0, 0.0, -0.015);
 const HALF: f32 = 0.006;
@@ -28,24 +28,22 @@ fn seen(sheen: Option<([f32; 3], f32)>) -> Option<([f32; 3], [f32; 3])> {
     block.push_cube(Vec3::ZERO, HALF, [1.0; 4]);
     block.transform(Mat4::from_translation(CENTRE) * Mat4::from_rotation_x(TILT_DEG.to_radians()));
     let (sheen_color, sheen_roughness) = sheen.unwrap_or(([0.0; 3], 0.0));
-    model.materials.push(Material {
-        name: "cloth".into(),
-        base_color: [0.08, 0.08, 0.1, 1.0],
-        metallic: 0.0,
-        roughness: 0.9,
-        layers: Layers {
-            sheen_color,
-            sheen_roughness,
-            ..Layers::default()
+    add_part(
+        &mut model,
+        block,
+        Material {
+            name: "cloth".into(),
+            base_color: [0.08, 0.08, 0.1, 1.0],
+            metallic: 0.0,
+            roughness: 0.9,
+            layers: Layers {
+                sheen_color,
+                sheen_roughness,
+                ..Layers::default()
+            },
+            ..Material::default()
         },
-        ..Material::default()
-    });
-    model.primitives.push(Primitive {
-        mesh: block,
-        material: model.materials.len() - 1,
-        is_floor: false,
-        lods: Vec::new(),
-    });
+    );
     let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
     let (face_on, grazing) = faces();
     let rgb = |p: Vec3| {

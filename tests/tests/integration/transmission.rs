@@ -8,9 +8,9 @@
 //! material under test floating over it; the pixel at the centre looks through the upper block's
 //! top face onto the lower block's.
 
-use crate::render::{OBLIQUE_LIGHT, pixel_at, push_floor_marker, render_over_floor};
+use crate::render::{OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_over_floor};
 use phantogram::glam::Vec3;
-use phantogram::model::{Image, Layers, Material, Mesh, Model, Primitive, TextureRef, Vertex};
+use phantogram::model::{Image, Layers, Material, Mesh, Model, TextureRef, Vertex};
 use phantogram::projection::OffAxisProjection;
 
 /// The centre of the lower block's top face, which the upper block hides from the eye.
@@ -31,13 +31,7 @@ fn render_under_with(
     if let Some(material) = over {
         let mut block = Mesh::default();
         block.push_cube(Vec3::new(0.0, 0.0, -0.012), 0.004, [1.0; 4]);
-        model.materials.push(material);
-        model.primitives.push(Primitive {
-            mesh: block,
-            material: model.materials.len() - 1,
-            is_floor: false,
-            lods: Vec::new(),
-        });
+        add_part(&mut model, block, material);
     }
     render_over_floor(model, true, OBLIQUE_LIGHT)
 }
@@ -302,13 +296,7 @@ fn shadow_and_lit(material: Material) -> Option<([f32; 3], [f32; 3])> {
     let mut model = Model::from_painted_mesh("glass shadow", marker);
     let mut block = Mesh::default();
     block.push_cube(Vec3::new(0.0, 0.0, -0.015), 0.004, [1.0; 4]);
-    model.materials.push(material);
-    model.primitives.push(Primitive {
-        mesh: block,
-        material: model.materials.len() - 1,
-        is_floor: false,
-        lods: Vec::new(),
-    });
+    add_part(&mut model, block, material);
     let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
     let rgb = |p: Vec3| {
         let c = pixel_at(&pixels, &proj, p);
@@ -375,24 +363,22 @@ fn the_near_side_of_double_sided_glass_filters_the_far_sides_light() {
     let mut floor = Mesh::default();
     push_floor_marker(&mut floor);
     let mut model = Model::from_painted_mesh("under a glass box", floor);
-    model.materials.push(Material {
-        name: "half-clear".into(),
-        base_color: [1.0; 4],
-        metallic: 0.0,
-        roughness: 0.0,
-        double_sided: true,
-        layers: Layers {
-            transmission: 0.5,
-            ..Layers::default()
+    add_part(
+        &mut model,
+        glass_box,
+        Material {
+            name: "half-clear".into(),
+            base_color: [1.0; 4],
+            metallic: 0.0,
+            roughness: 0.0,
+            double_sided: true,
+            layers: Layers {
+                transmission: 0.5,
+                ..Layers::default()
+            },
+            ..Material::default()
         },
-        ..Material::default()
-    });
-    model.primitives.push(Primitive {
-        mesh: glass_box,
-        material: model.materials.len() - 1,
-        is_floor: false,
-        lods: Vec::new(),
-    });
+    );
     let Some((pixels, proj)) = render_over_floor(model, false, OBLIQUE_LIGHT) else {
         return;
     };
