@@ -81,6 +81,9 @@ struct Material {
     volume: vec4<f32>,
     // KHR_materials_sheen: rgb the sheen's colour (black: none), w its roughness.
     sheen: vec4<f32>,
+    // KHR_materials_dispersion: x, y 1 / index of refraction of red and of blue light; z 1 where
+    // the volume splits the colours.
+    dispersion: vec4<f32>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -555,6 +558,9 @@ struct Surface {
     // shading keeps).
     refracted_path: f32,
     transmission_roughness: f32,
+    // 1 / the index of refraction of red and of blue light, where the volume splits the colours
+    // (a gem's fire; otherwise both `inv_ior`).
+    inv_ior_red_blue: vec2<f32>,
     // The sheen of fibres over it (cloth; black: none) and their roughness.
     sheen_color: vec3<f32>,
     sheen_roughness: f32,
@@ -573,6 +579,7 @@ fn core_layers(s: ptr<function, Surface>) {
     (*s).inv_ior = 1.0 / 1.5;
     (*s).refracted_path = 0.0;
     (*s).transmission_roughness = 0.0;
+    (*s).inv_ior_red_blue = vec2<f32>((*s).inv_ior);
     (*s).sheen_color = vec3<f32>(0.0);
     (*s).sheen_roughness = 0.0;
 }
@@ -653,6 +660,7 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
         s.transmission_roughness = roughness;
         s.sheen_color = material.sheen.rgb;
         s.sheen_roughness = material.sheen.w;
+        s.inv_ior_red_blue = select(vec2<f32>(s.inv_ior), material.dispersion.xy, material.dispersion.z > 0.5);
     } else {
         // Constants the compiler folds into the shading: the core material costs what it did
         // before the extensions.
@@ -698,24 +706,45 @@ fn fs_main(in: VsOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
 // the glTF sample viewer, which is exact for a flat slab of that thickness with the background far
 // behind it. The blur too is that viewer's: a level log2(width) × roughness × clamp(2·ior − 2, 0, 1)
 // of the backdrop's halvings, so a fully rough surface of index 1.5 shows the scene's mean and
-// one of index 1 (no change of medium) shows it sharp.
+// one of index 1 (no change of medium) shows it sharp. A dispersing volume (a gem's fire) bends
+// red, green and blue each by its own index and reads each where it lands.
 fn seen_through(world: vec3<f32>, pixel: vec2<f32>, s: Surface) -> vec3<f32> {
     let size = vec2<f32>(textureDimensions(backdrop, 0));
-    var uv = pixel / size;
-    if (s.refracted_path > 0.0) {
-        let v = normalize(eye.eye_pos.xyz - world);
-        let bent = refract(-v, s.n, s.inv_ior);
-        if (dot(bent, bent) > 0.0) {
-            let exit = eye.view_proj * vec4<f32>(world + normalize(bent) * s.refracted_path, 1.0);
-            if (exit.w > 0.0) {
-                let ndc = exit.xy / exit.w;
-                uv = vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
-            }
-        }
-    }
+    let straight = pixel / size;
     let index_change = clamp(2.0 / max(s.inv_ior, 1e-3) - 2.0, 0.0, 1.0);
     let level = log2(max(size.x, size.y)) * s.transmission_roughness * index_change;
-    return textureSampleLevel(backdrop, backdrop_sampler, uv, level).rgb;
+    if (s.refracted_path <= 0.0) {
+        return textureSampleLevel(backdrop, backdrop_sampler, straight, level).rgb;
+    }
+    let green = bent_to(world, s, s.inv_ior, straight);
+    if (all(s.inv_ior_red_blue == vec2<f32>(s.inv_ior))) {
+        return textureSampleLevel(backdrop, backdrop_sampler, green, level).rgb;
+    }
+    // A dispersing volume bends each colour by its own index: red least, blue most.
+    let red = bent_to(world, s, s.inv_ior_red_blue.x, straight);
+    let blue = bent_to(world, s, s.inv_ior_red_blue.y, straight);
+    return vec3<f32>(
+        textureSampleLevel(backdrop, backdrop_sampler, red, level).r,
+        textureSampleLevel(backdrop, backdrop_sampler, green, level).g,
+        textureSampleLevel(backdrop, backdrop_sampler, blue, level).b,
+    );
+}
+
+// Where in the backdrop a ray from the eye to `world`, refracted into the volume with 1 / index
+// `inv_ior`, leaves it one path length on (`straight` where it cannot enter or leaves behind the
+// eye).
+fn bent_to(world: vec3<f32>, s: Surface, inv_ior: f32, straight: vec2<f32>) -> vec2<f32> {
+    let v = normalize(eye.eye_pos.xyz - world);
+    let bent = refract(-v, s.n, inv_ior);
+    if (dot(bent, bent) <= 0.0) {
+        return straight;
+    }
+    let exit = eye.view_proj * vec4<f32>(world + normalize(bent) * s.refracted_path, 1.0);
+    if (exit.w <= 0.0) {
+        return straight;
+    }
+    let ndc = exit.xy / exit.w;
+    return vec2<f32>(0.5 + 0.5 * ndc.x, 0.5 - 0.5 * ndc.y);
 }
 
 struct Shaded {

@@ -75,6 +75,7 @@ pub(crate) struct MaterialUniform {
     pub(crate) dielectric: [f32; 4],
     pub(crate) volume: [f32; 4],
     pub(crate) sheen: [f32; 4],
+    pub(crate) dispersion: [f32; 4],
 }
 
 impl MaterialUniform {
@@ -146,6 +147,12 @@ impl MaterialUniform {
                 1.0 / l.ior,
             ],
             sheen: [l.sheen_color[0], l.sheen_color[1], l.sheen_color[2], l.sheen_roughness],
+            dispersion: {
+                // 1/ior of red and blue light, and whether they differ from green's.
+                let [r, _, b] = l.colour_iors();
+                let splits = l.refracts() && l.dispersion > 0.0;
+                [1.0 / r, 1.0 / b, f32::from(u8::from(splits)), 0.0]
+            },
         }
     }
 }

@@ -248,7 +248,7 @@ fn material_extensions_reach_the_material() {
         &dir,
         "amber.gltf",
         &format!(
-            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen"],
+            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion"],
         "extensionsRequired":["KHR_materials_transmission","KHR_materials_sheen"],
         "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
         "materials":[{{"name":"amber","extensions":{{
@@ -257,7 +257,8 @@ fn material_extensions_reach_the_material() {
           "KHR_materials_ior":{{"ior":1.54}},
           "KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]}},
           "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}}}},
-          "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6}}}}}}]"#
+          "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6}},
+          "KHR_materials_dispersion":{{"dispersion":0.4}}}}}}]"#
         ),
     );
     let model = load_gltf(&path).unwrap();
@@ -282,6 +283,7 @@ fn material_extensions_reach_the_material() {
     assert_eq!(l.attenuation_color, [0.9, 0.5, 0.1]);
     assert_eq!(l.specular_color, [1.0, 0.9, 0.8]);
     assert_eq!((l.sheen_color, l.sheen_roughness), ([0.3, 0.2, 0.1], 0.6));
+    assert_eq!(l.dispersion, 0.4);
     // The transmission and thickness textures are read (which parts are glass, how thick); the
     // varnish's texture is named.
     let texture = amber.transmission_texture.expect("the transmission texture");

@@ -2,7 +2,7 @@
 //! `seen_through` in `scene.wgsl`): frosted glass shows a blur of what is behind it, as much as its
 //! roughness and index say, and what it shows agrees with the plain filter's picture where it
 //! is smooth; a refracting volume shows what is behind it displaced the way Snell's law bends
-//! the ray, and not at normal incidence.
+//! the ray, and not at normal incidence; a dispersing one splits white into colours.
 
 use crate::golden;
 use crate::render::{
@@ -298,4 +298,33 @@ fn four_kinds_of_glass_match_their_golden_frame() {
         return;
     };
     golden::check("glass-four-kinds-mono", size.0, size.1, &frames[0], 3, 0.003);
+}
+
+/// Pixels of a frame whose red and blue differ by more than 40: colour where the scene has none.
+fn coloured_pixels(frame: &[u8]) -> usize {
+    frame.chunks(4).filter(|p| p[0].abs_diff(p[2]) > 40).count()
+}
+
+#[test]
+fn a_dispersing_gem_splits_white_into_colours() {
+    // White under a tilted gem on grey: no colour anywhere, unless the gem bends red and blue
+    // apart. The dispersion is far beyond any real stone's (an Abbe number of 1, so that the split
+    // spans pixels at this size; diamond's is 55).
+    let white = [0.9, 0.9, 0.9, 1.0];
+    let plain = diamond();
+    let fiery = Layers {
+        dispersion: 20.0,
+        ..diamond()
+    };
+    let Some(without) = render_methods_over_floor(gem_scene(plain, 0.0, 30.0, white), &[Method::Mono], None) else {
+        return;
+    };
+    let with = render_methods_over_floor(gem_scene(fiery, 0.0, 30.0, white), &[Method::Mono], None).expect("a frame");
+    let (before, after) = (coloured_pixels(&without[0]), coloured_pixels(&with[0]));
+    println!("coloured pixels: without dispersion {before}, with {after}");
+    assert!(before < 5, "a clear gem over white and grey shows no colour: {before}");
+    assert!(
+        after > 20,
+        "a dispersing gem fringes the white block with colour: {after}"
+    );
 }

@@ -2,8 +2,8 @@
 //! the dielectric's index of refraction (`KHR_materials_ior`) and specular strength and colour
 //! (`KHR_materials_specular`), a varnish over it (`KHR_materials_clearcoat`), light passing
 //! through it as through glass (`KHR_materials_transmission`) and absorbed inside it
-//! (`KHR_materials_volume`), and the sheen of cloth's fibres over it (`KHR_materials_sheen`:
-//! velvet, silk, felt).
+//! (`KHR_materials_volume`) and split into colours by it (`KHR_materials_dispersion`: a gem's
+//! fire), and the sheen of cloth's fibres over it (`KHR_materials_sheen`: velvet, silk, felt).
 //!
 //! Invariants of a [`Layers`] made by [`Layers::from_extensions`]: every value finite and in the
 //! range its extension allows (a value outside it is clamped, with a warning). The defaults are
@@ -22,13 +22,14 @@
 use serde_json::Value;
 
 /// The extensions [`Layers::from_extensions`] reads, for the loader's list of supported ones.
-pub const EXTENSIONS: [&str; 6] = [
+pub const EXTENSIONS: [&str; 7] = [
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
     "KHR_materials_transmission",
     "KHR_materials_volume",
     "KHR_materials_sheen",
+    "KHR_materials_dispersion",
 ];
 
 /// The layers over, in and through a material's base (see the module docs). Lengths are in the
@@ -66,6 +67,9 @@ pub struct Layers {
     /// angles like velvet's; high, a soft glow).
     pub sheen_color: [f32; 3],
     pub sheen_roughness: f32,
+    /// How much the index of refraction changes across the visible colours: 20 / the Abbe
+    /// number (0: none; crown glass about 0.3, diamond 0.36, flint glass up to 0.6).
+    pub dispersion: f32,
 }
 
 impl Default for Layers {
@@ -82,6 +86,7 @@ impl Default for Layers {
             attenuation_distance: f32::INFINITY,
             sheen_color: [0.0; 3],
             sheen_roughness: 0.0,
+            dispersion: 0.0,
         }
     }
 }
@@ -114,6 +119,14 @@ impl Layers {
         // A colour of 0 would absorb everything at once: kept finite, far past visible.
         self.attenuation_color
             .map(|c| -(c.max(1e-6)).ln() / self.attenuation_distance)
+    }
+
+    /// The indices of refraction of red, green and blue light: [`Self::ior`] spread by
+    /// [`Self::dispersion`] about green, by (ior − 1) × dispersion / 40 each way (from the Abbe
+    /// number's definition, V = (n_d − 1)/(n_F − n_C), and the extension's 20/V).
+    pub fn colour_iors(&self) -> [f32; 3] {
+        let half = (self.ior - 1.0) * self.dispersion / 40.0;
+        [self.ior - half, self.ior, self.ior + half]
     }
 
     /// Whether the surface has a sheen (a sheen colour other than black).
@@ -215,6 +228,11 @@ impl Layers {
             let r = reader.number(e, name, "sheenRoughnessFactor", 0.0);
             layers.sheen_roughness = reader.clamped(name, "sheenRoughnessFactor", r, 0.0, 1.0);
             reader.textures(e, name, &["sheenColorTexture", "sheenRoughnessTexture"]);
+        }
+        if let Some(e) = extension("KHR_materials_dispersion") {
+            let name = "KHR_materials_dispersion";
+            let d = reader.number(e, name, "dispersion", 0.0);
+            layers.dispersion = reader.clamped(name, "dispersion", d, 0.0, f32::MAX);
         }
         layers
     }
@@ -364,6 +382,25 @@ mod tests {
             );
         }
         assert_eq!(warnings.len(), 5, "{warnings:?}");
+    }
+
+    #[test]
+    fn dispersion_spreads_the_index_by_the_abbe_number() {
+        let (diamond, warnings) = read(json!({
+            "KHR_materials_ior": { "ior": 2.417 },
+            "KHR_materials_dispersion": { "dispersion": 0.3636 }
+        }));
+        assert!(warnings.is_empty(), "{warnings:?}");
+        // Diamond: Abbe number 55, so n_F − n_C = (n_d − 1)/55 = 0.0258 between blue and red.
+        let [r, g, b] = diamond.colour_iors();
+        assert_eq!(g, 2.417);
+        assert!(((b - r) - 1.417 / 55.0).abs() < 1e-4, "{r} {g} {b}");
+        assert!(r < g && g < b);
+        // None by default, and a negative factor is clamped to none.
+        assert_eq!(Layers::default().colour_iors(), [1.5; 3]);
+        let (bad, warnings) = read(json!({ "KHR_materials_dispersion": { "dispersion": -1.0 } }));
+        assert_eq!(bad.dispersion, 0.0);
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
     }
 
     #[test]
