@@ -306,6 +306,41 @@ fn material_extensions_reach_the_material() {
     );
 }
 
+/// A glass's thickness is in its mesh's units: a node that scales the mesh scales it too, in a
+/// copy of the material where another node draws the same material at another scale.
+#[test]
+fn a_node_scales_the_volume_of_the_glass_it_places() {
+    let dir = scratch("gltf-volume-scale");
+    let json = tiny_gltf_json(
+        r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume"],
+        "materials":[{"name":"glass","extensions":{
+          "KHR_materials_transmission":{"transmissionFactor":1},
+          "KHR_materials_volume":{"thicknessFactor":0.02,"attenuationDistance":0.1}}}]"#,
+    )
+    .replace(
+        r#""attributes":{"POSITION":0}"#,
+        r#""attributes":{"POSITION":0},"material":0"#,
+    )
+    .replace(
+        r#""nodes":[{"mesh":0}],"scenes":[{"nodes":[0]}]"#,
+        r#""nodes":[{"mesh":0,"scale":[0.5,0.5,0.5]},{"mesh":0,"translation":[2,0,0]}],"scenes":[{"nodes":[0,1]}]"#,
+    );
+    let path = dir.join("scaled.gltf");
+    std::fs::write(&path, json).unwrap();
+    let model = load_gltf(&path).unwrap();
+    assert_eq!(model.primitives.len(), 2);
+    let mut thicknesses: Vec<(f32, f32)> = model
+        .primitives
+        .iter()
+        .map(|p| {
+            let l = model.materials[p.material].layers;
+            (l.thickness, l.attenuation_distance)
+        })
+        .collect();
+    thicknesses.sort_by(|a, b| a.0.total_cmp(&b.0));
+    assert_eq!(thicknesses, [(0.01, 0.05), (0.02, 0.1)]);
+}
+
 /// `KHR_texture_transform` applies to every texture slot, normal and occlusion included (gltf-rs
 /// types it only on the other slots' `textureInfo`); a malformed one is reported, not fatal.
 #[test]

@@ -33,7 +33,8 @@ pub const EXTENSIONS: [&str; 7] = [
 ];
 
 /// The layers over, in and through a material's base (see the module docs). Lengths are in the
-/// model's units (glTF's metres), colours linear.
+/// model's units as its meshes stand (glTF's metres: the loader scales a volume with the node
+/// that places it, [`super::Model::transform`] with the model), colours linear.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Layers {
     /// Index of refraction of the dielectric: its reflectance at normal incidence is

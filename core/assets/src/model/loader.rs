@@ -751,6 +751,19 @@ fn skin_matrices(ctx: &Ctx, s: &gltf::Skin, node_worlds: &[Mat4]) -> Result<Vec<
         .collect()
 }
 
+/// How much `world` stretches a length: its linear part's largest column (exact for the similarity
+/// transforms glTF's nodes are in practice: rotation, uniform scale); 1 where that is not a
+/// positive finite number.
+fn length_scale(world: Mat4) -> f32 {
+    let linear = glam::Mat3::from_mat4(world);
+    let scale = linear
+        .x_axis
+        .length()
+        .max(linear.y_axis.length())
+        .max(linear.z_axis.length());
+    if scale.is_finite() && scale > 0.0 { scale } else { 1.0 }
+}
+
 /// The transforms of a node's `EXT_mesh_gpu_instancing` instances, `None` without the extension
 /// ([`instancing`]). Each attribute must be the extension's type (`TRANSLATION` and `SCALE`
 /// VEC3, `ROTATION` VEC4, integer rotations normalised), all of one count.
@@ -1597,6 +1610,10 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     } else {
         Vec::new()
     };
+    // A volume's thickness is in the mesh's own units, which a node's scale changes: materials
+    // with a volume drawn at another scale get a copy with their lengths scaled, by (material,
+    // scale).
+    let mut scaled_volumes: std::collections::HashMap<(usize, u32), usize> = std::collections::HashMap::new();
     let mut stack: Vec<(gltf::Node, Mat4)> = roots.into_iter().map(|n| (n, Mat4::IDENTITY)).collect();
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut visited[node.index()], true) {
@@ -1769,6 +1786,22 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                         ..single.clone()
                     });
                     material = materials.len() - 1;
+                }
+                // Where the node puts the mesh (not for a skinned one, which its joints place).
+                let scale = if node.skin().is_some() {
+                    1.0
+                } else {
+                    length_scale(world)
+                };
+                if scale != 1.0
+                    && let Some(volume) = materials.get(material).filter(|m| m.layers.thickness > 0.0)
+                {
+                    let mut copy = volume.clone();
+                    material = *scaled_volumes.entry((material, scale.to_bits())).or_insert_with(|| {
+                        copy.layers.scale_lengths(scale);
+                        materials.push(copy);
+                        materials.len() - 1
+                    });
                 }
                 model.primitives.push(Primitive {
                     mesh: m,
