@@ -84,6 +84,9 @@ struct Material {
     // KHR_materials_dispersion: x, y 1 / index of refraction of red and of blue light; z 1 where
     // the volume splits the colours.
     dispersion: vec4<f32>,
+    // KHR_materials_diffuse_transmission: rgb the colour light takes through a thin sheet, w the
+    // share of the diffuse light that goes through.
+    diffuse_transmission: vec4<f32>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -561,6 +564,10 @@ struct Surface {
     // 1 / the index of refraction of red and of blue light, where the volume splits the colours
     // (a gem's fire; otherwise both `inv_ior`).
     inv_ior_red_blue: vec2<f32>,
+    // The share of its diffuse light a thin sheet scatters to its other side, and that light's
+    // colour (paper, leaves).
+    diffuse_transmission: f32,
+    diffuse_transmission_color: vec3<f32>,
     // The sheen of fibres over it (cloth; black: none) and their roughness.
     sheen_color: vec3<f32>,
     sheen_roughness: f32,
@@ -580,6 +587,8 @@ fn core_layers(s: ptr<function, Surface>) {
     (*s).refracted_path = 0.0;
     (*s).transmission_roughness = 0.0;
     (*s).inv_ior_red_blue = vec2<f32>((*s).inv_ior);
+    (*s).diffuse_transmission = 0.0;
+    (*s).diffuse_transmission_color = vec3<f32>(1.0);
     (*s).sheen_color = vec3<f32>(0.0);
     (*s).sheen_roughness = 0.0;
 }
@@ -661,6 +670,8 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
         s.sheen_color = material.sheen.rgb;
         s.sheen_roughness = material.sheen.w;
         s.inv_ior_red_blue = select(vec2<f32>(s.inv_ior), material.dispersion.xy, material.dispersion.z > 0.5);
+        s.diffuse_transmission = material.diffuse_transmission.w;
+        s.diffuse_transmission_color = material.diffuse_transmission.rgb;
     } else {
         // Constants the compiler folds into the shading: the core material costs what it did
         // before the extensions.
@@ -860,8 +871,17 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let fresnel_m = base + (vec3<f32>(1.0) - base) * pow(1.0 - v_dot_h, 5.0);
         let fresnel = mix(fresnel_d, fresnel_m, metallic);
         let specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
-        let diffuse = (vec3<f32>(1.0) - fresnel) * (1.0 - metallic) * (1.0 - s.transmission) * base / PI;
+        // Lambert's share of what is not reflected, less what a thin sheet passes to its other
+        // side; and what it passes from its other side, lit from there (paper against a window).
+        let lambert = (1.0 - metallic) * (1.0 - s.transmission) * base / PI;
+        let through_sheet = s.diffuse_transmission;
+        let diffuse = (vec3<f32>(1.0) - fresnel) * lambert * (1.0 - through_sheet);
         direct = (diffuse + specular) * light_in;
+        if (through_sheet > 0.0) {
+            let back = -s.geometric_n;
+            let light_behind = light_rgb * max(dot(-n, l), 0.0) * light_visibility(world, back, l) * light_filter(world, back, l);
+            direct += lambert * through_sheet * s.diffuse_transmission_color * light_behind;
+        }
 
         // Image-based light, world-fixed: diffuse from the environment's irradiance (ρ/π·E),
         // specular by the split sum: the prefiltered radiance around the reflection direction at
@@ -869,7 +889,10 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         // levels: no derivatives, so the azimuth seam of the equirectangular map leaves no line.
         let fresnel_ambient_m = base + (max(vec3<f32>(1.0 - roughness), base) - base) * pow(1.0 - n_dot_v, 5.0);
         let fresnel_ambient = mix(fresnel_ambient_d, fresnel_ambient_m, metallic);
-        let diffuse_ambient = irradiance(to_world(n)) / PI * base * (1.0 - metallic) * (1.0 - s.transmission) * (vec3<f32>(1.0) - fresnel_ambient);
+        var diffuse_ambient = irradiance(to_world(n)) * lambert * (1.0 - through_sheet) * (vec3<f32>(1.0) - fresnel_ambient);
+        if (through_sheet > 0.0) {
+            diffuse_ambient += irradiance(to_world(-n)) * lambert * through_sheet * s.diffuse_transmission_color;
+        }
         let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), roughness * PREFILTERED_MAX_LEVEL).rgb;

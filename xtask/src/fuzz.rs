@@ -455,7 +455,7 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                 tri_gltf
                     .replace(
                         r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}}}]"#,
-                        r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},"extensions":{"KHR_materials_transmission":{"transmissionFactor":1,"transmissionTexture":{"index":0}},"KHR_materials_volume":{"thicknessFactor":0.1,"thicknessTexture":{"index":0,"texCoord":1},"attenuationDistance":0.2,"attenuationColor":[0.9,0.5,0.1]},"KHR_materials_ior":{"ior":1.54},"KHR_materials_specular":{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]},"KHR_materials_clearcoat":{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1},"KHR_materials_sheen":{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6},"KHR_materials_dispersion":{"dispersion":0.4}}}]"#,
+                        r#""materials":[{"pbrMetallicRoughness":{"baseColorTexture":{"index":0}},"extensions":{"KHR_materials_transmission":{"transmissionFactor":1,"transmissionTexture":{"index":0}},"KHR_materials_volume":{"thicknessFactor":0.1,"thicknessTexture":{"index":0,"texCoord":1},"attenuationDistance":0.2,"attenuationColor":[0.9,0.5,0.1]},"KHR_materials_ior":{"ior":1.54},"KHR_materials_specular":{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]},"KHR_materials_clearcoat":{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1},"KHR_materials_sheen":{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6},"KHR_materials_dispersion":{"dispersion":0.4},"KHR_materials_diffuse_transmission":{"diffuseTransmissionFactor":0.25}}}]"#,
                     )
                     .as_bytes(),
             )?;

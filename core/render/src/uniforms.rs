@@ -76,6 +76,7 @@ pub(crate) struct MaterialUniform {
     pub(crate) volume: [f32; 4],
     pub(crate) sheen: [f32; 4],
     pub(crate) dispersion: [f32; 4],
+    pub(crate) diffuse_transmission: [f32; 4],
 }
 
 impl MaterialUniform {
@@ -152,6 +153,10 @@ impl MaterialUniform {
                 let [r, _, b] = l.colour_iors();
                 let splits = l.refracts() && l.dispersion > 0.0;
                 [1.0 / r, 1.0 / b, f32::from(u8::from(splits)), 0.0]
+            },
+            diffuse_transmission: {
+                let c = l.diffuse_transmission_color;
+                [c[0], c[1], c[2], l.diffuse_transmission]
             },
         }
     }

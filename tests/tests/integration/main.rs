@@ -32,5 +32,6 @@ mod seen_through;
 mod shared_data;
 mod sheen;
 mod surface;
+mod thin_sheets;
 mod transmission;
 mod viewpoint_and_light;

@@ -248,7 +248,7 @@ fn material_extensions_reach_the_material() {
         &dir,
         "amber.gltf",
         &format!(
-            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion"],
+            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion","KHR_materials_diffuse_transmission"],
         "extensionsRequired":["KHR_materials_transmission","KHR_materials_sheen"],
         "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
         "materials":[{{"name":"amber","extensions":{{
@@ -258,7 +258,8 @@ fn material_extensions_reach_the_material() {
           "KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]}},
           "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}}}},
           "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6}},
-          "KHR_materials_dispersion":{{"dispersion":0.4}}}}}}]"#
+          "KHR_materials_dispersion":{{"dispersion":0.4}},
+          "KHR_materials_diffuse_transmission":{{"diffuseTransmissionFactor":0.25,"diffuseTransmissionColorFactor":[1,0.5,0.5]}}}}}}]"#
         ),
     );
     let model = load_gltf(&path).unwrap();
@@ -284,6 +285,10 @@ fn material_extensions_reach_the_material() {
     assert_eq!(l.specular_color, [1.0, 0.9, 0.8]);
     assert_eq!((l.sheen_color, l.sheen_roughness), ([0.3, 0.2, 0.1], 0.6));
     assert_eq!(l.dispersion, 0.4);
+    assert_eq!(
+        (l.diffuse_transmission, l.diffuse_transmission_color),
+        (0.25, [1.0, 0.5, 0.5])
+    );
     // The transmission and thickness textures are read (which parts are glass, how thick); the
     // varnish's texture is named.
     let texture = amber.transmission_texture.expect("the transmission texture");

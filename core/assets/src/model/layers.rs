@@ -3,7 +3,9 @@
 //! (`KHR_materials_specular`), a varnish over it (`KHR_materials_clearcoat`), light passing
 //! through it as through glass (`KHR_materials_transmission`) and absorbed inside it
 //! (`KHR_materials_volume`) and split into colours by it (`KHR_materials_dispersion`: a gem's
-//! fire), and the sheen of cloth's fibres over it (`KHR_materials_sheen`: velvet, silk, felt).
+//! fire), the sheen of cloth's fibres over it (`KHR_materials_sheen`: velvet, silk, felt), and
+//! light scattered through a thin sheet to its other side (`KHR_materials_diffuse_transmission`:
+//! paper, parchment, leaves, a lampshade).
 //!
 //! Invariants of a [`Layers`] made by [`Layers::from_extensions`]: every value finite and in the
 //! range its extension allows (a value outside it is clamped, with a warning). The defaults are
@@ -22,7 +24,7 @@
 use serde_json::Value;
 
 /// The extensions [`Layers::from_extensions`] reads, for the loader's list of supported ones.
-pub const EXTENSIONS: [&str; 7] = [
+pub const EXTENSIONS: [&str; 8] = [
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
@@ -30,6 +32,7 @@ pub const EXTENSIONS: [&str; 7] = [
     "KHR_materials_volume",
     "KHR_materials_sheen",
     "KHR_materials_dispersion",
+    "KHR_materials_diffuse_transmission",
 ];
 
 /// The layers over, in and through a material's base (see the module docs). Lengths are in the
@@ -71,6 +74,10 @@ pub struct Layers {
     /// How much the index of refraction changes across the visible colours: 20 / the Abbe
     /// number (0: none; crown glass about 0.3, diamond 0.36, flint glass up to 0.6).
     pub dispersion: f32,
+    /// Share of the diffusely scattered light that leaves through the other side of a thin sheet
+    /// (0–1), and the colour it takes on the way (linear, 0–1).
+    pub diffuse_transmission: f32,
+    pub diffuse_transmission_color: [f32; 3],
 }
 
 impl Default for Layers {
@@ -88,6 +95,8 @@ impl Default for Layers {
             sheen_color: [0.0; 3],
             sheen_roughness: 0.0,
             dispersion: 0.0,
+            diffuse_transmission: 0.0,
+            diffuse_transmission_color: [1.0; 3],
         }
     }
 }
@@ -229,6 +238,20 @@ impl Layers {
             let r = reader.number(e, name, "sheenRoughnessFactor", 0.0);
             layers.sheen_roughness = reader.clamped(name, "sheenRoughnessFactor", r, 0.0, 1.0);
             reader.textures(e, name, &["sheenColorTexture", "sheenRoughnessTexture"]);
+        }
+        if let Some(e) = extension("KHR_materials_diffuse_transmission") {
+            let name = "KHR_materials_diffuse_transmission";
+            let t = reader.number(e, name, "diffuseTransmissionFactor", 0.0);
+            layers.diffuse_transmission = reader.clamped(name, "diffuseTransmissionFactor", t, 0.0, 1.0);
+            if let Some(c) = reader.color(e, name, "diffuseTransmissionColorFactor") {
+                layers.diffuse_transmission_color =
+                    c.map(|c| reader.clamped(name, "diffuseTransmissionColorFactor", c, 0.0, 1.0));
+            }
+            reader.textures(
+                e,
+                name,
+                &["diffuseTransmissionTexture", "diffuseTransmissionColorTexture"],
+            );
         }
         if let Some(e) = extension("KHR_materials_dispersion") {
             let name = "KHR_materials_dispersion";
@@ -402,6 +425,27 @@ mod tests {
         let (bad, warnings) = read(json!({ "KHR_materials_dispersion": { "dispersion": -1.0 } }));
         assert_eq!(bad.dispersion, 0.0);
         assert_eq!(warnings.len(), 1, "{warnings:?}");
+    }
+
+    #[test]
+    fn a_thin_sheet_lets_diffuse_light_through() {
+        let (parchment, warnings) = read(json!({
+            "KHR_materials_diffuse_transmission": {
+                "diffuseTransmissionFactor": 0.4,
+                "diffuseTransmissionColorFactor": [1.0, 0.8, 0.5]
+            }
+        }));
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(parchment.diffuse_transmission, 0.4);
+        assert_eq!(parchment.diffuse_transmission_color, [1.0, 0.8, 0.5]);
+        let (bad, warnings) = read(json!({
+            "KHR_materials_diffuse_transmission": {
+                "diffuseTransmissionFactor": 1.5,
+                "diffuseTransmissionTexture": { "index": 0 }
+            }
+        }));
+        assert_eq!(bad.diffuse_transmission, 1.0);
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
     }
 
     #[test]

@@ -31,7 +31,8 @@
 //!   Where a texture names both, the core `source` (the lossless fallback) is used. A texture
 //!   whose image comes only from an extension we do not read is left out with a warning.
 //! * Glass, gems, varnish and cloth by their factors: `KHR_materials_ior`, `_specular`,
-//!   `_clearcoat`, `_transmission`, `_volume`, `_dispersion` and `_sheen` ([`Layers`]; of their textures the
+//!   `_clearcoat`, `_transmission`, `_volume`, `_dispersion`, `_sheen` and
+//!   `_diffuse_transmission` ([`Layers`]; of their textures the
 //!   transmission and thickness textures are read, the others are left out with a warning each).
 //! * `KHR_materials_pbrSpecularGlossiness` (archived by Khronos, but found in older exports) is
 //!   converted to metallic–roughness as Khronos published, texel by texel where it has a texture
