@@ -1,8 +1,8 @@
 // The backdrop of glass that blurs or bends the view through it (render crate, backdrop.rs): each
-// level of an eye's copy of its opaque scene drawn from the level above (level 0 from the eye's
-// HDR target, the same size). One bilinear read at the centre of each target pixel: the mean of
-// the 2 × 2 source texels under it for a halving (of the nearer ones where a size is odd), the
-// texel itself for the copy.
+// level of an eye's copy of what it drew before its farthest such glass, drawn from the level
+// above (level 0 from the eye's HDR target, the same size). One bilinear read at the centre of
+// each target pixel: the mean of the 2 × 2 source texels under it for a halving (of the nearer
+// ones where a size is odd), the texel itself for the copy.
 
 @group(0) @binding(0) var source: texture_2d<f32>;
 @group(0) @binding(1) var source_sampler: sampler;

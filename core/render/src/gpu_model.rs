@@ -92,7 +92,7 @@ impl GpuModel {
     }
 
     /// The backdrop the model's glass needs ([`DrawLayer::Backdrop`], `backdrop`): none without
-    /// glass that blurs or bends what is seen through it; the copy of the opaque scene alone
+    /// glass that blurs or bends what is seen through it; the copy of what lies behind alone
     /// where such glass only bends; the copy and its halvings where any blurs.
     pub(crate) fn backdrop_needed(&self) -> BackdropNeeded {
         let drawn = || self.primitives.iter().map(|p| &self.materials[p.material]);
@@ -155,9 +155,8 @@ pub(crate) struct MaterialVariant {
 /// (reflections, emission). So it is drawn twice, [`DrawLayer::Filter`] then
 /// [`DrawLayer::Light`]: the pixel becomes behind × filter + light. Every other surface is drawn
 /// once, [`DrawLayer::Whole`]. Glass that blurs or bends what is behind it cannot filter the
-/// pixel under it: its first draw is [`DrawLayer::Backdrop`], which reads what the opaque scene
-/// showed elsewhere behind it (the eye's `backdrop`: blurred by its roughness, shifted by
-/// refraction), filters that, and blends it over the pixel by the surface's coverage. The
+/// pixel under it: its first draw is [`DrawLayer::Backdrop`], which reads what the eye drew
+/// behind it before (the eye's `backdrop`: blurred by its roughness, shifted by refraction), filters that, and blends it over the pixel by the surface's coverage. The
 /// `TRANSMIT_LAYER` constant of `scene.wgsl`, in this order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub(crate) enum DrawLayer {
