@@ -487,7 +487,6 @@ fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
     return a2 / (PI * d * d);
 }
 
-// Smith visibility (height-correlated, including the 1 / (4 n·l n·v) term).
 // The sheen of cloth (KHR_materials_sheen; assets crate, `ibl::sheen`, which this mirrors and
 // tests): the Charlie distribution of fibre directions at α = roughness², and its visibility
 // G / (4 n·l n·v) with G = 1 / (1 + Λ(l) + Λ(v)), Λ from Estevez and Kulla's fitted profile.
@@ -518,6 +517,7 @@ fn sheen_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
     return clamp(g / max(4.0 * n_dot_l * n_dot_v, 1e-6), 0.0, 1.0);
 }
 
+// Smith visibility (height-correlated, including the 1 / (4 n·l n·v) term).
 fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
