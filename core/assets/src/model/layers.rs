@@ -134,7 +134,11 @@ impl Layers {
     /// The indices of refraction of red, green and blue light: [`Self::ior`] spread by
     /// [`Self::dispersion`] about green, by (ior − 1) × dispersion / 40 each way (from the Abbe
     /// number's definition, V = (n_d − 1)/(n_F − n_C), and the extension's 20/V).
+    /// An infinite index (the file's 0) has no spread: it is that for every colour.
     pub fn colour_iors(&self) -> [f32; 3] {
+        if !self.ior.is_finite() {
+            return [self.ior; 3];
+        }
         let half = (self.ior - 1.0) * self.dispersion / 40.0;
         [self.ior - half, self.ior, self.ior + half]
     }
@@ -422,6 +426,12 @@ mod tests {
         assert!(r < g && g < b);
         // None by default, and a negative factor is clamped to none.
         assert_eq!(Layers::default().colour_iors(), [1.5; 3]);
+        let infinite = Layers {
+            ior: f32::INFINITY,
+            dispersion: 1.0,
+            ..Layers::default()
+        };
+        assert_eq!(infinite.colour_iors(), [f32::INFINITY; 3]);
         let (bad, warnings) = read(json!({ "KHR_materials_dispersion": { "dispersion": -1.0 } }));
         assert_eq!(bad.dispersion, 0.0);
         assert_eq!(warnings.len(), 1, "{warnings:?}");
