@@ -22,7 +22,7 @@
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::HDR_FORMAT;
-use crate::bindings::filterable_texture_entry;
+use crate::bindings::{filterable_texture_entry, filtering_sampler_entry};
 use crate::pipelines::{create_fullscreen_pipeline, draw_fullscreen};
 
 pub(crate) const BACKDROP_WGSL: &str = include_str!("../../../shaders/backdrop.wgsl");
@@ -42,15 +42,7 @@ impl Halver {
         });
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("backdrop level"),
-            entries: &[
-                filterable_texture_entry(0),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 1,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
-            ],
+            entries: &[filterable_texture_entry(0), filtering_sampler_entry(1)],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some("backdrop level"),

@@ -125,6 +125,16 @@ pub(crate) fn eye_bind_group(
     })
 }
 
+/// A filtering sampler at `binding`, for the fragment stage.
+pub(crate) fn filtering_sampler_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+        count: None,
+    }
+}
+
 pub(crate) fn filterable_texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
     float_texture_entry(binding, true)
 }

@@ -353,34 +353,17 @@ impl Renderer {
         let backdrop = targets.backdrop.as_ref().filter(|_| with_backdrop);
         for (i, u) in uniforms.iter().enumerate() {
             let first = i == 0 && !shadow_pass;
-            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("scene"),
-                timestamp_writes: timer.filter(|_| first).map(|t| t.writes(true, false)),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &targets.hdr[i],
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(CLEAR_RADIANCE),
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                    view: &targets.depth,
-                    // Reverse-Z: 0 is infinitely far. Kept for the blended draws' own pass
-                    // where a backdrop is made between.
-                    depth_ops: Some(wgpu::Operations {
-                        load: wgpu::LoadOp::Clear(0.0),
-                        store: if backdrop.is_some() {
-                            wgpu::StoreOp::Store
-                        } else {
-                            wgpu::StoreOp::Discard
-                        },
-                    }),
-                    stencil_ops: None,
-                }),
-                ..Default::default()
-            });
+            // Reverse-Z depth, cleared to 0 (infinitely far); kept for the second half of the pass
+            // where a backdrop is made between.
+            let mut pass = begin_scene_pass(
+                &mut encoder,
+                &targets.hdr[i],
+                &targets.depth,
+                ScenePassPart::First {
+                    timestamps: timer.filter(|_| first).map(|t| t.writes(true, false)),
+                    keep_depth: backdrop.is_some(),
+                },
+            );
             pass.set_bind_group(0, &self.eye_bind[i], &[]);
             // Opaque and masked first; then blended, farthest first, as this eye sees them.
             let eye_at = Vec3::from_slice(&u.eye_pos[..3]);
@@ -431,27 +414,12 @@ impl Renderer {
                 {
                     drop(pass);
                     made.record(&mut encoder, halver, i);
-                    pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                        label: Some("scene, over the backdrop"),
-                        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                            view: &targets.hdr[i],
-                            depth_slice: None,
-                            resolve_target: None,
-                            ops: wgpu::Operations {
-                                load: wgpu::LoadOp::Load,
-                                store: wgpu::StoreOp::Store,
-                            },
-                        })],
-                        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                            view: &targets.depth,
-                            depth_ops: Some(wgpu::Operations {
-                                load: wgpu::LoadOp::Load,
-                                store: wgpu::StoreOp::Discard,
-                            }),
-                            stencil_ops: None,
-                        }),
-                        ..Default::default()
-                    });
+                    pass = begin_scene_pass(
+                        &mut encoder,
+                        &targets.hdr[i],
+                        &targets.depth,
+                        ScenePassPart::OverBackdrop,
+                    );
                     pass.set_bind_group(0, &self.eye_bind[i], &[]);
                 }
                 self.draw_primitive(&mut pass, p, input.levels, over_backdrop.is_some());
@@ -706,6 +674,70 @@ impl Renderer {
             p.draw(pass, levels);
         }
     }
+}
+
+/// Which part of an eye's scene pass [`begin_scene_pass`] begins.
+pub(crate) enum ScenePassPart<'a> {
+    /// The whole pass, or its first half: colour cleared to the background, depth to 0
+    /// (reverse-Z: infinitely far), timestamps if the frame's first pass; its depth kept only
+    /// where a second half follows (`keep_depth`).
+    First {
+        timestamps: Option<wgpu::RenderPassTimestampWrites<'a>>,
+        keep_depth: bool,
+    },
+    /// The second half, after the backdrop was made: what the first drew loaded, depth let go.
+    OverBackdrop,
+}
+
+/// Begins an eye's scene pass into `hdr` with depth in `depth`.
+pub(crate) fn begin_scene_pass<'e>(
+    encoder: &'e mut wgpu::CommandEncoder,
+    hdr: &wgpu::TextureView,
+    depth: &wgpu::TextureView,
+    part: ScenePassPart<'_>,
+) -> wgpu::RenderPass<'e> {
+    let (label, colour_load, depth_load, depth_store, timestamp_writes) = match part {
+        ScenePassPart::First { timestamps, keep_depth } => (
+            "scene",
+            wgpu::LoadOp::Clear(CLEAR_RADIANCE),
+            wgpu::LoadOp::Clear(0.0),
+            if keep_depth {
+                wgpu::StoreOp::Store
+            } else {
+                wgpu::StoreOp::Discard
+            },
+            timestamps,
+        ),
+        ScenePassPart::OverBackdrop => (
+            "scene, over the backdrop",
+            wgpu::LoadOp::Load,
+            wgpu::LoadOp::Load,
+            wgpu::StoreOp::Discard,
+            None,
+        ),
+    };
+    encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some(label),
+        timestamp_writes,
+        color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+            view: hdr,
+            depth_slice: None,
+            resolve_target: None,
+            ops: wgpu::Operations {
+                load: colour_load,
+                store: wgpu::StoreOp::Store,
+            },
+        })],
+        depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+            view: depth,
+            depth_ops: Some(wgpu::Operations {
+                load: depth_load,
+                store: depth_store,
+            }),
+            stencil_ops: None,
+        }),
+        ..Default::default()
+    })
 }
 
 /// The cross-fades' instance buffer's first size (entries): 31 fades at once; it grows when a

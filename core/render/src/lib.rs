@@ -344,12 +344,7 @@ impl Renderer {
                 },
                 filterable_texture_entry(3),
                 filterable_texture_entry(4),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 5,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                filtering_sampler_entry(5),
                 wgpu::BindGroupLayoutEntry {
                     binding: 6,
                     visibility: wgpu::ShaderStages::FRAGMENT,
@@ -361,20 +356,10 @@ impl Renderer {
                     count: None,
                 },
                 filterable_texture_entry(7),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 8,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                filtering_sampler_entry(8),
                 texture_entry(9),
                 filterable_texture_entry(10),
-                wgpu::BindGroupLayoutEntry {
-                    binding: 11,
-                    visibility: wgpu::ShaderStages::FRAGMENT,
-                    ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                    count: None,
-                },
+                filtering_sampler_entry(11),
             ],
         });
         let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {
@@ -459,12 +444,7 @@ impl Renderer {
                 },
                 count: None,
             });
-            material_entries.push(wgpu::BindGroupLayoutEntry {
-                binding: 2 + 2 * slot,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
-                count: None,
-            });
+            material_entries.push(filtering_sampler_entry(2 + 2 * slot));
         }
         let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("material"),

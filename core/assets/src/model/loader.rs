@@ -1794,11 +1794,9 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                 } else {
                     length_scale(world)
                 };
-                if scale != 1.0
-                    && let Some(volume) = materials.get(material).filter(|m| m.layers.thickness > 0.0)
-                {
-                    let mut copy = volume.clone();
+                if scale != 1.0 && materials.get(material).is_some_and(|m| m.layers.thickness > 0.0) {
                     material = *scaled_volumes.entry((material, scale.to_bits())).or_insert_with(|| {
+                        let mut copy = materials[material].clone();
                         copy.layers.scale_lengths(scale);
                         materials.push(copy);
                         materials.len() - 1
