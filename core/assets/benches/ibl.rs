@@ -3,13 +3,15 @@
 //! nine irradiance SH coefficients ([`IrradianceSh::from_environment`], on every core) beside a
 //! plain texel-by-texel loop on one thread, and the specular levels ([`prefiltered_levels`] at the
 //! renderer's 256-texel base) — for 1024-, 2048- and 4096-wide maps, as in the tabletop paper's
-//! table. Each figure is the median of several runs; the machine is shared and noisy, so compare
+//! table; and the renderer's start-up tables (the split-sum table and the sheen's albedo table,
+//! 64 × 64 each, made once per process on a background thread). Each figure is the median of
+//! several runs; the machine is shared and noisy, so compare
 //! figures of one run only. Prints a Markdown table.
 
 use std::time::Instant;
 
 use phantogram_assets::ibl::sh::reference_projection;
-use phantogram_assets::ibl::{Environment, IrradianceSh, prefiltered_levels};
+use phantogram_assets::ibl::{Environment, IrradianceSh, brdf_lut, prefiltered_levels, sheen_albedo_table};
 
 /// The renderer's prefiltered base width (`phantogram_render`'s `PREFILTERED_BASE_WIDTH`).
 const PREFILTERED_BASE_WIDTH: usize = 256;
@@ -45,4 +47,10 @@ fn main() {
             naive / fast
         );
     }
+    // The renderer's `BRDF_LUT_SIZE`.
+    let split_sum = median_ms(5, || brdf_lut(64));
+    let sheen = median_ms(5, || sheen_albedo_table(64));
+    println!(
+        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms (1 core), sheen albedo {sheen:.1} ms ({cores} cores)"
+    );
 }
