@@ -1,8 +1,10 @@
 // The backdrop of glass that blurs or bends the view through it (render crate, backdrop.rs): each
 // level of an eye's copy of what it drew before its farthest such glass, drawn from the level
-// above (level 0 from the eye's HDR target, the same size). One bilinear read at the centre of
-// each target pixel: the mean of the 2 × 2 source texels under it for a halving (of the nearer
-// ones where a size is odd), the texel itself for the copy.
+// above (level 0 from the eye's HDR target, the same size). The copy reads the texel itself. A
+// halving weighs the 4 × 4 source texels around each target texel by the separable kernel
+// [1 3 3 1] / 8 (four bilinear reads 0.75 texel off its centre, each the mean of a 2 × 2 block
+// weighted 1 : 3): a 2 × 2 box's chain aliases what repeats near its texel size into a pattern
+// of crosses and squares through frosted glass, this one's (a quadratic B-spline's) barely does.
 
 @group(0) @binding(0) var source: texture_2d<f32>;
 @group(0) @binding(1) var source_sampler: sampler;
@@ -24,6 +26,15 @@ fn vs_main(@builtin(vertex_index) i: u32) -> VsOut {
 }
 
 @fragment
-fn fs_main(in: VsOut) -> @location(0) vec4<f32> {
+fn fs_copy(in: VsOut) -> @location(0) vec4<f32> {
     return textureSampleLevel(source, source_sampler, in.uv, 0.0);
+}
+
+@fragment
+fn fs_halve(in: VsOut) -> @location(0) vec4<f32> {
+    let off = 0.75 / vec2<f32>(textureDimensions(source, 0));
+    return 0.25 * (textureSampleLevel(source, source_sampler, in.uv + vec2<f32>(-off.x, -off.y), 0.0)
+        + textureSampleLevel(source, source_sampler, in.uv + vec2<f32>(off.x, -off.y), 0.0)
+        + textureSampleLevel(source, source_sampler, in.uv + vec2<f32>(-off.x, off.y), 0.0)
+        + textureSampleLevel(source, source_sampler, in.uv + vec2<f32>(off.x, off.y), 0.0));
 }

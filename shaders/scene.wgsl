@@ -723,22 +723,74 @@ fn seen_through(world: vec3<f32>, pixel: vec2<f32>, s: Surface) -> vec3<f32> {
     let size = vec2<f32>(textureDimensions(backdrop, 0));
     let straight = pixel / size;
     let index_change = clamp(2.0 / max(s.inv_ior, 1e-3) - 2.0, 0.0, 1.0);
-    let level = log2(max(size.x, size.y)) * s.transmission_roughness * index_change;
+    let levels = log2(max(size.x, size.y));
+    let level = levels * s.transmission_roughness * index_change;
+    // The chain's last level (one texel), as `textureNumLevels` would say (GLSL ES 3.0 lacks it):
+    // there is a chain wherever some glass is rough, and only level 0 is read where none is.
+    let last = floor(levels + 1e-3);
     if (s.refracted_path <= 0.0) {
-        return textureSampleLevel(backdrop, backdrop_sampler, straight, level).rgb;
+        return backdrop_at(straight, level, last).rgb;
     }
     let green = bent_to(world, s, s.inv_ior, straight);
     if (all(s.inv_ior_red_blue == vec2<f32>(s.inv_ior))) {
-        return textureSampleLevel(backdrop, backdrop_sampler, green, level).rgb;
+        return backdrop_at(green, level, last).rgb;
     }
     // A dispersing volume bends each colour by its own index: red least, blue most.
     let red = bent_to(world, s, s.inv_ior_red_blue.x, straight);
     let blue = bent_to(world, s, s.inv_ior_red_blue.y, straight);
     return vec3<f32>(
-        textureSampleLevel(backdrop, backdrop_sampler, red, level).r,
-        textureSampleLevel(backdrop, backdrop_sampler, green, level).g,
-        textureSampleLevel(backdrop, backdrop_sampler, blue, level).b,
+        backdrop_at(red, level, last).r,
+        backdrop_at(green, level, last).g,
+        backdrop_at(blue, level, last).b,
     );
+}
+
+// How much wider, in levels, the blur of this backdrop's chain read as `backdrop_at` does is than
+// that of a chain of 2 × 2 means read bilinearly (the glTF sample viewer's, for which its level
+// heuristic was made), at the same level: at level L the halvings' [1 3 3 1] / 8 kernels add a
+// variance of 4^L / 4 texels² of level 0 and the cubic B-spline read 4^L / 3, against 4^L / 12
+// and 4^L / 6 for means and a bilinear read; ½ log2(7/3) levels keeps the same width.
+const BACKDROP_WIDER_LEVELS: f32 = 0.6112;
+
+// The backdrop at `uv`, blurred as much as level `level` of a chain of 2 × 2 means read
+// bilinearly would (none at level 0), without that chain's blocks: read with a cubic B-spline
+// from the two levels around it, mixed. `last`: the chain's last level.
+fn backdrop_at(uv: vec2<f32>, level: f32, last: f32) -> vec4<f32> {
+    if (level <= 0.0) {
+        return textureSampleLevel(backdrop, backdrop_sampler, uv, 0.0);
+    }
+    let l = clamp(level - BACKDROP_WIDER_LEVELS, 0.0, last);
+    let l0 = floor(l);
+    let below = backdrop_cubic(uv, l0);
+    if (l0 >= last || l - l0 <= 0.0) {
+        return below;
+    }
+    return mix(below, backdrop_cubic(uv, l0 + 1.0), l - l0);
+}
+
+// Level `level` of the backdrop at `uv` by a cubic B-spline over its 4 × 4 nearest texels, in four
+// bilinear reads (Sigg and Hadwiger, GPU Gems 2, ch. 20): smooth where a bilinear read of a
+// coarse level shows its texels' edges.
+fn backdrop_cubic(uv: vec2<f32>, level: f32) -> vec4<f32> {
+    let size = vec2<f32>(textureDimensions(backdrop, i32(level)));
+    let x = uv * size - 0.5;
+    let i = floor(x);
+    let f = x - i;
+    let f2 = f * f;
+    let f3 = f2 * f;
+    let w0 = (1.0 - 3.0 * f + 3.0 * f2 - f3) / 6.0;
+    let w1 = (4.0 - 6.0 * f2 + 3.0 * f3) / 6.0;
+    let w2 = (1.0 + 3.0 * f + 3.0 * f2 - 3.0 * f3) / 6.0;
+    let w3 = f3 / 6.0;
+    let g0 = w0 + w1;
+    let g1 = w2 + w3;
+    // Texel i's centre is at i + 0.5: each read lies between two centres, weighted as the pair.
+    let p0 = (i - 0.5 + w1 / g0) / size;
+    let p1 = (i + 1.5 + w3 / g1) / size;
+    return g0.y * (g0.x * textureSampleLevel(backdrop, backdrop_sampler, p0, level)
+            + g1.x * textureSampleLevel(backdrop, backdrop_sampler, vec2<f32>(p1.x, p0.y), level))
+        + g1.y * (g0.x * textureSampleLevel(backdrop, backdrop_sampler, vec2<f32>(p0.x, p1.y), level)
+            + g1.x * textureSampleLevel(backdrop, backdrop_sampler, p1, level));
 }
 
 // Where in the backdrop a ray from the eye to `world`, refracted into the volume with 1 / index

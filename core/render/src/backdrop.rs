@@ -15,9 +15,15 @@
 //! Made with the frame's targets, only while the model has such glass, for an eye only once a
 //! frame draws it (a 1080×2400 eye costs 21 MB, 28 MB with its halvings), and with the halvings
 //! only while some of that glass is rough (glass that only bends reads the copy itself); the
-//! eyes' bind groups are remade when the backdrop they hold is not the current one. Each level is one draw of `backdrop.wgsl` reading the level
-//! above: two passes of the eye's scene instead of one, plus one small one per level. Render
-//! thread only, like the renderer; no panics.
+//! eyes' bind groups are remade when the backdrop they hold is not the current one. Each level is
+//! one draw of `backdrop.wgsl` reading the level above: two passes of the eye's scene instead of
+//! one, plus one small one per level. Render thread only, like the renderer; no panics.
+//!
+//! The halvings weigh 4 × 4 texels by [1 3 3 1] / 8 and the scene shader reads them with a cubic
+//! B-spline (`backdrop_at`), as wide a blur at each roughness as the sample viewer's chain of
+//! 2 × 2 means read bilinearly, which snaps what is blurred to its texels (a pattern of crosses
+//! over anything that repeats near their size; a spot that jumps as what it blurs moves):
+//! `seen_through::frosted_glass_blurs_a_thing_alike_wherever_it_stands`.
 
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -29,7 +35,10 @@ pub(crate) const BACKDROP_WGSL: &str = include_str!("../../../shaders/backdrop.w
 
 /// Draws one level of a backdrop from the one above (or from the eye's target).
 pub(crate) struct Halver {
-    pipeline: wgpu::RenderPipeline,
+    /// Level 0: the eye's target as it is.
+    copy: wgpu::RenderPipeline,
+    /// Every further level: the one above, halved.
+    halve: wgpu::RenderPipeline,
     layout: wgpu::BindGroupLayout,
     sampler: wgpu::Sampler,
 }
@@ -49,9 +58,25 @@ impl Halver {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = create_fullscreen_pipeline(device, "backdrop level", &module, &pipeline_layout, HDR_FORMAT);
+        let copy = create_fullscreen_pipeline(
+            device,
+            "backdrop copy",
+            &module,
+            &pipeline_layout,
+            "fs_copy",
+            HDR_FORMAT,
+        );
+        let halve = create_fullscreen_pipeline(
+            device,
+            "backdrop halving",
+            &module,
+            &pipeline_layout,
+            "fs_halve",
+            HDR_FORMAT,
+        );
         Self {
-            pipeline,
+            copy,
+            halve,
             layout,
             sampler: sampler(device),
         }
@@ -201,8 +226,9 @@ impl Backdrop {
         let Some(Some(made)) = self.eyes.get(eye) else {
             return;
         };
-        for (level, source) in made.levels.iter().zip(&made.sources) {
-            draw_fullscreen(encoder, "backdrop level", level, &halver.pipeline, source, None);
+        for (k, (level, source)) in made.levels.iter().zip(&made.sources).enumerate() {
+            let pipeline = if k == 0 { &halver.copy } else { &halver.halve };
+            draw_fullscreen(encoder, "backdrop level", level, pipeline, source, None);
         }
     }
 }

@@ -221,7 +221,7 @@ pub(crate) fn create_compose_pipeline(
     layout: &wgpu::PipelineLayout,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
-    create_fullscreen_pipeline(device, "compose", module, layout, format)
+    create_fullscreen_pipeline(device, "compose", module, layout, "fs_main", format)
 }
 
 /// Records a pass that clears `target` to black and draws one triangle over it with `pipeline`
@@ -254,12 +254,14 @@ pub(crate) fn draw_fullscreen(
 }
 
 /// A pipeline that draws one triangle over its whole target (`module`'s `vs_main`, three
-/// vertices, no buffers) with `module`'s `fs_main` into `format`, without depth or blending.
+/// vertices, no buffers) with `module`'s `fragment_entry` into `format`, without depth or
+/// blending.
 pub(crate) fn create_fullscreen_pipeline(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,
     layout: &wgpu::PipelineLayout,
+    fragment_entry: &str,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -276,7 +278,7 @@ pub(crate) fn create_fullscreen_pipeline(
         multisample: Default::default(),
         fragment: Some(wgpu::FragmentState {
             module,
-            entry_point: Some("fs_main"),
+            entry_point: Some(fragment_entry),
             compilation_options: Default::default(),
             targets: &[Some(format.into())],
         }),

@@ -24,8 +24,8 @@ fn gpu() -> Option<Gpu> {
 }
 
 /// The output size used by the tests: the default phone's aspect, small for lavapipe.
-const W: u32 = 180;
-const H: u32 = 400;
+pub(crate) const W: u32 = 180;
+pub(crate) const H: u32 = 400;
 
 /// The view of a phone held 35° from horizontal, uncalibrated (the viewer looks obliquely, the
 /// classic phantogram view).

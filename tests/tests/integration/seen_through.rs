@@ -328,3 +328,92 @@ fn a_dispersing_gem_splits_white_into_colours() {
         "a dispersing gem fringes the white block with colour: {after}"
     );
 }
+
+/// What a white 3 mm cube standing on the floor at `x` (m) adds to the luminance of a
+/// [`render_in_turn_over_floor`] frame, against `empty`, within 40 px of where it is drawn:
+/// the centre (x, px) of what it adds, the most it adds to a pixel, and the spread (RMS, px)
+/// along x.
+fn blurred_spot(frame: &[u8], empty: &[u8], at_px: (f32, f32)) -> (f64, f32, f64) {
+    let luminance =
+        |f: &[u8], i: usize| 0.2126 * f[i * 4] as f32 + 0.7152 * f[i * 4 + 1] as f32 + 0.0722 * f[i * 4 + 2] as f32;
+    let (w, h) = (crate::render::W as usize, crate::render::H as usize);
+    let added: Vec<(f64, f64)> = (0..h)
+        .flat_map(|y| (0..w).map(move |x| (x, y)))
+        .filter(|(x, y)| (*x as f32 - at_px.0).abs() < 40.0 && (*y as f32 - at_px.1).abs() < 40.0)
+        .map(|(x, y)| {
+            let i = y * w + x;
+            (x as f64, (luminance(frame, i) - luminance(empty, i)).max(0.0) as f64)
+        })
+        .collect();
+    let total: f64 = added.iter().map(|(_, d)| d).sum();
+    let centre = added.iter().map(|(x, d)| x * d).sum::<f64>() / total;
+    let spread = (added.iter().map(|(x, d)| (x - centre).powi(2) * d).sum::<f64>() / total).sqrt();
+    let peak = added.iter().map(|(_, d)| *d as f32).fold(0.0, f32::max);
+    (centre, peak, spread)
+}
+
+#[test]
+fn frosted_glass_blurs_a_thing_alike_wherever_it_stands() {
+    // A small white cube moved along x in 1 mm steps (2.5 px) under a pane of roughness 0.5: the
+    // blur's texels are about 20 px there. A blur made of a chain of 2 × 2 means read bilinearly
+    // snaps what it shows to those texels (measured: the spot's centre up to 4.4 px off where the
+    // cube is, its peak varying 1.9 : 1, its width 1.5 : 1); the [1 3 3 1] halvings read with a
+    // cubic B-spline follow it (0.6 px, 1.13 : 1, 1.10 : 1).
+    let screen = phantogram::screen::Screen::default();
+    let mono = phantogram::projection::OffAxisProjection::new(&screen, Vec3::new(0.0, 0.0, 0.3), Default::default())
+        .expect("a projection");
+    let to_frame = crate::render::W as f32 / screen.width_px() as f32;
+    let cube_z = -0.03 + 0.0015;
+    let scene = |x: f32, y: f32| {
+        let mut mesh = Mesh::default();
+        mesh.push_cube(Vec3::new(x, y, cube_z), 0.0015, [1.0; 4]);
+        let mut model = Model::from_painted_mesh("a cube under frosted glass", mesh);
+        let mut pane = Mesh::default();
+        pane.push_cube(Vec3::ZERO, 0.5, [1.0; 4]);
+        pane.transform(
+            Mat4::from_translation(Vec3::new(0.0, 0.0, -0.012)) * Mat4::from_scale(Vec3::new(0.05, 0.05, 0.002)),
+        );
+        add_part(&mut model, pane, rough_glass(0.5, 1.5));
+        model
+    };
+    let xs: Vec<f32> = (0..9).map(|k| k as f32 * 0.001).collect();
+    // The cube out of sight (the floor stays where it is): what the pane shows without it.
+    let mut models = vec![scene(0.0, 0.2)];
+    models.extend(xs.iter().map(|x| scene(*x, 0.0)));
+    let Some(frames) = render_in_turn_over_floor(models, OBLIQUE_LIGHT) else {
+        return;
+    };
+    let drawn_at = |x: f32| {
+        let p = mono.project(Vec3::new(x, 0.0, cube_z)).expect("in view").pixel * to_frame;
+        (p.x, p.y)
+    };
+    let spots: Vec<(f64, f32, f64)> = xs
+        .iter()
+        .zip(&frames[1..])
+        .map(|(x, frame)| blurred_spot(frame, &frames[0], drawn_at(*x)))
+        .collect();
+    println!("the cube's blurred spot under frosted glass at each step (centre px, peak, spread px): {spots:?}");
+    let (first_centre, first_x) = (spots[0].0, drawn_at(0.0).0 as f64);
+    for ((x, spot), step) in xs.iter().zip(&spots).zip(0..) {
+        let moved = spot.0 - first_centre;
+        let expected = drawn_at(*x).0 as f64 - first_x;
+        assert!(
+            (moved - expected).abs() <= 1.5,
+            "step {step}: the spot moved {moved:.2} px where the cube moved {expected:.2} px"
+        );
+    }
+    let ratio = |f: &dyn Fn(&(f64, f32, f64)) -> f64| {
+        let values: Vec<f64> = spots.iter().map(f).collect();
+        values.iter().cloned().fold(f64::MIN, f64::max) / values.iter().cloned().fold(f64::MAX, f64::min)
+    };
+    let (peaks, spreads) = (ratio(&|s| s.1 as f64), ratio(&|s| s.2));
+    assert!(
+        spots.iter().all(|s| s.1 > 20.0),
+        "the cube shows through the pane: {spots:?}"
+    );
+    assert!(peaks <= 1.25, "the spot's peak varies {peaks:.2} : 1 as the cube moves");
+    assert!(
+        spreads <= 1.2,
+        "the spot's width varies {spreads:.2} : 1 as the cube moves"
+    );
+}
