@@ -65,9 +65,9 @@ struct Material {
     // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended; w: 1 if
     // unlit (KHR_materials_unlit).
     flags: vec4<f32>,
-    // KHR_texture_transform rows for the seven slots, in the order above plus emissive,
-    // transmission and thickness.
-    transforms: array<vec4<f32>, 14>,
+    // KHR_texture_transform rows for the fifteen slots: the seven in the order above plus
+    // emissive, transmission and thickness, then the eight layer slots (`layer_sample`).
+    transforms: array<vec4<f32>, 30>,
     // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is; y, z: UV
     // sets of the transmission and thickness textures.
     scene: vec4<f32>,
@@ -87,6 +87,12 @@ struct Material {
     // KHR_materials_diffuse_transmission: rgb the colour light takes through a thin sheet, w the
     // share of the diffuse light that goes through.
     diffuse_transmission: vec4<f32>,
+    // The layer textures' slots (assets crate, `model::LayerSlot`: clear coat, its roughness,
+    // specular, specular colour, sheen colour, sheen roughness, diffuse transmission, its
+    // colour), four a vector: the layer of `layer_textures` each reads (negative: none), and its
+    // UV set.
+    layer_index: array<vec4<f32>, 2>,
+    layer_uv_set: array<vec4<f32>, 2>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -100,6 +106,8 @@ override HAS_OCCLUSION_TEXTURE: bool = true;
 override HAS_EMISSIVE_TEXTURE: bool = true;
 override HAS_TRANSMISSION_TEXTURE: bool = true;
 override HAS_THICKNESS_TEXTURE: bool = true;
+// Whether the material has any layer texture (`layer_textures`).
+override HAS_LAYER_TEXTURES: bool = true;
 override ALPHA_MASK: bool = true;
 // A pipeline for the draws of a cross-fade between levels (`vs_fade`; render crate, `fades`).
 override FADE: bool = false;
@@ -157,6 +165,10 @@ override TRANSMIT_LAYER: u32 = 0u;
 // KHR_materials_volume: green scales the volume's thickness.
 @group(1) @binding(13) var thickness_texture: texture_2d<f32>;
 @group(1) @binding(14) var thickness_sampler: sampler;
+// The layer extensions' textures (render crate, `layer_textures`), one layer each, all of one size
+// and read with one sampler; colour ones hold sRGB codes.
+@group(1) @binding(15) var layer_textures: texture_2d_array<f32>;
+@group(1) @binding(16) var layer_sampler: sampler;
 
 struct VsIn {
     @location(0) position: vec3<f32>,
@@ -245,6 +257,7 @@ fn fs_shadow_filter(in: ShadowMaskedOut) -> @location(0) vec4<f32> {
     let mr = textureSample(mr_texture, mr_sampler, slot_uv(1u, material.uv_sets.y, in.uv));
     let transmitted = textureSample(transmission_texture, transmission_sampler, slot_uv(5u, material.scene.y, in.uv));
     let thickness = textureSample(thickness_texture, thickness_sampler, slot_uv(6u, material.scene.z, in.uv));
+    let lt = layer_samples(in.uv);
     if (material.params.z >= 0.0 && base.a < material.params.z) {
         discard;
     }
@@ -253,8 +266,8 @@ fn fs_shadow_filter(in: ShadowMaskedOut) -> @location(0) vec4<f32> {
     // varnish 4 % of its share, and the path across the volume is its thickness.
     let through = transmittance(
         material.layers.x * transmitted.r * (1.0 - metallic),
-        material.layers.y * material.dielectric.rgb,
-        0.04 * material.layers.z,
+        material.layers.y * lt.specular * min(material.dielectric.rgb * lt.specular_color, vec3<f32>(1.0)),
+        0.04 * material.layers.z * lt.clear_coat,
         base.rgb,
         material.volume.rgb * thickness.g,
     );
@@ -297,6 +310,51 @@ fn slot_uv(slot: u32, uv_set: f32, uv: vec4<f32>) -> vec2<f32> {
     }
     let p = vec3<f32>(coords, 1.0);
     return vec2<f32>(dot(material.transforms[slot * 2u].xyz, p), dot(material.transforms[slot * 2u + 1u].xyz, p));
+}
+
+// Layer slot `k`'s texture at the fragment (white where the material has none; colour slots
+// still sRGB-coded). The branch is on uniform data, so derivatives stay defined.
+fn layer_sample(k: u32, uv: vec4<f32>) -> vec4<f32> {
+    let layer = material.layer_index[k / 4u][k % 4u];
+    if (layer < 0.0) {
+        return vec4<f32>(1.0);
+    }
+    let coords = slot_uv(7u + k, material.layer_uv_set[k / 4u][k % 4u], uv);
+    return textureSample(layer_textures, layer_sampler, coords, i32(layer));
+}
+
+// sRGB codes (0–1) to linear.
+fn srgb_to_linear(c: vec3<f32>) -> vec3<f32> {
+    return select(pow((c + 0.055) / 1.055, vec3<f32>(2.4)), c / 12.92, c <= vec3<f32>(0.04045));
+}
+
+// What the layer textures make of the material's layer factors at a fragment.
+struct LayerSamples {
+    clear_coat: f32,
+    clear_coat_roughness: f32,
+    specular: f32,
+    specular_color: vec3<f32>,
+    sheen_color: vec3<f32>,
+    sheen_roughness: f32,
+    diffuse_transmission: f32,
+    diffuse_transmission_color: vec3<f32>,
+};
+
+// Each layer texture read from the channels its extension names (assets crate, `LayerSlot`);
+// all ones where the material has none (`HAS_LAYER_TEXTURES`).
+fn layer_samples(uv: vec4<f32>) -> LayerSamples {
+    var l = LayerSamples(1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), 1.0, 1.0, vec3<f32>(1.0));
+    if (HAS_LAYER_TEXTURES) {
+        l.clear_coat = layer_sample(0u, uv).r;
+        l.clear_coat_roughness = layer_sample(1u, uv).g;
+        l.specular = layer_sample(2u, uv).a;
+        l.specular_color = srgb_to_linear(layer_sample(3u, uv).rgb);
+        l.sheen_color = srgb_to_linear(layer_sample(4u, uv).rgb);
+        l.sheen_roughness = layer_sample(5u, uv).a;
+        l.diffuse_transmission = layer_sample(6u, uv).a;
+        l.diffuse_transmission_color = srgb_to_linear(layer_sample(7u, uv).rgb);
+    }
+    return l;
 }
 
 // Percentage-closer filtering of the shadow map at `uv` for receiver depth `depth` (1 = lit):
@@ -626,6 +684,7 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     if (HAS_THICKNESS_TEXTURE) {
         thickness_sample = textureSample(thickness_texture, thickness_sampler, slot_uv(6u, material.scene.z, in.uv));
     }
+    let lt = layer_samples(in.uv);
 
     var s: Surface;
     let base_rgba = in.color * material.base_color * base_sample;
@@ -657,21 +716,22 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     s.unlit = material.flags.w > 0.5;
     s.scenery = material.scene.x > 0.5;
     if (HAS_LAYERS) {
-        s.f0_dielectric = material.dielectric.rgb;
+        // The reflectance's colour is capped at 1 after its texture (KHR_materials_specular).
+        s.f0_dielectric = min(material.dielectric.rgb * lt.specular_color, vec3<f32>(1.0));
         s.fresnel_rises = material.dielectric.w > 0.5;
-        s.specular_weight = material.layers.y;
-        s.coat = material.layers.z;
-        s.coat_roughness = material.layers.w;
+        s.specular_weight = material.layers.y * lt.specular;
+        s.coat = material.layers.z * lt.clear_coat;
+        s.coat_roughness = material.layers.w * lt.clear_coat_roughness;
         s.transmission = material.layers.x * transmission_sample.r;
         s.optical_depth = material.volume.rgb * thickness_sample.g;
         s.inv_ior = material.volume.w;
         s.refracted_path = material.scene.w * thickness_sample.g;
         s.transmission_roughness = roughness;
-        s.sheen_color = material.sheen.rgb;
-        s.sheen_roughness = material.sheen.w;
+        s.sheen_color = material.sheen.rgb * lt.sheen_color;
+        s.sheen_roughness = material.sheen.w * lt.sheen_roughness;
         s.inv_ior_red_blue = select(vec2<f32>(s.inv_ior), material.dispersion.xy, material.dispersion.z > 0.5);
-        s.diffuse_transmission = material.diffuse_transmission.w;
-        s.diffuse_transmission_color = material.diffuse_transmission.rgb;
+        s.diffuse_transmission = material.diffuse_transmission.w * lt.diffuse_transmission;
+        s.diffuse_transmission_color = material.diffuse_transmission.rgb * lt.diffuse_transmission_color;
     } else {
         // Constants the compiler folds into the shading: the core material costs what it did
         // before the extensions.

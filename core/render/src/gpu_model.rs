@@ -145,6 +145,8 @@ pub(crate) struct MaterialVariant {
     /// Whether the material has any of glTF's extension layers; without, the shader uses the
     /// core material's constants (`HAS_LAYERS`), which its compiler folds away.
     pub(crate) layers: bool,
+    /// Whether the material has layer textures (`HAS_LAYER_TEXTURES`, `layer_textures`).
+    pub(crate) layer_textures: bool,
     /// Whether the model has glass, whose coloured shadow the surface may receive
     /// (`GLASS_SHADOWS`, `shadow_filter`); without, the shader leaves the filter out, at no cost.
     pub(crate) glass_shadows: bool,
@@ -286,6 +288,7 @@ mod tests {
             layer,
             backdrop,
             layers: true,
+            layer_textures: false,
             glass_shadows: true,
         }
     }

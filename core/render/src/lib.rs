@@ -45,7 +45,8 @@
 //!
 //! ## Models
 //! [`Model`]s upload as one vertex and index buffer per primitive, one bind group per material
-//! (uniform block, five textures and their samplers; missing textures bind 1×1 defaults), one
+//! (uniform block, seven textures and their samplers, and the layer extensions' textures as one
+//! array with its sampler, `layer_textures`; missing textures bind 1×1 defaults), one
 //! scene pipeline per kind of material (culling, blending, alpha mask, and which texture slots it
 //! has: the fragment shader is specialised by `override` constants and does not sample the
 //! defaults, the same picture for a fifth less time on lavapipe), and
@@ -92,6 +93,7 @@ mod gpu;
 mod gpu_model;
 mod gpu_timer;
 pub mod impostor;
+mod layer_textures;
 mod lighting_tables;
 mod lights;
 mod pipelines;
@@ -446,6 +448,18 @@ impl Renderer {
             });
             material_entries.push(filtering_sampler_entry(2 + 2 * slot));
         }
+        // The layer extensions' textures, one array (`layer_textures`).
+        material_entries.push(wgpu::BindGroupLayoutEntry {
+            binding: 15,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: true },
+                view_dimension: wgpu::TextureViewDimension::D2Array,
+                multisampled: false,
+            },
+            count: None,
+        });
+        material_entries.push(filtering_sampler_entry(16));
         let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("material"),
             entries: &material_entries,

@@ -92,6 +92,7 @@ impl ScenePipelines {
         constants.push(("FADE", flag(v.fade)));
         constants.push(("TRANSMIT_LAYER", v.layer.shader_constant()));
         constants.push(("HAS_LAYERS", flag(v.layers)));
+        constants.push(("HAS_LAYER_TEXTURES", flag(v.layer_textures)));
         constants.push(("GLASS_SHADOWS", flag(v.glass_shadows)));
         let fade_attributes = FADE_ATTRIBUTES;
         let plain = [Some(vertex_buffer(&vertex_attributes))];

@@ -69,7 +69,7 @@ pub(crate) struct MaterialUniform {
     pub(crate) params: [f32; 4],
     pub(crate) uv_sets: [f32; 4],
     pub(crate) flags: [f32; 4],
-    pub(crate) transforms: [[f32; 4]; 14],
+    pub(crate) transforms: [[f32; 4]; 30],
     pub(crate) scene: [f32; 4],
     pub(crate) layers: [f32; 4],
     pub(crate) dielectric: [f32; 4],
@@ -77,10 +77,15 @@ pub(crate) struct MaterialUniform {
     pub(crate) sheen: [f32; 4],
     pub(crate) dispersion: [f32; 4],
     pub(crate) diffuse_transmission: [f32; 4],
+    pub(crate) layer_index: [[f32; 4]; 2],
+    pub(crate) layer_uv_set: [[f32; 4]; 2],
 }
 
 impl MaterialUniform {
-    pub(crate) fn new(m: &Material) -> Self {
+    /// `m`'s block; `layer_index`: the layer of the material's layer textures each
+    /// [`phantogram_assets::model::LayerSlot`] reads ([`crate::layer_textures`]), none where it
+    /// has no texture.
+    pub(crate) fn new(m: &Material, layer_index: [Option<u32>; 8]) -> Self {
         let slots = [
             m.base_color_texture,
             m.metallic_roughness_texture,
@@ -90,15 +95,17 @@ impl MaterialUniform {
             m.transmission_texture,
             m.thickness_texture,
         ];
-        let mut transforms = [[0.0; 4]; 14];
-        for (i, slot) in slots.iter().enumerate() {
+        let layer_slots = m.layer_textures.slots();
+        let mut transforms = [[0.0; 4]; 30];
+        for (i, slot) in slots.iter().chain(&layer_slots).enumerate() {
             let rows = slot.map(|t| t.transform).unwrap_or_default().rows();
             transforms[2 * i] = [rows[0][0], rows[0][1], rows[0][2], 0.0];
             transforms[2 * i + 1] = [rows[1][0], rows[1][1], rows[1][2], 0.0];
         }
         let set = |t: Option<TextureRef>| t.map_or(0.0, |t| t.tex_coord as f32);
         let l = &m.layers;
-        let f0 = l.dielectric_f0();
+        // Capped by the shader, after the specular colour texture.
+        let f0 = l.dielectric_f0_uncapped();
         // Optical depth across the volume's thickness, at normal incidence.
         let depth = l.absorption_per_unit().map(|a| (a * l.thickness).min(1e4));
         Self {
@@ -157,6 +164,20 @@ impl MaterialUniform {
             diffuse_transmission: {
                 let c = l.diffuse_transmission_color;
                 [c[0], c[1], c[2], l.diffuse_transmission]
+            },
+            layer_index: {
+                let index = layer_index.map(|i| i.map_or(-1.0, |i| i as f32));
+                [
+                    [index[0], index[1], index[2], index[3]],
+                    [index[4], index[5], index[6], index[7]],
+                ]
+            },
+            layer_uv_set: {
+                let sets = layer_slots.map(set);
+                [
+                    [sets[0], sets[1], sets[2], sets[3]],
+                    [sets[4], sets[5], sets[6], sets[7]],
+                ]
             },
         }
     }

@@ -2,6 +2,7 @@
 //! light) and samplers.
 
 use super::*;
+use phantogram_assets::model::{Material, TextureRef};
 
 pub(super) use phantogram_geometry::srgb::{code_to_linear as srgb_to_linear, linear_to_code as linear_to_srgb};
 
@@ -131,13 +132,29 @@ pub(super) fn create_sampler(device: &wgpu::Device, s: &Sampler) -> wgpu::Sample
     })
 }
 
+/// A material's seven texture slots of their own bindings (`scene.wgsl`'s order: base colour,
+/// metallic-roughness, normal, occlusion, emissive, transmission, thickness), each with whether
+/// it holds colour.
+fn direct_slots(m: &Material) -> [Option<(TextureRef, bool)>; 7] {
+    [
+        m.base_color_texture.map(|t| (t, true)),
+        m.metallic_roughness_texture.map(|t| (t, false)),
+        m.normal_texture.map(|(t, _)| (t, false)),
+        m.occlusion_texture.map(|(t, _)| (t, false)),
+        m.emissive_texture.map(|t| (t, true)),
+        m.transmission_texture.map(|t| (t, false)),
+        m.thickness_texture.map(|t| (t, false)),
+    ]
+}
+
 pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> GpuModel {
     let device = &gpu.device;
     // Each image once per colour space it is used in; the mip chains are built on every core
     // (a good part of a textured scan's time to first frame), then uploaded in turn.
+    // (The layer extensions' textures go into an array per material: `layer_textures`.)
     let mut used: Vec<(usize, bool)> = Vec::new();
     for m in &model.materials {
-        for (t, srgb) in m.textures() {
+        for (t, srgb) in direct_slots(m).into_iter().flatten() {
             if t.image < model.images.len() && !used.contains(&(t.image, srgb)) {
                 used.push((t.image, srgb));
             }
@@ -159,37 +176,34 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let white = upload_texture(gpu, "white", 1, 1, &[255, 255, 255, 255], false);
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());
+    let no_layer_textures = crate::layer_textures::placeholder(gpu);
     let glass_shadows = model.materials.iter().any(|m| m.transmits());
     let materials = model
         .materials
         .iter()
         .map(|m| {
             let transmits = m.transmits();
+            let layer_textures = crate::layer_textures::upload(gpu, model, m);
+            let layer_of_slot = layer_textures.as_ref().map_or([None; 8], |l| l.layer_of_slot);
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),
-                contents: bytemuck::bytes_of(&MaterialUniform::new(m)),
+                contents: bytemuck::bytes_of(&MaterialUniform::new(m, layer_of_slot)),
                 usage: wgpu::BufferUsages::UNIFORM,
             });
-            let slots = [
-                (m.base_color_texture, true, &white),
-                (m.metallic_roughness_texture, false, &white),
-                (m.normal_texture.map(|(t, _)| t), false, &flat_normal),
-                (m.occlusion_texture.map(|(t, _)| t), false, &white),
-                (m.emissive_texture, true, &white),
-                (m.transmission_texture, false, &white),
-                (m.thickness_texture, false, &white),
-            ];
+            let fallbacks = [&white, &white, &flat_normal, &white, &white, &white, &white];
+            let slots: Vec<(Option<(TextureRef, bool)>, &wgpu::TextureView)> =
+                direct_slots(m).into_iter().zip(fallbacks).collect();
             let samplers: Vec<wgpu::Sampler> = slots
                 .iter()
-                .map(|(t, _, _)| t.map_or_else(|| default_sampler.clone(), |t| create_sampler(device, &t.sampler)))
+                .map(|(t, _)| t.map_or_else(|| default_sampler.clone(), |(t, _)| create_sampler(device, &t.sampler)))
                 .collect();
             let mut entries = vec![wgpu::BindGroupEntry {
                 binding: 0,
                 resource: uniform.as_entire_binding(),
             }];
             let mut textures = [false; 7];
-            for (i, (t, srgb, fallback)) in slots.iter().enumerate() {
-                let found = t.and_then(|t| views.get(&(t.image, *srgb)));
+            for (i, (t, fallback)) in slots.iter().enumerate() {
+                let found = t.and_then(|(t, srgb)| views.get(&(t.image, srgb)));
                 textures[i] = found.is_some();
                 let view = found.unwrap_or(fallback);
                 entries.push(wgpu::BindGroupEntry {
@@ -201,6 +215,18 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     resource: wgpu::BindingResource::Sampler(&samplers[i]),
                 });
             }
+            entries.push(wgpu::BindGroupEntry {
+                binding: 15,
+                resource: wgpu::BindingResource::TextureView(
+                    layer_textures.as_ref().map_or(&no_layer_textures, |l| &l.view),
+                ),
+            });
+            entries.push(wgpu::BindGroupEntry {
+                binding: 16,
+                resource: wgpu::BindingResource::Sampler(
+                    layer_textures.as_ref().map_or(&default_sampler, |l| &l.sampler),
+                ),
+            });
             GpuMaterial {
                 bind: device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some(&m.name),
@@ -220,7 +246,10 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
                     fade: false,
                     layer: if transmits { DrawLayer::Light } else { DrawLayer::Whole },
                     backdrop: m.blurs_or_bends(),
-                    layers: m.layers != Layers::default(),
+                    // A layer texture scales a factor even where the factors are the core
+                    // material's (a specular texture over the default strength).
+                    layers: m.layers != Layers::default() || layer_textures.is_some(),
+                    layer_textures: layer_textures.is_some(),
                     glass_shadows,
                 },
                 blurs: m.blurs(),

@@ -22,6 +22,7 @@ mod glasses;
 mod golden;
 mod impostor;
 mod lamp;
+mod layer_textures;
 mod materials;
 mod models;
 mod prefilter_gpu;

@@ -237,9 +237,9 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
     );
 }
 
-/// Glass, gems, varnish and cloth: each material extension's factors reach the material, the
-/// transmission and thickness textures too, another texture they name is reported (not read),
-/// and a file requiring them loads.
+/// Glass, gems, varnish and cloth: each material extension's factors reach the material, and
+/// its textures too (each slot its own, with its coordinates), the varnish's normal map is
+/// reported (not read), and a file requiring them loads.
 #[test]
 fn material_extensions_reach_the_material() {
     let dir = scratch("gltf-layers");
@@ -250,16 +250,16 @@ fn material_extensions_reach_the_material() {
         &format!(
             r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion","KHR_materials_diffuse_transmission"],
         "extensionsRequired":["KHR_materials_transmission","KHR_materials_sheen"],
-        "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
+        "images":[{{"uri":"{image}"}},{{"uri":"{image}"}}],"textures":[{{"source":0}},{{"source":1}}],
         "materials":[{{"name":"amber","extensions":{{
           "KHR_materials_transmission":{{"transmissionFactor":0.9,"transmissionTexture":{{"index":0,"texCoord":1}}}},
           "KHR_materials_volume":{{"thicknessFactor":0.02,"thicknessTexture":{{"index":0}},"attenuationDistance":0.05,"attenuationColor":[0.9,0.5,0.1]}},
           "KHR_materials_ior":{{"ior":1.54}},
-          "KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8]}},
-          "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}}}},
-          "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6}},
+          "KHR_materials_specular":{{"specularFactor":0.8,"specularColorFactor":[1,0.9,0.8],"specularTexture":{{"index":1}},"specularColorTexture":{{"index":0,"texCoord":1}}}},
+          "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}},"clearcoatRoughnessTexture":{{"index":1}},"clearcoatNormalTexture":{{"index":0}}}},
+          "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6,"sheenColorTexture":{{"index":1,"texCoord":1}},"sheenRoughnessTexture":{{"index":0}}}},
           "KHR_materials_dispersion":{{"dispersion":0.4}},
-          "KHR_materials_diffuse_transmission":{{"diffuseTransmissionFactor":0.25,"diffuseTransmissionColorFactor":[1,0.5,0.5]}}}}}}]"#
+          "KHR_materials_diffuse_transmission":{{"diffuseTransmissionFactor":0.25,"diffuseTransmissionColorFactor":[1,0.5,0.5],"diffuseTransmissionTexture":{{"index":1}},"diffuseTransmissionColorTexture":{{"index":9}}}}}}}}]"#
         ),
     );
     let model = load_gltf(&path).unwrap();
@@ -289,15 +289,42 @@ fn material_extensions_reach_the_material() {
         (l.diffuse_transmission, l.diffuse_transmission_color),
         (0.25, [1.0, 0.5, 0.5])
     );
-    // The transmission and thickness textures are read (which parts are glass, how thick); the
-    // varnish's texture is named.
+    // The transmission and thickness textures are read (which parts are glass, how thick), and
+    // the layers' textures, each into its slot; the varnish's normal map is named, and so is a
+    // texture that does not exist (left out).
     let texture = amber.transmission_texture.expect("the transmission texture");
     assert_eq!((texture.image, texture.tex_coord), (0, 1));
     let thickness = amber.thickness_texture.expect("the thickness texture");
     assert_eq!((thickness.image, thickness.tex_coord), (0, 0));
+    let slot = |t: Option<phantogram::model::TextureRef>| t.map(|t| (t.image, t.tex_coord));
+    let t = &amber.layer_textures;
+    assert_eq!(
+        [
+            slot(t.clear_coat),
+            slot(t.clear_coat_roughness),
+            slot(t.specular),
+            slot(t.specular_color),
+            slot(t.sheen_color),
+            slot(t.sheen_roughness),
+            slot(t.diffuse_transmission),
+            slot(t.diffuse_transmission_color),
+        ],
+        [
+            Some((0, 0)),
+            Some((1, 0)),
+            Some((1, 0)),
+            Some((0, 1)),
+            Some((1, 1)),
+            Some((0, 0)),
+            Some((1, 0)),
+            None
+        ]
+    );
     let named: Vec<&String> = model.warnings.iter().filter(|w| w.contains("amber")).collect();
     assert!(
-        named.len() == 1 && named[0].contains("clearcoatTexture"),
+        named.len() == 2
+            && named.iter().any(|w| w.contains("clearcoatNormalTexture"))
+            && named.iter().any(|w| w.contains("diffuseTransmissionColor")),
         "{:?}",
         model.warnings
     );
@@ -355,7 +382,7 @@ fn texture_transforms_reach_normal_and_occlusion_textures() {
     let materials = |occlusion_transform: &str| {
         format!(
             r#","extensionsUsed":["KHR_texture_transform"],
-            "images":[{{"uri":"{image}"}}],"textures":[{{"source":0}}],
+            "images":[{{"uri":"{image}"}},{{"uri":"{image}"}}],"textures":[{{"source":0}},{{"source":1}}],
             "materials":[{{"name":"relief",
               "normalTexture":{{"index":0,"scale":0.5,"extensions":{{"KHR_texture_transform":
                 {{"offset":[0.25,0.5],"rotation":0.3,"scale":[2,3],"texCoord":1}}}}}},

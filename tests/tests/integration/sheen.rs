@@ -4,7 +4,7 @@
 
 use crate::render::{OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_over_floor};
 use phantogram::glam::{Mat4, Vec3};
-use phantogram::model::{Layers, Material, Mesh, Model};
+use phantogram::model::{Image, Layers, Material, Mesh, Model};
 
 const CENTRE: Vec3 = Vec3::new(0.0, 0.0, -0.015);
 const HALF: f32 = 0.006;
@@ -21,16 +21,8 @@ fn faces() -> (Vec3, Vec3) {
 
 /// The block's two faces, a dark cloth with `sheen` (colour, roughness), as the eye sees them.
 fn seen(sheen: Option<([f32; 3], f32)>) -> Option<([f32; 3], [f32; 3])> {
-    let mut floor = Mesh::default();
-    push_floor_marker(&mut floor);
-    let mut model = Model::from_painted_mesh("velvet", floor);
-    let mut block = Mesh::default();
-    block.push_cube(Vec3::ZERO, HALF, [1.0; 4]);
-    block.transform(Mat4::from_translation(CENTRE) * Mat4::from_rotation_x(TILT_DEG.to_radians()));
     let (sheen_color, sheen_roughness) = sheen.unwrap_or(([0.0; 3], 0.0));
-    add_part(
-        &mut model,
-        block,
+    seen_as(
         Material {
             name: "cloth".into(),
             base_color: [0.08, 0.08, 0.1, 1.0],
@@ -43,7 +35,21 @@ fn seen(sheen: Option<([f32; 3], f32)>) -> Option<([f32; 3], [f32; 3])> {
             },
             ..Material::default()
         },
-    );
+        Vec::new(),
+    )
+}
+
+/// The block's two faces in `material` (with `images` for its textures), as the eye sees them:
+/// face on, then at a grazing angle.
+pub(crate) fn seen_as(material: Material, images: Vec<Image>) -> Option<([f32; 3], [f32; 3])> {
+    let mut floor = Mesh::default();
+    push_floor_marker(&mut floor);
+    let mut model = Model::from_painted_mesh("tilted block", floor);
+    model.images = images;
+    let mut block = Mesh::default();
+    block.push_cube(Vec3::ZERO, HALF, [1.0; 4]);
+    block.transform(Mat4::from_translation(CENTRE) * Mat4::from_rotation_x(TILT_DEG.to_radians()));
+    add_part(&mut model, block, material);
     let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
     let (face_on, grazing) = faces();
     let rgb = |p: Vec3| {

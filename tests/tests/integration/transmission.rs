@@ -50,7 +50,7 @@ fn seen_with(colour: [f32; 4], over: Option<Material>, images: Vec<Image>) -> Op
 
 /// A one-texel image of `rgba` (linear data, as the layers' textures are), and a reference to it
 /// as the model's first image.
-fn one_texel(rgba: [u8; 4]) -> (Image, TextureRef) {
+pub(crate) fn one_texel(rgba: [u8; 4]) -> (Image, TextureRef) {
     let image = Image {
         name: format!("texel {rgba:?}"),
         width: 1,

@@ -15,9 +15,10 @@
 //! [`super::Material::transmission_texture`] and [`super::Material::thickness_texture`]): the
 //! first says which parts of a surface are glass (without it a lantern's frame would be as clear
 //! as its panes), the second where a volume is thinner than its factor (without it a glass
-//! figure's thin fingers would be as dark as its body). The others are named in a warning and
-//! left out: their factors alone give a varnish its gloss and a specular layer its strength,
-//! which is what those textures modulate.
+//! figure's thin fingers would be as dark as its body). Those of the varnish, specular, sheen and
+//! diffuse transmission are read into [`super::Material::layer_textures`] (`layer_textures`).
+//! `clearcoatNormalTexture` is named in a warning and left out: the varnish keeps the surface's
+//! geometric normal.
 //!
 //! Pure data; no panics.
 
@@ -106,12 +107,18 @@ impl Layers {
     /// the specular colour, at most 1 (`KHR_materials_specular`'s definition). Not scaled by
     /// [`Self::specular`], which scales the whole lobe.
     pub fn dielectric_f0(&self) -> [f32; 3] {
+        self.dielectric_f0_uncapped().map(|c| c.min(1.0))
+    }
+
+    /// [`Self::dielectric_f0`] before its cap at 1: the extension caps it after the specular colour
+    /// texture has scaled it, which the renderer does per fragment.
+    pub fn dielectric_f0_uncapped(&self) -> [f32; 3] {
         let r = if self.ior.is_finite() {
             (self.ior - 1.0) / (self.ior + 1.0)
         } else {
             1.0
         };
-        self.specular_color.map(|c| (r * r * c).min(1.0))
+        self.specular_color.map(|c| r * r * c)
     }
 
     /// Whether the dielectric's reflectance rises towards 1 at grazing angles (Fresnel), as every
@@ -196,7 +203,6 @@ impl Layers {
             if let Some(c) = reader.color(e, name, "specularColorFactor") {
                 layers.specular_color = c.map(|c| reader.clamped(name, "specularColorFactor", c, 0.0, f32::MAX));
             }
-            reader.textures(e, name, &["specularTexture", "specularColorTexture"]);
         }
         if let Some(e) = extension("KHR_materials_clearcoat") {
             let name = "KHR_materials_clearcoat";
@@ -204,15 +210,7 @@ impl Layers {
             layers.clear_coat = reader.clamped(name, "clearcoatFactor", c, 0.0, 1.0);
             let r = reader.number(e, name, "clearcoatRoughnessFactor", 0.0);
             layers.clear_coat_roughness = reader.clamped(name, "clearcoatRoughnessFactor", r, 0.0, 1.0);
-            reader.textures(
-                e,
-                name,
-                &[
-                    "clearcoatTexture",
-                    "clearcoatRoughnessTexture",
-                    "clearcoatNormalTexture",
-                ],
-            );
+            reader.textures(e, name, &["clearcoatNormalTexture"]);
         }
         if let Some(e) = extension("KHR_materials_transmission") {
             let name = "KHR_materials_transmission";
@@ -241,7 +239,6 @@ impl Layers {
             }
             let r = reader.number(e, name, "sheenRoughnessFactor", 0.0);
             layers.sheen_roughness = reader.clamped(name, "sheenRoughnessFactor", r, 0.0, 1.0);
-            reader.textures(e, name, &["sheenColorTexture", "sheenRoughnessTexture"]);
         }
         if let Some(e) = extension("KHR_materials_diffuse_transmission") {
             let name = "KHR_materials_diffuse_transmission";
@@ -251,11 +248,6 @@ impl Layers {
                 layers.diffuse_transmission_color =
                     c.map(|c| reader.clamped(name, "diffuseTransmissionColorFactor", c, 0.0, 1.0));
             }
-            reader.textures(
-                e,
-                name,
-                &["diffuseTransmissionTexture", "diffuseTransmissionColorTexture"],
-            );
         }
         if let Some(e) = extension("KHR_materials_dispersion") {
             let name = "KHR_materials_dispersion";
@@ -455,11 +447,12 @@ mod tests {
             }
         }));
         assert_eq!(bad.diffuse_transmission, 1.0);
-        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        // The factor clamped; the texture is the loader's to read.
+        assert_eq!(warnings.len(), 1, "{warnings:?}");
     }
 
     #[test]
-    fn a_sheen_is_read_clamped_and_its_textures_named() {
+    fn a_sheen_is_read_and_clamped() {
         let (velvet, warnings) = read(json!({
             "KHR_materials_sheen": { "sheenColorFactor": [0.6, 0.1, 0.2], "sheenRoughnessFactor": 0.3 }
         }));
@@ -479,8 +472,12 @@ mod tests {
         }));
         assert_eq!(bad.sheen_color, [1.0, 0.0, 0.5]);
         assert_eq!(bad.sheen_roughness, 1.0);
-        assert_eq!(warnings.len(), 4, "{warnings:?}");
-        assert!(warnings.iter().any(|w| w.contains("sheenColorTexture")), "{warnings:?}");
+        // Three values clamped; the texture is the loader's to read.
+        assert_eq!(warnings.len(), 3, "{warnings:?}");
+        assert!(
+            !warnings.iter().any(|w| w.contains("sheenColorTexture")),
+            "{warnings:?}"
+        );
     }
 
     #[test]
@@ -495,8 +492,8 @@ mod tests {
         assert_eq!(layers.dielectric_f0(), [0.5, 0.25, 1.0]);
         assert!(!layers.fresnel_rises());
         assert!(Layers::default().fresnel_rises());
-        // The transmission and thickness textures are the loader's to read; the varnish's
-        // normal map is named.
+        // The transmission and thickness textures are the loader's to read (as are the other
+        // layers' textures); the varnish's normal map is named.
         assert_eq!(warnings.len(), 1, "{warnings:?}");
         assert!(warnings[0].contains("clearcoatNormalTexture"), "{warnings:?}");
     }

@@ -9,6 +9,7 @@ use glam::{Mat4, Quat, Vec3};
 use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
+use super::LayerSlot;
 use super::encoded_image::Encoded;
 use super::instancing;
 use super::meshopt_views::{self, DecodedViews};
@@ -598,6 +599,7 @@ fn material_of(m: &gltf::Material, warnings: &mut Vec<String>) -> Material {
         thickness_texture: None,
         scenery: false,
         layers,
+        layer_textures: Default::default(),
     }
 }
 
@@ -1559,6 +1561,14 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                 images.len(),
                 &mut warnings,
             );
+        }
+        for slot in LayerSlot::ALL {
+            let (extension, field) = slot.field();
+            if let Some(value) = m.extension_value(extension) {
+                let name = field.trim_end_matches("Texture");
+                let texture = extension_texture(&material, value, field, name, doc, images.len(), &mut warnings);
+                material.layer_textures.set(slot, texture);
+            }
         }
         if let Some(value) = m.extension_value("KHR_materials_pbrSpecularGlossiness") {
             with_spec_gloss(&mut material, value, doc, &mut images, &ctx.spending, &mut warnings)

@@ -302,6 +302,9 @@ pub struct Material {
     /// Index of refraction, specular strength, varnish, transmission and absorption (glTF's
     /// material extensions); the core material has none.
     pub layers: Layers,
+    /// The textures that scale [`Self::layers`]' varnish, specular, sheen and diffuse
+    /// transmission over the surface.
+    pub layer_textures: LayerTextures,
 }
 
 impl Default for Material {
@@ -325,6 +328,7 @@ impl Default for Material {
             unlit: false,
             scenery: false,
             layers: Layers::default(),
+            layer_textures: LayerTextures::default(),
         }
     }
 }
@@ -394,6 +398,11 @@ impl Material {
             self.thickness_texture.map(|t| (t, false)),
         ]
         .into_iter()
+        .chain(
+            LayerSlot::ALL
+                .into_iter()
+                .map(|slot| self.layer_textures.get(slot).map(|t| (t, slot.is_colour()))),
+        )
         .flatten()
     }
 }
@@ -765,6 +774,7 @@ fn push_ball(mesh: &mut Mesh, centre: Vec3, radius: f32, segments: u32, rings: u
     }
 }
 
+pub use layer_textures::{LayerSlot, LayerTextures};
 pub use layers::Layers;
 pub use loader::{
     MAX_COORDINATE, ModelError, SUPPORTED_EXTENSIONS, load_gltf, load_gltf_with, load_gltf_within, load_model,
@@ -775,6 +785,7 @@ pub use mesh_file::MeshFormat;
 
 mod encoded_image;
 mod instancing;
+pub mod layer_textures;
 pub mod layers;
 mod loader;
 mod mesh_file;

@@ -1,0 +1,179 @@
+//! The textures of glTF's layer extensions that scale a layer's factors over a surface: where a
+//! varnish lies and how glossy it is (`KHR_materials_clearcoat`), how strong and what colour the
+//! dielectric's reflection is (`KHR_materials_specular`), the colour and roughness of cloth's
+//! sheen (`KHR_materials_sheen`), and how much light a thin sheet scatters through and in what
+//! colour (`KHR_materials_diffuse_transmission`). Each is read from the channels its extension
+//! names ([`LayerSlot::channels`]); colour ones are sRGB-encoded, the others linear.
+//!
+//! `clearcoatNormalTexture` is not among them: the varnish keeps the surface's geometric normal
+//! (a warning names the texture when a file has one). The transmission and thickness textures are
+//! [`super::Material::transmission_texture`] and [`super::Material::thickness_texture`].
+//!
+//! Pure data; no panics.
+
+use super::TextureRef;
+
+/// One texture of a layer extension, by what it scales.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum LayerSlot {
+    /// `clearcoatTexture`: R scales the varnish's share.
+    ClearCoat,
+    /// `clearcoatRoughnessTexture`: G scales its roughness.
+    ClearCoatRoughness,
+    /// `specularTexture`: A scales the dielectric's specular strength.
+    Specular,
+    /// `specularColorTexture`: RGB (sRGB) scales its reflectance's colour.
+    SpecularColor,
+    /// `sheenColorTexture`: RGB (sRGB) scales the sheen's colour.
+    SheenColor,
+    /// `sheenRoughnessTexture`: A scales the sheen's roughness.
+    SheenRoughness,
+    /// `diffuseTransmissionTexture`: A scales the share of diffuse light passed through.
+    DiffuseTransmission,
+    /// `diffuseTransmissionColorTexture`: RGB (sRGB) scales that light's colour.
+    DiffuseTransmissionColor,
+}
+
+impl LayerSlot {
+    /// Every slot, in the order [`LayerTextures::slots`] gives them (the renderer's order too).
+    pub const ALL: [LayerSlot; 8] = [
+        LayerSlot::ClearCoat,
+        LayerSlot::ClearCoatRoughness,
+        LayerSlot::Specular,
+        LayerSlot::SpecularColor,
+        LayerSlot::SheenColor,
+        LayerSlot::SheenRoughness,
+        LayerSlot::DiffuseTransmission,
+        LayerSlot::DiffuseTransmissionColor,
+    ];
+
+    /// The extension and the texture field it is read from.
+    pub fn field(self) -> (&'static str, &'static str) {
+        match self {
+            LayerSlot::ClearCoat => ("KHR_materials_clearcoat", "clearcoatTexture"),
+            LayerSlot::ClearCoatRoughness => ("KHR_materials_clearcoat", "clearcoatRoughnessTexture"),
+            LayerSlot::Specular => ("KHR_materials_specular", "specularTexture"),
+            LayerSlot::SpecularColor => ("KHR_materials_specular", "specularColorTexture"),
+            LayerSlot::SheenColor => ("KHR_materials_sheen", "sheenColorTexture"),
+            LayerSlot::SheenRoughness => ("KHR_materials_sheen", "sheenRoughnessTexture"),
+            LayerSlot::DiffuseTransmission => ("KHR_materials_diffuse_transmission", "diffuseTransmissionTexture"),
+            LayerSlot::DiffuseTransmissionColor => {
+                ("KHR_materials_diffuse_transmission", "diffuseTransmissionColorTexture")
+            }
+        }
+    }
+
+    /// The channels it is read from: "R", "G", "A" or "RGB".
+    pub fn channels(self) -> &'static str {
+        match self {
+            LayerSlot::ClearCoat => "R",
+            LayerSlot::ClearCoatRoughness => "G",
+            LayerSlot::Specular | LayerSlot::SheenRoughness | LayerSlot::DiffuseTransmission => "A",
+            LayerSlot::SpecularColor | LayerSlot::SheenColor | LayerSlot::DiffuseTransmissionColor => "RGB",
+        }
+    }
+
+    /// Whether it holds colour (sRGB-encoded, as glTF's colour textures are).
+    pub fn is_colour(self) -> bool {
+        self.channels() == "RGB"
+    }
+}
+
+/// A material's layer textures, each where its file gives one.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct LayerTextures {
+    pub clear_coat: Option<TextureRef>,
+    pub clear_coat_roughness: Option<TextureRef>,
+    pub specular: Option<TextureRef>,
+    pub specular_color: Option<TextureRef>,
+    pub sheen_color: Option<TextureRef>,
+    pub sheen_roughness: Option<TextureRef>,
+    pub diffuse_transmission: Option<TextureRef>,
+    pub diffuse_transmission_color: Option<TextureRef>,
+}
+
+impl LayerTextures {
+    /// The texture of `slot`.
+    pub fn get(&self, slot: LayerSlot) -> Option<TextureRef> {
+        *self.field(slot)
+    }
+
+    /// Sets the texture of `slot`.
+    pub fn set(&mut self, slot: LayerSlot, texture: Option<TextureRef>) {
+        *self.field_mut(slot) = texture;
+    }
+
+    /// Each slot's texture, in [`LayerSlot::ALL`]'s order.
+    pub fn slots(&self) -> [Option<TextureRef>; 8] {
+        LayerSlot::ALL.map(|s| self.get(s))
+    }
+
+    /// Whether any slot has a texture.
+    pub fn any(&self) -> bool {
+        self.slots().iter().any(Option::is_some)
+    }
+
+    fn field(&self, slot: LayerSlot) -> &Option<TextureRef> {
+        match slot {
+            LayerSlot::ClearCoat => &self.clear_coat,
+            LayerSlot::ClearCoatRoughness => &self.clear_coat_roughness,
+            LayerSlot::Specular => &self.specular,
+            LayerSlot::SpecularColor => &self.specular_color,
+            LayerSlot::SheenColor => &self.sheen_color,
+            LayerSlot::SheenRoughness => &self.sheen_roughness,
+            LayerSlot::DiffuseTransmission => &self.diffuse_transmission,
+            LayerSlot::DiffuseTransmissionColor => &self.diffuse_transmission_color,
+        }
+    }
+
+    fn field_mut(&mut self, slot: LayerSlot) -> &mut Option<TextureRef> {
+        match slot {
+            LayerSlot::ClearCoat => &mut self.clear_coat,
+            LayerSlot::ClearCoatRoughness => &mut self.clear_coat_roughness,
+            LayerSlot::Specular => &mut self.specular,
+            LayerSlot::SpecularColor => &mut self.specular_color,
+            LayerSlot::SheenColor => &mut self.sheen_color,
+            LayerSlot::SheenRoughness => &mut self.sheen_roughness,
+            LayerSlot::DiffuseTransmission => &mut self.diffuse_transmission,
+            LayerSlot::DiffuseTransmissionColor => &mut self.diffuse_transmission_color,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_slot_is_its_own_field() {
+        let mut textures = LayerTextures::default();
+        assert!(!textures.any());
+        for (k, slot) in LayerSlot::ALL.into_iter().enumerate() {
+            let t = TextureRef {
+                image: k,
+                tex_coord: 0,
+                transform: Default::default(),
+                sampler: Default::default(),
+            };
+            textures.set(slot, Some(t));
+        }
+        assert!(textures.any());
+        let images: Vec<usize> = textures.slots().iter().map(|t| t.expect("set").image).collect();
+        assert_eq!(images, (0..8).collect::<Vec<_>>());
+        let fields: std::collections::HashSet<_> = LayerSlot::ALL.iter().map(|s| s.field()).collect();
+        assert_eq!(fields.len(), 8);
+    }
+
+    #[test]
+    fn colour_slots_are_the_rgb_ones() {
+        let colour: Vec<LayerSlot> = LayerSlot::ALL.into_iter().filter(|s| s.is_colour()).collect();
+        assert_eq!(
+            colour,
+            [
+                LayerSlot::SpecularColor,
+                LayerSlot::SheenColor,
+                LayerSlot::DiffuseTransmissionColor
+            ]
+        );
+    }
+}

@@ -1,0 +1,231 @@
+//! The layer extensions' textures on the GPU (the assets crate's `model::LayerTextures`, the
+//! render crate's `layer_textures`, `scene.wgsl`'s `layer_samples`): each scales its factor from
+//! the channel its extension names, colour ones decoded from sRGB, so that a texel of value v
+//! draws what the factor times v draws without the texture; textures of different sizes share one
+//! array.
+//!
+//! Each case: the tilted block of the sheen tests (`sheen::seen_as`), dark and rough, seen face on
+//! and at a grazing angle, where the layers' light is most of what it shows.
+
+use crate::sheen::seen_as;
+use crate::transmission::{largest_difference, one_texel};
+use phantogram::model::{Image, LayerSlot, Layers, Material, TextureRef};
+
+/// The dark, rough block with `layers` and `textures` (slot, texture) over `images`.
+fn block(layers: Layers, textures: &[(LayerSlot, TextureRef)], images: Vec<Image>) -> Option<([f32; 3], [f32; 3])> {
+    let mut material = Material {
+        name: "layered".into(),
+        base_color: [0.05, 0.05, 0.06, 1.0],
+        metallic: 0.0,
+        roughness: 0.8,
+        layers,
+        ..Material::default()
+    };
+    for (slot, texture) in textures {
+        material.layer_textures.set(*slot, Some(*texture));
+    }
+    seen_as(material, images)
+}
+
+/// An sRGB code's linear value.
+fn linear(code: u8) -> f32 {
+    let c = f32::from(code) / 255.0;
+    if c <= 0.04045 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// A `size × size` image of one `rgba`, as the model's image `index`.
+fn flat_image(size: u32, rgba: [u8; 4], index: usize) -> (Image, TextureRef) {
+    let (mut image, mut reference) = one_texel(rgba);
+    image.width = size;
+    image.height = size;
+    image.rgba8 = rgba.repeat((size * size) as usize);
+    reference.image = index;
+    (image, reference)
+}
+
+struct Case {
+    what: &'static str,
+    /// The factors, untextured.
+    layers: Layers,
+    /// Each textured slot and its texel.
+    texels: Vec<(LayerSlot, [u8; 4])>,
+    /// The factors that the texels make of `layers`.
+    equivalent: Layers,
+}
+
+fn cases() -> Vec<Case> {
+    let d = Layers::default();
+    let varnish = Layers {
+        clear_coat: 1.0,
+        clear_coat_roughness: 0.0,
+        ..d
+    };
+    let half = linear(188);
+    vec![
+        Case {
+            what: "clear coat (R)",
+            layers: varnish,
+            texels: vec![(LayerSlot::ClearCoat, [0, 255, 255, 255])],
+            equivalent: Layers {
+                clear_coat: 0.0,
+                ..varnish
+            },
+        },
+        Case {
+            what: "clear coat roughness (G)",
+            layers: Layers {
+                clear_coat_roughness: 1.0,
+                ..varnish
+            },
+            texels: vec![(LayerSlot::ClearCoatRoughness, [255, 0, 255, 255])],
+            equivalent: varnish,
+        },
+        Case {
+            what: "specular (A)",
+            layers: d,
+            texels: vec![(LayerSlot::Specular, [255, 255, 255, 0])],
+            equivalent: Layers { specular: 0.0, ..d },
+        },
+        Case {
+            what: "specular colour (RGB, sRGB)",
+            layers: d,
+            texels: vec![(LayerSlot::SpecularColor, [188, 255, 0, 0])],
+            equivalent: Layers {
+                specular_color: [half, 1.0, 0.0],
+                ..d
+            },
+        },
+        Case {
+            what: "sheen colour (RGB, sRGB)",
+            layers: Layers {
+                sheen_color: [1.0, 1.0, 1.0],
+                sheen_roughness: 0.3,
+                ..d
+            },
+            texels: vec![(LayerSlot::SheenColor, [188, 255, 0, 0])],
+            equivalent: Layers {
+                sheen_color: [half, 1.0, 0.0],
+                sheen_roughness: 0.3,
+                ..d
+            },
+        },
+        Case {
+            what: "sheen roughness (A)",
+            layers: Layers {
+                sheen_color: [1.0, 1.0, 1.0],
+                sheen_roughness: 1.0,
+                ..d
+            },
+            texels: vec![(LayerSlot::SheenRoughness, [0, 0, 0, 77])],
+            equivalent: Layers {
+                sheen_color: [1.0, 1.0, 1.0],
+                sheen_roughness: 77.0 / 255.0,
+                ..d
+            },
+        },
+        Case {
+            what: "diffuse transmission (A)",
+            layers: Layers {
+                diffuse_transmission: 1.0,
+                ..d
+            },
+            texels: vec![(LayerSlot::DiffuseTransmission, [255, 255, 255, 0])],
+            equivalent: d,
+        },
+        Case {
+            what: "diffuse transmission colour (RGB, sRGB)",
+            layers: Layers {
+                diffuse_transmission: 1.0,
+                ..d
+            },
+            texels: vec![(LayerSlot::DiffuseTransmissionColor, [188, 255, 0, 0])],
+            equivalent: Layers {
+                diffuse_transmission: 1.0,
+                diffuse_transmission_color: [half, 1.0, 0.0],
+                ..d
+            },
+        },
+        Case {
+            what: "clear coat (R) of one size and specular (A) of another",
+            layers: varnish,
+            texels: vec![
+                (LayerSlot::ClearCoat, [0, 255, 255, 255]),
+                (LayerSlot::Specular, [255, 255, 255, 0]),
+            ],
+            equivalent: Layers {
+                clear_coat: 0.0,
+                specular: 0.0,
+                ..varnish
+            },
+        },
+    ]
+}
+
+#[test]
+fn each_layer_texture_scales_its_factor_from_its_channel() {
+    if block(Layers::default(), &[], Vec::new()).is_none() {
+        return;
+    }
+    for case in cases() {
+        // Each texel its own image, the second of another size (4 × 4 against 1 × 1).
+        let (images, textures): (Vec<Image>, Vec<(LayerSlot, TextureRef)>) = case
+            .texels
+            .iter()
+            .enumerate()
+            .map(|(k, (slot, rgba))| {
+                let (image, reference) = flat_image(if k == 0 { 1 } else { 4 }, *rgba, k);
+                (image, (*slot, reference))
+            })
+            .unzip();
+        let textured = block(case.layers, &textures, images).expect("a frame");
+        let untextured = block(case.layers, &[], Vec::new()).expect("a frame");
+        let equivalent = block(case.equivalent, &[], Vec::new()).expect("a frame");
+        println!(
+            "{}: textured {textured:?}, its factors alone {untextured:?}, the factors it makes {equivalent:?}",
+            case.what
+        );
+        // The comparison means something: the texture changes what the factors alone draw.
+        let change = largest_difference(untextured.0, equivalent.0).max(largest_difference(untextured.1, equivalent.1));
+        assert!(
+            change >= 3.0,
+            "{}: the texels should make a visible change ({change})",
+            case.what
+        );
+        for (face, (t, e)) in [
+            ("face on", (textured.0, equivalent.0)),
+            ("grazing", (textured.1, equivalent.1)),
+        ] {
+            assert!(
+                largest_difference(t, e) <= 2.0,
+                "{} {face}: textured {t:?} against the factors it makes {e:?}",
+                case.what
+            );
+        }
+    }
+}
+
+#[test]
+fn a_white_layer_texture_changes_nothing() {
+    let layers = Layers {
+        clear_coat: 1.0,
+        sheen_color: [0.6, 0.3, 0.2],
+        sheen_roughness: 0.5,
+        ..Layers::default()
+    };
+    let Some(plain) = block(layers, &[], Vec::new()) else {
+        return;
+    };
+    let (image, reference) = one_texel([255; 4]);
+    let textures: Vec<(LayerSlot, TextureRef)> = LayerSlot::ALL.iter().map(|s| (*s, reference)).collect();
+    let white = block(layers, &textures, vec![image]).expect("a frame");
+    for (t, e) in [(white.0, plain.0), (white.1, plain.1)] {
+        assert!(
+            largest_difference(t, e) <= 1.0,
+            "white textures {t:?} against none {e:?}"
+        );
+    }
+}
