@@ -65,9 +65,9 @@ struct Material {
     // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended; w: 1 if
     // unlit (KHR_materials_unlit).
     flags: vec4<f32>,
-    // KHR_texture_transform rows for the fifteen slots: the seven in the order above plus
-    // emissive, transmission and thickness, then the eight layer slots (`layer_sample`).
-    transforms: array<vec4<f32>, 30>,
+    // KHR_texture_transform rows for the sixteen slots: the seven in the order above plus
+    // emissive, transmission and thickness, then the nine layer slots (`layer_sample`).
+    transforms: array<vec4<f32>, 32>,
     // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is; y, z: UV
     // sets of the transmission and thickness textures.
     scene: vec4<f32>,
@@ -89,10 +89,12 @@ struct Material {
     diffuse_transmission: vec4<f32>,
     // The layer textures' slots (assets crate, `model::LayerSlot`: clear coat, its roughness,
     // specular, specular colour, sheen colour, sheen roughness, diffuse transmission, its
-    // colour), four a vector: the layer of `layer_textures` each reads (negative: none), and its
-    // UV set.
-    layer_index: array<vec4<f32>, 2>,
-    layer_uv_set: array<vec4<f32>, 2>,
+    // colour, the clear coat's normal map), four a vector: the layer of `layer_textures` each
+    // reads (negative: none), and its UV set.
+    layer_index: array<vec4<f32>, 3>,
+    layer_uv_set: array<vec4<f32>, 3>,
+    // x: the clear coat's normal map's scale.
+    coat_normal: vec4<f32>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -338,12 +340,14 @@ struct LayerSamples {
     sheen_roughness: f32,
     diffuse_transmission: f32,
     diffuse_transmission_color: vec3<f32>,
+    // The clear coat's tangent-space normal (its scale applied); (0, 0, 1) without its map.
+    coat_normal: vec3<f32>,
 };
 
 // Each layer texture read from the channels its extension names (assets crate, `LayerSlot`);
 // all ones where the material has none (`HAS_LAYER_TEXTURES`).
 fn layer_samples(uv: vec4<f32>) -> LayerSamples {
-    var l = LayerSamples(1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), 1.0, 1.0, vec3<f32>(1.0));
+    var l = LayerSamples(1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0));
     if (HAS_LAYER_TEXTURES) {
         l.clear_coat = layer_sample(0u, uv).r;
         l.clear_coat_roughness = layer_sample(1u, uv).g;
@@ -353,6 +357,10 @@ fn layer_samples(uv: vec4<f32>) -> LayerSamples {
         l.sheen_roughness = layer_sample(5u, uv).a;
         l.diffuse_transmission = layer_sample(6u, uv).a;
         l.diffuse_transmission_color = srgb_to_linear(layer_sample(7u, uv).rgb);
+        if (material.layer_index[2].x >= 0.0) {
+            let m = layer_sample(8u, uv).xyz * 2.0 - vec3<f32>(1.0);
+            l.coat_normal = vec3<f32>(m.xy * material.coat_normal.x, m.z);
+        }
     }
     return l;
 }
@@ -593,6 +601,9 @@ struct Surface {
     n: vec3<f32>,
     t: vec3<f32>,
     geometric_n: vec3<f32>,
+    // The clear coat's normal: the geometric one, or its own normal map's (not the base's: a
+    // varnish lies smooth over carved grain unless its own map says otherwise).
+    coat_n: vec3<f32>,
     metallic: f32,
     roughness: f32,
     occlusion: f32,
@@ -699,12 +710,18 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
         t = -t;
     }
     s.geometric_n = n;
-    if (HAS_NORMAL_TEXTURE && material.flags.y > 0.5 && dot(t, t) > 1e-8) {
+    s.coat_n = n;
+    if (dot(t, t) > 1e-8) {
         let tn = normalize(t - n * dot(n, t));
         let bn = cross(n, tn) * select(1.0, -1.0, handedness < 0.0);
-        var m = normal_sample.xyz * 2.0 - vec3<f32>(1.0);
-        m = vec3<f32>(m.xy * material.emissive.w, m.z);
-        n = normalize(tn * m.x + bn * m.y + n * m.z);
+        if (HAS_LAYER_TEXTURES && material.layer_index[2].x >= 0.0) {
+            s.coat_n = normalize(tn * lt.coat_normal.x + bn * lt.coat_normal.y + n * lt.coat_normal.z);
+        }
+        if (HAS_NORMAL_TEXTURE && material.flags.y > 0.5) {
+            var m = normal_sample.xyz * 2.0 - vec3<f32>(1.0);
+            m = vec3<f32>(m.xy * material.emissive.w, m.z);
+            n = normalize(tn * m.x + bn * m.y + n * m.z);
+        }
     }
     s.n = n;
     s.t = t;
@@ -923,7 +940,9 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let n_dot_v = max(dot(n, v), 1e-4);
     let n_dot_h = max(dot(n, h), 0.0);
     let v_dot_h = max(dot(v, h), 0.0);
-    let light_in = light_rgb * n_dot_l * light_visibility(world, s.geometric_n, l) * light_filter(world, s.geometric_n, l);
+    // The light arriving unshadowed, and on the surface.
+    let light_seen = light_rgb * light_visibility(world, s.geometric_n, l) * light_filter(world, s.geometric_n, l);
+    let light_in = light_seen * n_dot_l;
     let occlusion = s.occlusion;
     let reflected = to_world(reflect(-v, n));
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));
@@ -1043,14 +1062,20 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     // What the varnish reflects of the view's light, and so keeps from what is behind.
     var coat_reflects = 0.0;
     if (coat > 0.0) {
+        // About the varnish's own normal (`Surface::coat_n`), not the base's.
+        let cn = s.coat_n;
+        let coat_n_dot_l = max(dot(cn, l), 0.0);
+        let coat_n_dot_v = max(dot(cn, v), 1e-4);
         let coat_alpha = coat_rough * coat_rough;
         let fc = (0.04 + 0.96 * pow(1.0 - v_dot_h, 5.0)) * coat;
-        let coat_direct = fc * ggx(n_dot_h, coat_alpha) * smith_visibility(n_dot_l, n_dot_v, coat_alpha) * light_in;
+        let coat_direct = fc * ggx(max(dot(cn, h), 0.0), coat_alpha)
+            * smith_visibility(coat_n_dot_l, coat_n_dot_v, coat_alpha) * light_seen * coat_n_dot_l;
         direct = direct * (1.0 - fc) + coat_direct;
-        let fc_ambient = (0.04 + 0.96 * pow(1.0 - n_dot_v, 5.0)) * coat;
-        let lut_uv = clamp(vec2<f32>(n_dot_v, coat_rough), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+        let fc_ambient = (0.04 + 0.96 * pow(1.0 - coat_n_dot_v, 5.0)) * coat;
+        let lut_uv = clamp(vec2<f32>(coat_n_dot_v, coat_rough), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
-        let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), coat_rough * PREFILTERED_MAX_LEVEL).rgb;
+        let coat_reflected = to_world(reflect(-v, cn));
+        let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(coat_reflected), coat_rough * PREFILTERED_MAX_LEVEL).rgb;
         ambient_light = ambient_light * (1.0 - fc_ambient) + prefiltered * (0.04 * scale_bias.x + scale_bias.y) * coat;
         coat_reflects = fc_ambient;
     }
@@ -1303,6 +1328,7 @@ fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
     s.n = from_octahedral(normal.xy);
     s.t = vec3<f32>(0.0);
     s.geometric_n = s.n;
+    s.coat_n = s.n;
     s.metallic = colour.a;
     s.roughness = max(normal.z, 0.045);
     s.occlusion = normal.w;

@@ -60,6 +60,15 @@ pub(crate) struct ComposeUniform {
     pub(crate) params: [f32; 4],
 }
 
+/// Nine values four to a vector, as `array<vec4<f32>, 3>` holds them (the last three unused).
+fn by_fours(v: [f32; 9]) -> [[f32; 4]; 3] {
+    [
+        [v[0], v[1], v[2], v[3]],
+        [v[4], v[5], v[6], v[7]],
+        [v[8], 0.0, 0.0, 0.0],
+    ]
+}
+
 /// Matches `Material` in `scene.wgsl`.
 #[repr(C)]
 #[derive(Clone, Copy, bytemuck::Pod, bytemuck::Zeroable)]
@@ -69,7 +78,7 @@ pub(crate) struct MaterialUniform {
     pub(crate) params: [f32; 4],
     pub(crate) uv_sets: [f32; 4],
     pub(crate) flags: [f32; 4],
-    pub(crate) transforms: [[f32; 4]; 30],
+    pub(crate) transforms: [[f32; 4]; 32],
     pub(crate) scene: [f32; 4],
     pub(crate) layers: [f32; 4],
     pub(crate) dielectric: [f32; 4],
@@ -77,15 +86,16 @@ pub(crate) struct MaterialUniform {
     pub(crate) sheen: [f32; 4],
     pub(crate) dispersion: [f32; 4],
     pub(crate) diffuse_transmission: [f32; 4],
-    pub(crate) layer_index: [[f32; 4]; 2],
-    pub(crate) layer_uv_set: [[f32; 4]; 2],
+    pub(crate) layer_index: [[f32; 4]; 3],
+    pub(crate) layer_uv_set: [[f32; 4]; 3],
+    pub(crate) coat_normal: [f32; 4],
 }
 
 impl MaterialUniform {
     /// `m`'s block; `layer_index`: the layer of the material's layer textures each
     /// [`phantogram_assets::model::LayerSlot`] reads ([`crate::layer_textures`]), none where it
     /// has no texture.
-    pub(crate) fn new(m: &Material, layer_index: [Option<u32>; 8]) -> Self {
+    pub(crate) fn new(m: &Material, layer_index: [Option<u32>; 9]) -> Self {
         let slots = [
             m.base_color_texture,
             m.metallic_roughness_texture,
@@ -96,7 +106,7 @@ impl MaterialUniform {
             m.thickness_texture,
         ];
         let layer_slots = m.layer_textures.slots();
-        let mut transforms = [[0.0; 4]; 30];
+        let mut transforms = [[0.0; 4]; 32];
         for (i, slot) in slots.iter().chain(&layer_slots).enumerate() {
             let rows = slot.map(|t| t.transform).unwrap_or_default().rows();
             transforms[2 * i] = [rows[0][0], rows[0][1], rows[0][2], 0.0];
@@ -165,20 +175,9 @@ impl MaterialUniform {
                 let c = l.diffuse_transmission_color;
                 [c[0], c[1], c[2], l.diffuse_transmission]
             },
-            layer_index: {
-                let index = layer_index.map(|i| i.map_or(-1.0, |i| i as f32));
-                [
-                    [index[0], index[1], index[2], index[3]],
-                    [index[4], index[5], index[6], index[7]],
-                ]
-            },
-            layer_uv_set: {
-                let sets = layer_slots.map(set);
-                [
-                    [sets[0], sets[1], sets[2], sets[3]],
-                    [sets[4], sets[5], sets[6], sets[7]],
-                ]
-            },
+            layer_index: by_fours(layer_index.map(|i| i.map_or(-1.0, |i| i as f32))),
+            layer_uv_set: by_fours(layer_slots.map(set)),
+            coat_normal: [m.layer_textures.clear_coat_normal_scale, 0.0, 0.0, 0.0],
         }
     }
 }

@@ -2,7 +2,7 @@
 //! render crate's `layer_textures`, `scene.wgsl`'s `layer_samples`): each scales its factor from
 //! the channel its extension names, colour ones decoded from sRGB, so that a texel of value v
 //! draws what the factor times v draws without the texture; textures of different sizes share one
-//! array.
+//! array; and the varnish follows its own normal map, not the base's.
 //!
 //! Each case: the tilted block of the sheen tests (`sheen::seen_as`), dark and rough, seen face on
 //! and at a grazing angle, where the layers' light is most of what it shows.
@@ -220,7 +220,12 @@ fn a_white_layer_texture_changes_nothing() {
         return;
     };
     let (image, reference) = one_texel([255; 4]);
-    let textures: Vec<(LayerSlot, TextureRef)> = LayerSlot::ALL.iter().map(|s| (*s, reference)).collect();
+    // (Every slot that scales: white is no normal map's "nothing".)
+    let textures: Vec<(LayerSlot, TextureRef)> = LayerSlot::ALL
+        .iter()
+        .filter(|s| **s != LayerSlot::ClearCoatNormal)
+        .map(|s| (*s, reference))
+        .collect();
     let white = block(layers, &textures, vec![image]).expect("a frame");
     for (t, e) in [(white.0, plain.0), (white.1, plain.1)] {
         assert!(
@@ -228,4 +233,76 @@ fn a_white_layer_texture_changes_nothing() {
             "white textures {t:?} against none {e:?}"
         );
     }
+}
+
+/// A one-texel tangent-space normal map tilted 30° towards +x (the texel (0.5, 0, 0.866)
+/// encoded), as the model's image `index`.
+fn tilted_normal(index: usize) -> (Image, TextureRef) {
+    let (image, mut reference) = one_texel([191, 128, 238, 255]);
+    reference.image = index;
+    (image, reference)
+}
+
+/// Black, and reflecting nothing itself: all it shows is its varnish (factor 1, smooth).
+fn varnished_black(normal_map: Option<TextureRef>, coat_normal: Option<(TextureRef, f32)>) -> Material {
+    let mut m = Material {
+        name: "varnished black".into(),
+        base_color: [0.0, 0.0, 0.0, 1.0],
+        metallic: 0.0,
+        roughness: 0.5,
+        normal_texture: normal_map.map(|t| (t, 1.0)),
+        layers: Layers {
+            specular: 0.0,
+            clear_coat: 1.0,
+            clear_coat_roughness: 0.0,
+            ..Layers::default()
+        },
+        ..Material::default()
+    };
+    if let Some((t, scale)) = coat_normal {
+        m.layer_textures.clear_coat_normal = Some(t);
+        m.layer_textures.clear_coat_normal_scale = scale;
+    }
+    m
+}
+
+#[test]
+fn a_varnish_follows_its_own_normal_map_not_the_bases() {
+    // glTF: without `clearcoatNormalTexture` the varnish takes the geometric normal, whatever the
+    // base's normal map does (a lacquer over carved grain is a smooth mirror).
+    let (image, tilt) = tilted_normal(0);
+    let Some(smooth) = seen_as(varnished_black(None, None), Vec::new()) else {
+        return;
+    };
+    let over_bumps = seen_as(varnished_black(Some(tilt), None), vec![image.clone()]).expect("a frame");
+    let own_tilt = seen_as(varnished_black(None, Some((tilt, 1.0))), vec![image.clone()]).expect("a frame");
+    let own_tilt_over_bumps =
+        seen_as(varnished_black(Some(tilt), Some((tilt, 1.0))), vec![image.clone()]).expect("a frame");
+    let own_flattened = seen_as(varnished_black(None, Some((tilt, 0.0))), vec![image]).expect("a frame");
+    println!(
+        "a black block's varnish: smooth {smooth:?}; over a tilted normal map {over_bumps:?}; tilted by its own map {own_tilt:?}, \
+         the same over the tilted base {own_tilt_over_bumps:?}; its own map at scale 0 {own_flattened:?}"
+    );
+    let differ = |a: ([f32; 3], [f32; 3]), b: ([f32; 3], [f32; 3])| {
+        largest_difference(a.0, b.0).max(largest_difference(a.1, b.1))
+    };
+    // The tilt shows in the varnish when it is the varnish's own.
+    assert!(
+        differ(own_tilt, smooth) >= 3.0,
+        "own tilt {own_tilt:?} against smooth {smooth:?}"
+    );
+    // The base's map leaves the varnish as it is; the varnish's own map alone tilts it; at scale 0
+    // it tilts nothing.
+    assert!(
+        differ(over_bumps, smooth) <= 1.0,
+        "over bumps {over_bumps:?} against smooth {smooth:?}"
+    );
+    assert!(
+        differ(own_tilt_over_bumps, own_tilt) <= 1.0,
+        "own tilt over bumps {own_tilt_over_bumps:?} against own tilt {own_tilt:?}"
+    );
+    assert!(
+        differ(own_flattened, smooth) <= 1.0,
+        "scale 0 {own_flattened:?} against smooth {smooth:?}"
+    );
 }

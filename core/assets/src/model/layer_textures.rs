@@ -5,9 +5,10 @@
 //! colour (`KHR_materials_diffuse_transmission`). Each is read from the channels its extension
 //! names ([`LayerSlot::channels`]); colour ones are sRGB-encoded, the others linear.
 //!
-//! `clearcoatNormalTexture` is not among them: the varnish keeps the surface's geometric normal
-//! (a warning names the texture when a file has one). The transmission and thickness textures are
-//! [`super::Material::transmission_texture`] and [`super::Material::thickness_texture`].
+//! The varnish's own normal map (`clearcoatNormalTexture`) is among them: without it the varnish
+//! lies smooth over the surface's geometric normal, whatever the base's normal map does (glTF's
+//! rule: a lacquer over carved grain is a smooth mirror). The transmission and thickness textures
+//! are [`super::Material::transmission_texture`] and [`super::Material::thickness_texture`].
 //!
 //! Pure data; no panics.
 
@@ -32,11 +33,14 @@ pub enum LayerSlot {
     DiffuseTransmission,
     /// `diffuseTransmissionColorTexture`: RGB (sRGB) scales that light's colour.
     DiffuseTransmissionColor,
+    /// `clearcoatNormalTexture`: RGB, a tangent-space normal map of the varnish (times its scale
+    /// in x and y, [`LayerTextures::clear_coat_normal_scale`]).
+    ClearCoatNormal,
 }
 
 impl LayerSlot {
     /// Every slot, in the order [`LayerTextures::slots`] gives them (the renderer's order too).
-    pub const ALL: [LayerSlot; 8] = [
+    pub const ALL: [LayerSlot; 9] = [
         LayerSlot::ClearCoat,
         LayerSlot::ClearCoatRoughness,
         LayerSlot::Specular,
@@ -45,6 +49,7 @@ impl LayerSlot {
         LayerSlot::SheenRoughness,
         LayerSlot::DiffuseTransmission,
         LayerSlot::DiffuseTransmissionColor,
+        LayerSlot::ClearCoatNormal,
     ];
 
     /// The extension and the texture field it is read from.
@@ -60,6 +65,7 @@ impl LayerSlot {
             LayerSlot::DiffuseTransmissionColor => {
                 ("KHR_materials_diffuse_transmission", "diffuseTransmissionColorTexture")
             }
+            LayerSlot::ClearCoatNormal => ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
         }
     }
 
@@ -69,18 +75,25 @@ impl LayerSlot {
             LayerSlot::ClearCoat => "R",
             LayerSlot::ClearCoatRoughness => "G",
             LayerSlot::Specular | LayerSlot::SheenRoughness | LayerSlot::DiffuseTransmission => "A",
-            LayerSlot::SpecularColor | LayerSlot::SheenColor | LayerSlot::DiffuseTransmissionColor => "RGB",
+            LayerSlot::SpecularColor
+            | LayerSlot::SheenColor
+            | LayerSlot::DiffuseTransmissionColor
+            | LayerSlot::ClearCoatNormal => "RGB",
         }
     }
 
-    /// Whether it holds colour (sRGB-encoded, as glTF's colour textures are).
+    /// Whether it holds colour (sRGB-encoded, as glTF's colour textures are; a normal map is
+    /// linear).
     pub fn is_colour(self) -> bool {
-        self.channels() == "RGB"
+        matches!(
+            self,
+            LayerSlot::SpecularColor | LayerSlot::SheenColor | LayerSlot::DiffuseTransmissionColor
+        )
     }
 }
 
 /// A material's layer textures, each where its file gives one.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LayerTextures {
     pub clear_coat: Option<TextureRef>,
     pub clear_coat_roughness: Option<TextureRef>,
@@ -90,6 +103,26 @@ pub struct LayerTextures {
     pub sheen_roughness: Option<TextureRef>,
     pub diffuse_transmission: Option<TextureRef>,
     pub diffuse_transmission_color: Option<TextureRef>,
+    pub clear_coat_normal: Option<TextureRef>,
+    /// `clearcoatNormalTexture`'s `scale`: the factor on its normals' x and y (1 by default).
+    pub clear_coat_normal_scale: f32,
+}
+
+impl Default for LayerTextures {
+    fn default() -> Self {
+        Self {
+            clear_coat: None,
+            clear_coat_roughness: None,
+            specular: None,
+            specular_color: None,
+            sheen_color: None,
+            sheen_roughness: None,
+            diffuse_transmission: None,
+            diffuse_transmission_color: None,
+            clear_coat_normal: None,
+            clear_coat_normal_scale: 1.0,
+        }
+    }
 }
 
 impl LayerTextures {
@@ -104,7 +137,7 @@ impl LayerTextures {
     }
 
     /// Each slot's texture, in [`LayerSlot::ALL`]'s order.
-    pub fn slots(&self) -> [Option<TextureRef>; 8] {
+    pub fn slots(&self) -> [Option<TextureRef>; 9] {
         LayerSlot::ALL.map(|s| self.get(s))
     }
 
@@ -123,6 +156,7 @@ impl LayerTextures {
             LayerSlot::SheenRoughness => &self.sheen_roughness,
             LayerSlot::DiffuseTransmission => &self.diffuse_transmission,
             LayerSlot::DiffuseTransmissionColor => &self.diffuse_transmission_color,
+            LayerSlot::ClearCoatNormal => &self.clear_coat_normal,
         }
     }
 
@@ -136,6 +170,7 @@ impl LayerTextures {
             LayerSlot::SheenRoughness => &mut self.sheen_roughness,
             LayerSlot::DiffuseTransmission => &mut self.diffuse_transmission,
             LayerSlot::DiffuseTransmissionColor => &mut self.diffuse_transmission_color,
+            LayerSlot::ClearCoatNormal => &mut self.clear_coat_normal,
         }
     }
 }
@@ -159,9 +194,10 @@ mod tests {
         }
         assert!(textures.any());
         let images: Vec<usize> = textures.slots().iter().map(|t| t.expect("set").image).collect();
-        assert_eq!(images, (0..8).collect::<Vec<_>>());
+        assert_eq!(images, (0..9).collect::<Vec<_>>());
         let fields: std::collections::HashSet<_> = LayerSlot::ALL.iter().map(|s| s.field()).collect();
-        assert_eq!(fields.len(), 8);
+        assert_eq!(fields.len(), 9);
+        assert_eq!(LayerTextures::default().clear_coat_normal_scale, 1.0);
     }
 
     #[test]

@@ -16,9 +16,8 @@
 //! first says which parts of a surface are glass (without it a lantern's frame would be as clear
 //! as its panes), the second where a volume is thinner than its factor (without it a glass
 //! figure's thin fingers would be as dark as its body). Those of the varnish, specular, sheen and
-//! diffuse transmission are read into [`super::Material::layer_textures`] (`layer_textures`).
-//! `clearcoatNormalTexture` is named in a warning and left out: the varnish keeps the surface's
-//! geometric normal.
+//! diffuse transmission, and the varnish's normal map, are read into
+//! [`super::Material::layer_textures`] (`layer_textures`).
 //!
 //! Pure data; no panics.
 
@@ -178,7 +177,7 @@ impl Layers {
 
     /// The layers a material's extensions give; `extension` returns an extension's object by
     /// name. `what` names the material in warnings; values out of range are clamped, malformed
-    /// ones ignored, textures left out, each with a warning.
+    /// ones ignored, each with a warning. Their textures are the loader's to read.
     pub fn from_extensions<'a>(
         extension: impl Fn(&str) -> Option<&'a Value>,
         what: &str,
@@ -210,7 +209,6 @@ impl Layers {
             layers.clear_coat = reader.clamped(name, "clearcoatFactor", c, 0.0, 1.0);
             let r = reader.number(e, name, "clearcoatRoughnessFactor", 0.0);
             layers.clear_coat_roughness = reader.clamped(name, "clearcoatRoughnessFactor", r, 0.0, 1.0);
-            reader.textures(e, name, &["clearcoatNormalTexture"]);
         }
         if let Some(e) = extension("KHR_materials_transmission") {
             let name = "KHR_materials_transmission";
@@ -309,14 +307,6 @@ impl Reader<'_> {
             self.warn(extension, field, "is not three numbers: its default used");
         }
         c
-    }
-
-    fn textures(&mut self, object: &Value, extension: &str, fields: &[&str]) {
-        for field in fields {
-            if object.get(*field).is_some() {
-                self.warn(extension, field, "is not read: its factor alone is used");
-            }
-        }
     }
 }
 
@@ -481,7 +471,7 @@ mod tests {
     }
 
     #[test]
-    fn an_ior_of_zero_makes_the_specular_colour_the_reflectance_and_textures_are_named() {
+    fn an_ior_of_zero_makes_the_specular_colour_the_reflectance() {
         let (layers, warnings) = read(json!({
             "KHR_materials_ior": { "ior": 0 },
             "KHR_materials_specular": { "specularColorFactor": [0.5, 0.25, 2.0] },
@@ -492,9 +482,7 @@ mod tests {
         assert_eq!(layers.dielectric_f0(), [0.5, 0.25, 1.0]);
         assert!(!layers.fresnel_rises());
         assert!(Layers::default().fresnel_rises());
-        // The transmission and thickness textures are the loader's to read (as are the other
-        // layers' textures); the varnish's normal map is named.
-        assert_eq!(warnings.len(), 1, "{warnings:?}");
-        assert!(warnings[0].contains("clearcoatNormalTexture"), "{warnings:?}");
+        // Every texture is the loader's to read.
+        assert!(warnings.is_empty(), "{warnings:?}");
     }
 }

@@ -1568,6 +1568,17 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                 let name = field.trim_end_matches("Texture");
                 let texture = extension_texture(&material, value, field, name, doc, images.len(), &mut warnings);
                 material.layer_textures.set(slot, texture);
+                if slot == LayerSlot::ClearCoatNormal && texture.is_some() {
+                    let scale = value.get(field).and_then(|t| t.get("scale"));
+                    match scale.map(|s| s.as_f64().map(|s| s as f32).filter(|s| s.is_finite())) {
+                        None => {}
+                        Some(Some(scale)) => material.layer_textures.clear_coat_normal_scale = scale,
+                        Some(None) => warnings.push(format!(
+                            "material {}, {name} texture: its scale is not a number; 1 used",
+                            material.name
+                        )),
+                    }
+                }
             }
         }
         if let Some(value) = m.extension_value("KHR_materials_pbrSpecularGlossiness") {
