@@ -601,8 +601,8 @@ struct Surface {
     n: vec3<f32>,
     t: vec3<f32>,
     geometric_n: vec3<f32>,
-    // The clear coat's normal: the geometric one, or its own normal map's (not the base's: a
-    // varnish lies smooth over carved grain unless its own map says otherwise).
+    // The material's clear coat's normal: the geometric one, or its own normal map's (not the
+    // base's: glTF's varnish lies smooth over carved grain unless its own map says otherwise).
     coat_n: vec3<f32>,
     metallic: f32,
     roughness: f32,
@@ -1053,17 +1053,19 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     // Clear coat: a smooth dielectric layer (4 %) over everything; what it reflects the layer
     // below does not receive, nor what is behind it. The visitor's varnish where it is the
     // stronger, else the material's own.
+    // The visitor's varnish follows the surface as drawn (a scan's normal map is its real
+    // relief); the material's own lies over its own normal (`Surface::coat_n`, glTF's rule).
     var coat = look.params.z;
     var coat_rough = clamp(look.params.w, 0.045, 1.0);
+    var cn = n;
     if (s.coat > coat) {
         coat = s.coat;
         coat_rough = clamp(s.coat_roughness, 0.045, 1.0);
+        cn = s.coat_n;
     }
     // What the varnish reflects of the view's light, and so keeps from what is behind.
     var coat_reflects = 0.0;
     if (coat > 0.0) {
-        // About the varnish's own normal (`Surface::coat_n`), not the base's.
-        let cn = s.coat_n;
         let coat_n_dot_l = max(dot(cn, l), 0.0);
         let coat_n_dot_v = max(dot(cn, v), 1e-4);
         let coat_alpha = coat_rough * coat_rough;

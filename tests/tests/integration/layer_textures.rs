@@ -7,8 +7,9 @@
 //! Each case: the tilted block of the sheen tests (`sheen::seen_as`), dark and rough, seen face on
 //! and at a grazing angle, where the layers' light is most of what it shows.
 
-use crate::sheen::seen_as;
+use crate::sheen::{seen_as, seen_in};
 use crate::transmission::{largest_difference, one_texel};
+use phantogram::appearance::Appearance;
 use phantogram::model::{Image, LayerSlot, Layers, Material, TextureRef};
 
 /// The dark, rough block with `layers` and `textures` (slot, texture) over `images`.
@@ -305,4 +306,30 @@ fn a_varnish_follows_its_own_normal_map_not_the_bases() {
         differ(own_flattened, smooth) <= 1.0,
         "scale 0 {own_flattened:?} against smooth {smooth:?}"
     );
+}
+
+#[test]
+fn the_visitors_varnish_follows_the_surface_as_drawn() {
+    // The material screen's clear coat over a scan: its normal map is the object's real relief,
+    // which a varnish brushed on follows.
+    let (image, tilt) = tilted_normal(0);
+    let bare = |normal_map: Option<TextureRef>| Material {
+        layers: Layers {
+            clear_coat: 0.0,
+            ..varnished_black(None, None).layers
+        },
+        ..varnished_black(normal_map, None)
+    };
+    let varnish = Appearance {
+        clear_coat: 1.0,
+        clear_coat_roughness: 0.0,
+        ..Appearance::default()
+    };
+    let Some(smooth) = seen_in(bare(None), Vec::new(), varnish) else {
+        return;
+    };
+    let over_bumps = seen_in(bare(Some(tilt)), vec![image], varnish).expect("a frame");
+    println!("the visitor's varnish on a black block: smooth {smooth:?}, over a tilted normal map {over_bumps:?}");
+    let differ = largest_difference(over_bumps.0, smooth.0).max(largest_difference(over_bumps.1, smooth.1));
+    assert!(differ >= 3.0, "over bumps {over_bumps:?} against smooth {smooth:?}");
 }

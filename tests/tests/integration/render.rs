@@ -283,13 +283,33 @@ pub(crate) fn render_over_floor(
     render_over_floor_lit(model, shadows, toward_light, None).map(|(px, proj, _)| (px, proj))
 }
 
+/// [`render_over_floor`] (with shadows, lit from [`OBLIQUE_LIGHT`]) in the visitor's
+/// `appearance`.
+pub(crate) fn render_over_floor_as(
+    model: Model,
+    appearance: phantogram::appearance::Appearance,
+) -> Option<(Vec<u8>, OffAxisProjection)> {
+    render_over_floor_with(model, true, OBLIQUE_LIGHT, None, appearance).map(|(px, proj, _)| (px, proj))
+}
+
 /// [`render_over_floor`], with `lamp` in place of the directional light if given; also the
 /// triangles the shadow passes drew.
 fn render_over_floor_lit(
+    model: Model,
+    shadows: bool,
+    toward_light: Vec3,
+    lamp: Option<phantogram::render::Lamp>,
+) -> Option<(Vec<u8>, OffAxisProjection, u64)> {
+    render_over_floor_with(model, shadows, toward_light, lamp, Default::default())
+}
+
+/// [`render_over_floor_lit`] in the visitor's `appearance`.
+fn render_over_floor_with(
     mut model: Model,
     shadows: bool,
     toward_light: Vec3,
     lamp: Option<phantogram::render::Lamp>,
+    appearance: phantogram::appearance::Appearance,
 ) -> Option<(Vec<u8>, OffAxisProjection, u64)> {
     let gpu = gpu()?;
     let screen = Screen::default();
@@ -299,6 +319,7 @@ fn render_over_floor_lit(
     let mut renderer = Renderer::new(gpu, &model).unwrap();
     renderer.lighting.shadows = shadows;
     renderer.lamp = lamp;
+    renderer.appearance = appearance;
     let input = still_input(&mono, &mono, &mono, toward_light);
     let pixels = renderer.render(&input, Method::Mono, W, H).unwrap();
     Some((pixels, mono, renderer.shadow_triangles_last_frame()))

@@ -2,7 +2,8 @@
 //! `charlie`): velvet's fibres catch the light where the surface turns away from the eye, and
 //! hardly where it faces it.
 
-use crate::render::{OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_over_floor};
+use crate::render::{add_part, pixel_at, push_floor_marker, render_over_floor_as};
+use phantogram::appearance::Appearance;
 use phantogram::glam::{Mat4, Vec3};
 use phantogram::model::{Image, Layers, Material, Mesh, Model};
 
@@ -42,6 +43,11 @@ fn seen(sheen: Option<([f32; 3], f32)>) -> Option<([f32; 3], [f32; 3])> {
 /// The block's two faces in `material` (with `images` for its textures), as the eye sees them:
 /// face on, then at a grazing angle.
 pub(crate) fn seen_as(material: Material, images: Vec<Image>) -> Option<([f32; 3], [f32; 3])> {
+    seen_in(material, images, Appearance::default())
+}
+
+/// [`seen_as`], in the visitor's `appearance`.
+pub(crate) fn seen_in(material: Material, images: Vec<Image>, appearance: Appearance) -> Option<([f32; 3], [f32; 3])> {
     let mut floor = Mesh::default();
     push_floor_marker(&mut floor);
     let mut model = Model::from_painted_mesh("tilted block", floor);
@@ -50,7 +56,7 @@ pub(crate) fn seen_as(material: Material, images: Vec<Image>) -> Option<([f32; 3
     block.push_cube(Vec3::ZERO, HALF, [1.0; 4]);
     block.transform(Mat4::from_translation(CENTRE) * Mat4::from_rotation_x(TILT_DEG.to_radians()));
     add_part(&mut model, block, material);
-    let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
+    let (pixels, proj) = render_over_floor_as(model, appearance)?;
     let (face_on, grazing) = faces();
     let rgb = |p: Vec3| {
         let c = pixel_at(&pixels, &proj, p);
