@@ -65,9 +65,9 @@ struct Material {
     // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended; w: 1 if
     // unlit (KHR_materials_unlit).
     flags: vec4<f32>,
-    // KHR_texture_transform rows for the sixteen slots: the seven in the order above plus
-    // emissive, transmission and thickness, then the nine layer slots (`layer_sample`).
-    transforms: array<vec4<f32>, 32>,
+    // KHR_texture_transform rows for the seventeen slots: the seven in the order above plus
+    // emissive, transmission and thickness, then the ten layer slots (`layer_sample`).
+    transforms: array<vec4<f32>, 34>,
     // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is; y, z: UV
     // sets of the transmission and thickness textures.
     scene: vec4<f32>,
@@ -89,12 +89,15 @@ struct Material {
     diffuse_transmission: vec4<f32>,
     // The layer textures' slots (assets crate, `model::LayerSlot`: clear coat, its roughness,
     // specular, specular colour, sheen colour, sheen roughness, diffuse transmission, its
-    // colour, the clear coat's normal map), four a vector: the layer of `layer_textures` each
-    // reads (negative: none), and its UV set.
+    // colour, the clear coat's normal map, anisotropy), four a vector: the layer of
+    // `layer_textures` each reads (negative: none), and its UV set.
     layer_index: array<vec4<f32>, 3>,
     layer_uv_set: array<vec4<f32>, 3>,
     // x: the clear coat's normal map's scale.
     coat_normal: vec4<f32>,
+    // KHR_materials_anisotropy: x its strength (0: none), y, z the cosine and sine of its
+    // direction's angle from the tangent.
+    anisotropy: vec4<f32>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -342,12 +345,14 @@ struct LayerSamples {
     diffuse_transmission_color: vec3<f32>,
     // The clear coat's tangent-space normal (its scale applied); (0, 0, 1) without its map.
     coat_normal: vec3<f32>,
+    // The anisotropy texture as stored (direction in RG, strength in B); (1, 0.5, 1) without.
+    anisotropy: vec3<f32>,
 };
 
 // Each layer texture read from the channels its extension names (assets crate, `LayerSlot`);
 // all ones where the material has none (`HAS_LAYER_TEXTURES`).
 fn layer_samples(uv: vec4<f32>) -> LayerSamples {
-    var l = LayerSamples(1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0));
+    var l = LayerSamples(1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(1.0, 0.5, 1.0));
     if (HAS_LAYER_TEXTURES) {
         l.clear_coat = layer_sample(0u, uv).r;
         l.clear_coat_roughness = layer_sample(1u, uv).g;
@@ -360,6 +365,9 @@ fn layer_samples(uv: vec4<f32>) -> LayerSamples {
         if (material.layer_index[2].x >= 0.0) {
             let m = layer_sample(8u, uv).xyz * 2.0 - vec3<f32>(1.0);
             l.coat_normal = vec3<f32>(m.xy * material.coat_normal.x, m.z);
+        }
+        if (material.layer_index[2].y >= 0.0) {
+            l.anisotropy = layer_sample(9u, uv).rgb;
         }
     }
     return l;
@@ -553,6 +561,39 @@ fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
     return a2 / (PI * d * d);
 }
 
+// The GGX distribution stretched: α_t along the surface direction t, α_b across it
+// (KHR_materials_anisotropy, Burley 2012): D = 1 / (π α_t α_b ((t·h/α_t)² + (b·h/α_b)² + (n·h)²)²).
+fn ggx_anisotropic(n_dot_h: f32, t_dot_h: f32, b_dot_h: f32, alpha_t: f32, alpha_b: f32) -> f32 {
+    let a2 = alpha_t * alpha_b;
+    let f = vec3<f32>(alpha_b * t_dot_h, alpha_t * b_dot_h, a2 * n_dot_h);
+    let w2 = a2 / max(dot(f, f), 1e-12);
+    return a2 * w2 * w2 / PI;
+}
+
+// Its height-correlated Smith visibility G / (4 n·l n·v) (Heitz 2014), `tb_v` and `tb_l` the
+// view's and the light's components along t and b.
+fn smith_visibility_anisotropic(n_dot_l: f32, n_dot_v: f32, tb_v: vec2<f32>, tb_l: vec2<f32>, alpha_t: f32, alpha_b: f32) -> f32 {
+    let gv = n_dot_l * length(vec3<f32>(alpha_t * tb_v.x, alpha_b * tb_v.y, n_dot_v));
+    let gl = n_dot_v * length(vec3<f32>(alpha_t * tb_l.x, alpha_b * tb_l.y, n_dot_l));
+    return 0.5 / max(gv + gl, 1e-5);
+}
+
+// Where an anisotropic lobe's image light is looked up (the glTF sample viewer's bent normal,
+// after Filament): the normal turned towards the one that faces the eye across the stretch
+// direction `ta`, the more the stronger the stretch and the smoother the surface, so that the
+// prefiltered environment's reflection is drawn out along `ta`.
+fn anisotropic_reflection(n: vec3<f32>, v: vec3<f32>, ta: vec3<f32>, roughness: f32, anisotropy: f32) -> vec3<f32> {
+    let across = cross(ta, v);
+    let facing = cross(across, ta);
+    let bend = 1.0 - anisotropy * (1.0 - roughness);
+    let bend4 = bend * bend * bend * bend;
+    var bent = mix(facing, n, bend4);
+    if (dot(bent, bent) < 1e-8) {
+        bent = n;
+    }
+    return reflect(-v, normalize(bent));
+}
+
 // The sheen of cloth (KHR_materials_sheen; assets crate, `ibl::sheen`, which this mirrors and
 // tests): the Charlie distribution of fibre directions at α = roughness², and its visibility
 // G / (4 n·l n·v) with G = 1 / (1 + Λ(l) + Λ(v)), Λ from Estevez and Kulla's fitted profile.
@@ -604,6 +645,10 @@ struct Surface {
     // The material's clear coat's normal: the geometric one, or its own normal map's (not the
     // base's: glTF's varnish lies smooth over carved grain unless its own map says otherwise).
     coat_n: vec3<f32>,
+    // KHR_materials_anisotropy: the strength of the specular lobe's stretch (0: none) and the
+    // direction it is stretched along (unit, in the surface).
+    anisotropy: f32,
+    anisotropy_t: vec3<f32>,
     metallic: f32,
     roughness: f32,
     occlusion: f32,
@@ -711,6 +756,8 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
     }
     s.geometric_n = n;
     s.coat_n = n;
+    s.anisotropy = 0.0;
+    s.anisotropy_t = vec3<f32>(0.0);
     if (dot(t, t) > 1e-8) {
         let tn = normalize(t - n * dot(n, t));
         let bn = cross(n, tn) * select(1.0, -1.0, handedness < 0.0);
@@ -721,6 +768,23 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
             var m = normal_sample.xyz * 2.0 - vec3<f32>(1.0);
             m = vec3<f32>(m.xy * material.emissive.w, m.z);
             n = normalize(tn * m.x + bn * m.y + n * m.z);
+        }
+        if (HAS_LAYERS && material.anisotropy.x > 0.0) {
+            // The texture's direction turned by the rotation (the rotation alone without one),
+            // then laid into the shading plane.
+            let turn = material.anisotropy.yz;
+            var d = turn;
+            let stored = lt.anisotropy.xy * 2.0 - vec2<f32>(1.0);
+            if (HAS_LAYER_TEXTURES && material.layer_index[2].y >= 0.0 && dot(stored, stored) > 1e-8) {
+                let u = normalize(stored);
+                d = vec2<f32>(turn.x * u.x - turn.y * u.y, turn.y * u.x + turn.x * u.y);
+            }
+            let along = tn * d.x + bn * d.y;
+            let in_plane = along - n * dot(n, along);
+            if (dot(in_plane, in_plane) > 1e-8) {
+                s.anisotropy = clamp(material.anisotropy.x * lt.anisotropy.z, 0.0, 1.0);
+                s.anisotropy_t = normalize(in_plane);
+            }
         }
     }
     s.n = n;
@@ -1001,7 +1065,18 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     } else {
         let fresnel_m = base + (vec3<f32>(1.0) - base) * pow(1.0 - v_dot_h, 5.0);
         let fresnel = mix(fresnel_d, fresnel_m, metallic);
-        let specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
+        var specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
+        // Where the light's reflection is looked up: about the normal, or for an anisotropic lobe
+        // about a normal bent towards the stretch (`anisotropic_reflection`).
+        var reflected_base = reflected;
+        if (s.anisotropy > 0.0) {
+            let ta = s.anisotropy_t;
+            let ba = cross(n, ta);
+            let alpha_t = mix(alpha, 1.0, s.anisotropy * s.anisotropy);
+            specular = fresnel * ggx_anisotropic(n_dot_h, dot(ta, h), dot(ba, h), alpha_t, alpha)
+                * smith_visibility_anisotropic(n_dot_l, n_dot_v, vec2<f32>(dot(ta, v), dot(ba, v)), vec2<f32>(dot(ta, l), dot(ba, l)), alpha_t, alpha);
+            reflected_base = to_world(anisotropic_reflection(n, v, ta, roughness, s.anisotropy));
+        }
         // Lambert's share of what is not reflected, less what a thin sheet passes to its other
         // side; and what it passes from its other side, lit from there (paper against a window).
         let lambert = (1.0 - metallic) * (1.0 - s.transmission) * base / PI;
@@ -1026,7 +1101,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         }
         let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
-        let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), roughness * PREFILTERED_MAX_LEVEL).rgb;
+        let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected_base), roughness * PREFILTERED_MAX_LEVEL).rgb;
         let albedo_d = s.specular_weight * (f0_d * scale_bias.x + f90_d * scale_bias.y);
         let albedo_m = base * scale_bias.x + vec3<f32>(scale_bias.y);
         let specular_ambient = prefiltered * mix(albedo_d, albedo_m, metallic);
@@ -1331,6 +1406,8 @@ fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
     s.t = vec3<f32>(0.0);
     s.geometric_n = s.n;
     s.coat_n = s.n;
+    s.anisotropy = 0.0;
+    s.anisotropy_t = vec3<f32>(0.0);
     s.metallic = colour.a;
     s.roughness = max(normal.z, 0.045);
     s.occlusion = normal.w;

@@ -7,6 +7,7 @@
 //! binary (`tests/tests/memory.rs`).
 
 mod accessibility;
+mod anisotropy;
 mod artifacts;
 mod assets;
 mod calibration_ui;

@@ -237,9 +237,10 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
     );
 }
 
-/// Glass, gems, varnish and cloth: each material extension's factors reach the material, and
-/// its textures too (each slot its own, with its coordinates; the varnish's normal map with its
-/// scale), a texture that does not exist is reported, and a file requiring them loads.
+/// Glass, gems, varnish, cloth and brushed metal: each material extension's factors reach the
+/// material, and its textures too (each slot its own, with its coordinates; the varnish's normal
+/// map with its scale), a texture that does not exist is reported, and a file requiring them
+/// loads.
 #[test]
 fn material_extensions_reach_the_material() {
     let dir = scratch("gltf-layers");
@@ -248,7 +249,7 @@ fn material_extensions_reach_the_material() {
         &dir,
         "amber.gltf",
         &format!(
-            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion","KHR_materials_diffuse_transmission"],
+            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion","KHR_materials_diffuse_transmission","KHR_materials_anisotropy"],
         "extensionsRequired":["KHR_materials_transmission","KHR_materials_sheen"],
         "images":[{{"uri":"{image}"}},{{"uri":"{image}"}}],"textures":[{{"source":0}},{{"source":1}}],
         "materials":[{{"name":"amber","extensions":{{
@@ -259,6 +260,7 @@ fn material_extensions_reach_the_material() {
           "KHR_materials_clearcoat":{{"clearcoatFactor":0.5,"clearcoatRoughnessFactor":0.1,"clearcoatTexture":{{"index":0}},"clearcoatRoughnessTexture":{{"index":1}},"clearcoatNormalTexture":{{"index":0,"scale":0.5}}}},
           "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6,"sheenColorTexture":{{"index":1,"texCoord":1}},"sheenRoughnessTexture":{{"index":0}}}},
           "KHR_materials_dispersion":{{"dispersion":0.4}},
+          "KHR_materials_anisotropy":{{"anisotropyStrength":0.7,"anisotropyRotation":0.5,"anisotropyTexture":{{"index":1,"texCoord":1}}}},
           "KHR_materials_diffuse_transmission":{{"diffuseTransmissionFactor":0.25,"diffuseTransmissionColorFactor":[1,0.5,0.5],"diffuseTransmissionTexture":{{"index":1}},"diffuseTransmissionColorTexture":{{"index":9}}}}}}}}]"#
         ),
     );
@@ -285,6 +287,7 @@ fn material_extensions_reach_the_material() {
     assert_eq!(l.specular_color, [1.0, 0.9, 0.8]);
     assert_eq!((l.sheen_color, l.sheen_roughness), ([0.3, 0.2, 0.1], 0.6));
     assert_eq!(l.dispersion, 0.4);
+    assert_eq!((l.anisotropy, l.anisotropy_rotation_rad), (0.7, 0.5));
     assert_eq!(
         (l.diffuse_transmission, l.diffuse_transmission_color),
         (0.25, [1.0, 0.5, 0.5])
@@ -309,6 +312,7 @@ fn material_extensions_reach_the_material() {
             slot(t.diffuse_transmission),
             slot(t.diffuse_transmission_color),
             slot(t.clear_coat_normal),
+            slot(t.anisotropy),
         ],
         [
             Some((0, 0)),
@@ -320,6 +324,7 @@ fn material_extensions_reach_the_material() {
             Some((1, 0)),
             None,
             Some((0, 0)),
+            Some((1, 1)),
         ]
     );
     assert_eq!(t.clear_coat_normal_scale, 0.5);

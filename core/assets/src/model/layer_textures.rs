@@ -1,8 +1,9 @@
 //! The textures of glTF's layer extensions that scale a layer's factors over a surface: where a
 //! varnish lies and how glossy it is (`KHR_materials_clearcoat`), how strong and what colour the
 //! dielectric's reflection is (`KHR_materials_specular`), the colour and roughness of cloth's
-//! sheen (`KHR_materials_sheen`), and how much light a thin sheet scatters through and in what
-//! colour (`KHR_materials_diffuse_transmission`). Each is read from the channels its extension
+//! sheen (`KHR_materials_sheen`), how much light a thin sheet scatters through and in what
+//! colour (`KHR_materials_diffuse_transmission`), and along which direction and how strongly a
+//! specular lobe is stretched (`KHR_materials_anisotropy`). Each is read from the channels its extension
 //! names ([`LayerSlot::channels`]); colour ones are sRGB-encoded, the others linear.
 //!
 //! The varnish's own normal map (`clearcoatNormalTexture`) is among them: without it the varnish
@@ -36,11 +37,14 @@ pub enum LayerSlot {
     /// `clearcoatNormalTexture`: RGB, a tangent-space normal map of the varnish (times its scale
     /// in x and y, [`LayerTextures::clear_coat_normal_scale`]).
     ClearCoatNormal,
+    /// `anisotropyTexture`: RG the direction of the stretch in tangent space (−1–1, before the
+    /// rotation), B scales its strength.
+    Anisotropy,
 }
 
 impl LayerSlot {
     /// Every slot, in the order [`LayerTextures::slots`] gives them (the renderer's order too).
-    pub const ALL: [LayerSlot; 9] = [
+    pub const ALL: [LayerSlot; 10] = [
         LayerSlot::ClearCoat,
         LayerSlot::ClearCoatRoughness,
         LayerSlot::Specular,
@@ -50,6 +54,7 @@ impl LayerSlot {
         LayerSlot::DiffuseTransmission,
         LayerSlot::DiffuseTransmissionColor,
         LayerSlot::ClearCoatNormal,
+        LayerSlot::Anisotropy,
     ];
 
     /// The extension and the texture field it is read from.
@@ -66,6 +71,7 @@ impl LayerSlot {
                 ("KHR_materials_diffuse_transmission", "diffuseTransmissionColorTexture")
             }
             LayerSlot::ClearCoatNormal => ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
+            LayerSlot::Anisotropy => ("KHR_materials_anisotropy", "anisotropyTexture"),
         }
     }
 
@@ -78,7 +84,8 @@ impl LayerSlot {
             LayerSlot::SpecularColor
             | LayerSlot::SheenColor
             | LayerSlot::DiffuseTransmissionColor
-            | LayerSlot::ClearCoatNormal => "RGB",
+            | LayerSlot::ClearCoatNormal
+            | LayerSlot::Anisotropy => "RGB",
         }
     }
 
@@ -104,6 +111,7 @@ pub struct LayerTextures {
     pub diffuse_transmission: Option<TextureRef>,
     pub diffuse_transmission_color: Option<TextureRef>,
     pub clear_coat_normal: Option<TextureRef>,
+    pub anisotropy: Option<TextureRef>,
     /// `clearcoatNormalTexture`'s `scale`: the factor on its normals' x and y (1 by default).
     pub clear_coat_normal_scale: f32,
 }
@@ -120,6 +128,7 @@ impl Default for LayerTextures {
             diffuse_transmission: None,
             diffuse_transmission_color: None,
             clear_coat_normal: None,
+            anisotropy: None,
             clear_coat_normal_scale: 1.0,
         }
     }
@@ -137,7 +146,7 @@ impl LayerTextures {
     }
 
     /// Each slot's texture, in [`LayerSlot::ALL`]'s order.
-    pub fn slots(&self) -> [Option<TextureRef>; 9] {
+    pub fn slots(&self) -> [Option<TextureRef>; 10] {
         LayerSlot::ALL.map(|s| self.get(s))
     }
 
@@ -157,6 +166,7 @@ impl LayerTextures {
             LayerSlot::DiffuseTransmission => &self.diffuse_transmission,
             LayerSlot::DiffuseTransmissionColor => &self.diffuse_transmission_color,
             LayerSlot::ClearCoatNormal => &self.clear_coat_normal,
+            LayerSlot::Anisotropy => &self.anisotropy,
         }
     }
 
@@ -171,6 +181,7 @@ impl LayerTextures {
             LayerSlot::DiffuseTransmission => &mut self.diffuse_transmission,
             LayerSlot::DiffuseTransmissionColor => &mut self.diffuse_transmission_color,
             LayerSlot::ClearCoatNormal => &mut self.clear_coat_normal,
+            LayerSlot::Anisotropy => &mut self.anisotropy,
         }
     }
 }
@@ -194,9 +205,9 @@ mod tests {
         }
         assert!(textures.any());
         let images: Vec<usize> = textures.slots().iter().map(|t| t.expect("set").image).collect();
-        assert_eq!(images, (0..9).collect::<Vec<_>>());
+        assert_eq!(images, (0..10).collect::<Vec<_>>());
         let fields: std::collections::HashSet<_> = LayerSlot::ALL.iter().map(|s| s.field()).collect();
-        assert_eq!(fields.len(), 9);
+        assert_eq!(fields.len(), 10);
         assert_eq!(LayerTextures::default().clear_coat_normal_scale, 1.0);
     }
 

@@ -5,7 +5,8 @@
 //! (`KHR_materials_volume`) and split into colours by it (`KHR_materials_dispersion`: a gem's
 //! fire), the sheen of cloth's fibres over it (`KHR_materials_sheen`: velvet, silk, felt), and
 //! light scattered through a thin sheet to its other side (`KHR_materials_diffuse_transmission`:
-//! paper, parchment, leaves, a lampshade).
+//! paper, parchment, leaves, a lampshade), and a specular lobe stretched along one direction of
+//! the surface (`KHR_materials_anisotropy`: brushed metal).
 //!
 //! Invariants of a [`Layers`] made by [`Layers::from_extensions`]: every value finite and in the
 //! range its extension allows (a value outside it is clamped, with a warning). The defaults are
@@ -24,7 +25,7 @@
 use serde_json::Value;
 
 /// The extensions [`Layers::from_extensions`] reads, for the loader's list of supported ones.
-pub const EXTENSIONS: [&str; 8] = [
+pub const EXTENSIONS: [&str; 9] = [
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
@@ -33,6 +34,7 @@ pub const EXTENSIONS: [&str; 8] = [
     "KHR_materials_sheen",
     "KHR_materials_dispersion",
     "KHR_materials_diffuse_transmission",
+    "KHR_materials_anisotropy",
 ];
 
 /// The layers over, in and through a material's base (see the module docs). Lengths are in the
@@ -78,6 +80,11 @@ pub struct Layers {
     /// (0–1), and the colour it takes on the way (linear, 0–1).
     pub diffuse_transmission: f32,
     pub diffuse_transmission_color: [f32; 3],
+    /// How much the specular lobe's roughness grows along one direction of the surface (0–1; its
+    /// alpha becomes mix(α, 1, strength²) there, the other direction keeps α), and that
+    /// direction's angle from the mesh's tangent towards its bitangent (radians).
+    pub anisotropy: f32,
+    pub anisotropy_rotation_rad: f32,
 }
 
 impl Default for Layers {
@@ -97,6 +104,8 @@ impl Default for Layers {
             dispersion: 0.0,
             diffuse_transmission: 0.0,
             diffuse_transmission_color: [1.0; 3],
+            anisotropy: 0.0,
+            anisotropy_rotation_rad: 0.0,
         }
     }
 }
@@ -251,6 +260,12 @@ impl Layers {
             let name = "KHR_materials_dispersion";
             let d = reader.number(e, name, "dispersion", 0.0);
             layers.dispersion = reader.clamped(name, "dispersion", d, 0.0, f32::MAX);
+        }
+        if let Some(e) = extension("KHR_materials_anisotropy") {
+            let name = "KHR_materials_anisotropy";
+            let a = reader.number(e, name, "anisotropyStrength", 0.0);
+            layers.anisotropy = reader.clamped(name, "anisotropyStrength", a, 0.0, 1.0);
+            layers.anisotropy_rotation_rad = reader.number(e, name, "anisotropyRotation", 0.0);
         }
         layers
     }
@@ -484,5 +499,20 @@ mod tests {
         assert!(Layers::default().fresnel_rises());
         // Every texture is the loader's to read.
         assert!(warnings.is_empty(), "{warnings:?}");
+    }
+
+    #[test]
+    fn anisotropy_is_read_and_clamped() {
+        let (brushed, warnings) = read(json!({
+            "KHR_materials_anisotropy": { "anisotropyStrength": 0.6, "anisotropyRotation": 1.57 }
+        }));
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!((brushed.anisotropy, brushed.anisotropy_rotation_rad), (0.6, 1.57));
+        let (bad, warnings) = read(json!({
+            "KHR_materials_anisotropy": { "anisotropyStrength": 2.0, "anisotropyRotation": "up" }
+        }));
+        assert_eq!((bad.anisotropy, bad.anisotropy_rotation_rad), (1.0, 0.0));
+        assert_eq!(warnings.len(), 2, "{warnings:?}");
+        assert_eq!(Layers::default().anisotropy, 0.0);
     }
 }
