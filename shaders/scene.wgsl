@@ -65,9 +65,9 @@ struct Material {
     // x: UV set of the emissive texture; y: 1 if a normal map is bound; z: 1 if blended; w: 1 if
     // unlit (KHR_materials_unlit).
     flags: vec4<f32>,
-    // KHR_texture_transform rows for the seventeen slots: the seven in the order above plus
-    // emissive, transmission and thickness, then the ten layer slots (`layer_sample`).
-    transforms: array<vec4<f32>, 34>,
+    // KHR_texture_transform rows for the nineteen slots: the seven in the order above plus
+    // emissive, transmission and thickness, then the twelve layer slots (`layer_sample`).
+    transforms: array<vec4<f32>, 38>,
     // x: 1 for scenery (the floor), which the visitor's `Appearance` leaves as it is; y, z: UV
     // sets of the transmission and thickness textures.
     scene: vec4<f32>,
@@ -89,8 +89,8 @@ struct Material {
     diffuse_transmission: vec4<f32>,
     // The layer textures' slots (assets crate, `model::LayerSlot`: clear coat, its roughness,
     // specular, specular colour, sheen colour, sheen roughness, diffuse transmission, its
-    // colour, the clear coat's normal map, anisotropy), four a vector: the layer of
-    // `layer_textures` each reads (negative: none), and its UV set.
+    // colour, the clear coat's normal map, anisotropy, iridescence, its thickness), four a vector:
+    // the layer of `layer_textures` each reads (negative: none), and its UV set.
     layer_index: array<vec4<f32>, 3>,
     layer_uv_set: array<vec4<f32>, 3>,
     // x: the clear coat's normal map's scale.
@@ -98,6 +98,9 @@ struct Material {
     // KHR_materials_anisotropy: x its strength (0: none), y, z the cosine and sine of its
     // direction's angle from the tangent.
     anisotropy: vec4<f32>,
+    // KHR_materials_iridescence: x its strength (0: none), y the film's index of refraction, z, w
+    // its thinnest and thickest (nm).
+    iridescence: vec4<f32>,
 };
 
 // Pipeline constants, set per material by render.rs (`MaterialVariant`): which texture slots the
@@ -347,12 +350,16 @@ struct LayerSamples {
     coat_normal: vec3<f32>,
     // The anisotropy texture as stored (direction in RG, strength in B); (1, 0.5, 1) without.
     anisotropy: vec3<f32>,
+    // The thin film's strength factor, and where its thickness lies from thinnest (0) to
+    // thickest (1; without a thickness texture).
+    iridescence: f32,
+    iridescence_thickness: f32,
 };
 
 // Each layer texture read from the channels its extension names (assets crate, `LayerSlot`);
 // all ones where the material has none (`HAS_LAYER_TEXTURES`).
 fn layer_samples(uv: vec4<f32>) -> LayerSamples {
-    var l = LayerSamples(1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(1.0, 0.5, 1.0));
+    var l = LayerSamples(1.0, 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(1.0), 1.0, 1.0, vec3<f32>(1.0), vec3<f32>(0.0, 0.0, 1.0), vec3<f32>(1.0, 0.5, 1.0), 1.0, 1.0);
     if (HAS_LAYER_TEXTURES) {
         l.clear_coat = layer_sample(0u, uv).r;
         l.clear_coat_roughness = layer_sample(1u, uv).g;
@@ -369,6 +376,8 @@ fn layer_samples(uv: vec4<f32>) -> LayerSamples {
         if (material.layer_index[2].y >= 0.0) {
             l.anisotropy = layer_sample(9u, uv).rgb;
         }
+        l.iridescence = layer_sample(10u, uv).r;
+        l.iridescence_thickness = layer_sample(11u, uv).g;
     }
     return l;
 }
@@ -594,6 +603,83 @@ fn anisotropic_reflection(n: vec3<f32>, v: vec3<f32>, ta: vec3<f32>, roughness: 
     return reflect(-v, normalize(bent));
 }
 
+// CIE XYZ to linear Rec. 709 (sRGB primaries, D65), columns.
+const XYZ_TO_REC709: mat3x3<f32> = mat3x3<f32>(
+    vec3<f32>(3.2404542, -0.9692660, 0.0556434),
+    vec3<f32>(-1.5371385, 1.8760108, -0.2040259),
+    vec3<f32>(-0.4985314, 0.0415560, 1.0572252),
+);
+
+// The eye's response (linear Rec. 709) to a reflectance that oscillates over the spectrum as
+// cos(2π·OPD/λ + shift): Belcour and Barla's (2017) Fourier-space fit of the CIE matching
+// functions as Gaussians, the constants KHR_materials_iridescence gives (OPD in nm).
+fn thin_film_sensitivity(opd_nm: f32, shift: vec3<f32>) -> vec3<f32> {
+    let phase = 2.0 * PI * opd_nm * 1e-9;
+    let amplitude = vec3<f32>(5.4856e-13, 4.4201e-13, 5.2481e-13);
+    let centre = vec3<f32>(1.6810e6, 1.7953e6, 2.2084e6);
+    let spread = vec3<f32>(4.3278e9, 9.3046e9, 6.6121e9);
+    var xyz = amplitude * sqrt(2.0 * PI * spread) * cos(centre * phase + shift) * exp(-phase * phase * spread);
+    // X's second, blue lobe.
+    xyz.x += 9.7470e-14 * sqrt(2.0 * PI * 4.5282e9) * cos(2.2399e6 * phase + shift.x) * exp(-4.5282e9 * phase * phase);
+    return XYZ_TO_REC709 * (xyz / 1.0685e-7);
+}
+
+// The reflectance of a surface of reflectance `f0` under a thin film (index `film_ior`,
+// `thickness_nm` thick) in air, at cos θ = `cos1` from its normal: the two interfaces'
+// reflectances, the phase each adds (π where light reflects off a lower index), and the Airy sum
+// of the multiple reflections integrated over the spectrum to its first two orders (Belcour and
+// Barla 2017, as KHR_materials_iridescence evaluates it; the base's index from its F0, without
+// extinction, also for metals). The optical path difference is taken along the refracted ray
+// (2 n d cos θ₂). A film of no thickness is none: its index fades to air's over the first 30 nm,
+// and then the sum is the surface's own Schlick term, because the air–film interface is
+// Fresnel's exact (unpolarised) reflectance, which vanishes with the contrast (Schlick's would
+// still rise towards 1 at grazing angles), and the film–base one Schlick's, as the bare surface's.
+fn thin_film_fresnel(cos1: f32, f0: vec3<f32>, film_ior: f32, thickness_nm: f32) -> vec3<f32> {
+    let n2 = mix(1.0, film_ior, smoothstep(0.0, 30.0, thickness_nm));
+    let cos2_sq = 1.0 - (1.0 - cos1 * cos1) / (n2 * n2);
+    if (cos2_sq <= 0.0) {
+        return vec3<f32>(1.0);
+    }
+    let cos2 = sqrt(cos2_sq);
+    // Air to the film.
+    let rs = (cos1 - n2 * cos2) / (cos1 + n2 * cos2);
+    let rp = (n2 * cos1 - cos2) / (n2 * cos1 + cos2);
+    let r12 = 0.5 * (rs * rs + rp * rp);
+    let t121 = 1.0 - r12;
+    let phi12 = select(0.0, PI, n2 < 1.0);
+    // The film to the base.
+    let root_f0 = sqrt(clamp(f0, vec3<f32>(0.0), vec3<f32>(0.9999)));
+    let n3 = (vec3<f32>(1.0) + root_f0) / (vec3<f32>(1.0) - root_f0);
+    let contrast = (n3 - vec3<f32>(n2)) / (n3 + vec3<f32>(n2));
+    let r1 = contrast * contrast;
+    let r23 = r1 + (vec3<f32>(1.0) - r1) * pow(1.0 - cos2, 5.0);
+    let phi23 = select(vec3<f32>(0.0), vec3<f32>(PI), n3 < vec3<f32>(n2));
+    let phi = vec3<f32>(PI - phi12) + phi23;
+    let opd = 2.0 * n2 * thickness_nm * cos2;
+    // The Airy sum: the DC term, then two orders of the oscillating ones. (Below 1 for the sum's
+    // denominator; not raised above 0, which would add a film's colours where there is none.)
+    let r123 = clamp(r12 * r23, vec3<f32>(0.0), vec3<f32>(0.9999));
+    let rs_sum = t121 * t121 * r23 / (vec3<f32>(1.0) - r123);
+    var reflectance = vec3<f32>(r12) + rs_sum;
+    var cm = rs_sum - vec3<f32>(t121);
+    for (var m = 1; m <= 2; m++) {
+        cm *= sqrt(r123);
+        reflectance += cm * 2.0 * thin_film_sensitivity(f32(m) * opd, f32(m) * phi);
+    }
+    return max(reflectance, vec3<f32>(0.0));
+}
+
+// The F0 at which Schlick's curve towards `f90` reaches `reflectance` at cos θ = `cos_v`: what
+// stands for a film's reflectance in the split sum's F0·A + F90·B (`fallback` where the curve
+// hardly depends on F0, at grazing angles).
+fn film_f0(reflectance: vec3<f32>, fallback: vec3<f32>, f90: vec3<f32>, cos_v: f32) -> vec3<f32> {
+    let rise = pow(1.0 - cos_v, 5.0);
+    if (1.0 - rise < 1e-3) {
+        return fallback;
+    }
+    return clamp((reflectance - f90 * rise) / (1.0 - rise), vec3<f32>(0.0), vec3<f32>(1.0));
+}
+
 // The sheen of cloth (KHR_materials_sheen; assets crate, `ibl::sheen`, which this mirrors and
 // tests): the Charlie distribution of fibre directions at α = roughness², and its visibility
 // G / (4 n·l n·v) with G = 1 / (1 + Λ(l) + Λ(v)), Λ from Estevez and Kulla's fitted profile.
@@ -649,6 +735,10 @@ struct Surface {
     // direction it is stretched along (unit, in the surface).
     anisotropy: f32,
     anisotropy_t: vec3<f32>,
+    // KHR_materials_iridescence: the thin film's strength (0: none), index and thickness (nm).
+    iridescence: f32,
+    iridescence_ior: f32,
+    iridescence_thickness_nm: f32,
     metallic: f32,
     roughness: f32,
     occlusion: f32,
@@ -705,6 +795,9 @@ fn core_layers(s: ptr<function, Surface>) {
     (*s).diffuse_transmission_color = vec3<f32>(1.0);
     (*s).sheen_color = vec3<f32>(0.0);
     (*s).sheen_roughness = 0.0;
+    (*s).iridescence = 0.0;
+    (*s).iridescence_ior = 1.3;
+    (*s).iridescence_thickness_nm = 0.0;
 }
 
 // The material's surface at a fragment of the scene pass. Samples every texture first:
@@ -813,6 +906,9 @@ fn material_surface(in: VsOut, front: bool) -> Surface {
         s.inv_ior_red_blue = select(vec2<f32>(s.inv_ior), material.dispersion.xy, material.dispersion.z > 0.5);
         s.diffuse_transmission = material.diffuse_transmission.w * lt.diffuse_transmission;
         s.diffuse_transmission_color = material.diffuse_transmission.rgb * lt.diffuse_transmission_color;
+        s.iridescence = material.iridescence.x * lt.iridescence;
+        s.iridescence_ior = material.iridescence.y;
+        s.iridescence_thickness_nm = mix(material.iridescence.z, material.iridescence.w, lt.iridescence_thickness);
     } else {
         // Constants the compiler folds into the shading: the core material costs what it did
         // before the extensions.
@@ -1064,7 +1160,22 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * (scale_bias.x + scale_bias.y);
     } else {
         let fresnel_m = base + (vec3<f32>(1.0) - base) * pow(1.0 - v_dot_h, 5.0);
-        let fresnel = mix(fresnel_d, fresnel_m, metallic);
+        var fresnel = mix(fresnel_d, fresnel_m, metallic);
+        // A thin film's colours (KHR_materials_iridescence): the Fresnel term mixed towards the
+        // film's by its strength; in the image light, the F0 whose Schlick curve meets the film's
+        // reflectance at n·v (`film_f0`), so that the split sum's own grazing rise is not added
+        // twice and a film of no thickness changes nothing.
+        var f0_ambient_d = f0_d;
+        var f0_ambient_m = base;
+        if (s.iridescence > 0.0) {
+            let film_d = s.specular_weight * thin_film_fresnel(v_dot_h, f0_d, s.iridescence_ior, s.iridescence_thickness_nm);
+            let film_m = thin_film_fresnel(v_dot_h, base, s.iridescence_ior, s.iridescence_thickness_nm);
+            fresnel = mix(fresnel, mix(film_d, film_m, metallic), s.iridescence);
+            let at_view_d = thin_film_fresnel(n_dot_v, f0_d, s.iridescence_ior, s.iridescence_thickness_nm);
+            let at_view_m = thin_film_fresnel(n_dot_v, base, s.iridescence_ior, s.iridescence_thickness_nm);
+            f0_ambient_d = mix(f0_d, film_f0(at_view_d, f0_d, f90_d, n_dot_v), s.iridescence);
+            f0_ambient_m = mix(base, film_f0(at_view_m, base, vec3<f32>(1.0), n_dot_v), s.iridescence);
+        }
         var specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
         // Where the light's reflection is looked up: about the normal, or for an anisotropic lobe
         // about a normal bent towards the stretch (`anisotropic_reflection`).
@@ -1102,8 +1213,8 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected_base), roughness * PREFILTERED_MAX_LEVEL).rgb;
-        let albedo_d = s.specular_weight * (f0_d * scale_bias.x + f90_d * scale_bias.y);
-        let albedo_m = base * scale_bias.x + vec3<f32>(scale_bias.y);
+        let albedo_d = s.specular_weight * (f0_ambient_d * scale_bias.x + f90_d * scale_bias.y);
+        let albedo_m = f0_ambient_m * scale_bias.x + vec3<f32>(scale_bias.y);
         let specular_ambient = prefiltered * mix(albedo_d, albedo_m, metallic);
         ambient_light = diffuse_ambient + specular_ambient;
 

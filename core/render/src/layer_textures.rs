@@ -1,6 +1,6 @@
 //! A material's layer textures (assets crate, `model::LayerTextures`: varnish and its normal map,
-//! specular, sheen, diffuse transmission and anisotropy) as one 2D array texture, one layer per image they
-//! use, so that the ten slots take one texture binding and one sampler (`layer_textures` and `layer_sampler`
+//! specular, sheen, diffuse transmission, anisotropy and iridescence) as one 2D array texture, one layer per image they
+//! use, so that the twelve slots take one texture binding and one sampler (`layer_textures` and `layer_sampler`
 //! in `scene.wgsl`; the fragment stage has 16 texture bindings, 14 of them taken before).
 //!
 //! Invariants: every layer has the size of the largest image used (smaller ones are resized
@@ -24,14 +24,14 @@ pub(crate) struct GpuLayerTextures {
     pub(crate) view: wgpu::TextureView,
     pub(crate) sampler: wgpu::Sampler,
     /// The layer each slot reads ([`LayerSlot::ALL`] order), none where it has no texture.
-    pub(crate) layer_of_slot: [Option<u32>; 10],
+    pub(crate) layer_of_slot: [Option<u32>; 12],
 }
 
 /// The images a material's layer slots use, once per colour space, and the layer of each slot
 /// ([`LayerSlot::ALL`] order): slots naming an image the model lacks have none.
-pub(crate) fn layers_of(material: &Material, image_count: usize) -> (Vec<(usize, bool)>, [Option<u32>; 10]) {
+pub(crate) fn layers_of(material: &Material, image_count: usize) -> (Vec<(usize, bool)>, [Option<u32>; 12]) {
     let mut images: Vec<(usize, bool)> = Vec::new();
-    let mut layer_of_slot = [None; 10];
+    let mut layer_of_slot = [None; 12];
     for (k, slot) in LayerSlot::ALL.into_iter().enumerate() {
         let Some(t) = material.layer_textures.get(slot) else {
             continue;
@@ -212,7 +212,20 @@ mod tests {
         assert_eq!(images, [(0, false), (1, true), (1, false)]);
         assert_eq!(
             layers,
-            [Some(0), Some(0), None, None, Some(1), Some(2), None, None, None, None]
+            [
+                Some(0),
+                Some(0),
+                None,
+                None,
+                Some(1),
+                Some(2),
+                None,
+                None,
+                None,
+                None,
+                None,
+                None
+            ]
         );
         assert_eq!(layers_of(&Material::default(), 2).0, []);
     }

@@ -60,12 +60,12 @@ pub(crate) struct ComposeUniform {
     pub(crate) params: [f32; 4],
 }
 
-/// Ten values four to a vector, as `array<vec4<f32>, 3>` holds them (the last two unused).
-fn by_fours(v: [f32; 10]) -> [[f32; 4]; 3] {
+/// Twelve values four to a vector, as `array<vec4<f32>, 3>` holds them.
+fn by_fours(v: [f32; 12]) -> [[f32; 4]; 3] {
     [
         [v[0], v[1], v[2], v[3]],
         [v[4], v[5], v[6], v[7]],
-        [v[8], v[9], 0.0, 0.0],
+        [v[8], v[9], v[10], v[11]],
     ]
 }
 
@@ -78,7 +78,7 @@ pub(crate) struct MaterialUniform {
     pub(crate) params: [f32; 4],
     pub(crate) uv_sets: [f32; 4],
     pub(crate) flags: [f32; 4],
-    pub(crate) transforms: [[f32; 4]; 34],
+    pub(crate) transforms: [[f32; 4]; 38],
     pub(crate) scene: [f32; 4],
     pub(crate) layers: [f32; 4],
     pub(crate) dielectric: [f32; 4],
@@ -90,13 +90,14 @@ pub(crate) struct MaterialUniform {
     pub(crate) layer_uv_set: [[f32; 4]; 3],
     pub(crate) coat_normal: [f32; 4],
     pub(crate) anisotropy: [f32; 4],
+    pub(crate) iridescence: [f32; 4],
 }
 
 impl MaterialUniform {
     /// `m`'s block; `layer_index`: the layer of the material's layer textures each
     /// [`phantogram_assets::model::LayerSlot`] reads ([`crate::layer_textures`]), none where it
     /// has no texture.
-    pub(crate) fn new(m: &Material, layer_index: [Option<u32>; 10]) -> Self {
+    pub(crate) fn new(m: &Material, layer_index: [Option<u32>; 12]) -> Self {
         let slots = [
             m.base_color_texture,
             m.metallic_roughness_texture,
@@ -107,7 +108,7 @@ impl MaterialUniform {
             m.thickness_texture,
         ];
         let layer_slots = m.layer_textures.slots();
-        let mut transforms = [[0.0; 4]; 34];
+        let mut transforms = [[0.0; 4]; 38];
         for (i, slot) in slots.iter().chain(&layer_slots).enumerate() {
             let rows = slot.map(|t| t.transform).unwrap_or_default().rows();
             transforms[2 * i] = [rows[0][0], rows[0][1], rows[0][2], 0.0];
@@ -184,6 +185,12 @@ impl MaterialUniform {
                 l.anisotropy_rotation_rad.cos(),
                 l.anisotropy_rotation_rad.sin(),
                 0.0,
+            ],
+            iridescence: [
+                l.iridescence,
+                l.iridescence_ior,
+                l.iridescence_thickness_nm[0],
+                l.iridescence_thickness_nm[1],
             ],
         }
     }

@@ -184,7 +184,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
         .map(|m| {
             let transmits = m.transmits();
             let layer_textures = crate::layer_textures::upload(gpu, model, m);
-            let layer_of_slot = layer_textures.as_ref().map_or([None; 10], |l| l.layer_of_slot);
+            let layer_of_slot = layer_textures.as_ref().map_or([None; 12], |l| l.layer_of_slot);
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),
                 contents: bytemuck::bytes_of(&MaterialUniform::new(m, layer_of_slot)),

@@ -22,6 +22,7 @@ mod fusion_vigorous;
 mod glasses;
 mod golden;
 mod impostor;
+mod iridescence;
 mod lamp;
 mod layer_textures;
 mod materials;

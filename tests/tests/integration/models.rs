@@ -208,18 +208,18 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
 
     let needs = tiny_gltf(
         &dir,
-        "iridescence.gltf",
-        r#","extensionsUsed":["KHR_materials_iridescence"],"extensionsRequired":["KHR_materials_iridescence"]"#,
+        "volume-scatter.gltf",
+        r#","extensionsUsed":["KHR_materials_volume_scatter"],"extensionsRequired":["KHR_materials_volume_scatter"]"#,
     );
     match load_gltf(&needs) {
-        Err(ModelError::UnsupportedExtension { name, .. }) => assert_eq!(name, "KHR_materials_iridescence"),
+        Err(ModelError::UnsupportedExtension { name, .. }) => assert_eq!(name, "KHR_materials_volume_scatter"),
         other => panic!("expected an unsupported-extension error, got {other:?}"),
     }
     // Merely *used* (optional) extensions are fine.
     let optional = tiny_gltf(
         &dir,
         "optional.gltf",
-        r#","extensionsUsed":["KHR_materials_iridescence"]"#,
+        r#","extensionsUsed":["KHR_materials_volume_scatter"]"#,
     );
     assert!(load_gltf(&optional).is_ok());
 
@@ -232,15 +232,15 @@ fn loader_reads_a_minimal_file_and_names_unsupported_extensions() {
     ));
     let text = load_gltf(&needs).unwrap_err().to_string();
     assert!(
-        text.contains("iridescence.gltf") && text.contains("KHR_materials_iridescence"),
+        text.contains("volume-scatter.gltf") && text.contains("KHR_materials_volume_scatter"),
         "{text}"
     );
 }
 
-/// Glass, gems, varnish, cloth and brushed metal: each material extension's factors reach the
-/// material, and its textures too (each slot its own, with its coordinates; the varnish's normal
-/// map with its scale), a texture that does not exist is reported, and a file requiring them
-/// loads.
+/// Glass, gems, varnish, cloth, brushed metal and thin films: each material extension's factors
+/// reach the material, and its textures too (each slot its own, with its coordinates; the
+/// varnish's normal map with its scale), a texture that does not exist is reported, and a file
+/// requiring them loads.
 #[test]
 fn material_extensions_reach_the_material() {
     let dir = scratch("gltf-layers");
@@ -249,7 +249,7 @@ fn material_extensions_reach_the_material() {
         &dir,
         "amber.gltf",
         &format!(
-            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion","KHR_materials_diffuse_transmission","KHR_materials_anisotropy"],
+            r#","extensionsUsed":["KHR_materials_transmission","KHR_materials_volume","KHR_materials_ior","KHR_materials_specular","KHR_materials_clearcoat","KHR_materials_sheen","KHR_materials_dispersion","KHR_materials_diffuse_transmission","KHR_materials_anisotropy","KHR_materials_iridescence"],
         "extensionsRequired":["KHR_materials_transmission","KHR_materials_sheen"],
         "images":[{{"uri":"{image}"}},{{"uri":"{image}"}}],"textures":[{{"source":0}},{{"source":1}}],
         "materials":[{{"name":"amber","extensions":{{
@@ -261,6 +261,7 @@ fn material_extensions_reach_the_material() {
           "KHR_materials_sheen":{{"sheenColorFactor":[0.3,0.2,0.1],"sheenRoughnessFactor":0.6,"sheenColorTexture":{{"index":1,"texCoord":1}},"sheenRoughnessTexture":{{"index":0}}}},
           "KHR_materials_dispersion":{{"dispersion":0.4}},
           "KHR_materials_anisotropy":{{"anisotropyStrength":0.7,"anisotropyRotation":0.5,"anisotropyTexture":{{"index":1,"texCoord":1}}}},
+          "KHR_materials_iridescence":{{"iridescenceFactor":0.9,"iridescenceIOR":1.6,"iridescenceThicknessMinimum":50,"iridescenceThicknessMaximum":650,"iridescenceTexture":{{"index":0}},"iridescenceThicknessTexture":{{"index":1}}}},
           "KHR_materials_diffuse_transmission":{{"diffuseTransmissionFactor":0.25,"diffuseTransmissionColorFactor":[1,0.5,0.5],"diffuseTransmissionTexture":{{"index":1}},"diffuseTransmissionColorTexture":{{"index":9}}}}}}}}]"#
         ),
     );
@@ -289,6 +290,10 @@ fn material_extensions_reach_the_material() {
     assert_eq!(l.dispersion, 0.4);
     assert_eq!((l.anisotropy, l.anisotropy_rotation_rad), (0.7, 0.5));
     assert_eq!(
+        (l.iridescence, l.iridescence_ior, l.iridescence_thickness_nm),
+        (0.9, 1.6, [50.0, 650.0])
+    );
+    assert_eq!(
         (l.diffuse_transmission, l.diffuse_transmission_color),
         (0.25, [1.0, 0.5, 0.5])
     );
@@ -313,6 +318,8 @@ fn material_extensions_reach_the_material() {
             slot(t.diffuse_transmission_color),
             slot(t.clear_coat_normal),
             slot(t.anisotropy),
+            slot(t.iridescence),
+            slot(t.iridescence_thickness),
         ],
         [
             Some((0, 0)),
@@ -325,6 +332,8 @@ fn material_extensions_reach_the_material() {
             None,
             Some((0, 0)),
             Some((1, 1)),
+            Some((0, 0)),
+            Some((1, 0)),
         ]
     );
     assert_eq!(t.clear_coat_normal_scale, 0.5);

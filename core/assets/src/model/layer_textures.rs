@@ -2,8 +2,9 @@
 //! varnish lies and how glossy it is (`KHR_materials_clearcoat`), how strong and what colour the
 //! dielectric's reflection is (`KHR_materials_specular`), the colour and roughness of cloth's
 //! sheen (`KHR_materials_sheen`), how much light a thin sheet scatters through and in what
-//! colour (`KHR_materials_diffuse_transmission`), and along which direction and how strongly a
-//! specular lobe is stretched (`KHR_materials_anisotropy`). Each is read from the channels its extension
+//! colour (`KHR_materials_diffuse_transmission`), along which direction and how strongly a
+//! specular lobe is stretched (`KHR_materials_anisotropy`), and where a thin film lies and how
+//! thick it is (`KHR_materials_iridescence`). Each is read from the channels its extension
 //! names ([`LayerSlot::channels`]); colour ones are sRGB-encoded, the others linear.
 //!
 //! The varnish's own normal map (`clearcoatNormalTexture`) is among them: without it the varnish
@@ -40,11 +41,15 @@ pub enum LayerSlot {
     /// `anisotropyTexture`: RG the direction of the stretch in tangent space (−1–1, before the
     /// rotation), B scales its strength.
     Anisotropy,
+    /// `iridescenceTexture`: R scales the thin film's strength.
+    Iridescence,
+    /// `iridescenceThicknessTexture`: G blends its thickness from the minimum to the maximum.
+    IridescenceThickness,
 }
 
 impl LayerSlot {
     /// Every slot, in the order [`LayerTextures::slots`] gives them (the renderer's order too).
-    pub const ALL: [LayerSlot; 10] = [
+    pub const ALL: [LayerSlot; 12] = [
         LayerSlot::ClearCoat,
         LayerSlot::ClearCoatRoughness,
         LayerSlot::Specular,
@@ -55,6 +60,8 @@ impl LayerSlot {
         LayerSlot::DiffuseTransmissionColor,
         LayerSlot::ClearCoatNormal,
         LayerSlot::Anisotropy,
+        LayerSlot::Iridescence,
+        LayerSlot::IridescenceThickness,
     ];
 
     /// The extension and the texture field it is read from.
@@ -72,14 +79,16 @@ impl LayerSlot {
             }
             LayerSlot::ClearCoatNormal => ("KHR_materials_clearcoat", "clearcoatNormalTexture"),
             LayerSlot::Anisotropy => ("KHR_materials_anisotropy", "anisotropyTexture"),
+            LayerSlot::Iridescence => ("KHR_materials_iridescence", "iridescenceTexture"),
+            LayerSlot::IridescenceThickness => ("KHR_materials_iridescence", "iridescenceThicknessTexture"),
         }
     }
 
     /// The channels it is read from: "R", "G", "A" or "RGB".
     pub fn channels(self) -> &'static str {
         match self {
-            LayerSlot::ClearCoat => "R",
-            LayerSlot::ClearCoatRoughness => "G",
+            LayerSlot::ClearCoat | LayerSlot::Iridescence => "R",
+            LayerSlot::ClearCoatRoughness | LayerSlot::IridescenceThickness => "G",
             LayerSlot::Specular | LayerSlot::SheenRoughness | LayerSlot::DiffuseTransmission => "A",
             LayerSlot::SpecularColor
             | LayerSlot::SheenColor
@@ -112,6 +121,8 @@ pub struct LayerTextures {
     pub diffuse_transmission_color: Option<TextureRef>,
     pub clear_coat_normal: Option<TextureRef>,
     pub anisotropy: Option<TextureRef>,
+    pub iridescence: Option<TextureRef>,
+    pub iridescence_thickness: Option<TextureRef>,
     /// `clearcoatNormalTexture`'s `scale`: the factor on its normals' x and y (1 by default).
     pub clear_coat_normal_scale: f32,
 }
@@ -129,6 +140,8 @@ impl Default for LayerTextures {
             diffuse_transmission_color: None,
             clear_coat_normal: None,
             anisotropy: None,
+            iridescence: None,
+            iridescence_thickness: None,
             clear_coat_normal_scale: 1.0,
         }
     }
@@ -146,7 +159,7 @@ impl LayerTextures {
     }
 
     /// Each slot's texture, in [`LayerSlot::ALL`]'s order.
-    pub fn slots(&self) -> [Option<TextureRef>; 10] {
+    pub fn slots(&self) -> [Option<TextureRef>; 12] {
         LayerSlot::ALL.map(|s| self.get(s))
     }
 
@@ -167,6 +180,8 @@ impl LayerTextures {
             LayerSlot::DiffuseTransmissionColor => &self.diffuse_transmission_color,
             LayerSlot::ClearCoatNormal => &self.clear_coat_normal,
             LayerSlot::Anisotropy => &self.anisotropy,
+            LayerSlot::Iridescence => &self.iridescence,
+            LayerSlot::IridescenceThickness => &self.iridescence_thickness,
         }
     }
 
@@ -182,6 +197,8 @@ impl LayerTextures {
             LayerSlot::DiffuseTransmissionColor => &mut self.diffuse_transmission_color,
             LayerSlot::ClearCoatNormal => &mut self.clear_coat_normal,
             LayerSlot::Anisotropy => &mut self.anisotropy,
+            LayerSlot::Iridescence => &mut self.iridescence,
+            LayerSlot::IridescenceThickness => &mut self.iridescence_thickness,
         }
     }
 }
@@ -205,9 +222,9 @@ mod tests {
         }
         assert!(textures.any());
         let images: Vec<usize> = textures.slots().iter().map(|t| t.expect("set").image).collect();
-        assert_eq!(images, (0..10).collect::<Vec<_>>());
+        assert_eq!(images, (0..12).collect::<Vec<_>>());
         let fields: std::collections::HashSet<_> = LayerSlot::ALL.iter().map(|s| s.field()).collect();
-        assert_eq!(fields.len(), 10);
+        assert_eq!(fields.len(), 12);
         assert_eq!(LayerTextures::default().clear_coat_normal_scale, 1.0);
     }
 

@@ -5,8 +5,9 @@
 //! (`KHR_materials_volume`) and split into colours by it (`KHR_materials_dispersion`: a gem's
 //! fire), the sheen of cloth's fibres over it (`KHR_materials_sheen`: velvet, silk, felt), and
 //! light scattered through a thin sheet to its other side (`KHR_materials_diffuse_transmission`:
-//! paper, parchment, leaves, a lampshade), and a specular lobe stretched along one direction of
-//! the surface (`KHR_materials_anisotropy`: brushed metal).
+//! paper, parchment, leaves, a lampshade), a specular lobe stretched along one direction of
+//! the surface (`KHR_materials_anisotropy`: brushed metal), and the colours of a thin film on it
+//! (`KHR_materials_iridescence`: weathered Roman glass, tarnish, a soap bubble).
 //!
 //! Invariants of a [`Layers`] made by [`Layers::from_extensions`]: every value finite and in the
 //! range its extension allows (a value outside it is clamped, with a warning). The defaults are
@@ -25,7 +26,7 @@
 use serde_json::Value;
 
 /// The extensions [`Layers::from_extensions`] reads, for the loader's list of supported ones.
-pub const EXTENSIONS: [&str; 9] = [
+pub const EXTENSIONS: [&str; 10] = [
     "KHR_materials_ior",
     "KHR_materials_specular",
     "KHR_materials_clearcoat",
@@ -35,6 +36,7 @@ pub const EXTENSIONS: [&str; 9] = [
     "KHR_materials_dispersion",
     "KHR_materials_diffuse_transmission",
     "KHR_materials_anisotropy",
+    "KHR_materials_iridescence",
 ];
 
 /// The layers over, in and through a material's base (see the module docs). Lengths are in the
@@ -85,6 +87,12 @@ pub struct Layers {
     /// direction's angle from the mesh's tangent towards its bitangent (radians).
     pub anisotropy: f32,
     pub anisotropy_rotation_rad: f32,
+    /// How much a thin film over the surface colours its reflection (0–1: the Fresnel term mixed
+    /// towards the film's), the film's index of refraction, and its thickness range (nm): the
+    /// maximum where no thickness texture says otherwise, which blends from the minimum.
+    pub iridescence: f32,
+    pub iridescence_ior: f32,
+    pub iridescence_thickness_nm: [f32; 2],
 }
 
 impl Default for Layers {
@@ -106,6 +114,9 @@ impl Default for Layers {
             diffuse_transmission_color: [1.0; 3],
             anisotropy: 0.0,
             anisotropy_rotation_rad: 0.0,
+            iridescence: 0.0,
+            iridescence_ior: 1.3,
+            iridescence_thickness_nm: [100.0, 400.0],
         }
     }
 }
@@ -266,6 +277,19 @@ impl Layers {
             let a = reader.number(e, name, "anisotropyStrength", 0.0);
             layers.anisotropy = reader.clamped(name, "anisotropyStrength", a, 0.0, 1.0);
             layers.anisotropy_rotation_rad = reader.number(e, name, "anisotropyRotation", 0.0);
+        }
+        if let Some(e) = extension("KHR_materials_iridescence") {
+            let name = "KHR_materials_iridescence";
+            let f = reader.number(e, name, "iridescenceFactor", 0.0);
+            layers.iridescence = reader.clamped(name, "iridescenceFactor", f, 0.0, 1.0);
+            let n = reader.number(e, name, "iridescenceIOR", 1.3);
+            layers.iridescence_ior = reader.clamped(name, "iridescenceIOR", n, 1.0, f32::MAX);
+            let lo = reader.number(e, name, "iridescenceThicknessMinimum", 100.0);
+            let hi = reader.number(e, name, "iridescenceThicknessMaximum", 400.0);
+            layers.iridescence_thickness_nm = [
+                reader.clamped(name, "iridescenceThicknessMinimum", lo, 0.0, f32::MAX),
+                reader.clamped(name, "iridescenceThicknessMaximum", hi, 0.0, f32::MAX),
+            ];
         }
         layers
     }
@@ -514,5 +538,26 @@ mod tests {
         assert_eq!((bad.anisotropy, bad.anisotropy_rotation_rad), (1.0, 0.0));
         assert_eq!(warnings.len(), 2, "{warnings:?}");
         assert_eq!(Layers::default().anisotropy, 0.0);
+    }
+
+    #[test]
+    fn iridescence_is_read_with_the_extensions_defaults() {
+        let (film, warnings) = read(json!({
+            "KHR_materials_iridescence": { "iridescenceFactor": 1.0, "iridescenceIOR": 1.8, "iridescenceThicknessMaximum": 800 }
+        }));
+        assert!(warnings.is_empty(), "{warnings:?}");
+        assert_eq!(
+            (film.iridescence, film.iridescence_ior, film.iridescence_thickness_nm),
+            (1.0, 1.8, [100.0, 800.0])
+        );
+        let (bad, warnings) = read(json!({
+            "KHR_materials_iridescence": { "iridescenceFactor": 3, "iridescenceIOR": 0.5, "iridescenceThicknessMinimum": -5 }
+        }));
+        assert_eq!(
+            (bad.iridescence, bad.iridescence_ior, bad.iridescence_thickness_nm),
+            (1.0, 1.0, [0.0, 400.0])
+        );
+        assert_eq!(warnings.len(), 3, "{warnings:?}");
+        assert_eq!(Layers::default().iridescence, 0.0);
     }
 }

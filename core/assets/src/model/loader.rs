@@ -32,7 +32,7 @@ pub const MAX_COORDINATE: f32 = 1e9;
 
 /// Extensions this loader implements; a file requiring any other fails to load, one merely
 /// using another loads with a warning naming it.
-pub const SUPPORTED_EXTENSIONS: [&str; 20] = [
+pub const SUPPORTED_EXTENSIONS: [&str; 21] = [
     "KHR_draco_mesh_compression",
     "EXT_mesh_gpu_instancing",
     "EXT_meshopt_compression",
@@ -53,6 +53,7 @@ pub const SUPPORTED_EXTENSIONS: [&str; 20] = [
     super::layers::EXTENSIONS[6],
     super::layers::EXTENSIONS[7],
     super::layers::EXTENSIONS[8],
+    super::layers::EXTENSIONS[9],
 ];
 
 #[derive(Debug, Error)]
