@@ -16,7 +16,7 @@
 use phantogram_assets::model::{LayerSlot, Material, Model};
 
 use crate::Gpu;
-use crate::upload::{create_sampler, mip_chain};
+use crate::upload::{create_sampler, mip_chain, write_mip_chain};
 
 /// A material's layer textures on the GPU.
 pub(crate) struct GpuLayerTextures {
@@ -80,31 +80,7 @@ pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material) -> Option<Gp
         view_formats: &[],
     });
     for (layer, chain) in chains.iter().enumerate() {
-        for (level, (w, h, data)) in chain.iter().enumerate() {
-            gpu.queue.write_texture(
-                wgpu::TexelCopyTextureInfo {
-                    texture: &texture,
-                    mip_level: level as u32,
-                    origin: wgpu::Origin3d {
-                        x: 0,
-                        y: 0,
-                        z: layer as u32,
-                    },
-                    aspect: wgpu::TextureAspect::All,
-                },
-                data,
-                wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(w * 4),
-                    rows_per_image: Some(*h),
-                },
-                wgpu::Extent3d {
-                    width: *w,
-                    height: *h,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
+        write_mip_chain(gpu, &texture, layer as u32, chain);
     }
     let first = LayerSlot::ALL
         .into_iter()
@@ -136,20 +112,7 @@ pub(crate) fn placeholder(gpu: &Gpu) -> wgpu::TextureView {
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
-    gpu.queue.write_texture(
-        texture.as_image_copy(),
-        &[255; 4],
-        wgpu::TexelCopyBufferLayout {
-            offset: 0,
-            bytes_per_row: Some(4),
-            rows_per_image: Some(1),
-        },
-        wgpu::Extent3d {
-            width: 1,
-            height: 1,
-            depth_or_array_layers: 1,
-        },
-    );
+    write_mip_chain(gpu, &texture, 0, &[(1, 1, vec![255; 4])]);
     texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()

@@ -449,16 +449,7 @@ impl Renderer {
             material_entries.push(filtering_sampler_entry(2 + 2 * slot));
         }
         // The layer extensions' textures, one array (`layer_textures`).
-        material_entries.push(wgpu::BindGroupLayoutEntry {
-            binding: 15,
-            visibility: wgpu::ShaderStages::FRAGMENT,
-            ty: wgpu::BindingType::Texture {
-                sample_type: wgpu::TextureSampleType::Float { filterable: true },
-                view_dimension: wgpu::TextureViewDimension::D2Array,
-                multisampled: false,
-            },
-            count: None,
-        });
+        material_entries.push(filterable_texture_array_entry(15));
         material_entries.push(filtering_sampler_entry(16));
         let material_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("material"),

@@ -80,12 +80,18 @@ pub(super) fn upload_mip_chain(
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
+    write_mip_chain(gpu, &texture, 0, levels);
+    texture.create_view(&Default::default())
+}
+
+/// Writes RGBA8 mip `levels` ([`mip_chain`]) into array layer `layer` of `texture`.
+pub(super) fn write_mip_chain(gpu: &Gpu, texture: &wgpu::Texture, layer: u32, levels: &[(u32, u32, Vec<u8>)]) {
     for (level, (w, h, data)) in levels.iter().enumerate() {
         gpu.queue.write_texture(
             wgpu::TexelCopyTextureInfo {
-                texture: &texture,
+                texture,
                 mip_level: level as u32,
-                origin: wgpu::Origin3d::ZERO,
+                origin: wgpu::Origin3d { x: 0, y: 0, z: layer },
                 aspect: wgpu::TextureAspect::All,
             },
             data,
@@ -101,7 +107,6 @@ pub(super) fn upload_mip_chain(
             },
         );
     }
-    texture.create_view(&Default::default())
 }
 
 pub(super) fn create_sampler(device: &wgpu::Device, s: &Sampler) -> wgpu::Sampler {
