@@ -2,7 +2,7 @@
 //! light) and samplers.
 
 use super::*;
-use phantogram_assets::model::{Material, TextureRef};
+use phantogram_assets::model::TextureRef;
 
 pub(super) use phantogram_geometry::srgb::{code_to_linear as srgb_to_linear, linear_to_code as linear_to_srgb};
 
@@ -137,21 +137,6 @@ pub(super) fn create_sampler(device: &wgpu::Device, s: &Sampler) -> wgpu::Sample
     })
 }
 
-/// A material's seven texture slots of their own bindings (`scene.wgsl`'s order: base colour,
-/// metallic-roughness, normal, occlusion, emissive, transmission, thickness), each with whether
-/// it holds colour.
-fn direct_slots(m: &Material) -> [Option<(TextureRef, bool)>; 7] {
-    [
-        m.base_color_texture.map(|t| (t, true)),
-        m.metallic_roughness_texture.map(|t| (t, false)),
-        m.normal_texture.map(|(t, _)| (t, false)),
-        m.occlusion_texture.map(|(t, _)| (t, false)),
-        m.emissive_texture.map(|t| (t, true)),
-        m.transmission_texture.map(|t| (t, false)),
-        m.thickness_texture.map(|t| (t, false)),
-    ]
-}
-
 pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Model) -> GpuModel {
     let device = &gpu.device;
     // Each image once per colour space it is used in; the mip chains are built on every core
@@ -159,7 +144,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     // (The layer extensions' textures go into an array per material: `layer_textures`.)
     let mut used: Vec<(usize, bool)> = Vec::new();
     for m in &model.materials {
-        for (t, srgb) in direct_slots(m).into_iter().flatten() {
+        for (t, srgb) in m.own_slot_textures().into_iter().flatten() {
             if t.image < model.images.len() && !used.contains(&(t.image, srgb)) {
                 used.push((t.image, srgb));
             }
@@ -197,7 +182,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
             });
             let fallbacks = [&white, &white, &flat_normal, &white, &white, &white, &white];
             let slots: Vec<(Option<(TextureRef, bool)>, &wgpu::TextureView)> =
-                direct_slots(m).into_iter().zip(fallbacks).collect();
+                m.own_slot_textures().into_iter().zip(fallbacks).collect();
             let samplers: Vec<wgpu::Sampler> = slots
                 .iter()
                 .map(|(t, _)| t.map_or_else(|| default_sampler.clone(), |(t, _)| create_sampler(device, &t.sampler)))

@@ -386,8 +386,9 @@ impl Material {
         self.transmits() && self.roughness > 0.0 && self.layers.ior != 1.0
     }
 
-    /// Every texture the material uses, with whether it holds colour (sRGB-encoded) data.
-    pub fn textures(&self) -> impl Iterator<Item = (TextureRef, bool)> + '_ {
+    /// The textures of the core material and of transmission and thickness, in this order (the
+    /// renderer binds each on its own), each with whether it holds colour (sRGB-encoded) data.
+    pub fn own_slot_textures(&self) -> [Option<(TextureRef, bool)>; 7] {
         [
             self.base_color_texture.map(|t| (t, true)),
             self.metallic_roughness_texture.map(|t| (t, false)),
@@ -397,13 +398,18 @@ impl Material {
             self.transmission_texture.map(|t| (t, false)),
             self.thickness_texture.map(|t| (t, false)),
         ]
-        .into_iter()
-        .chain(
-            LayerSlot::ALL
-                .into_iter()
-                .map(|slot| self.layer_textures.get(slot).map(|t| (t, slot.is_colour()))),
-        )
-        .flatten()
+    }
+
+    /// Every texture the material uses, with whether it holds colour (sRGB-encoded) data.
+    pub fn textures(&self) -> impl Iterator<Item = (TextureRef, bool)> + '_ {
+        self.own_slot_textures()
+            .into_iter()
+            .chain(
+                LayerSlot::ALL
+                    .into_iter()
+                    .map(|slot| self.layer_textures.get(slot).map(|t| (t, slot.is_colour()))),
+            )
+            .flatten()
     }
 }
 
