@@ -3,6 +3,9 @@
 //! use, so that the twelve slots take one texture binding and one sampler (`layer_textures` and `layer_sampler`
 //! in `scene.wgsl`; the fragment stage has 16 texture bindings, 14 of them taken before).
 //!
+//! Materials whose layer slots use the same images (in the same order of first use) share one
+//! array ([`Arrays`]), as a model's materials often share one packed texture.
+//!
 //! Invariants: every layer has the size of the largest image used (smaller ones are resized
 //! bilinearly up to it: the layers of an array share their size) and the full mip chain; colour
 //! slots' images are stored as their sRGB codes in a linear format (their mips averaged in
@@ -49,11 +52,28 @@ pub(crate) fn layers_of(material: &Material, image_count: usize) -> (Vec<(usize,
     (images, layer_of_slot)
 }
 
-/// Uploads `material`'s layer textures from `model`'s images; `None` where it has none.
-pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material) -> Option<GpuLayerTextures> {
+/// The arrays made so far for a model, by the images (and colour spaces) of their layers in
+/// order: materials whose layer slots use the same images share one.
+pub(crate) type Arrays = std::collections::HashMap<Vec<(usize, bool)>, wgpu::TextureView>;
+
+/// `material`'s layer textures from `model`'s images, uploaded or found in `made`; `None` where
+/// it has none.
+pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material, made: &mut Arrays) -> Option<GpuLayerTextures> {
     let (images, layer_of_slot) = layers_of(material, model.images.len());
     if images.is_empty() {
         return None;
+    }
+    let first = LayerSlot::ALL
+        .into_iter()
+        .zip(layer_of_slot)
+        .find_map(|(slot, layer)| layer.and(material.layer_textures.get(slot)))?;
+    let sampler = create_sampler(&gpu.device, &first.sampler);
+    if let Some(view) = made.get(&images) {
+        return Some(GpuLayerTextures {
+            view: view.clone(),
+            sampler,
+            layer_of_slot,
+        });
     }
     let width = images.iter().map(|(i, _)| model.images[*i].width).max()?.max(1);
     let height = images.iter().map(|(i, _)| model.images[*i].height).max()?.max(1);
@@ -66,7 +86,7 @@ pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material) -> Option<Gp
         })
         .collect();
     let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some(&format!("{}: layer textures", material.name)),
+        label: Some("layer textures"),
         size: wgpu::Extent3d {
             width,
             height,
@@ -82,16 +102,14 @@ pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material) -> Option<Gp
     for (layer, chain) in chains.iter().enumerate() {
         write_mip_chain(gpu, &texture, layer as u32, chain);
     }
-    let first = LayerSlot::ALL
-        .into_iter()
-        .zip(layer_of_slot)
-        .find_map(|(slot, layer)| layer.and(material.layer_textures.get(slot)))?;
+    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..Default::default()
+    });
+    made.insert(images, view.clone());
     Some(GpuLayerTextures {
-        view: texture.create_view(&wgpu::TextureViewDescriptor {
-            dimension: Some(wgpu::TextureViewDimension::D2Array),
-            ..Default::default()
-        }),
-        sampler: create_sampler(&gpu.device, &first.sampler),
+        view,
+        sampler,
         layer_of_slot,
     })
 }

@@ -167,13 +167,14 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());
     let no_layer_textures = crate::layer_textures::placeholder(gpu);
+    let mut layer_arrays = crate::layer_textures::Arrays::new();
     let glass_shadows = model.materials.iter().any(|m| m.transmits());
     let materials = model
         .materials
         .iter()
         .map(|m| {
             let transmits = m.transmits();
-            let layer_textures = crate::layer_textures::upload(gpu, model, m);
+            let layer_textures = crate::layer_textures::upload(gpu, model, m, &mut layer_arrays);
             let layer_of_slot = layer_textures.as_ref().map_or([None; 12], |l| l.layer_of_slot);
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),

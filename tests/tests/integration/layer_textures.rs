@@ -333,3 +333,74 @@ fn the_visitors_varnish_follows_the_surface_as_drawn() {
     let differ = largest_difference(over_bumps.0, smooth.0).max(largest_difference(over_bumps.1, smooth.1));
     assert!(differ >= 3.0, "over bumps {over_bumps:?} against smooth {smooth:?}");
 }
+
+/// Two blocks side by side on the floor, the left of `left`, the right of `right`, over
+/// `images`: each one's top face as the eye sees it.
+fn two_blocks(left: Material, right: Material, images: Vec<Image>) -> Option<([f32; 3], [f32; 3])> {
+    use crate::render::{OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_over_floor};
+    use phantogram::glam::Vec3;
+    let mut floor = phantogram::model::Mesh::default();
+    push_floor_marker(&mut floor);
+    let mut model = phantogram::model::Model::from_painted_mesh("two blocks", floor);
+    model.images = images;
+    let tops = [Vec3::new(-0.012, 0.0, -0.02), Vec3::new(0.012, 0.0, -0.02)];
+    for (top, material) in tops.iter().zip([left, right]) {
+        let mut block = phantogram::model::Mesh::default();
+        block.push_cube(*top - Vec3::new(0.0, 0.0, 0.006), 0.006, [1.0; 4]);
+        add_part(&mut model, block, material);
+    }
+    let (pixels, proj) = render_over_floor(model, true, OBLIQUE_LIGHT)?;
+    let rgb = |p: Vec3| {
+        let c = pixel_at(&pixels, &proj, p);
+        [f32::from(c[0]), f32::from(c[1]), f32::from(c[2])]
+    };
+    Some((rgb(tops[0]), rgb(tops[1])))
+}
+
+#[test]
+fn materials_sharing_a_layer_image_each_read_their_own_slots() {
+    // One image in both materials' slots (so one array for both): the left reads it as its
+    // varnish's share (R 0: none), the right as its specular strength (A 0: none).
+    let (image, texel) = one_texel([0, 255, 255, 0]);
+    let base = |layers: Layers| Material {
+        name: "layered".into(),
+        base_color: [0.05, 0.05, 0.06, 1.0],
+        metallic: 0.0,
+        roughness: 0.8,
+        layers,
+        ..Material::default()
+    };
+    let varnish = Layers {
+        clear_coat: 1.0,
+        ..Layers::default()
+    };
+    let mut left = base(varnish);
+    left.layer_textures.set(LayerSlot::ClearCoat, Some(texel));
+    let mut right = base(Layers::default());
+    right.layer_textures.set(LayerSlot::Specular, Some(texel));
+    let Some(textured) = two_blocks(left, right, vec![image]) else {
+        return;
+    };
+    let plain = two_blocks(base(varnish), base(Layers::default()), Vec::new()).expect("a frame");
+    let expected = two_blocks(
+        base(Layers::default()),
+        base(Layers {
+            specular: 0.0,
+            ..Layers::default()
+        }),
+        Vec::new(),
+    )
+    .expect("a frame");
+    println!(
+        "two blocks' tops: textured {textured:?}, factors alone {plain:?}, the factors the texels make {expected:?}"
+    );
+    assert!(largest_difference(plain.0, expected.0) >= 3.0 && largest_difference(plain.1, expected.1) >= 3.0);
+    assert!(
+        largest_difference(textured.0, expected.0) <= 2.0,
+        "left: {textured:?} against {expected:?}"
+    );
+    assert!(
+        largest_difference(textured.1, expected.1) <= 2.0,
+        "right: {textured:?} against {expected:?}"
+    );
+}
