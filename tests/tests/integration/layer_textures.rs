@@ -261,7 +261,7 @@ fn varnished_black(normal_map: Option<TextureRef>, coat_normal: Option<(TextureR
         ..Material::default()
     };
     if let Some((t, scale)) = coat_normal {
-        m.layer_textures.clear_coat_normal = Some(t);
+        m.layer_textures.set(LayerSlot::ClearCoatNormal, Some(t));
         m.layer_textures.clear_coat_normal_scale = scale;
     }
     m

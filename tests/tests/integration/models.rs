@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use phantogram::glam::Vec3;
-use phantogram::model::{ModelError, load_gltf, load_model};
+use phantogram::model::{LayerSlot, ModelError, load_gltf, load_model};
 use phantogram::render::{Gpu, Renderer};
 use phantogram::screen::Screen;
 use phantogram::{Session, SessionConfig};
@@ -308,18 +308,18 @@ fn material_extensions_reach_the_material() {
     let t = &amber.layer_textures;
     assert_eq!(
         [
-            slot(t.clear_coat),
-            slot(t.clear_coat_roughness),
-            slot(t.specular),
-            slot(t.specular_color),
-            slot(t.sheen_color),
-            slot(t.sheen_roughness),
-            slot(t.diffuse_transmission),
-            slot(t.diffuse_transmission_color),
-            slot(t.clear_coat_normal),
-            slot(t.anisotropy),
-            slot(t.iridescence),
-            slot(t.iridescence_thickness),
+            slot(t.get(LayerSlot::ClearCoat)),
+            slot(t.get(LayerSlot::ClearCoatRoughness)),
+            slot(t.get(LayerSlot::Specular)),
+            slot(t.get(LayerSlot::SpecularColor)),
+            slot(t.get(LayerSlot::SheenColor)),
+            slot(t.get(LayerSlot::SheenRoughness)),
+            slot(t.get(LayerSlot::DiffuseTransmission)),
+            slot(t.get(LayerSlot::DiffuseTransmissionColor)),
+            slot(t.get(LayerSlot::ClearCoatNormal)),
+            slot(t.get(LayerSlot::Anisotropy)),
+            slot(t.get(LayerSlot::Iridescence)),
+            slot(t.get(LayerSlot::IridescenceThickness)),
         ],
         [
             Some((0, 0)),

@@ -111,18 +111,8 @@ impl LayerSlot {
 /// A material's layer textures, each where its file gives one.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LayerTextures {
-    pub clear_coat: Option<TextureRef>,
-    pub clear_coat_roughness: Option<TextureRef>,
-    pub specular: Option<TextureRef>,
-    pub specular_color: Option<TextureRef>,
-    pub sheen_color: Option<TextureRef>,
-    pub sheen_roughness: Option<TextureRef>,
-    pub diffuse_transmission: Option<TextureRef>,
-    pub diffuse_transmission_color: Option<TextureRef>,
-    pub clear_coat_normal: Option<TextureRef>,
-    pub anisotropy: Option<TextureRef>,
-    pub iridescence: Option<TextureRef>,
-    pub iridescence_thickness: Option<TextureRef>,
+    /// By slot, in [`LayerSlot::ALL`]'s order (a slot's index is its discriminant).
+    textures: [Option<TextureRef>; 12],
     /// `clearcoatNormalTexture`'s `scale`: the factor on its normals' x and y (1 by default).
     pub clear_coat_normal_scale: f32,
 }
@@ -130,18 +120,7 @@ pub struct LayerTextures {
 impl Default for LayerTextures {
     fn default() -> Self {
         Self {
-            clear_coat: None,
-            clear_coat_roughness: None,
-            specular: None,
-            specular_color: None,
-            sheen_color: None,
-            sheen_roughness: None,
-            diffuse_transmission: None,
-            diffuse_transmission_color: None,
-            clear_coat_normal: None,
-            anisotropy: None,
-            iridescence: None,
-            iridescence_thickness: None,
+            textures: [None; 12],
             clear_coat_normal_scale: 1.0,
         }
     }
@@ -150,62 +129,35 @@ impl Default for LayerTextures {
 impl LayerTextures {
     /// The texture of `slot`.
     pub fn get(&self, slot: LayerSlot) -> Option<TextureRef> {
-        *self.field(slot)
+        self.textures[slot as usize]
     }
 
     /// Sets the texture of `slot`.
     pub fn set(&mut self, slot: LayerSlot, texture: Option<TextureRef>) {
-        *self.field_mut(slot) = texture;
+        self.textures[slot as usize] = texture;
     }
 
     /// Each slot's texture, in [`LayerSlot::ALL`]'s order.
     pub fn slots(&self) -> [Option<TextureRef>; 12] {
-        LayerSlot::ALL.map(|s| self.get(s))
+        self.textures
     }
 
     /// Whether any slot has a texture.
     pub fn any(&self) -> bool {
-        self.slots().iter().any(Option::is_some)
-    }
-
-    fn field(&self, slot: LayerSlot) -> &Option<TextureRef> {
-        match slot {
-            LayerSlot::ClearCoat => &self.clear_coat,
-            LayerSlot::ClearCoatRoughness => &self.clear_coat_roughness,
-            LayerSlot::Specular => &self.specular,
-            LayerSlot::SpecularColor => &self.specular_color,
-            LayerSlot::SheenColor => &self.sheen_color,
-            LayerSlot::SheenRoughness => &self.sheen_roughness,
-            LayerSlot::DiffuseTransmission => &self.diffuse_transmission,
-            LayerSlot::DiffuseTransmissionColor => &self.diffuse_transmission_color,
-            LayerSlot::ClearCoatNormal => &self.clear_coat_normal,
-            LayerSlot::Anisotropy => &self.anisotropy,
-            LayerSlot::Iridescence => &self.iridescence,
-            LayerSlot::IridescenceThickness => &self.iridescence_thickness,
-        }
-    }
-
-    fn field_mut(&mut self, slot: LayerSlot) -> &mut Option<TextureRef> {
-        match slot {
-            LayerSlot::ClearCoat => &mut self.clear_coat,
-            LayerSlot::ClearCoatRoughness => &mut self.clear_coat_roughness,
-            LayerSlot::Specular => &mut self.specular,
-            LayerSlot::SpecularColor => &mut self.specular_color,
-            LayerSlot::SheenColor => &mut self.sheen_color,
-            LayerSlot::SheenRoughness => &mut self.sheen_roughness,
-            LayerSlot::DiffuseTransmission => &mut self.diffuse_transmission,
-            LayerSlot::DiffuseTransmissionColor => &mut self.diffuse_transmission_color,
-            LayerSlot::ClearCoatNormal => &mut self.clear_coat_normal,
-            LayerSlot::Anisotropy => &mut self.anisotropy,
-            LayerSlot::Iridescence => &mut self.iridescence,
-            LayerSlot::IridescenceThickness => &mut self.iridescence_thickness,
-        }
+        self.textures.iter().any(Option::is_some)
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn each_slot_indexes_its_place_in_all() {
+        for (k, slot) in LayerSlot::ALL.into_iter().enumerate() {
+            assert_eq!(slot as usize, k, "{slot:?}");
+        }
+    }
 
     #[test]
     fn each_slot_is_its_own_field() {
