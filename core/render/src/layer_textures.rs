@@ -13,13 +13,13 @@
 //! The array is read with the sampler of the first slot that has a texture (glTF lets each
 //! texture have its own; the layer textures of one material share theirs in practice).
 //!
-//! Render thread only (uploads through the queue); no panics: slots naming an image the model
-//! lacks read as having none.
+//! Render thread only (uploads through the queue; the mip chains are built on every core); no
+//! panics: slots naming an image the model lacks read as having none.
 
 use phantogram_assets::model::{LayerSlot, Material, Model};
 
 use crate::Gpu;
-use crate::upload::{create_sampler, mip_chain, write_mip_chain};
+use crate::upload::{create_rgba8_texture, create_sampler, mip_chain, write_mip_chain};
 
 /// A material's layer textures on the GPU.
 pub(crate) struct GpuLayerTextures {
@@ -77,28 +77,19 @@ pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material, made: &mut A
     }
     let width = images.iter().map(|(i, _)| model.images[*i].width).max()?.max(1);
     let height = images.iter().map(|(i, _)| model.images[*i].height).max()?.max(1);
-    let chains: Vec<Vec<(u32, u32, Vec<u8>)>> = images
-        .iter()
-        .map(|&(i, colour)| {
-            let image = &model.images[i];
-            let rgba8 = resized(image.width, image.height, &image.rgba8, width, height);
-            mip_chain(width, height, &rgba8, colour)
-        })
-        .collect();
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("layer textures"),
-        size: wgpu::Extent3d {
-            width,
-            height,
-            depth_or_array_layers: images.len() as u32,
-        },
-        mip_level_count: chains[0].len() as u32,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
+    // Each layer's mip chain on every core, as the model's other textures are built.
+    let chains = phantogram_assets::parallel::map(&images, |&(i, colour)| {
+        let image = &model.images[i];
+        let rgba8 = resized(image.width, image.height, &image.rgba8, width, height);
+        mip_chain(width, height, &rgba8, colour)
     });
+    let texture = create_rgba8_texture(
+        gpu,
+        "layer textures",
+        (width, height, images.len() as u32),
+        chains[0].len() as u32,
+        false,
+    );
     for (layer, chain) in chains.iter().enumerate() {
         write_mip_chain(gpu, &texture, layer as u32, chain);
     }
@@ -116,20 +107,7 @@ pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material, made: &mut A
 
 /// What a material without layer textures binds: one white texel in one layer.
 pub(crate) fn placeholder(gpu: &Gpu) -> wgpu::TextureView {
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("no layer textures"),
-        size: wgpu::Extent3d {
-            width: 1,
-            height: 1,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::Rgba8Unorm,
-        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
-        view_formats: &[],
-    });
+    let texture = create_rgba8_texture(gpu, "no layer textures", (1, 1, 1), 1, false);
     write_mip_chain(gpu, &texture, 0, &[(1, 1, vec![255; 4])]);
     texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),

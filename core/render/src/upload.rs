@@ -61,27 +61,38 @@ pub(super) fn upload_mip_chain(
     levels: &[(u32, u32, Vec<u8>)],
     srgb: bool,
 ) -> wgpu::TextureView {
-    let format = if srgb {
-        wgpu::TextureFormat::Rgba8UnormSrgb
-    } else {
-        wgpu::TextureFormat::Rgba8Unorm
-    };
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
+    let texture = create_rgba8_texture(gpu, label, (width, height, 1), levels.len() as u32, srgb);
+    write_mip_chain(gpu, &texture, 0, levels);
+    texture.create_view(&Default::default())
+}
+
+/// An RGBA8 texture of `(width, height, layers)` with `level_count` mip levels, to be written
+/// ([`write_mip_chain`]) and sampled; its texels decoded from sRGB where `srgb`.
+pub(super) fn create_rgba8_texture(
+    gpu: &Gpu,
+    label: &str,
+    (width, height, layers): (u32, u32, u32),
+    level_count: u32,
+    srgb: bool,
+) -> wgpu::Texture {
+    gpu.device.create_texture(&wgpu::TextureDescriptor {
         label: Some(label),
         size: wgpu::Extent3d {
             width,
             height,
-            depth_or_array_layers: 1,
+            depth_or_array_layers: layers,
         },
-        mip_level_count: levels.len() as u32,
+        mip_level_count: level_count,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format,
+        format: if srgb {
+            wgpu::TextureFormat::Rgba8UnormSrgb
+        } else {
+            wgpu::TextureFormat::Rgba8Unorm
+        },
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
-    });
-    write_mip_chain(gpu, &texture, 0, levels);
-    texture.create_view(&Default::default())
+    })
 }
 
 /// Writes RGBA8 mip `levels` ([`mip_chain`]) into array layer `layer` of `texture`.
