@@ -30,10 +30,10 @@
 //!   `KHR_texture_basisu` (ETC1S or UASTC, gltfpack's `-tc`; the pure-Rust `basisu` transcoder).
 //!   Where a texture names both, the core `source` (the lossless fallback) is used. A texture
 //!   whose image comes only from an extension we do not read is left out with a warning.
-//! * Glass, gems, varnish and cloth by their factors: `KHR_materials_ior`, `_specular`,
-//!   `_clearcoat`, `_transmission`, `_volume`, `_dispersion`, `_sheen` and
-//!   `_diffuse_transmission` ([`Layers`]; of their textures the
-//!   transmission and thickness textures are read, the others are left out with a warning each).
+//! * Glass, gems, varnish, cloth, brushed metal and thin films: `KHR_materials_ior`, `_specular`,
+//!   `_clearcoat`, `_transmission`, `_volume`, `_dispersion`, `_sheen`, `_diffuse_transmission`,
+//!   `_anisotropy` and `_iridescence` (their factors in [`Layers`]; the transmission and thickness
+//!   textures in their own slots, every other texture they name in [`LayerTextures`]).
 //! * `KHR_materials_pbrSpecularGlossiness` (archived by Khronos, but found in older exports) is
 //!   converted to metallic–roughness as Khronos published, texel by texel where it has a texture
 //!   (`spec_gloss`).
@@ -302,8 +302,8 @@ pub struct Material {
     /// Index of refraction, specular strength, varnish, transmission and absorption (glTF's
     /// material extensions); the core material has none.
     pub layers: Layers,
-    /// The textures that scale [`Self::layers`]' varnish, specular, sheen and diffuse
-    /// transmission over the surface.
+    /// The textures that scale [`Self::layers`]' varnish (and tilt it: its normal map), specular,
+    /// sheen, diffuse transmission, anisotropy and thin film over the surface.
     pub layer_textures: LayerTextures,
 }
 
