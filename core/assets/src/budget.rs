@@ -71,7 +71,8 @@ impl ResourceBudget {
 }
 
 /// Bytes `model` takes in memory, as the loader charged them: vertices, indices (every level
-/// of detail's too) and textures with their mip chains.
+/// of detail's too), textures with their mip chains, and what the GPU's layer texture arrays
+/// take beyond those textures ([`crate::model::LayerArrays::extra_bytes`]).
 pub fn model_bytes(model: &crate::model::Model) -> u64 {
     let meshes = model
         .primitives
@@ -86,7 +87,9 @@ pub fn model_bytes(model: &crate::model::Model) -> u64 {
         .iter()
         .map(|i| ResourceBudget::texture_bytes(i.width, i.height))
         .fold(0u64, u64::saturating_add);
-    meshes.saturating_add(images)
+    let layer_arrays =
+        crate::model::LayerArrays::of(&model.materials, &model.images).extra_bytes(&model.materials, &model.images);
+    meshes.saturating_add(images).saturating_add(layer_arrays)
 }
 
 impl Default for ResourceBudget {

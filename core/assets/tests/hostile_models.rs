@@ -379,3 +379,74 @@ fn a_file_larger_than_the_budget_is_refused_before_it_is_read() {
         "{err}"
     );
 }
+
+/// The GPU's layer textures are arrays of one size: one 256² varnish map beside forty 1² sheen
+/// colours (a few hundred bytes of JSON) would make forty-one 256² layers. What that takes beyond
+/// the images is charged; when it does not fit, the layer textures are left out with a warning
+/// and the artifact still opens.
+#[test]
+fn layer_texture_arrays_are_charged_and_left_out_when_they_do_not_fit() {
+    let dir = Scratch::new("hostile-layer-arrays");
+    std::fs::write(dir.join("tri.bin"), triangle_bin(TRIANGLE)).unwrap();
+    std::fs::write(dir.join("big.png"), png(256)).unwrap();
+    std::fs::write(dir.join("tiny.png"), png(1)).unwrap();
+    let count = 40;
+    let images: Vec<&str> = std::iter::once(r#"{"uri":"big.png"}"#)
+        .chain((0..count).map(|_| r#"{"uri":"tiny.png"}"#))
+        .collect();
+    let textures: Vec<String> = (0..=count).map(|i| format!(r#"{{"source":{i}}}"#)).collect();
+    let materials: Vec<String> = (1..=count)
+        .map(|i| {
+            format!(
+                r#"{{"extensions":{{"KHR_materials_clearcoat":{{"clearcoatFactor":1,"clearcoatTexture":{{"index":0}}}},
+                "KHR_materials_sheen":{{"sheenColorFactor":[1,1,1],"sheenColorTexture":{{"index":{i}}}}}}}}}"#
+            )
+        })
+        .collect();
+    let extra = format!(
+        r#","extensionsUsed":["KHR_materials_clearcoat","KHR_materials_sheen"],"images":[{}],"textures":[{}],"materials":[{}]"#,
+        images.join(","),
+        textures.join(","),
+        materials.join(",")
+    );
+    let text = gltf_with_buffer_uri("tri.bin", &extra).replace(
+        r#""attributes":{"POSITION":0}"#,
+        r#""attributes":{"POSITION":0},"material":0"#,
+    );
+    let path = write(&dir, "layers.gltf", &text);
+    let layer = ResourceBudget::texture_bytes(256, 256);
+    let has_layer_textures = |m: &phantogram_assets::model::Model| m.materials.iter().any(|m| m.layer_textures.any());
+
+    // Room for them: kept, and counted in what the model takes.
+    let roomy = ResourceBudget {
+        memory_bytes: 64 << 20,
+        ..ResourceBudget::PHONE
+    };
+    let model = load_gltf_within(&path, roomy).unwrap();
+    assert!(has_layer_textures(&model));
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let bytes = phantogram_assets::budget::model_bytes(&model);
+    assert!(
+        bytes >= (count as u64 + 1) * layer && bytes <= roomy.memory_bytes,
+        "{bytes}"
+    );
+
+    // 4 MiB holds the images (0.33 MiB) but not the 14 MiB of layers: left out, said, and the
+    // model within its budget.
+    let tight = ResourceBudget {
+        memory_bytes: 4 << 20,
+        ..ResourceBudget::PHONE
+    };
+    let model = load_gltf_within(&path, tight).unwrap();
+    assert!(!has_layer_textures(&model));
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("layer textures") && w.contains("memory_bytes") && w.contains("left out")),
+        "{:?}",
+        model.warnings
+    );
+    assert!(phantogram_assets::budget::model_bytes(&model) <= tight.memory_bytes);
+    assert_eq!(model.triangle_count(), 1);
+}

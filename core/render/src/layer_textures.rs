@@ -1,107 +1,91 @@
-//! A material's layer textures (assets crate, `model::LayerTextures`: varnish and its normal map,
-//! specular, sheen, diffuse transmission, anisotropy and iridescence) as one 2D array texture, one layer per image they
-//! use, so that the twelve slots take one texture binding and one sampler (`layer_textures` and `layer_sampler`
-//! in `scene.wgsl`; the fragment stage has 16 texture bindings, 14 of them taken before).
+//! The model's layer textures (assets crate, `model::LayerTextures`: varnish and its normal map,
+//! specular, sheen, diffuse transmission, anisotropy and iridescence) as 2D array textures, one
+//! layer per image, so that a material's twelve slots take one texture binding and one sampler
+//! (`layer_textures` and `layer_sampler` in `scene.wgsl`; the fragment stage has 16 texture
+//! bindings, 14 of them taken before). Which arrays there are, which images they hold and which
+//! one each material reads is the assets crate's `model::LayerArrays` (the plan the loader
+//! charged against the memory budget); this module makes them.
 //!
-//! Materials whose layer slots use the same images (in the same order of first use) share one
-//! array ([`Arrays`]), as a model's materials often share one packed texture.
-//!
-//! Invariants: every layer has the size of the largest image used (smaller ones are resized
-//! bilinearly up to it: the layers of an array share their size) and the full mip chain; colour
-//! slots' images are stored as their sRGB codes in a linear format (their mips averaged in
-//! linear light) and decoded by the shader after filtering, since one array has one format.
-//! The array is read with the sampler of the first slot that has a texture (glTF lets each
-//! texture have its own; the layer textures of one material share theirs in practice).
+//! Invariants: every layer of an array has the array's size and the full mip chain (smaller
+//! images are resized bilinearly up to it); colour slots' images are stored as their sRGB codes
+//! in a linear format (their mips averaged in linear light) and decoded by the shader after
+//! filtering, since one array has one format. A material reads its array with the sampler of its
+//! first slot that has a texture (glTF lets each texture have its own; the layer textures of one
+//! material share theirs in practice).
 //!
 //! Render thread only (uploads through the queue; the mip chains are built on every core); no
 //! panics: slots naming an image the model lacks read as having none.
 
-use phantogram_assets::model::{LayerSlot, Material, Model};
+use phantogram_assets::model::{LayerArray, LayerArrays, LayerSlot, Material, Model};
 
 use crate::Gpu;
 use crate::upload::{create_rgba8_texture, create_sampler, mip_chain, write_mip_chain};
 
 /// A material's layer textures on the GPU.
 pub(crate) struct GpuLayerTextures {
-    /// The layers together (`texture_2d_array`).
+    /// Its array's layers together (`texture_2d_array`).
     pub(crate) view: wgpu::TextureView,
     pub(crate) sampler: wgpu::Sampler,
     /// The layer each slot reads ([`LayerSlot::ALL`] order), none where it has no texture.
     pub(crate) layer_of_slot: [Option<u32>; 12],
 }
 
-/// The images a material's layer slots use, once per colour space, and the layer of each slot
-/// ([`LayerSlot::ALL`] order): slots naming an image the model lacks have none.
-pub(crate) fn layers_of(material: &Material, image_count: usize) -> (Vec<(usize, bool)>, [Option<u32>; 12]) {
-    let mut images: Vec<(usize, bool)> = Vec::new();
-    let mut layer_of_slot = [None; 12];
-    for (k, slot) in LayerSlot::ALL.into_iter().enumerate() {
-        let Some(t) = material.layer_textures.get(slot) else {
-            continue;
-        };
-        if t.image >= image_count {
-            continue;
-        }
-        let key = (t.image, slot.is_colour());
-        let layer = images.iter().position(|i| *i == key).unwrap_or_else(|| {
-            images.push(key);
-            images.len() - 1
-        });
-        layer_of_slot[k] = Some(layer as u32);
-    }
-    (images, layer_of_slot)
+/// The model's layer arrays ([`LayerArrays::of`]) uploaded, and each material's share of them
+/// (by material index; none for a material without layer textures).
+pub(crate) fn upload_all(gpu: &Gpu, model: &Model) -> Vec<Option<GpuLayerTextures>> {
+    let plan = LayerArrays::of(&model.materials, &model.images);
+    let views: Vec<wgpu::TextureView> = plan.arrays.iter().map(|a| upload_array(gpu, model, a)).collect();
+    model
+        .materials
+        .iter()
+        .zip(&plan.materials)
+        .map(|(material, layers)| {
+            let layers = layers.as_ref()?;
+            Some(GpuLayerTextures {
+                view: views.get(layers.array)?.clone(),
+                sampler: create_sampler(&gpu.device, &first_texture(material, &layers.layer_of_slot)?.sampler),
+                layer_of_slot: layers.layer_of_slot,
+            })
+        })
+        .collect()
 }
 
-/// The arrays made so far for a model, by the images (and colour spaces) of their layers in
-/// order: materials whose layer slots use the same images share one.
-pub(crate) type Arrays = std::collections::HashMap<Vec<(usize, bool)>, wgpu::TextureView>;
-
-/// `material`'s layer textures from `model`'s images, uploaded or found in `made`; `None` where
-/// it has none.
-pub(crate) fn upload(gpu: &Gpu, model: &Model, material: &Material, made: &mut Arrays) -> Option<GpuLayerTextures> {
-    let (images, layer_of_slot) = layers_of(material, model.images.len());
-    if images.is_empty() {
-        return None;
-    }
-    let first = LayerSlot::ALL
+/// The texture of `material`'s first slot that has a layer.
+fn first_texture(
+    material: &Material,
+    layer_of_slot: &[Option<u32>; 12],
+) -> Option<phantogram_assets::model::TextureRef> {
+    LayerSlot::ALL
         .into_iter()
         .zip(layer_of_slot)
-        .find_map(|(slot, layer)| layer.and(material.layer_textures.get(slot)))?;
-    let sampler = create_sampler(&gpu.device, &first.sampler);
-    if let Some(view) = made.get(&images) {
-        return Some(GpuLayerTextures {
-            view: view.clone(),
-            sampler,
-            layer_of_slot,
-        });
-    }
-    let width = images.iter().map(|(i, _)| model.images[*i].width).max()?.max(1);
-    let height = images.iter().map(|(i, _)| model.images[*i].height).max()?.max(1);
+        .find_map(|(slot, layer)| layer.and(material.layer_textures.get(slot)))
+}
+
+/// One array of `model`'s images.
+fn upload_array(gpu: &Gpu, model: &Model, array: &LayerArray) -> wgpu::TextureView {
+    let (width, height) = (array.width.max(1), array.height.max(1));
     // Each layer's mip chain on every core, as the model's other textures are built.
-    let chains = phantogram_assets::parallel::map(&images, |&(i, colour)| {
-        let image = &model.images[i];
-        let rgba8 = resized(image.width, image.height, &image.rgba8, width, height);
+    let chains = phantogram_assets::parallel::map(&array.images, |&(i, colour)| {
+        let rgba8 = model.images.get(i).map_or_else(
+            || vec![255; (width * height * 4) as usize],
+            |image| resized(image.width, image.height, &image.rgba8, width, height),
+        );
         mip_chain(width, height, &rgba8, colour)
     });
+    let levels = chains.first().map_or(1, |c| c.len() as u32);
     let texture = create_rgba8_texture(
         gpu,
         "layer textures",
-        (width, height, images.len() as u32),
-        chains[0].len() as u32,
+        (width, height, chains.len().max(1) as u32),
+        levels,
         false,
     );
     for (layer, chain) in chains.iter().enumerate() {
         write_mip_chain(gpu, &texture, layer as u32, chain);
     }
-    let view = texture.create_view(&wgpu::TextureViewDescriptor {
+    texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),
         ..Default::default()
-    });
-    made.insert(images, view.clone());
-    Some(GpuLayerTextures {
-        view,
-        sampler,
-        layer_of_slot,
     })
 }
 
@@ -145,49 +129,6 @@ fn resized(width: u32, height: u32, rgba8: &[u8], to_width: u32, to_height: u32)
 #[cfg(test)]
 mod tests {
     use super::*;
-    use phantogram_assets::model::TextureRef;
-
-    fn texture(image: usize) -> Option<TextureRef> {
-        Some(TextureRef {
-            image,
-            tex_coord: 0,
-            transform: Default::default(),
-            sampler: Default::default(),
-        })
-    }
-
-    #[test]
-    fn slots_share_a_layer_per_image_and_colour_space() {
-        let mut m = Material::default();
-        // A varnish's share in R and its roughness in G of one image (as glTF's samples pack
-        // them), the sheen's colour (sRGB) and roughness (linear) of another: three layers.
-        m.layer_textures.set(LayerSlot::ClearCoat, texture(0));
-        m.layer_textures.set(LayerSlot::ClearCoatRoughness, texture(0));
-        m.layer_textures.set(LayerSlot::SheenColor, texture(1));
-        m.layer_textures.set(LayerSlot::SheenRoughness, texture(1));
-        // An image the model lacks: no layer.
-        m.layer_textures.set(LayerSlot::Specular, texture(7));
-        let (images, layers) = layers_of(&m, 2);
-        assert_eq!(images, [(0, false), (1, true), (1, false)]);
-        assert_eq!(
-            layers,
-            [
-                Some(0),
-                Some(0),
-                None,
-                None,
-                Some(1),
-                Some(2),
-                None,
-                None,
-                None,
-                None,
-                None,
-                None
-            ]
-        );
-        assert_eq!(layers_of(&Material::default(), 2).0, []);
-    }
 
     #[test]
     fn resizing_keeps_flat_colour_and_stretches_steps() {

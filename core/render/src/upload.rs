@@ -152,7 +152,7 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let device = &gpu.device;
     // Each image once per colour space it is used in; the mip chains are built on every core
     // (a good part of a textured scan's time to first frame), then uploaded in turn.
-    // (The layer extensions' textures go into an array per material: `layer_textures`.)
+    // (The layer extensions' textures go into arrays shared by the materials: `layer_textures`.)
     let mut used: Vec<(usize, bool)> = Vec::new();
     for m in &model.materials {
         for (t, srgb) in m.own_slot_textures().into_iter().flatten() {
@@ -178,14 +178,14 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());
     let no_layer_textures = crate::layer_textures::placeholder(gpu);
-    let mut layer_arrays = crate::layer_textures::Arrays::new();
+    let mut layer_textures = crate::layer_textures::upload_all(gpu, model).into_iter();
     let glass_shadows = model.materials.iter().any(|m| m.transmits());
     let materials = model
         .materials
         .iter()
         .map(|m| {
             let transmits = m.transmits();
-            let layer_textures = crate::layer_textures::upload(gpu, model, m, &mut layer_arrays);
+            let layer_textures = layer_textures.next().flatten();
             let layer_of_slot = layer_textures.as_ref().map_or([None; 12], |l| l.layer_of_slot);
             let uniform = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("material"),

@@ -1847,6 +1847,23 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         }
     }
     model.materials = materials;
+    // What the GPU's layer texture arrays take beyond the images, charged last: unlike the
+    // meshes and images they can be left out, and the artifact still shows.
+    let layer_arrays = LayerArrays::of(&model.materials, &model.images);
+    let charged = ctx.spending.borrow_mut().charge_bytes(
+        || format!("the layer textures' {} arrays", layer_arrays.arrays.len()),
+        layer_arrays.extra_bytes(&model.materials, &model.images),
+    );
+    if let Err(e) = charged {
+        for m in &mut model.materials {
+            for slot in LayerSlot::ALL {
+                m.layer_textures.set(slot, None);
+            }
+        }
+        model.warnings.push(format!(
+            "{e}: the varnish, sheen, specular, diffuse transmission, anisotropy and iridescence textures were left out"
+        ));
+    }
     meshes_share.step(1.0).map_err(cancelled)?;
     if model.triangle_count() == 0 {
         return Err(ModelError::Empty {

@@ -780,6 +780,7 @@ fn push_ball(mesh: &mut Mesh, centre: Vec3, radius: f32, segments: u32, rings: u
     }
 }
 
+pub use layer_arrays::{LayerArray, LayerArrays, MaterialLayers};
 pub use layer_textures::{LayerSlot, LayerTextures};
 pub use layers::Layers;
 pub use loader::{
@@ -791,6 +792,7 @@ pub use mesh_file::MeshFormat;
 
 mod encoded_image;
 mod instancing;
+pub mod layer_arrays;
 pub mod layer_textures;
 pub mod layers;
 mod loader;
