@@ -71,7 +71,7 @@ impl ResourceBudget {
 }
 
 /// Bytes `model` takes in memory, as the loader charged them: vertices, indices (every level
-/// of detail's too), textures with their mip chains, and what the GPU's layer texture arrays
+/// of detail's too), textures with their mip chains (and the KTX 2.0 files kept beside them), and what the GPU's layer texture arrays
 /// take beyond those textures ([`crate::model::LayerArrays::extra_bytes`]).
 pub fn model_bytes(model: &crate::model::Model) -> u64 {
     let meshes = model
@@ -85,7 +85,10 @@ pub fn model_bytes(model: &crate::model::Model) -> u64 {
     let images = model
         .images
         .iter()
-        .map(|i| ResourceBudget::texture_bytes(i.width, i.height))
+        .map(|i| {
+            let kept = i.basis.as_ref().map_or(0, |b| b.ktx2.len() as u64);
+            ResourceBudget::texture_bytes(i.width, i.height).saturating_add(kept)
+        })
         .fold(0u64, u64::saturating_add);
     let layer_arrays =
         crate::model::LayerArrays::of(&model.materials, &model.images).extra_bytes(&model.materials, &model.images);

@@ -68,7 +68,8 @@ impl Gpu {
         let (device, queue) = pollster::block_on(adapter.request_device(&wgpu::DeviceDescriptor {
             label: Some("phantogram"),
             // Timestamp queries where offered: the frame budget of big scans follows GPU time.
-            required_features: adapter.features() & wgpu::Features::TIMESTAMP_QUERY,
+            // Block-compressed textures where offered: a quarter of RGBA8's memory.
+            required_features: adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | crate::block_textures::FEATURES),
             required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
             ..Default::default()
         }))

@@ -80,6 +80,8 @@ pub(crate) struct GpuModel {
     pub(crate) standing: phantogram_geometry::containment::Aabb,
     /// Baked impostors by the model's primitive index ([`Renderer::bake_impostors`]).
     pub(crate) impostors: Vec<Option<impostor::GpuImpostor>>,
+    /// Bytes its textures take ([`Renderer::texture_bytes`]).
+    pub(crate) texture_bytes: u64,
 }
 
 impl GpuModel {

@@ -30,12 +30,12 @@ pub(crate) struct GpuLayerTextures {
     pub(crate) layer_of_slot: [Option<u32>; 12],
 }
 
-/// The model's layer arrays ([`LayerArrays::of`]) uploaded, and each material's share of them
-/// (by material index; none for a material without layer textures).
-pub(crate) fn upload_all(gpu: &Gpu, model: &Model) -> Vec<Option<GpuLayerTextures>> {
+/// The model's layer arrays ([`LayerArrays::of`]) uploaded: each material's share of them (by
+/// material index; none for a material without layer textures), and the bytes they take.
+pub(crate) fn upload_all(gpu: &Gpu, model: &Model) -> (Vec<Option<GpuLayerTextures>>, u64) {
     let plan = LayerArrays::of(&model.materials, &model.images);
     let views: Vec<wgpu::TextureView> = plan.arrays.iter().map(|a| upload_array(gpu, model, a)).collect();
-    model
+    let materials = model
         .materials
         .iter()
         .zip(&plan.materials)
@@ -47,7 +47,8 @@ pub(crate) fn upload_all(gpu: &Gpu, model: &Model) -> Vec<Option<GpuLayerTexture
                 layer_of_slot: layers.layer_of_slot,
             })
         })
-        .collect()
+        .collect();
+    (materials, plan.bytes())
 }
 
 /// The texture of `material`'s first slot that has a layer.

@@ -87,6 +87,7 @@ use phantogram_geometry::projection::OffAxisProjection;
 
 mod backdrop;
 mod bindings;
+mod block_textures;
 mod environment;
 mod frame;
 mod gpu;
@@ -587,6 +588,13 @@ impl Renderer {
 
     pub fn gpu(&self) -> &Gpu {
         &self.gpu
+    }
+
+    /// Bytes the model's textures take on the GPU, with their mips: the materials' own (RGBA8,
+    /// or block-compressed where the image came from a Basis Universal texture and the device
+    /// samples a block format) and the layer arrays.
+    pub fn texture_bytes(&self) -> u64 {
+        self.model.texture_bytes
     }
 
     /// Replaces the model drawn (keeps pipelines and targets).

@@ -161,16 +161,34 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
             }
         }
     }
+    // A Basis Universal texture in the device's block format where it gives a whole chain.
+    let block_format = crate::block_textures::format_for(device);
     let chains = phantogram_assets::parallel::map(&used, |&(image, srgb)| {
         let img = &model.images[image];
-        mip_chain(img.width, img.height, &img.rgba8, srgb)
+        let blocks = img
+            .basis
+            .as_ref()
+            .zip(block_format)
+            .and_then(|(b, f)| Some((f, b.blocks(f)?)));
+        blocks.ok_or_else(|| mip_chain(img.width, img.height, &img.rgba8, srgb))
     });
+    let mut texture_bytes = 0u64;
     let views: std::collections::HashMap<(usize, bool), wgpu::TextureView> = used
         .iter()
         .zip(chains)
         .map(|(&(image, srgb), levels)| {
             let img = &model.images[image];
-            let view = upload_mip_chain(gpu, &img.name, img.width, img.height, &levels, srgb);
+            let view = match levels {
+                Ok((format, blocks)) => {
+                    let (view, bytes) = crate::block_textures::upload(gpu, &img.name, format, srgb, &blocks);
+                    texture_bytes += bytes;
+                    view
+                }
+                Err(levels) => {
+                    texture_bytes += levels.iter().map(|(_, _, l)| l.len() as u64).sum::<u64>();
+                    upload_mip_chain(gpu, &img.name, img.width, img.height, &levels, srgb)
+                }
+            };
             ((image, srgb), view)
         })
         .collect();
@@ -178,7 +196,8 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
     let flat_normal = upload_texture(gpu, "flat normal", 1, 1, &[128, 128, 255, 255], false);
     let default_sampler = create_sampler(device, &Sampler::default());
     let no_layer_textures = crate::layer_textures::placeholder(gpu);
-    let mut layer_textures = crate::layer_textures::upload_all(gpu, model).into_iter();
+    let (layer_textures, layer_texture_bytes) = crate::layer_textures::upload_all(gpu, model);
+    let mut layer_textures = layer_textures.into_iter();
     let glass_shadows = model.materials.iter().any(|m| m.transmits());
     let materials = model
         .materials
@@ -337,5 +356,6 @@ pub(super) fn upload_model(gpu: &Gpu, layout: &wgpu::BindGroupLayout, model: &Mo
         bounds,
         standing,
         impostors: Vec::new(),
+        texture_bytes: texture_bytes.saturating_add(layer_texture_bytes),
     }
 }

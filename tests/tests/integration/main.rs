@@ -10,6 +10,7 @@ mod accessibility;
 mod anisotropy;
 mod artifacts;
 mod assets;
+mod block_textures;
 mod calibration_ui;
 mod containment_sweep;
 mod detail;

@@ -535,6 +535,7 @@ fn alpha_masked_surfaces_shadow_only_where_they_are_kept() {
         width: 1,
         height: 1,
         rgba8: vec![255, 255, 255, 0],
+        basis: None,
     });
     let transparent = TextureRef {
         image: 0,
@@ -779,6 +780,7 @@ fn pipelines_that_skip_missing_textures_draw_the_same_picture() {
         width: 2,
         height: 2,
         rgba8: rgba.repeat(4),
+        basis: None,
     };
     let slot = |image: usize| TextureRef {
         image,

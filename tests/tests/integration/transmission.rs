@@ -56,6 +56,7 @@ pub(crate) fn one_texel(rgba: [u8; 4]) -> (Image, TextureRef) {
         width: 1,
         height: 1,
         rgba8: rgba.to_vec(),
+        basis: None,
     };
     let reference = TextureRef {
         image: 0,

@@ -14,9 +14,10 @@
 //! larger than the device draws, the file's own mip level nearest above the fitted size is
 //! transcoded instead of the base level. A KTX 2.0 file that is not Basis Universal (plain
 //! `VK_FORMAT` data), a cube map or array, a video or an HDR texture is refused by name.
-//! TODO(phones): transcode to ASTC / ETC2 / BC7 where the device samples them, to keep the
-//! texture compressed on the GPU (4–8× less memory); today every texture is uploaded as RGBA8,
-//! so the file's compression saves download size and decode time, not GPU memory.
+//! The file is also kept beside that copy (`super::gpu_blocks`), so that the renderer can
+//! transcode it again to ASTC, BC7 or ETC2, whichever the device samples, and keep the texture
+//! compressed on the GPU (a quarter of RGBA8's memory). That needs the file's own mips down to
+//! 1 × 1 and a size in whole 4 × 4 blocks; other files are drawn from the RGBA8 copy.
 //!
 //! **Panics**: none escape; a decoder that panics on damaged data becomes that image's error
 //! (the transcoder does on some: a million mutated copies of the test textures found a slice
@@ -156,7 +157,7 @@ impl Encoded {
 
 /// Opens a KTX 2.0 file as a Basis Universal texture a material can use: 2D, one image, a codec
 /// that transcodes to 8-bit RGBA.
-fn open_basis(raw: &[u8]) -> Result<basisu::Transcoder<'_>, String> {
+pub(super) fn open_basis(raw: &[u8]) -> Result<basisu::Transcoder<'_>, String> {
     check_level_claims(raw)?;
     let basis = std::panic::catch_unwind(|| basisu::Transcoder::new(raw))
         .map_err(|_| "the KTX 2.0 reader failed on damaged data".to_owned())?

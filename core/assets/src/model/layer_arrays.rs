@@ -178,6 +178,7 @@ mod tests {
             width: side,
             height: side,
             rgba8: Vec::new(),
+            basis: None,
         }
     }
 

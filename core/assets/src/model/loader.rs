@@ -10,7 +10,7 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use super::LayerSlot;
-use super::encoded_image::Encoded;
+use super::encoded_image::{Codec, Encoded};
 use super::instancing;
 use super::meshopt_views::{self, DecodedViews};
 use super::point_cloud;
@@ -1491,12 +1491,17 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         images_share.advance(done as f32 / image_count);
         // Larger than the device's textures: the user is told it was scaled down.
         let note = header.scaled_down_note(&what(), *fitted);
+        // A Basis Universal texture is kept beside its texels for the GPU's own block formats.
+        let basis = (header.codec == Codec::Basis)
+            .then(|| BasisSource::of_level(raw, decoded.width(), decoded.height()))
+            .flatten();
         Ok((
             Image {
                 name: name.clone(),
                 width: decoded.width(),
                 height: decoded.height(),
                 rgba8: decoded.into_raw(),
+                basis,
             },
             note,
         ))
@@ -1516,7 +1521,16 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
             }
         }
     })?;
-    let (images, image_notes): (Vec<Image>, Vec<Option<String>>) = images.into_iter().unzip();
+    let (mut images, image_notes): (Vec<Image>, Vec<Option<String>>) = images.into_iter().unzip();
+    // The KTX 2.0 files kept are charged too; one that does not fit is dropped (its texels are
+    // drawn from the RGBA8 copy).
+    for image in &mut images {
+        if let Some(basis) = &image.basis
+            && spending.charge_bytes(String::new, basis.ktx2.len() as u64).is_err()
+        {
+            image.basis = None;
+        }
+    }
     images_share.step(1.0).map_err(cancelled)?;
     drop(encoded); // the compressed copies are not needed while the meshes are built
     let ctx = Ctx {
@@ -1538,7 +1552,6 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         })
         .chain(image_notes.into_iter().flatten())
         .collect();
-    let mut images = images;
     let mut materials = Vec::with_capacity(doc.materials().len() + 1);
     for m in doc.materials() {
         let mut material = material_of(&m, &mut warnings);

@@ -420,6 +420,9 @@ pub struct Image {
     pub width: u32,
     pub height: u32,
     pub rgba8: Vec<u8>,
+    /// The Basis Universal texture these texels were transcoded from, where they are one of its
+    /// levels: the renderer transcodes it again to a block-compressed format its GPU samples.
+    pub basis: Option<BasisSource>,
 }
 
 #[derive(Clone, Debug, PartialEq)]
@@ -780,6 +783,7 @@ fn push_ball(mesh: &mut Mesh, centre: Vec3, radius: f32, segments: u32, rings: u
     }
 }
 
+pub use gpu_blocks::{BasisSource, BlockFormat, BlockLevel};
 pub use layer_arrays::{LayerArray, LayerArrays, MaterialLayers};
 pub use layer_textures::{LayerSlot, LayerTextures};
 pub use layers::Layers;
@@ -791,6 +795,7 @@ pub use loader::{
 pub use mesh_file::MeshFormat;
 
 mod encoded_image;
+pub mod gpu_blocks;
 mod instancing;
 pub mod layer_arrays;
 pub mod layer_textures;

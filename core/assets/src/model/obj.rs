@@ -259,6 +259,7 @@ fn texture(
                 width: decoded.width(),
                 height: decoded.height(),
                 rgba8: decoded.into_raw(),
+                basis: None,
             });
             Ok(Some(images.len() - 1))
         }

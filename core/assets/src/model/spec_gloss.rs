@@ -136,6 +136,7 @@ pub(super) fn bake(sg: &SpecGloss, specular_glossiness: &Image, diffuse: Option<
         width: w,
         height: h,
         rgba8,
+        basis: None,
     };
     (
         image("metallic-roughness from specular-glossiness", metal_rough),
@@ -225,12 +226,14 @@ mod tests {
             width: 2,
             height: 1,
             rgba8: vec![56, 56, 56, 230, 255, 226, 159, 51],
+            basis: None,
         };
         let diffuse = Image {
             name: "d".into(),
             width: 2,
             height: 1,
             rgba8: vec![200, 50, 50, 255, 0, 0, 0, 255],
+            basis: None,
         };
         let sg = read(&serde_json::json!({})).expect("defaults");
         let (mr, base) = bake(&sg, &sg_image, Some(&diffuse));
@@ -255,6 +258,7 @@ mod tests {
             width: 1,
             height: 1,
             rgba8: vec![0, 0, 0, 255],
+            basis: None,
         };
         let (mr2, base2) = bake(&sg, &sg_image, Some(&small));
         assert!(base2.is_none());
