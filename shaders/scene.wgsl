@@ -147,9 +147,10 @@ override TRANSMIT_LAYER: u32 = 0u;
 @group(0) @binding(7) var ward_map: texture_2d<f32>;
 @group(0) @binding(8) var ward_sampler: sampler;
 // What glass between the light and a surface leaves of the light (render crate,
-// `shadow_filter`): rgb the share passed, alpha the light-space depth of the nearest glass. Read
+// `shadow_filter`): rgb the share passed, alpha the light-space depth of the nearest glass; one
+// layer for one view of the light, six (the faces of its cube) for a lamp among its casters. Read
 // only where `eye.shadow.w` says it holds this frame's glass.
-@group(0) @binding(9) var shadow_filter: texture_2d<f32>;
+@group(0) @binding(9) var shadow_filter: texture_2d_array<f32>;
 // What this eye drew before its farthest glass that blurs or bends the view through it, with its
 // halvings (render crate, `backdrop`): such glass reads what is behind it here (`TRANSMIT_LAYER`
 // 3). A 1×1 placeholder while the model has no such glass.
@@ -455,14 +456,51 @@ fn light_filter(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     if (!GLASS_SHADOWS || eye.shadow.w < 0.5) {
         return vec3<f32>(1.0);
     }
+    if (eye.lamp_shadow.w > 0.5) {
+        return lamp_cube_filter(world, n, l);
+    }
     let p = shadow_map_point(world, n, l);
     if (p.w < 0.5) {
         return vec3<f32>(1.0);
     }
     let size = vec2<f32>(textureDimensions(shadow_filter));
     let texel = vec2<i32>(clamp(p.xy * size, vec2<f32>(0.0), size - vec2<f32>(1.0)));
-    let f = textureLoad(shadow_filter, texel, 0);
+    let f = textureLoad(shadow_filter, texel, 0, 0);
     return select(vec3<f32>(1.0), f.rgb, p.z > f.a);
+}
+
+// `light_filter` for a lamp seen from its cube: the filter's face and texel along the direction
+// from the lamp (offset along the normal as `lamp_cube_visibility` does), by the cube-map lookup
+// rule that the faces were drawn for (render crate, `point_shadow`: layer k the k-th face of +X,
+// −X, +Y, −Y, +Z, −Z, `s` and `t` from the other two components), compared at the cube's depth.
+fn lamp_cube_filter(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
+    let from_lamp = world - eye.lamp_position.xyz;
+    let texel_m = 2.0 * length(from_lamp) / eye.lamp_shadow.z;
+    let n_dot_l = clamp(dot(n, l), 0.05, 1.0);
+    let r = from_lamp + n * texel_m * (1.5 + 2.0 * sqrt(1.0 - n_dot_l * n_dot_l) / n_dot_l);
+    let a = abs(r);
+    var face = 0;
+    var st = vec2<f32>(0.0);
+    var major = 1.0;
+    if (a.x >= a.y && a.x >= a.z) {
+        major = a.x;
+        face = select(1, 0, r.x > 0.0);
+        st = vec2<f32>(select(r.z, -r.z, r.x > 0.0), -r.y);
+    } else if (a.y >= a.z) {
+        major = a.y;
+        face = select(3, 2, r.y > 0.0);
+        st = vec2<f32>(r.x, select(-r.z, r.z, r.y > 0.0));
+    } else {
+        major = a.z;
+        face = select(5, 4, r.z > 0.0);
+        st = vec2<f32>(select(-r.x, r.x, r.z > 0.0), -r.y);
+    }
+    let uv = (st / max(major, 1e-9) + vec2<f32>(1.0)) * 0.5;
+    let size = vec2<f32>(textureDimensions(shadow_filter));
+    let texel = vec2<i32>(clamp(uv * size, vec2<f32>(0.0), size - vec2<f32>(1.0)));
+    let f = textureLoad(shadow_filter, texel, face, 0);
+    let depth = cube_depth(major, eye.lamp_shadow.x, eye.lamp_shadow.y);
+    return select(vec3<f32>(1.0), f.rgb, depth > f.a);
 }
 
 // The depth a cube face stores for a point `major` metres along its axis (point_shadow.rs,

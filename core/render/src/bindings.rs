@@ -33,7 +33,7 @@ pub(crate) struct EyeViews<'a> {
     pub(crate) shadow: &'a wgpu::TextureView,
     pub(crate) shadow_sampler: &'a wgpu::Sampler,
     pub(crate) shadow_cube: &'a wgpu::TextureView,
-    /// What glass leaves of the light (`shadow_filter`).
+    /// What glass leaves of the light (`shadow_filter`): the one view's or the lamp cube's.
     pub(crate) shadow_filter: &'a wgpu::TextureView,
     pub(crate) ward_map: &'a wgpu::TextureView,
     pub(crate) ward_sampler: &'a wgpu::Sampler,
@@ -145,13 +145,18 @@ pub(crate) fn texture_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
 
 /// A filterable 2D array texture at `binding`, read by the fragment stage.
 pub(crate) fn filterable_texture_array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+    texture_array_entry(binding, true)
+}
+
+/// A float 2D array texture at `binding` (filterable or only loaded), read by the fragment stage.
+pub(crate) fn texture_array_entry(binding: u32, filterable: bool) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            sample_type: wgpu::TextureSampleType::Float { filterable },
             view_dimension: wgpu::TextureViewDimension::D2Array,
             multisampled: false,
         },
-        ..float_texture_entry(binding, true)
+        ..float_texture_entry(binding, filterable)
     }
 }
 

@@ -151,7 +151,11 @@ impl Renderer {
             shadow: &self.shadow_view,
             shadow_sampler: &self.shadow_sampler,
             shadow_cube: &self.point_shadow.cube_view,
-            shadow_filter: &self.shadow_filter.view,
+            shadow_filter: if self.cube_filter_bound {
+                &self.cube_filter.view
+            } else {
+                &self.shadow_filter.view
+            },
             ward_map: &self.ward_map.1,
             ward_sampler: &self.ward_sampler,
             backdrop: [0, 1].map(|eye| {

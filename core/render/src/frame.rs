@@ -242,18 +242,26 @@ impl Renderer {
                 faces = Some(views);
             }
         }
-        // Glass filters the light of one view (not a lamp's cube): drawn after the shadows.
-        let mut filter_pass = self.lighting.shadows && cube.is_none() && self.model.glass().next().is_some();
-        if filter_pass && self.shadow_filter.size < SHADOW_SIZE {
+        // Glass filters the light of the one view, or of the lamp cube's six: drawn after the
+        // shadows, with the same views.
+        let on_cube = cube.is_some();
+        let mut filter_pass = self.lighting.shadows && (!on_cube || cube_pass) && self.model.glass().next().is_some();
+        let (size, layers) = if on_cube {
+            (point_shadow::POINT_SHADOW_SIZE, 6)
+        } else {
+            (SHADOW_SIZE, 1)
+        };
+        let mut made_new = false;
+        if filter_pass && self.filter_for(on_cube).size < size {
             let device = self.gpu.device.clone();
             // A device that cannot make it: glass casts no shadow (as before the filter) and the
             // frames go on.
             match checked(&device, "the shadow filter of glass", || {
-                shadow_filter::ShadowFilter::new(&device, SHADOW_SIZE)
+                shadow_filter::ShadowFilter::new(&device, size, layers)
             }) {
                 Ok(made) => {
-                    self.shadow_filter = made;
-                    self.remake_eye_binds();
+                    *self.filter_for(on_cube) = made;
+                    made_new = true;
                 }
                 Err(_) => filter_pass = false,
             }
@@ -261,10 +269,19 @@ impl Renderer {
         if filter_pass {
             let device = self.gpu.device.clone();
             let (module, layout) = (&self.scene.module, &self.scene.shadow_masked_layout);
+            let filter = if on_cube {
+                &mut self.cube_filter
+            } else {
+                &mut self.shadow_filter
+            };
             filter_pass = checked(&device, "the shadow filter's pipeline", || {
-                self.shadow_filter.prepare(&device, module, layout)
+                filter.prepare(&device, module, layout)
             })
             .is_ok();
+        }
+        if filter_pass && (made_new || self.cube_filter_bound != on_cube) {
+            self.cube_filter_bound = on_cube;
+            self.remake_eye_binds();
         }
         if filter_pass {
             for u in &mut uniforms {
@@ -327,11 +344,24 @@ impl Renderer {
                 shadow_triangles +=
                     self.draw_shadow_casters(&mut pass, bind, &shadow_levels, floor_casts, cull.as_ref());
             }
-            if let Some(pipeline) = self.shadow_filter.pipeline().filter(|_| filter_pass) {
+            let filter = if on_cube {
+                &self.cube_filter
+            } else {
+                &self.shadow_filter
+            };
+            // Each view with its matrix, to draw only the glass its frustum reaches.
+            let binds: Vec<(&wgpu::BindGroup, Option<Mat4>)> = match &faces {
+                Some(faces) if on_cube => self.point_shadow.face_binds.iter().zip(faces.map(Some)).collect(),
+                _ => vec![(&self.shadow_bind, None)],
+            };
+            for (view, (bind, cull)) in filter.layer_views.iter().zip(binds) {
+                let Some(pipeline) = filter.pipeline().filter(|_| filter_pass) else {
+                    break;
+                };
                 let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                     label: Some("shadow filter"),
                     color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                        view: &self.shadow_filter.view,
+                        view,
                         depth_slice: None,
                         resolve_target: None,
                         ops: wgpu::Operations {
@@ -342,8 +372,12 @@ impl Renderer {
                     ..Default::default()
                 });
                 pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &self.shadow_bind, &[]);
-                for p in self.model.glass() {
+                pass.set_bind_group(0, bind, &[]);
+                let seen = |p: &GpuPrimitive| match (&cull, &p.bounds) {
+                    (Some(m), Some(b)) => !point_shadow::outside_frustum(m, b),
+                    _ => true,
+                };
+                for p in self.model.glass().filter(|p| seen(p)) {
                     pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
                     p.draw(&mut pass, &shadow_levels);
                 }
@@ -443,6 +477,15 @@ impl Renderer {
 }
 
 impl Renderer {
+    /// The glass filter for a lamp's cube (`cube`) or for one view of the light.
+    fn filter_for(&mut self, cube: bool) -> &mut shadow_filter::ShadowFilter {
+        if cube {
+            &mut self.cube_filter
+        } else {
+            &mut self.shadow_filter
+        }
+    }
+
     /// Makes the eyes' backdrops for the current targets if the model has glass that blurs or
     /// bends (`backdrop`), drops them if it has none, and points the eyes' bind groups at what is
     /// there. Whether this frame draws with a backdrop: not where the device could not make one

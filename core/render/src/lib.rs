@@ -230,8 +230,12 @@ pub struct Renderer {
     shadow_layout: wgpu::BindGroupLayout,
     /// The shadows of a lamp among its casters ([`point_shadow`]).
     point_shadow: point_shadow::PointShadowMap,
-    /// What glass between the light and a surface leaves of the light (`shadow_filter`).
+    /// What glass between the light and a surface leaves of the light (`shadow_filter`): for the
+    /// one view of the light, and for a lamp's cube.
     shadow_filter: shadow_filter::ShadowFilter,
+    cube_filter: shadow_filter::ShadowFilter,
+    /// Whether the eyes' bind groups hold `cube_filter` (else `shadow_filter`).
+    cube_filter_bound: bool,
     /// Draws the levels of the eyes' backdrops (`backdrop`), made with the first that is needed.
     backdrop_halver: Option<backdrop::Halver>,
     /// What the eyes' bind groups hold without a backdrop, and how backdrops are sampled.
@@ -360,7 +364,7 @@ impl Renderer {
                 },
                 filterable_texture_entry(7),
                 filtering_sampler_entry(8),
-                texture_entry(9),
+                texture_array_entry(9, false),
                 filterable_texture_entry(10),
                 filtering_sampler_entry(11),
             ],
@@ -398,7 +402,8 @@ impl Renderer {
         // 1×1 a face until a lamp stands among its casters (see `point_shadow`).
         let point_shadow = point_shadow::PointShadowMap::new(device, &shadow_layout, 1);
         // 1×1 until a model with glass is drawn with shadows.
-        let shadow_filter = shadow_filter::ShadowFilter::new(device, 1);
+        let shadow_filter = shadow_filter::ShadowFilter::new(device, 1, 1);
+        let cube_filter = shadow_filter::ShadowFilter::new(device, 1, 6);
         let ward_map = (WardMap::Uniform, upload_ward_map(&gpu, WardMap::Uniform));
         let ward_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("Ward map"),
@@ -548,6 +553,8 @@ impl Renderer {
             shadow_layout,
             point_shadow,
             shadow_filter,
+            cube_filter,
+            cube_filter_bound: false,
             backdrop_halver: None,
             backdrop_placeholder,
             backdrop_sampler,

@@ -5,18 +5,22 @@
 //! tinted by it. A glass vase then casts a pale shadow, tinted glass a coloured one, where the
 //! depth-only shadow map would give none (transmissive surfaces do not cast there) or a black one.
 //!
-//! Drawn when the frame has transmissive primitives and one view of the light (the directional
-//! light's, or a lamp's single perspective view; a lamp among its casters, seen from a cube, has
-//! no filter: its light passes glass unfiltered). The scene shader reads it by `light_filter`
-//! when the eye block's `shadow.w` says it holds this frame's glass; the pipelines of a model
+//! Drawn when the frame has transmissive primitives and shadows: into one layer for one view of
+//! the light (the directional light's, or a lamp's single perspective view), or into six, the
+//! faces of the lamp's shadow cube (`point_shadow`, same order and views, its depth the cube's),
+//! when a lamp stands among its casters. The renderer keeps one filter of each kind and binds the
+//! one the frame needs. The scene shader reads it by `light_filter` (a face's texel from the
+//! direction, `lamp_cube_filter`, for the cube) when the eye block's `shadow.w` says it holds this
+//! frame's glass; the pipelines of a model
 //! without glass are made with that read compiled out (`GLASS_SHADOWS`: read behind the branch
 //! alone, it cost such frames 4–7 % on lavapipe, `benchmarks/render.md`), and so are the
 //! impostors' (a big scan's far parts receive glass's light unfiltered). The share is taken at
 //! normal incidence (the Fresnel loss at the light's angle and the refracted path's length are
 //! not modelled, nor caustics).
 //!
-//! Made 1×1 and grown to the shadow map's size with the first model that needs it (the eyes'
-//! bind groups are remade then). Render thread only, like the renderer; no panics.
+//! Made 1×1 and grown to its shadow map's size the first time a frame needs it (the eyes' bind
+//! groups are remade then): 8 MiB for the one view, 12 MiB for the cube. Render thread only,
+//! like the renderer; no panics.
 
 use crate::pipelines::{SHADOW_MASKED_ATTRIBUTES, SHADOW_PRIMITIVE, vertex_buffer};
 
@@ -33,19 +37,24 @@ pub(crate) const NOTHING_FILTERED: wgpu::Color = wgpu::Color {
 };
 
 pub(crate) struct ShadowFilter {
+    /// Every layer (`texture_2d_array`), as the scene shader reads it.
     pub(crate) view: wgpu::TextureView,
+    /// Each layer alone, as the filter pass draws into it.
+    pub(crate) layer_views: Vec<wgpu::TextureView>,
+    /// Texels along a side.
     pub(crate) size: u32,
     pipeline: Option<wgpu::RenderPipeline>,
 }
 
 impl ShadowFilter {
-    pub(crate) fn new(device: &wgpu::Device, size: u32) -> Self {
+    /// A filter of `layers` layers (1: one view; 6: a cube's faces) of `size`² texels.
+    pub(crate) fn new(device: &wgpu::Device, size: u32, layers: u32) -> Self {
         let texture = device.create_texture(&wgpu::TextureDescriptor {
             label: Some("shadow filter"),
             size: wgpu::Extent3d {
                 width: size,
                 height: size,
-                depth_or_array_layers: 1,
+                depth_or_array_layers: layers,
             },
             mip_level_count: 1,
             sample_count: 1,
@@ -54,8 +63,22 @@ impl ShadowFilter {
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
             view_formats: &[],
         });
+        let layer_views = (0..layers)
+            .map(|layer| {
+                texture.create_view(&wgpu::TextureViewDescriptor {
+                    dimension: Some(wgpu::TextureViewDimension::D2),
+                    base_array_layer: layer,
+                    array_layer_count: Some(1),
+                    ..Default::default()
+                })
+            })
+            .collect();
         Self {
-            view: texture.create_view(&Default::default()),
+            view: texture.create_view(&wgpu::TextureViewDescriptor {
+                dimension: Some(wgpu::TextureViewDimension::D2Array),
+                ..Default::default()
+            }),
+            layer_views,
             size,
             pipeline: None,
         }

@@ -294,7 +294,7 @@ pub(crate) fn render_over_floor_as(
 
 /// [`render_over_floor`], with `lamp` in place of the directional light if given; also the
 /// triangles the shadow passes drew.
-fn render_over_floor_lit(
+pub(crate) fn render_over_floor_lit(
     model: Model,
     shadows: bool,
     toward_light: Vec3,

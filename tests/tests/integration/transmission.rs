@@ -8,7 +8,7 @@
 //! material under test floating over it; the pixel at the centre looks through the upper block's
 //! top face onto the lower block's.
 
-use crate::render::{OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_over_floor};
+use crate::render::{OBLIQUE_LIGHT, add_part, pixel_at, push_floor_marker, render_over_floor, render_over_floor_lit};
 use phantogram::glam::Vec3;
 use phantogram::model::{Image, Layers, Material, Mesh, Model, TextureRef, Vertex};
 use phantogram::projection::OffAxisProjection;
@@ -330,6 +330,52 @@ fn glass_casts_a_pale_shadow_and_tinted_glass_a_coloured_one() {
     assert!(
         red_shadow[0] > 0.85 * red_lit[0] && red_shadow[1] < 0.8 * red_lit[1] && red_shadow[2] < 0.8 * red_lit[2],
         "red glass's shadow: {red_shadow:?} vs {red_lit:?}"
+    );
+}
+
+/// A lamp among what it shadows (seen from its cube, `render::a_lamp_among_its_casters_shadows_every_way`'s
+/// scene): red glass to its −x casts a red shadow and an opaque block to its +y a dark one, each
+/// read on the floor beyond the block against the point mirrored across the lamp in x, where
+/// nothing stands between. Before the cube had a glass filter, the lamp's light passed the glass
+/// as if it were not there.
+#[test]
+fn glass_among_a_lamps_casters_casts_a_coloured_shadow() {
+    let mut marker = Mesh::default();
+    push_floor_marker(&mut marker);
+    let mut model = Model::from_painted_mesh("glass among a lamp's casters", marker);
+    let mut red = Mesh::default();
+    red.push_cube(Vec3::new(-0.012, 0.006, -0.024), 0.003, [1.0; 4]);
+    add_part(&mut model, red, glass([1.0, 0.1, 0.1], Layers::default()));
+    let mut block = Mesh::default();
+    block.push_cube(Vec3::new(0.006, 0.012, -0.024), 0.003, [1.0; 4]);
+    add_part(&mut model, block, opaque_white());
+    let lamp = phantogram::render::Lamp {
+        position_m: Vec3::new(0.0, 0.0, -0.022),
+        axis: Vec3::NEG_Z,
+        cone_half_angle_rad: None,
+        intensity_rgb: Vec3::splat(0.004),
+    };
+    let Some((pixels, proj, _)) = render_over_floor_lit(model, true, OBLIQUE_LIGHT, Some(lamp)) else {
+        return;
+    };
+    let rgb = |(x, y): (f32, f32)| {
+        let c = pixel_at(&pixels, &proj, Vec3::new(x, y, -0.031));
+        [c[0] as f32, c[1] as f32, c[2] as f32]
+    };
+    let (red_shadow, red_lit) = (rgb((-0.029, 0.018)), rgb((0.029, 0.018)));
+    let (dark, dark_lit) = (rgb((0.018, 0.029)), rgb((-0.018, 0.029)));
+    println!(
+        "floor beyond the red glass {red_shadow:?} (mirrored {red_lit:?}), beyond the block {dark:?} (mirrored {dark_lit:?})"
+    );
+    assert!(
+        red_shadow[0] > 0.85 * red_lit[0] && red_shadow[1] < 0.8 * red_lit[1] && red_shadow[2] < 0.8 * red_lit[2],
+        "red glass's shadow: {red_shadow:?} vs {red_lit:?}"
+    );
+    // Behind the block only the room's light is left (about 51 of the lit floor's 82 here):
+    // what the red glass leaves in green and blue.
+    assert!(
+        (0..3).all(|c| dark[c] < dark_lit[c] - 20.0 && (dark[c] - red_shadow[1]).abs() < 3.0),
+        "the opaque block's shadow: {dark:?} vs {dark_lit:?}"
     );
 }
 
