@@ -4,9 +4,10 @@
 //! Read: the `vertex` element's `x y z`, `nx ny nz` (when all three are there) and
 //! `red green blue [alpha]` (8-bit, or 0–1 floats; a Gaussian-splat file's `f_dc_0..2` colour
 //! where these are absent), and the `face` element's index list (`vertex_indices` or
-//! `vertex_index`; polygons become fans; without faces the file is a point cloud). Every other
-//! element and property is skipped, list properties included (a splat's opacity, scales and
-//! rotation too: its points are drawn as `point_cloud`'s discs). Texture coordinates and
+//! `vertex_index`; polygons become fans; without faces the file is a point cloud). A splat file's
+//! points are drawn as `point_cloud`'s discs: those less than half opaque are left out, and a
+//! flat splat's plane (from its scales and rotation) is its disc's ([`splat_normal`]). Every other
+//! element and property is skipped, list properties included. Texture coordinates and
 //! `TextureFile` comments are not read: such a scan shows its vertex colours, or none.
 //! **Panics**: none; an element's count is held to what the rest of the file can hold (at least a
 //! byte an element in binary, two characters in ASCII) before it sizes anything.
@@ -298,8 +299,21 @@ fn read_vertices(body: &mut Body, element: &Element, soup: &mut Soup) -> Result<
         (None, [Some(r), Some(g), Some(b)]) => Some([r, g, b]),
         _ => None,
     };
+    // Its opacity (a logit) and its shape (the log of each axis's standard deviation, and the
+    // axes' rotation as an unnormalised w x y z quaternion).
+    let opacity = dc.and(find("opacity"));
+    let shape = match (
+        [find("scale_0"), find("scale_1"), find("scale_2")],
+        [find("rot_0"), find("rot_1"), find("rot_2"), find("rot_3")],
+    ) {
+        ([Some(a), Some(b), Some(c)], [Some(w), Some(i), Some(j), Some(k)]) if dc.is_some() => {
+            Some(([a, b, c], [w, i, j, k]))
+        }
+        _ => None,
+    };
     soup.positions.reserve(element.count);
     let mut values = vec![0.0f64; element.properties.len()];
+    let mut splat_normals = Vec::new();
     for _ in 0..element.count {
         for (value, property) in values.iter_mut().zip(&element.properties) {
             if property.list.is_some() {
@@ -308,9 +322,18 @@ fn read_vertices(body: &mut Body, element: &Element, soup: &mut Soup) -> Result<
                 *value = body.value(property.scalar)?;
             }
         }
+        // A splat less than half opaque at its centre (logit below 0) is haze where it is drawn
+        // (and often a floater the fitting left in the air): an opaque disc would misstate it.
+        if opacity.is_some_and(|k| values[k] < 0.0) {
+            continue;
+        }
         soup.positions
             .push([values[x] as f32, values[y] as f32, values[z] as f32]);
-        if let Some([a, b, c]) = normal {
+        if let Some((scales, rotation)) = shape {
+            let normal = splat_normal(scales.map(|k| values[k]), rotation.map(|k| values[k]));
+            splat_normals.push(soup.positions.len() - 1);
+            soup.normals.get_or_insert_with(Vec::new).push(normal);
+        } else if let Some([a, b, c]) = normal {
             soup.normals
                 .get_or_insert_with(Vec::new)
                 .push([values[a] as f32, values[b] as f32, values[c] as f32]);
@@ -332,7 +355,49 @@ fn read_vertices(body: &mut Body, element: &Element, soup: &mut Soup) -> Result<
             soup.colors.get_or_insert_with(Vec::new).push([r, g, b, 1.0]);
         }
     }
+    // A splat's axis faces either way: turned away from the cloud's centre, as a scanned object
+    // is seen from outside (as `point_cloud` turns the normals it estimates).
+    if let Some(normals) = soup.normals.as_mut().filter(|_| !splat_normals.is_empty()) {
+        let n = soup.positions.len().max(1) as f64;
+        let centre = soup.positions.iter().fold([0.0f64; 3], |c, p| {
+            [
+                c[0] + f64::from(p[0]) / n,
+                c[1] + f64::from(p[1]) / n,
+                c[2] + f64::from(p[2]) / n,
+            ]
+        });
+        for i in splat_normals {
+            let (p, normal) = (soup.positions[i], &mut normals[i]);
+            let outwards: f64 = (0..3)
+                .map(|k| (f64::from(p[k]) - centre[k]) * f64::from(normal[k]))
+                .sum();
+            if outwards < 0.0 {
+                *normal = normal.map(|v| -v);
+            }
+        }
+    }
     Ok(())
+}
+
+/// The plane a Gaussian splat lies in, as its normal: the axis of its smallest standard deviation
+/// (`log_scales`, natural log), turned by `rotation` (w x y z, any length), where that axis is at
+/// most half the next smallest: a splat at least twice as wide as it is thick lies in a surface
+/// (the fitting flattens the splats of a surface into it). A rounder splat says nothing of its
+/// surface's direction: zero, so that `point_cloud` estimates it from the neighbours. Zero too for
+/// a rotation of no length or non-finite values.
+fn splat_normal(log_scales: [f64; 3], rotation: [f64; 4]) -> [f32; 3] {
+    let mut axes = [0usize, 1, 2];
+    axes.sort_by(|&a, &b| log_scales[a].total_cmp(&log_scales[b]));
+    let flat = log_scales[axes[0]] + std::f64::consts::LN_2 <= log_scales[axes[1]];
+    let [w, x, y, z] = rotation;
+    let length = (w * w + x * x + y * y + z * z).sqrt();
+    if !(flat && length.is_finite() && length > 0.0) {
+        return [0.0; 3];
+    }
+    let q = glam::DQuat::from_xyzw(x / length, y / length, z / length, w / length);
+    let mut axis = glam::DVec3::ZERO;
+    axis[axes[0]] = 1.0;
+    (q * axis).as_vec3().to_array()
 }
 
 fn read_faces(body: &mut Body, element: &Element, soup: &mut Soup) -> Result<(), String> {
@@ -385,7 +450,7 @@ mod tests {
     /// the SH DC term, opacity, scales and rotation): coloured by the DC term.
     #[test]
     fn a_gaussian_splat_ply_is_coloured_by_its_dc_term() {
-        let text = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float f_dc_0\nproperty float f_dc_1\nproperty float f_dc_2\nproperty float opacity\nproperty float scale_0\nproperty float rot_0\nend_header\n0 0 0 0 0 0 0 1.7724539 -1.7724539 2.0 -4 1\n1 0 0 0 0 0 10 -10 0.5 -1.0 -4 1\n";
+        let text = "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float f_dc_0\nproperty float f_dc_1\nproperty float f_dc_2\nproperty float opacity\nproperty float scale_0\nproperty float rot_0\nend_header\n0 0 0 0 0 0 0 1.7724539 -1.7724539 2.0 -4 1\n1 0 0 0 0 0 10 -10 0.5 1.0 -4 1\n";
         let soup = parse(text.as_bytes()).expect("parses");
         assert!(soup.indices.is_empty(), "a point cloud");
         let colors = soup.colors.expect("coloured");
@@ -397,6 +462,32 @@ mod tests {
                 "{c:?} against {e:?}"
             );
         }
+    }
+
+    /// A splat file's haze is left out and its flat splats give their discs' planes: four splats
+    /// around a centre below them (3D Gaussian Splatting's properties, normals of zero): one
+    /// under half opaque (left out), two flat ones turned so that their thin axis is along x
+    /// and along y (their normals, turned away from the centre), and a round one (no normal: its
+    /// neighbours decide).
+    #[test]
+    fn a_splat_files_haze_is_left_out_and_its_flat_splats_give_their_planes() {
+        let header = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float f_dc_0\nproperty float f_dc_1\nproperty float f_dc_2\nproperty float opacity\nproperty float scale_0\nproperty float scale_1\nproperty float scale_2\nproperty float rot_0\nproperty float rot_1\nproperty float rot_2\nproperty float rot_3\nend_header\n";
+        // Rotations (w x y z, unnormalised): 90° about y takes the thin z axis to ±x; 90° about x
+        // takes it to ∓y.
+        let body = [
+            "0 0 5 0 0 0 0 0 0 -0.2 0 0 -3 1 0 0 0",   // haze: opacity logit below 0
+            "-2 0 1 0 0 0 0 0 0 3 -1 -1 -4 2 0 2 0",   // thin along z, turned to x; at −x
+            "0 2 1 0 0 0 0 0 0 3 -1 -1 -4 1 1 0 0",    // thin along z, turned to y; at +y
+            "0 0 -3 0 0 0 0 0 0 3 -1 -1 -1.2 1 0 0 0", // round: scales within a factor of 2
+        ];
+        let soup = parse(format!("{header}{}\n", body.join("\n")).as_bytes()).expect("parses");
+        assert_eq!(soup.positions, [[-2.0, 0.0, 1.0], [0.0, 2.0, 1.0], [0.0, 0.0, -3.0]]);
+        let normals = soup.normals.expect("the splats' normals");
+        let near = |a: [f32; 3], b: [f32; 3]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-5);
+        assert!(near(normals[0], [-1.0, 0.0, 0.0]), "{:?}", normals[0]);
+        assert!(near(normals[1], [0.0, 1.0, 0.0]), "{:?}", normals[1]);
+        assert_eq!(normals[2], [0.0; 3]);
+        assert_eq!(soup.colors.map(|c| c.len()), Some(3));
     }
 
     /// The same quad, binary, with a skipped element and a skipped list property before the faces.
