@@ -7,9 +7,11 @@
 //! * **Points kept**: at most [`MAX_SURFELS`] (or fewer where the budget is smaller), thinned
 //!   evenly in space ([`kept`]: one point per cell of a grid), each kept point's disc wide enough
 //!   to cover the points dropped beside it, so that a thinned cloud stays closed.
-//! * **Size**: a disc's radius is the distance to its 6th nearest neighbour / √3 × 1.25. On a
-//!   hexagonal lattice of spacing `s` six neighbours lie at `s` and discs of radius `s/√3` just
-//!   cover the plane; the quarter more covers irregular sampling.
+//! * **Size**: a disc reaches the farthest corner of its point's Voronoi cell in the disc's plane
+//!   among its 12 nearest neighbours ([`cell_radius`]), so the discs cover the surface between
+//!   the points however irregular their spacing. On a hexagonal lattice of spacing `s` that is
+//!   `s/√3`. (The rule it replaced, the 6th neighbour's distance / √3 × 1.25, left 1.5–1.8 % of
+//!   a sphere of 2 k–20 k uniformly random points uncovered, as holes; this one none.)
 //! * **Normal**: the point's where it has a non-zero one; else the direction in which the point
 //!   and its neighbours spread least (the covariance's smallest eigenvector, Hoppe et al.,
 //!   SIGGRAPH 1992), turned away from the cloud's centre, as a scanned object is seen from
@@ -33,8 +35,12 @@ pub const MAX_SURFELS: usize = 150_000;
 const VERTICES_PER_SURFEL: u64 = 6;
 const INDICES_PER_SURFEL: u64 = 12;
 
-/// Neighbours that set a disc's radius and plane.
+/// Neighbours that set a disc's plane.
 const NEIGHBOURS: usize = 6;
+
+/// Neighbours whose bisectors bound a disc's Voronoi cell ([`cell_radius`]): twice the six of a
+/// regular lattice, as an irregular point has more cell edges.
+const CELL_NEIGHBOURS: usize = 12;
 
 /// Charges `spending` for the discs of a cloud of `points` and says how many to make: as many
 /// as the budget left holds, up to [`MAX_SURFELS`], and at least one (with no room even for
@@ -153,21 +159,33 @@ pub fn discs(kept: &[Vertex], cell_m: Option<f64>) -> Mesh {
     }
     let tree = KdTree::new(&points);
     let centre = points.iter().copied().sum::<DVec3>() / points.len() as f64;
-    let mut found = Vec::with_capacity(64);
-    let mut radii = Vec::with_capacity(points.len());
-    let mut normals = Vec::with_capacity(points.len());
-    for (k, &p) in points.iter().enumerate() {
-        tree.nearest(&points, k, NEIGHBOURS, &mut found);
-        let given = Some(DVec3::from(kept[k].normal.map(f64::from)))
-            .filter(|v| v.is_finite() && v.length_squared() > 0.0)
-            .map(DVec3::normalize);
-        let normal = given.unwrap_or_else(|| {
-            let spread = least_spread(p, found.iter().map(|&(_, j)| points[j]));
-            if spread.dot(p - centre) < 0.0 { -spread } else { spread }
-        });
-        normals.push(normal);
-        radii.push(found.last().map(|&(d2, _)| d2.sqrt()));
-    }
+    // Each point's plane and cell on every core, in chunks that each keep their search buffers.
+    let indices: Vec<usize> = (0..points.len()).collect();
+    let chunks: Vec<&[usize]> = indices.chunks(4096).collect();
+    let (normals, radii): (Vec<DVec3>, Vec<Option<f64>>) = crate::parallel::map(&chunks, |chunk| {
+        let mut found = Vec::with_capacity(64);
+        let mut around = Vec::with_capacity(CELL_NEIGHBOURS);
+        chunk
+            .iter()
+            .map(|&k| {
+                let p = points[k];
+                tree.nearest(&points, k, CELL_NEIGHBOURS, &mut found);
+                let given = Some(DVec3::from(kept[k].normal.map(f64::from)))
+                    .filter(|v| v.is_finite() && v.length_squared() > 0.0)
+                    .map(DVec3::normalize);
+                let normal = given.unwrap_or_else(|| {
+                    let spread = least_spread(p, found.iter().take(NEIGHBOURS).map(|&(_, j)| points[j]));
+                    if spread.dot(p - centre) < 0.0 { -spread } else { spread }
+                });
+                around.clear();
+                around.extend(found.iter().map(|&(_, j)| points[j]));
+                (normal, cell_radius(p, normal, &around))
+            })
+            .collect::<Vec<_>>()
+    })
+    .into_iter()
+    .flatten()
+    .unzip();
     // A point whose neighbours all lie on it (or the one point of a cloud of one) takes the
     // median radius; a cloud where none has another beside it takes a hundredth of its size.
     let mut known: Vec<f64> = radii.iter().flatten().copied().filter(|r| *r > 0.0).collect();
@@ -181,19 +199,23 @@ pub fn discs(kept: &[Vertex], cell_m: Option<f64>) -> Mesh {
     if fallback.is_nan() || fallback <= 0.0 {
         return Mesh::default();
     }
-    let scale = 1.25 / 3f64.sqrt();
     let mut mesh = Mesh {
         vertices: Vec::with_capacity(points.len() * VERTICES_PER_SURFEL as usize),
         indices: Vec::with_capacity(points.len() * INDICES_PER_SURFEL as usize),
     };
     for (k, &p) in points.iter().enumerate() {
-        let r = (radii[k].filter(|r| *r > 0.0).unwrap_or(fallback) * scale).max(cell_m.unwrap_or(0.0) * 3f64.sqrt());
+        let r = radii[k]
+            .filter(|r| *r > 0.0)
+            .unwrap_or(fallback)
+            .max(cell_m.unwrap_or(0.0) * 3f64.sqrt());
         let n = normals[k].as_vec3();
         let (u, v) = n.any_orthonormal_pair();
+        // The hexagon holds the disc of radius r: its corners at r / cos 30°.
+        let corner_m = r * 2.0 / 3f64.sqrt();
         let first = mesh.vertices.len() as u32;
         for corner in 0..6 {
             let angle = corner as f32 * std::f32::consts::FRAC_PI_3;
-            let offset = (u * angle.cos() + v * angle.sin()) * r as f32;
+            let offset = (u * angle.cos() + v * angle.sin()) * corner_m as f32;
             mesh.vertices.push(Vertex {
                 position: (p.as_vec3() + offset).to_array(),
                 normal: n.to_array(),
@@ -207,6 +229,49 @@ pub fn discs(kept: &[Vertex], cell_m: Option<f64>) -> Mesh {
         }
     }
     mesh
+}
+
+/// The radius of a disc about `p` in the plane normal to `n` that covers `p`'s Voronoi cell
+/// there among `neighbours` (projected onto the plane): the distance to the cell's farthest
+/// corner, so that the discs of all points cover the plane between them however irregular their
+/// spacing. A cell open on one side (a point at the edge of a scan, or one whose neighbours all
+/// lie to one side) is closed by the octagon about `p` that reaches the farthest neighbour.
+/// `None` without a neighbour off `p`.
+fn cell_radius(p: DVec3, n: DVec3, neighbours: &[DVec3]) -> Option<f64> {
+    let (u, v) = n.any_orthonormal_pair();
+    let offsets: Vec<glam::DVec2> = neighbours
+        .iter()
+        .map(|q| {
+            let d = *q - p;
+            glam::DVec2::new(d.dot(u), d.dot(v))
+        })
+        .filter(|d| d.length_squared() > 0.0)
+        .collect();
+    let reach = offsets.iter().map(|d| d.length()).fold(0.0, f64::max);
+    if !(reach.is_finite() && reach > 0.0) {
+        return None;
+    }
+    let mut cell: Vec<glam::DVec2> = (0..8)
+        .map(|i| glam::DVec2::from_angle(f64::from(i) * std::f64::consts::FRAC_PI_4) * reach)
+        .collect();
+    let mut clipped = Vec::with_capacity(16);
+    for d in &offsets {
+        // The side of the bisector between p and its neighbour that p is on: x·d ≤ |d|²/2.
+        let limit = d.length_squared() * 0.5;
+        clipped.clear();
+        for (i, &a) in cell.iter().enumerate() {
+            let b = cell[(i + 1) % cell.len()];
+            let (fa, fb) = (a.dot(*d) - limit, b.dot(*d) - limit);
+            if fa <= 0.0 {
+                clipped.push(a);
+            }
+            if (fa < 0.0 && fb > 0.0) || (fa > 0.0 && fb < 0.0) {
+                clipped.push(a + (b - a) * (fa / (fa - fb)));
+            }
+        }
+        std::mem::swap(&mut cell, &mut clipped);
+    }
+    cell.iter().map(|c| c.length()).reduce(f64::max)
 }
 
 /// The unit direction in which `p` and `others` spread least: the smallest eigenvector of their
@@ -330,13 +395,15 @@ mod tests {
         }
     }
 
-    /// Each disc of a surfel mesh: centre, normal, radius.
+    /// Each disc of a surfel mesh: centre, normal, and the radius of the circle its hexagon holds
+    /// (the hexagon's inradius, cos 30° of its corners' distance).
     fn discs_of(mesh: &Mesh) -> Vec<(Vec3, Vec3, f32)> {
         mesh.vertices
             .chunks(6)
             .map(|d| {
                 let c = d.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
-                (c, Vec3::from(d[0].normal), Vec3::from(d[0].position).distance(c))
+                let inradius = Vec3::from(d[0].position).distance(c) * 3f32.sqrt() / 2.0;
+                (c, Vec3::from(d[0].normal), inradius)
             })
             .collect()
     }
@@ -352,6 +419,38 @@ mod tests {
             });
             assert!(covered, "a hole at {dir:?}");
         }
+    }
+
+    /// Points spread at random (uniformly over the sphere, as a photogrammetry cloud is irregular)
+    /// leave gaps up to twice the mean spacing: each disc reaches its Voronoi cell's farthest
+    /// corner, so none stays open. (The 6th neighbour's distance / √3 × 1.25 left 1.5–1.8 % of
+    /// such spheres of 2 k–20 k points uncovered.) Nor are the discs grossly larger than needed.
+    #[test]
+    fn a_sphere_of_random_points_is_covered() {
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut random = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        let n = 4000;
+        let points: Vec<[f32; 3]> = (0..n)
+            .map(|_| {
+                let z = random() * 2.0 - 1.0;
+                let azimuth = random() * std::f64::consts::TAU;
+                let r = (1.0 - z * z).sqrt();
+                [(r * azimuth.cos()) as f32, (r * azimuth.sin()) as f32, z as f32]
+            })
+            .collect();
+        let discs = discs_of(&surfels(&cloud(&points), MAX_SURFELS));
+        assert_eq!(discs.len(), n);
+        assert_covers_the_unit_sphere(&discs);
+        let spacing = (8.0 * std::f32::consts::PI / (3f32.sqrt() * n as f32)).sqrt();
+        let mean = discs.iter().map(|d| d.2).sum::<f32>() / n as f32;
+        println!("mean radius {:.3} spacings (a lattice needs 0.577)", mean / spacing);
+        // Measured 0.97: a random point's cell reaches farther than a lattice point's.
+        assert!(mean < 1.1 * spacing, "mean radius {mean} for spacing {spacing}");
     }
 
     /// A thinned cloud stays closed. Every third point of a Fibonacci sphere would not: its
