@@ -1,5 +1,5 @@
 //! The model loader on any bytes, as a `.glb`, a `.gltf`, a `scene.svx.json`, a `.ply`, an
-//! `.stl` or an `.obj` (by the first bytes), beside a small valid buffer and PNG that URIs and
+//! `.stl`, an `.obj` or a point cloud as text, `.xyz` (by the first bytes), beside a small valid buffer and PNG that URIs and
 //! material libraries may name. Within the phone
 //! budget: an input may fail, never panic, hang or take more than the budget.
 #![no_main]
@@ -34,6 +34,7 @@ fuzz_target!(|data: &[u8]| {
         Some(b'v' | b'o' | b'#' | b'm') => "model.obj",
         // ASCII STL, and binary STL whose header begins with the same word, as many do.
         Some(b's') => "model.stl",
+        Some(b'0'..=b'9' | b'-' | b'+' | b'.') => "model.xyz",
         _ => "model.glb",
     };
     let path = scratch::write(dir, name, data);

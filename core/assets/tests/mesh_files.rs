@@ -275,3 +275,65 @@ fn a_point_cloud_over_the_budget_is_thinned_to_fit() {
         other => panic!("{other:?}"),
     }
 }
+
+/// A scanner's point cloud as text (`.xyz`, CloudCompare's export: x y z r g b, metres with +Z
+/// up): a georeferenced sphere of radius 0.1 m whose top (+z) half is red, loaded as discs in
+/// glTF's frame (its top up, +Y), about its centre, coloured by the file; a Leica `.pts` of the
+/// same points (count, then x y z intensity r g b) alike; and opened from a share without a name.
+#[test]
+fn a_point_cloud_as_text_is_drawn_as_discs_the_right_way_up() {
+    let points = phantogram_geometry::sphere::fibonacci(2000);
+    let (east, north) = (512_345.678, 5_412_345.678);
+    let mut xyz = String::from("// x y z r g b\n");
+    let mut pts = format!("{}\n", points.len());
+    for p in &points {
+        let (x, y, z) = (
+            east + 0.1 * f64::from(p.x),
+            north + 0.1 * f64::from(p.y),
+            200.0 + 0.1 * f64::from(p.z),
+        );
+        let red = if p.z > 0.0 { 200 } else { 40 };
+        xyz.push_str(&format!("{x:.4} {y:.4} {z:.4} {red} 90 60\n"));
+        pts.push_str(&format!("{x:.4} {y:.4} {z:.4} -512 {red} 90 60\n"));
+    }
+    for (name, text) in [("scan.xyz", &xyz), ("scan.pts", &pts)] {
+        let model = load("text-cloud", name, text.as_bytes()).expect("loads");
+        let mesh = &model.primitives[0].mesh;
+        assert_eq!(mesh.vertices.len(), points.len() * 6, "{name}: a hexagon per point");
+        let bounds = mesh.bounds().expect("bounds");
+        for k in 0..3 {
+            assert!(
+                (bounds.max[k] - 0.1).abs() < 0.01 && (bounds.min[k] + 0.1).abs() < 0.01,
+                "{name}: about its centre, {bounds:?}"
+            );
+        }
+        // The file's +z (red) is glTF's +y.
+        let top = mesh
+            .vertices
+            .iter()
+            .find(|v| v.position[1] > 0.09)
+            .expect("a disc on top");
+        assert!(
+            (top.color[0] - 0.578).abs() < 0.01,
+            "{name}: sRGB 200 on top: {:?}",
+            top.color
+        );
+        let bottom = mesh
+            .vertices
+            .iter()
+            .find(|v| v.position[1] < -0.09)
+            .expect("a disc below");
+        assert!(bottom.color[0] < 0.1, "{name}: {:?}", bottom.color);
+    }
+    let dir = Scratch::new("mesh-files-text-cloud-library");
+    let lib = Library::new(Some(dir.to_path_buf()), None);
+    let imported = lib
+        .import("document.bin", xyz.as_bytes(), ResourceBudget::PHONE, &Progress::new())
+        .expect("imported");
+    assert_eq!(imported.model.triangle_count(), points.len() * 4);
+    // A line that is not a point is named.
+    let err = load("text-cloud-bad", "bad.xyz", b"0 0 0\n1 1 one\n")
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("line 2") && err.contains("\"one\""), "{err}");
+}

@@ -14,7 +14,8 @@ use phantogram::model::{DioramaFit, Placement};
 #[derive(clap::Args)]
 pub struct SceneArgs {
     /// A glTF 2.0 model (.gltf or .glb), a Smithsonian Voyager folder or its scene.svx.json
-    /// (its best scan present), or an .stl, .ply or .obj scan; the default artifact when omitted.
+    /// (its best scan present), an .stl, .ply or .obj scan, or a point cloud as text (.xyz, .pts);
+    /// the default artifact when omitted.
     model: Option<PathBuf>,
     /// One of the built-in artifacts instead: amphora (the default), medal or tablet; or the
     /// Diorama (marbles, dice, coins and vessels in a tray, under the log's gravity).

@@ -144,11 +144,11 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
         }
     }
 
-    /// The core's menu asked for a file: the system's document browser for glTF, STL, PLY, OBJ
-    /// and zip files.
+    /// The core's menu asked for a file: the system's document browser for glTF, STL, PLY, OBJ,
+    /// point clouds as text (.xyz, .pts) and zip files.
     private func presentDocumentPicker() {
         var types: [UTType] = [.zip]
-        for ext in ["glb", "gltf", "stl", "ply", "obj"] {
+        for ext in ["glb", "gltf", "stl", "ply", "obj", "xyz", "pts"] {
             if let t = UTType(filenameExtension: ext) { types.append(t) }
         }
         let picker = UIDocumentPickerViewController(forOpeningContentTypes: types, asCopy: true)

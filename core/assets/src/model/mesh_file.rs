@@ -1,6 +1,6 @@
-//! Scans published as meshes rather than glTF: STL (`stl`) and PLY (`ply`), loaded into a
-//! [`Model`] of one primitive; OBJ with its materials is `obj`'s, reached through the
-//! same [`MeshFormat`].
+//! Scans published as meshes rather than glTF: STL (`stl`) and PLY (`ply`), and point clouds as
+//! text (`.xyz`, `.pts`: `xyz`, metres with +Z up), loaded into a [`Model`] of one primitive;
+//! OBJ with its materials is `obj`'s, reached through the same [`MeshFormat`].
 //!
 //! **Conventions** (neither format states them): STL is read as millimetres with +Z up, as 3D
 //! printing writes it (Scan the World's museum scans, museums' "download for printing"), and
@@ -23,7 +23,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file};
-use super::{Material, Mesh, Model, Primitive, Vertex, ply, point_cloud, stl};
+use super::{Material, Mesh, Model, Primitive, Vertex, ply, point_cloud, stl, xyz};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
 
@@ -56,6 +56,8 @@ pub enum MeshFormat {
     Ply,
     /// Wavefront OBJ, with its MTL materials (the `obj` module).
     Obj,
+    /// A point cloud as text, a point a line: `.xyz` or Leica's `.pts` (the `xyz` module).
+    Xyz,
 }
 
 impl MeshFormat {
@@ -66,6 +68,7 @@ impl MeshFormat {
             "stl" => Some(MeshFormat::Stl),
             "ply" => Some(MeshFormat::Ply),
             "obj" => Some(MeshFormat::Obj),
+            "xyz" | "pts" => Some(MeshFormat::Xyz),
             _ => None,
         }
     }
@@ -87,7 +90,10 @@ impl MeshFormat {
             .find(|line| !line.is_empty() && !line.starts_with(b"#"))?;
         let keyword = statement.split(u8::is_ascii_whitespace).next()?;
         const OBJ: [&[u8]; 9] = [b"v", b"vt", b"vn", b"f", b"o", b"g", b"s", b"mtllib", b"usemtl"];
-        (OBJ.contains(&keyword) && statement.len() > keyword.len()).then_some(MeshFormat::Obj)
+        if OBJ.contains(&keyword) && statement.len() > keyword.len() {
+            return Some(MeshFormat::Obj);
+        }
+        xyz::recognises(bytes).then_some(MeshFormat::Xyz)
     }
 
     pub fn extension(self) -> &'static str {
@@ -95,6 +101,7 @@ impl MeshFormat {
             MeshFormat::Stl => "stl",
             MeshFormat::Ply => "ply",
             MeshFormat::Obj => "obj",
+            MeshFormat::Xyz => "xyz",
         }
     }
 }
@@ -114,6 +121,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     progress.step(0.1).map_err(cancelled)?;
     let parsed = match format {
         MeshFormat::Stl => stl::parse(&bytes),
+        MeshFormat::Xyz => xyz::parse(&bytes),
         _ => ply::parse(&bytes),
     };
     drop(bytes);
@@ -162,9 +170,14 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
             path: path.to_path_buf(),
         });
     }
-    if format == MeshFormat::Stl {
+    match format {
         // Millimetres, +Z up → metres, +Y up (a quarter turn about x).
-        mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(0.001)));
+        MeshFormat::Stl => {
+            mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(0.001)))
+        }
+        // Metres, +Z up, as scanners write them.
+        MeshFormat::Xyz => mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        _ => {}
     }
     // Checked in the model's frame, as glTF's vertices are after their node transforms.
     if let Some((i, position)) = mesh.out_of_range_vertex() {

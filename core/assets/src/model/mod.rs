@@ -813,6 +813,7 @@ mod split;
 mod stl;
 mod texture_info;
 mod topology;
+mod xyz;
 
 #[cfg(test)]
 mod tests {

@@ -303,12 +303,15 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         /** The APK's assets folder of bundled artifacts, and its copy in the app's files. */
         const val BUNDLED = "artifacts"
         /** What the document picker offers: glTF binary and JSON, STL, PLY and OBJ (under the types
-         *  apps report them as), zip (Voyager downloads), and octet-stream, as which many
-         *  providers report a .glb or .stl. */
+         *  apps report them as), point clouds as text (.xyz and .pts: reported as plain text, or
+         *  as the molecule format that shares the .xyz name), zip (Voyager downloads), and
+         *  octet-stream, as which many providers report a .glb or .stl. The core recognises
+         *  each by its bytes. */
         val MODEL_TYPES = arrayOf(
             "model/gltf-binary", "model/gltf+json",
             "model/stl", "model/x.stl-binary", "model/x.stl-ascii", "application/sla", "application/vnd.ms-pki.stl",
             "application/ply", "model/ply", "model/obj",
+            "text/plain", "chemical/x-xyz",
             "application/zip", "application/octet-stream"
         )
     }
