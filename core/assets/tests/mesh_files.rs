@@ -191,6 +191,15 @@ fn an_stl_opened_from_bytes_is_kept_and_loaded_whatever_its_name() {
     assert_eq!(again.model.triangle_count(), 12);
 }
 
+/// The colour of the first vertex of `mesh` at a height (+y) that `at` accepts.
+fn colour_where(mesh: &phantogram_assets::model::Mesh, at: impl Fn(f32) -> bool) -> [f32; 4] {
+    mesh.vertices
+        .iter()
+        .find(|v| at(v.position[1]))
+        .map(|v| v.color)
+        .expect("a vertex there")
+}
+
 /// A scanner's point cloud: a PLY of coloured vertices on a sphere of radius 0.1 m, no faces.
 fn point_cloud_ply(n: usize) -> String {
     let mut text = format!(
@@ -213,16 +222,8 @@ fn a_point_cloud_ply_is_drawn_as_discs_that_close_its_surface() {
     let material = &model.materials[model.primitives[0].material];
     assert!(material.double_sided, "a disc turned the wrong way still draws");
     // The colours of the file, linear; the discs facing out from the centre.
-    let top = mesh
-        .vertices
-        .iter()
-        .find(|v| v.position[1] > 0.09)
-        .expect("a disc near the top");
-    assert!(
-        (top.color[0] - 0.578).abs() < 0.01,
-        "sRGB 200 is linear 0.578: {:?}",
-        top.color
-    );
+    let top = colour_where(mesh, |y| y > 0.09);
+    assert!((top[0] - 0.578).abs() < 0.01, "sRGB 200 is linear 0.578: {top:?}");
     for disc in mesh.vertices.chunks(6) {
         let centre = disc.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0;
         assert!(Vec3::from(disc[0].normal).dot(centre.normalize()) > 0.98);
@@ -308,22 +309,9 @@ fn a_point_cloud_as_text_is_drawn_as_discs_the_right_way_up() {
             );
         }
         // The file's +z (red) is glTF's +y.
-        let top = mesh
-            .vertices
-            .iter()
-            .find(|v| v.position[1] > 0.09)
-            .expect("a disc on top");
-        assert!(
-            (top.color[0] - 0.578).abs() < 0.01,
-            "{name}: sRGB 200 on top: {:?}",
-            top.color
-        );
-        let bottom = mesh
-            .vertices
-            .iter()
-            .find(|v| v.position[1] < -0.09)
-            .expect("a disc below");
-        assert!(bottom.color[0] < 0.1, "{name}: {:?}", bottom.color);
+        let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
+        assert!((top[0] - 0.578).abs() < 0.01, "{name}: sRGB 200 on top: {top:?}");
+        assert!(bottom[0] < 0.1, "{name}: {bottom:?}");
     }
     let dir = Scratch::new("mesh-files-text-cloud-library");
     let lib = Library::new(Some(dir.to_path_buf()), None);
