@@ -621,8 +621,8 @@ fn ggx_anisotropic(n_dot_h: f32, t_dot_h: f32, b_dot_h: f32, alpha_t: f32, alpha
 // view's and the light's components along t and b.
 fn smith_visibility_anisotropic(n_dot_l: f32, n_dot_v: f32, tb_v: vec2<f32>, tb_l: vec2<f32>, alpha_t: f32, alpha_b: f32) -> f32 {
     let gv = n_dot_l * length(vec3<f32>(alpha_t * tb_v.x, alpha_b * tb_v.y, n_dot_v));
-    let gl = n_dot_v * length(vec3<f32>(alpha_t * tb_l.x, alpha_b * tb_l.y, n_dot_l));
-    return 0.5 / max(gv + gl, 1e-5);
+    let g_l = n_dot_v * length(vec3<f32>(alpha_t * tb_l.x, alpha_b * tb_l.y, n_dot_l));
+    return 0.5 / max(gv + g_l, 1e-5);
 }
 
 // Where an anisotropic lobe's image light is looked up (the glTF sample viewer's bent normal,
@@ -752,8 +752,9 @@ fn sheen_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
 fn smith_visibility(n_dot_l: f32, n_dot_v: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let gv = n_dot_l * sqrt(n_dot_v * n_dot_v * (1.0 - a2) + a2);
-    let gl = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
-    return 0.5 / max(gv + gl, 1e-5);
+    // Not `gl`: naga's GLSL writer renames that to `gl_1`, a name GLSL reserves.
+    let g_l = n_dot_v * sqrt(n_dot_l * n_dot_l * (1.0 - a2) + a2);
+    return 0.5 / max(gv + g_l, 1e-5);
 }
 
 // A surface point as the material describes it, before the visitor's `Appearance`: what the scene

@@ -251,6 +251,7 @@ impl Renderer {
         } else {
             (SHADOW_SIZE, 1)
         };
+        let layers = self.gpu.array_layers(size, size, layers);
         let mut made_new = false;
         if filter_pass && self.filter_for(on_cube).size < size {
             let device = self.gpu.device.clone();

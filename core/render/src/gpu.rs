@@ -83,6 +83,17 @@ impl Gpu {
         })
     }
 
+    /// How many layers to allocate for a 2D array texture of `layers` layers of `width` ×
+    /// `height` that a shader reads as a `texture_2d_array`: `layers`, except on OpenGL (ES),
+    /// where wgpu makes a texture of one layer a plain 2D texture and one of a multiple of six
+    /// square layers a cube map, neither of which a `sampler2DArray` can read (it reads zeros):
+    /// there one more layer, never read, keeps it an array.
+    pub(crate) fn array_layers(&self, width: u32, height: u32, layers: u32) -> u32 {
+        let gl = self.adapter.get_info().backend == wgpu::Backend::Gl;
+        let plain_or_cube = layers == 1 || (width == height && layers.is_multiple_of(6));
+        if gl && plain_or_cube { layers + 1 } else { layers }
+    }
+
     /// The adapter's name and backend, for logs.
     pub fn describe(&self) -> String {
         let info = self.adapter.get_info();

@@ -400,13 +400,15 @@ impl crate::Renderer {
         let bounds = ImpostorBox { texels, ..bounds };
         let device = self.gpu.device.clone();
         let queue = self.gpu.queue.clone();
+        // Six views, read as an array (a seventh layer on OpenGL: `Gpu::array_layers`).
+        let layers = self.gpu.array_layers(texels, texels, 6);
         let map = |label, format| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d {
                     width: texels,
                     height: texels,
-                    depth_or_array_layers: 6,
+                    depth_or_array_layers: layers,
                 },
                 mip_level_count: 1,
                 sample_count: 1,

@@ -74,13 +74,9 @@ fn upload_array(gpu: &Gpu, model: &Model, array: &LayerArray) -> wgpu::TextureVi
         mip_chain(width, height, &rgba8, colour)
     });
     let levels = chains.first().map_or(1, |c| c.len() as u32);
-    let texture = create_rgba8_texture(
-        gpu,
-        "layer textures",
-        (width, height, chains.len().max(1) as u32),
-        levels,
-        false,
-    );
+    // Read as an array: a layer more on OpenGL where it would not be one (`Gpu::array_layers`).
+    let layers = gpu.array_layers(width, height, chains.len().max(1) as u32);
+    let texture = create_rgba8_texture(gpu, "layer textures", (width, height, layers), levels, false);
     for (layer, chain) in chains.iter().enumerate() {
         write_mip_chain(gpu, &texture, layer as u32, chain);
     }
@@ -92,7 +88,7 @@ fn upload_array(gpu: &Gpu, model: &Model, array: &LayerArray) -> wgpu::TextureVi
 
 /// What a material without layer textures binds: one white texel in one layer.
 pub(crate) fn placeholder(gpu: &Gpu) -> wgpu::TextureView {
-    let texture = create_rgba8_texture(gpu, "no layer textures", (1, 1, 1), 1, false);
+    let texture = create_rgba8_texture(gpu, "no layer textures", (1, 1, gpu.array_layers(1, 1, 1)), 1, false);
     write_mip_chain(gpu, &texture, 0, &[(1, 1, vec![255; 4])]);
     texture.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2Array),

@@ -402,8 +402,8 @@ impl Renderer {
         // 1×1 a face until a lamp stands among its casters (see `point_shadow`).
         let point_shadow = point_shadow::PointShadowMap::new(device, &shadow_layout, 1);
         // 1×1 until a model with glass is drawn with shadows.
-        let shadow_filter = shadow_filter::ShadowFilter::new(device, 1, 1);
-        let cube_filter = shadow_filter::ShadowFilter::new(device, 1, 6);
+        let shadow_filter = shadow_filter::ShadowFilter::new(device, 1, gpu.array_layers(1, 1, 1));
+        let cube_filter = shadow_filter::ShadowFilter::new(device, 1, gpu.array_layers(1, 1, 6));
         let ward_map = (WardMap::Uniform, upload_ward_map(&gpu, WardMap::Uniform));
         let ward_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
             label: Some("Ward map"),
