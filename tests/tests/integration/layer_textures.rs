@@ -12,16 +12,21 @@ use crate::transmission::{largest_difference, one_texel};
 use phantogram::appearance::Appearance;
 use phantogram::model::{Image, LayerSlot, Layers, Material, TextureRef};
 
-/// The dark, rough block with `layers` and `textures` (slot, texture) over `images`.
-fn block(layers: Layers, textures: &[(LayerSlot, TextureRef)], images: Vec<Image>) -> Option<([f32; 3], [f32; 3])> {
-    let mut material = Material {
+/// The dark, rough material of the blocks, with `layers`.
+fn dark_rough(layers: Layers) -> Material {
+    Material {
         name: "layered".into(),
         base_color: [0.05, 0.05, 0.06, 1.0],
         metallic: 0.0,
         roughness: 0.8,
         layers,
         ..Material::default()
-    };
+    }
+}
+
+/// The dark, rough block with `layers` and `textures` (slot, texture) over `images`.
+fn block(layers: Layers, textures: &[(LayerSlot, TextureRef)], images: Vec<Image>) -> Option<([f32; 3], [f32; 3])> {
+    let mut material = dark_rough(layers);
     for (slot, texture) in textures {
         material.layer_textures.set(*slot, Some(*texture));
     }
@@ -362,29 +367,21 @@ fn materials_sharing_a_layer_image_each_read_their_own_slots() {
     // One image in both materials' slots (so one array for both): the left reads it as its
     // varnish's share (R 0: none), the right as its specular strength (A 0: none).
     let (image, texel) = one_texel([0, 255, 255, 0]);
-    let base = |layers: Layers| Material {
-        name: "layered".into(),
-        base_color: [0.05, 0.05, 0.06, 1.0],
-        metallic: 0.0,
-        roughness: 0.8,
-        layers,
-        ..Material::default()
-    };
     let varnish = Layers {
         clear_coat: 1.0,
         ..Layers::default()
     };
-    let mut left = base(varnish);
+    let mut left = dark_rough(varnish);
     left.layer_textures.set(LayerSlot::ClearCoat, Some(texel));
-    let mut right = base(Layers::default());
+    let mut right = dark_rough(Layers::default());
     right.layer_textures.set(LayerSlot::Specular, Some(texel));
     let Some(textured) = two_blocks(left, right, vec![image]) else {
         return;
     };
-    let plain = two_blocks(base(varnish), base(Layers::default()), Vec::new()).expect("a frame");
+    let plain = two_blocks(dark_rough(varnish), dark_rough(Layers::default()), Vec::new()).expect("a frame");
     let expected = two_blocks(
-        base(Layers::default()),
-        base(Layers {
+        dark_rough(Layers::default()),
+        dark_rough(Layers {
             specular: 0.0,
             ..Layers::default()
         }),

@@ -306,21 +306,11 @@ fn material_extensions_reach_the_material() {
     assert_eq!((thickness.image, thickness.tex_coord), (0, 0));
     let slot = |t: Option<phantogram::model::TextureRef>| t.map(|t| (t.image, t.tex_coord));
     let t = &amber.layer_textures;
+    // In `LayerSlot::ALL`'s order: ClearCoat, ClearCoatRoughness, Specular, SpecularColor,
+    // SheenColor, SheenRoughness, DiffuseTransmission, DiffuseTransmissionColor, ClearCoatNormal,
+    // Anisotropy, Iridescence, IridescenceThickness.
     assert_eq!(
-        [
-            slot(t.get(LayerSlot::ClearCoat)),
-            slot(t.get(LayerSlot::ClearCoatRoughness)),
-            slot(t.get(LayerSlot::Specular)),
-            slot(t.get(LayerSlot::SpecularColor)),
-            slot(t.get(LayerSlot::SheenColor)),
-            slot(t.get(LayerSlot::SheenRoughness)),
-            slot(t.get(LayerSlot::DiffuseTransmission)),
-            slot(t.get(LayerSlot::DiffuseTransmissionColor)),
-            slot(t.get(LayerSlot::ClearCoatNormal)),
-            slot(t.get(LayerSlot::Anisotropy)),
-            slot(t.get(LayerSlot::Iridescence)),
-            slot(t.get(LayerSlot::IridescenceThickness)),
-        ],
+        LayerSlot::ALL.map(|s| slot(t.get(s))),
         [
             Some((0, 0)),
             Some((1, 0)),
