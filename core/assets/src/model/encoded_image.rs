@@ -86,18 +86,30 @@ impl Encoded {
     /// Decodes `raw` (the bytes [`Encoded::probe`] read) to RGBA8 at `fitted` texels (the size
     /// the budget allows, at most the probed one), using at most `max_bytes` of memory.
     pub fn decode(&self, raw: &[u8], fitted: (u32, u32), max_bytes: u64) -> Result<image::RgbaImage, String> {
+        self.decode_with_level(raw, fitted, max_bytes).map(|(image, _)| image)
+    }
+
+    /// [`Encoded::decode`], and for a Basis Universal texture whose texels are one of the file's
+    /// levels as it holds it (not scaled further), that level's index (`super::gpu_blocks`).
+    pub fn decode_with_level(
+        &self,
+        raw: &[u8],
+        fitted: (u32, u32),
+        max_bytes: u64,
+    ) -> Result<(image::RgbaImage, Option<u32>), String> {
         // A decoder panic on a damaged image is this file's error, not the app's end.
-        let decoded = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match self.codec {
-            Codec::Raster(format) => self.decode_raster(raw, format, max_bytes),
-            Codec::Basis => self.decode_basis(raw, fitted),
+        let (decoded, level) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match self.codec {
+            Codec::Raster(format) => self.decode_raster(raw, format, max_bytes).map(|i| (i, None)),
+            Codec::Basis => self.decode_basis(raw, fitted).map(|(i, level)| (i, Some(level))),
         }))
         .map_err(|_| "the decoder failed on damaged data".to_owned())??;
         // Larger than the device's textures: scaled down (a triangle filter averages the texels
         // each new one covers).
         Ok(if (decoded.width(), decoded.height()) == fitted {
-            decoded
+            (decoded, level)
         } else {
-            image::imageops::resize(&decoded, fitted.0, fitted.1, image::imageops::FilterType::Triangle)
+            let scaled = image::imageops::resize(&decoded, fitted.0, fitted.1, image::imageops::FilterType::Triangle);
+            (scaled, None)
         })
     }
 
@@ -135,8 +147,8 @@ impl Encoded {
     }
 
     /// The smallest of the file's levels that covers `fitted` (the base level unless the budget
-    /// scaled the texture down and the file carries mips), transcoded to RGBA8.
-    fn decode_basis(&self, raw: &[u8], fitted: (u32, u32)) -> Result<image::RgbaImage, String> {
+    /// scaled the texture down and the file carries mips), transcoded to RGBA8, and its index.
+    fn decode_basis(&self, raw: &[u8], fitted: (u32, u32)) -> Result<(image::RgbaImage, u32), String> {
         let basis = open_basis(raw)?;
         let mut level = 0;
         let (mut width, mut height) = (self.width, self.height);
@@ -151,6 +163,7 @@ impl Encoded {
             .transcode(level, basisu::TargetFormat::Rgba32, basisu::DecodeFlags::NONE)
             .map_err(|e| format!("Basis Universal level {level}: {e:?}"))?;
         image::RgbaImage::from_raw(width, height, rgba)
+            .map(|image| (image, level))
             .ok_or_else(|| format!("Basis Universal level {level} is not the {width}×{height} texels its header says"))
     }
 }

@@ -63,25 +63,6 @@ pub struct BasisSource {
 }
 
 impl BasisSource {
-    /// `ktx2` as the source of texels of `width × height`: `None` unless it is a Basis Universal
-    /// texture with a level of that size.
-    pub fn of_level(ktx2: &[u8], width: u32, height: u32) -> Option<Self> {
-        let level = std::panic::catch_unwind(|| {
-            let basis = open_basis(ktx2).ok()?;
-            (0..basis.level_count()).find(|&l| {
-                basis
-                    .image_level_info(l)
-                    .is_ok_and(|i| (i.width, i.height) == (width, height))
-            })
-        })
-        .ok()
-        .flatten()?;
-        Some(Self {
-            ktx2: Arc::from(ktx2),
-            level,
-        })
-    }
-
     /// The image's texels and every smaller level down to 1 × 1, in `format`; `None` where the
     /// file lacks some of those levels (a texture without mips), where the image's size is not
     /// whole blocks (the GPU requires it of a block-compressed texture's first level), or where

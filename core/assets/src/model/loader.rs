@@ -10,7 +10,7 @@ use gltf::accessor::{DataType, Dimensions};
 use thiserror::Error;
 
 use super::LayerSlot;
-use super::encoded_image::{Codec, Encoded};
+use super::encoded_image::Encoded;
 use super::instancing;
 use super::meshopt_views::{self, DecodedViews};
 use super::point_cloud;
@@ -1484,17 +1484,18 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         if progress.is_cancelled() {
             return Err((what(), "cancelled".to_owned()));
         }
-        let decoded = header
-            .decode(raw, *fitted, budget.memory_bytes)
+        let (decoded, level) = header
+            .decode_with_level(raw, *fitted, budget.memory_bytes)
             .map_err(|e| (what(), e))?;
         let done = decoded_count.fetch_add(1, std::sync::atomic::Ordering::Relaxed) + 1;
         images_share.advance(done as f32 / image_count);
         // Larger than the device's textures: the user is told it was scaled down.
         let note = header.scaled_down_note(&what(), *fitted);
         // A Basis Universal texture is kept beside its texels for the GPU's own block formats.
-        let basis = (header.codec == Codec::Basis)
-            .then(|| BasisSource::of_level(raw, decoded.width(), decoded.height()))
-            .flatten();
+        let basis = level.map(|level| BasisSource {
+            ktx2: std::sync::Arc::from(raw.as_slice()),
+            level,
+        });
         Ok((
             Image {
                 name: name.clone(),
