@@ -253,7 +253,7 @@ impl Renderer {
         };
         let layers = self.gpu.array_layers(size, size, layers);
         let mut made_new = false;
-        if filter_pass && self.filter_for(on_cube).size < size {
+        if filter_pass && self.filter(on_cube).size < size {
             let device = self.gpu.device.clone();
             // A device that cannot make it: glass casts no shadow (as before the filter) and the
             // frames go on.
@@ -269,14 +269,11 @@ impl Renderer {
         }
         if filter_pass {
             let device = self.gpu.device.clone();
-            let (module, layout) = (&self.scene.module, &self.scene.shadow_masked_layout);
-            let filter = if on_cube {
-                &mut self.cube_filter
-            } else {
-                &mut self.shadow_filter
-            };
+            // Handles (reference-counted), so that the filter can be borrowed beside them.
+            let (module, layout) = (self.scene.module.clone(), self.scene.shadow_masked_layout.clone());
+            let filter = self.filter_for(on_cube);
             filter_pass = checked(&device, "the shadow filter's pipeline", || {
-                filter.prepare(&device, module, layout)
+                filter.prepare(&device, &module, &layout)
             })
             .is_ok();
         }
@@ -345,11 +342,7 @@ impl Renderer {
                 shadow_triangles +=
                     self.draw_shadow_casters(&mut pass, bind, &shadow_levels, floor_casts, cull.as_ref());
             }
-            let filter = if on_cube {
-                &self.cube_filter
-            } else {
-                &self.shadow_filter
-            };
+            let filter = self.filter(on_cube);
             // Each view with its matrix, to draw only the glass its frustum reaches.
             let binds: Vec<(&wgpu::BindGroup, Option<Mat4>)> = match &faces {
                 Some(faces) if on_cube => self.point_shadow.face_binds.iter().zip(faces.map(Some)).collect(),
@@ -479,6 +472,11 @@ impl Renderer {
 
 impl Renderer {
     /// The glass filter for a lamp's cube (`cube`) or for one view of the light.
+    fn filter(&self, cube: bool) -> &shadow_filter::ShadowFilter {
+        if cube { &self.cube_filter } else { &self.shadow_filter }
+    }
+
+    /// [`Self::filter`], to remake or prepare.
     fn filter_for(&mut self, cube: bool) -> &mut shadow_filter::ShadowFilter {
         if cube {
             &mut self.cube_filter
