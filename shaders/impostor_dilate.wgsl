@@ -3,9 +3,10 @@
 // through another point of that texel may meet the surface nearer (a slope seen at a grazing
 // angle, or the surface's edge covering part of the texel only). The ray's inside test reads,
 // in green, the nearest depth of the texel and its eight neighbours — never behind the surface
-// anywhere in the texel — and the material's lookups read the centre's, in red.
+// anywhere in the texel — and the material's lookups read the centre's, in red. Each value is
+// the bits of an f32 in a u32 (impostor.rs says why).
 
-@group(0) @binding(0) var raw_depth: texture_2d<f32>;
+@group(0) @binding(0) var raw_depth: texture_2d<u32>;
 
 @vertex
 fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
@@ -15,16 +16,16 @@ fn vs_main(@builtin(vertex_index) index: u32) -> @builtin(position) vec4<f32> {
 }
 
 @fragment
-fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<f32> {
+fn fs_main(@builtin(position) position: vec4<f32>) -> @location(0) vec4<u32> {
     let size = vec2<i32>(textureDimensions(raw_depth));
     let at = vec2<i32>(position.xy);
-    let centre = textureLoad(raw_depth, at, 0).r;
+    let centre = bitcast<f32>(textureLoad(raw_depth, at, 0).r);
     var nearest = centre;
     for (var dy = -1; dy <= 1; dy = dy + 1) {
         for (var dx = -1; dx <= 1; dx = dx + 1) {
             let p = clamp(at + vec2<i32>(dx, dy), vec2<i32>(0), size - vec2<i32>(1));
-            nearest = min(nearest, textureLoad(raw_depth, p, 0).r);
+            nearest = min(nearest, bitcast<f32>(textureLoad(raw_depth, p, 0).r));
         }
     }
-    return vec4<f32>(centre, nearest, 0.0, 1.0);
+    return vec4<u32>(bitcast<u32>(centre), bitcast<u32>(nearest), 0u, 0u);
 }

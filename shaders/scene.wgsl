@@ -1334,9 +1334,9 @@ struct GBufferOut {
     @location(0) colour: vec4<f32>,
     // Octahedral normal (mesh coordinates), roughness (−1: unlit), occlusion.
     @location(1) normal: vec4<f32>,
-    // Depth along the face's axis, 0 to 1 over the box (made conservative in green by
-    // impostor_dilate.wgsl).
-    @location(2) depth: vec4<f32>,
+    // Depth along the face's axis, 0 to 1 over the box, as the bits of an f32 (made
+    // conservative in green by impostor_dilate.wgsl; impostor.rs says why integers).
+    @location(2) depth: vec4<u32>,
 };
 
 fn octahedral(n: vec3<f32>) -> vec2<f32> {
@@ -1365,7 +1365,7 @@ fn fs_gbuffer(in: VsOut, @builtin(front_facing) front: bool) -> GBufferOut {
     out.colour = vec4<f32>(s.base, s.metallic);
     out.normal = vec4<f32>(octahedral(s.n), select(s.roughness, -1.0, s.unlit), s.occlusion);
     // In a fragment, `clip` is its window position: z is the depth in the face view.
-    out.depth = vec4<f32>(in.clip.z, 0.0, 0.0, 1.0);
+    out.depth = vec4<u32>(bitcast<u32>(in.clip.z), 0u, 0u, 0u);
     return out;
 }
 
@@ -1378,7 +1378,13 @@ struct Impostor {
 @group(2) @binding(0) var<uniform> impostor: Impostor;
 @group(2) @binding(1) var impostor_colour: texture_2d_array<f32>;
 @group(2) @binding(2) var impostor_normal: texture_2d_array<f32>;
-@group(2) @binding(3) var impostor_depth: texture_2d_array<f32>;
+// Red: the depth at the texel's centre; green: the nearest around it; each the bits of an f32.
+@group(2) @binding(3) var impostor_depth: texture_2d_array<u32>;
+
+// Face f's depths at texel `at`: centre (x) and nearest around it (y).
+fn impostor_depths(at: vec2<i32>, f: u32) -> vec2<f32> {
+    return bitcast<vec2<f32>>(textureLoad(impostor_depth, at, i32(f), 0).rg);
+}
 
 struct ImpostorVsOut {
     @builtin(position) clip: vec4<f32>,
@@ -1431,7 +1437,7 @@ fn impostor_depth_along(q: vec3<f32>, f: u32) -> f32 {
 // How far behind face f's first surface at its texel's centre the box point q lies (negative:
 // in front of it), in units of the box along the face's axis.
 fn impostor_behind(q: vec3<f32>, f: u32, size: f32) -> f32 {
-    return impostor_depth_along(q, f) - textureLoad(impostor_depth, impostor_texel(q, f, size), i32(f), 0).r;
+    return impostor_depth_along(q, f) - impostor_depths(impostor_texel(q, f, size), f).x;
 }
 
 // Inside the relief hull, read conservatively (the nearest depth around the texel, see
@@ -1441,7 +1447,7 @@ fn impostor_behind(q: vec3<f32>, f: u32, size: f32) -> f32 {
 // (`ImpostorBox::error_m` counts it).
 fn impostor_inside(q: vec3<f32>, size: f32) -> bool {
     for (var f = 0u; f < 6u; f = f + 1u) {
-        let nearest = textureLoad(impostor_depth, impostor_texel(q, f, size), i32(f), 0).g;
+        let nearest = impostor_depths(impostor_texel(q, f, size), f).y;
         if (impostor_depth_along(q, f) < nearest - 1.0 / size) {
             return false;
         }
@@ -1529,7 +1535,7 @@ fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
         }
     }
     var at = impostor_texel(q, face, size);
-    if (textureLoad(impostor_depth, at, i32(face), 0).r > 1.5) {
+    if (impostor_depths(at, face).x > 1.5) {
         // On the hull's conservative rim, where the texel's centre saw nothing: the material of
         // the neighbour that made the rim.
         var nearest = 3.0;
@@ -1538,7 +1544,7 @@ fn fs_impostor(in: ImpostorVsOut) -> ImpostorFsOut {
         for (var dy = -1; dy <= 1; dy = dy + 1) {
             for (var dx = -1; dx <= 1; dx = dx + 1) {
                 let p = clamp(at + vec2<i32>(dx, dy), vec2<i32>(0), last);
-                let r = textureLoad(impostor_depth, p, i32(face), 0).r;
+                let r = impostor_depths(p, face).x;
                 if (r < nearest) {
                     nearest = r;
                     source = p;

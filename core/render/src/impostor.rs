@@ -30,16 +30,23 @@ pub use phantogram_assets::model::IMPOSTOR_LEVEL;
 /// unlit) and occlusion; depth along the face's axis (2 where the texel sees nothing) at the
 /// texel's centre and, conservatively, around it (`impostor_dilate.wgsl`). The bake renders the
 /// depth into a transient map of the first format, then makes the kept one.
+///
+/// The depths are f32 values kept as their bits in 32-bit unsigned integers (the shaders
+/// `bitcast` them; only `textureLoad` reads them, so nothing is filtered or blended): OpenGL ES
+/// 3, Android's fallback, renders to 32-bit integer formats everywhere but to 32-bit float ones
+/// only with `EXT_color_buffer_float` — which wgpu also fails to see on desktop OpenGL's core
+/// profiles — and an `R32Float` target there made the impostors' pipelines fail, so big scans
+/// were drawn from polygons only.
 pub(crate) const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 pub(crate) const NORMAL_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
-pub(crate) const RAW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Float;
-pub(crate) const DEPTH_MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Float;
+pub(crate) const RAW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::R32Uint;
+pub(crate) const DEPTH_MAP_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rg32Uint;
 /// The WGSL of the depth map's second pass, validated by naga in the tests.
 pub const IMPOSTOR_DILATE_WGSL: &str = include_str!("../../../shaders/impostor_dilate.wgsl");
 /// Bytes per texel of the three maps kept.
 pub const BYTES_PER_TEXEL: u64 = 4 + 8 + 8;
 /// What an empty texel's depth holds: beyond the box, so no point is behind it.
-pub(crate) const EMPTY_DEPTH: f64 = 2.0;
+pub(crate) const EMPTY_DEPTH: f32 = 2.0;
 
 /// An impostor's box and resolution (GPU-free).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -186,7 +193,7 @@ pub(crate) struct GpuImpostor {
     _maps: [wgpu::Texture; 3],
 }
 
-/// Layer `face` of a six-layer map, as a 2D view (a render target, or the raw depth read).
+/// Layer `face` of a six-layer map, as a 2D view (a render target).
 fn layer_view(t: &wgpu::Texture, face: u32) -> wgpu::TextureView {
     t.create_view(&wgpu::TextureViewDescriptor {
         dimension: Some(wgpu::TextureViewDimension::D2),
@@ -196,18 +203,26 @@ fn layer_view(t: &wgpu::Texture, face: u32) -> wgpu::TextureView {
     })
 }
 
-fn array_entry(binding: u32) -> wgpu::BindGroupLayoutEntry {
+/// A map read by `textureLoad` only, at `binding`: a six-layer array (`D2Array`) when drawn, one
+/// layer (`D2`) in the bake's depth pass.
+fn map_entry(
+    binding: u32,
+    sample_type: wgpu::TextureSampleType,
+    view_dimension: wgpu::TextureViewDimension,
+) -> wgpu::BindGroupLayoutEntry {
     wgpu::BindGroupLayoutEntry {
         binding,
         visibility: wgpu::ShaderStages::FRAGMENT,
         ty: wgpu::BindingType::Texture {
-            sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2Array,
+            sample_type,
+            view_dimension,
             multisampled: false,
         },
         count: None,
     }
 }
+
+const FLOAT: wgpu::TextureSampleType = wgpu::TextureSampleType::Float { filterable: false };
 
 impl crate::Renderer {
     /// Makes the impostors' pipelines if they are not made yet.
@@ -218,9 +233,9 @@ impl crate::Renderer {
                 label: Some("impostor"),
                 entries: &[
                     crate::uniform_entry(0, wgpu::ShaderStages::VERTEX_FRAGMENT),
-                    array_entry(1),
-                    array_entry(2),
-                    array_entry(3),
+                    map_entry(1, FLOAT, wgpu::TextureViewDimension::D2Array),
+                    map_entry(2, FLOAT, wgpu::TextureViewDimension::D2Array),
+                    map_entry(3, wgpu::TextureSampleType::Uint, wgpu::TextureViewDimension::D2Array),
                 ],
             });
             let empty_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -309,7 +324,11 @@ impl crate::Renderer {
             });
             let dilate_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
                 label: Some("impostor depth (raw)"),
-                entries: &[crate::texture_entry(0)],
+                entries: &[map_entry(
+                    0,
+                    wgpu::TextureSampleType::Uint,
+                    wgpu::TextureViewDimension::D2,
+                )],
             });
             let dilate_pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
                 label: Some("impostor depth (conservative)"),
@@ -402,7 +421,7 @@ impl crate::Renderer {
         let queue = self.gpu.queue.clone();
         // Six views, read as an array (a seventh layer on OpenGL: `Gpu::array_layers`).
         let layers = self.gpu.array_layers(texels, texels, 6);
-        let map = |label, format| {
+        let map = |label, format, layers| {
             device.create_texture(&wgpu::TextureDescriptor {
                 label: Some(label),
                 size: wgpu::Extent3d {
@@ -419,11 +438,14 @@ impl crate::Renderer {
             })
         };
         let maps = [
-            map("impostor colour", COLOUR_FORMAT),
-            map("impostor normal", NORMAL_FORMAT),
-            map("impostor depth", DEPTH_MAP_FORMAT),
+            map("impostor colour", COLOUR_FORMAT, layers),
+            map("impostor normal", NORMAL_FORMAT, layers),
+            map("impostor depth", DEPTH_MAP_FORMAT, layers),
         ];
-        let raw_depth = map("impostor depth (raw)", RAW_DEPTH_FORMAT);
+        // One face's raw depth at a time, a plain 2D texture: each face's bake is followed by its
+        // depth pass. (OpenGL cannot read one layer of an array as a 2D texture: its views keep
+        // the texture's own target, and such a read gave zeros.)
+        let raw_depth = map("impostor depth (raw)", RAW_DEPTH_FORMAT, 1).create_view(&Default::default());
         let depth = device
             .create_texture(&wgpu::TextureDescriptor {
                 label: Some("impostor bake depth"),
@@ -449,9 +471,21 @@ impl crate::Renderer {
             };
             queue.write_buffer(buffer, 0, bytemuck::bytes_of(&uniform));
         }
+        let raw_bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("impostor depth (raw)"),
+            layout: &pipelines.dilate_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&raw_depth),
+            }],
+        });
         let mut encoder = device.create_command_encoder(&Default::default());
         for face in 0..6u32 {
-            let views = [&maps[0], &maps[1], &raw_depth].map(|t| layer_view(t, face));
+            let views = [
+                layer_view(&maps[0], face),
+                layer_view(&maps[1], face),
+                raw_depth.clone(),
+            ];
             let clear = |view, colour| {
                 Some(wgpu::RenderPassColorAttachment {
                     view,
@@ -478,8 +512,9 @@ impl crate::Renderer {
                     ),
                     clear(
                         &views[2],
+                        // The integer target is cleared to the value's bits (exact in f64).
                         wgpu::Color {
-                            r: EMPTY_DEPTH,
+                            r: f64::from(EMPTY_DEPTH.to_bits()),
                             g: 0.0,
                             b: 0.0,
                             a: 1.0,
@@ -502,24 +537,13 @@ impl crate::Renderer {
                 pass.set_bind_group(1, &self.model.materials[p.material].bind, &[]);
                 p.draw(&mut pass, &[]);
             }
-        }
-        for face in 0..6u32 {
-            let raw = layer_view(&raw_depth, face);
-            let target = layer_view(&maps[2], face);
-            let bind = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("impostor depth (raw)"),
-                layout: &pipelines.dilate_layout,
-                entries: &[wgpu::BindGroupEntry {
-                    binding: 0,
-                    resource: wgpu::BindingResource::TextureView(&raw),
-                }],
-            });
+            drop(pass);
             crate::pipelines::draw_fullscreen(
                 &mut encoder,
                 "impostor depth (conservative)",
-                &target,
+                &layer_view(&maps[2], face),
                 &pipelines.dilate,
-                &bind,
+                &raw_bind,
                 None,
             );
         }
