@@ -70,7 +70,10 @@ impl Gpu {
             // Timestamp queries where offered: the frame budget of big scans follows GPU time.
             // Block-compressed textures where offered: a quarter of RGBA8's memory.
             required_features: adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | crate::block_textures::FEATURES),
-            required_limits: wgpu::Limits::downlevel_defaults().using_resolution(adapter.limits()),
+            required_limits: limits_for(
+                &adapter.limits(),
+                std::env::var_os("PHANTOGRAM_GPU_LIMITS").is_some_and(|v| v == "gles3"),
+            ),
             ..Default::default()
         }))
         .map_err(|e| RenderError::Device(e.to_string()))?;
@@ -131,5 +134,56 @@ pub(super) fn window_target(
         wgpu::SurfaceTarget::Window(Box::new(WindowOnly(SharedWindow(window))))
     } else {
         wgpu::SurfaceTarget::DisplayAndWindow(Box::new(SharedWindow(window)))
+    }
+}
+
+/// The limits asked of a device: wgpu's downlevel defaults (what every Vulkan phone, Metal and
+/// OpenGL ES 3.1 give), or WebGL 2's where the adapter offers less — OpenGL ES 3.0, which has no
+/// compute shaders or storage buffers, and on which asking for more opened no device at all —,
+/// with the adapter's own texture sizes. Asking for a tier, not for all the adapter has, keeps
+/// the tests here (lavapipe offers far more) within what a phone gives.
+///
+/// `forced_low` (`PHANTOGRAM_GPU_LIMITS=gles3`) asks for the lower tier on any adapter: how the
+/// tests check that the renderer draws within OpenGL ES 3.0's limits (its CPU paths where
+/// compute is missing), which no GPU here has.
+fn limits_for(adapter: &wgpu::Limits, forced_low: bool) -> wgpu::Limits {
+    let tier = wgpu::Limits::downlevel_defaults();
+    let tier = if tier.check_limits(adapter) && !forced_low {
+        tier
+    } else {
+        wgpu::Limits::downlevel_webgl2_defaults()
+    };
+    tier.using_resolution(adapter.clone())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::limits_for;
+
+    /// A GLES 3.0 adapter (WebGL 2's limits, larger textures) gets a device within them, not a
+    /// request it must refuse; a GLES 3.1 or Vulkan one gets the downlevel defaults, unless the
+    /// lower tier is forced. Texture sizes are the adapter's in every case.
+    #[test]
+    fn each_adapter_is_asked_for_limits_it_has() {
+        let gles3 = wgpu::Limits {
+            max_texture_dimension_2d: 4096,
+            ..wgpu::Limits::downlevel_webgl2_defaults()
+        };
+        let asked = limits_for(&gles3, false);
+        assert!(asked.check_limits(&gles3));
+        assert_eq!(asked.max_storage_buffers_per_shader_stage, 0);
+        assert_eq!(asked.max_texture_dimension_2d, 4096);
+
+        let vulkan = wgpu::Limits {
+            max_texture_dimension_2d: 8192,
+            ..wgpu::Limits::default()
+        };
+        let asked = limits_for(&vulkan, false);
+        assert_eq!(
+            asked.max_storage_buffers_per_shader_stage,
+            wgpu::Limits::downlevel_defaults().max_storage_buffers_per_shader_stage
+        );
+        assert_eq!(asked.max_texture_dimension_2d, 8192);
+        assert_eq!(limits_for(&vulkan, true).max_storage_buffers_per_shader_stage, 0);
     }
 }

@@ -819,6 +819,19 @@ fn pipelines_that_skip_missing_textures_draw_the_same_picture() {
 /// Runs `shader`'s compute entry point `main` (workgroups of 64) over `queries` and returns its
 /// `results`, `per_query` f32s a query. Its group 0 holds `leading` at bindings 0, 1, …, then
 /// the queries (`array<vec4<f32>>`, read-only storage) and the results (read-write storage).
+/// Whether `gpu` runs the compute shaders of [`run_compute`] (64 invocations, storage buffers):
+/// an OpenGL ES 3.0 device, or any under `PHANTOGRAM_GPU_LIMITS=gles3`, does not.
+fn computes(gpu: &Gpu) -> bool {
+    let limits = gpu.device.limits();
+    gpu.adapter
+        .get_downlevel_capabilities()
+        .flags
+        .contains(phantogram::wgpu::DownlevelFlags::COMPUTE_SHADERS)
+        && limits.max_storage_buffers_per_shader_stage >= 2
+        && limits.max_compute_workgroup_size_x >= 64
+        && limits.max_compute_invocations_per_workgroup >= 64
+}
+
 fn run_compute(
     gpu: &Gpu,
     shader: &str,
@@ -911,8 +924,8 @@ fn shadow_filter_equals_nine_bilinear_comparisons() {
     let Some(gpu) = gpu() else { return };
     // The test writes its depth map from the CPU and reads results from a storage buffer, which
     // OpenGL ES devices may lack (the renderer itself does neither).
-    let needed = wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES | wgpu::DownlevelFlags::COMPUTE_SHADERS;
-    if !gpu.adapter.get_downlevel_capabilities().flags.contains(needed) {
+    let copies = wgpu::DownlevelFlags::DEPTH_TEXTURE_AND_BUFFER_COPIES;
+    if !gpu.adapter.get_downlevel_capabilities().flags.contains(copies) || !computes(&gpu) {
         println!("skipped: the device cannot copy into depth textures or run compute shaders");
         return;
     }
@@ -1020,6 +1033,10 @@ fn main(@builtin(global_invocation_id) id: vec3<u32>) {{
 fn the_shaders_cube_depth_is_the_faces() {
     use phantogram::render::point_shadow::cube_depth;
     let Some(gpu) = gpu() else { return };
+    if !computes(&gpu) {
+        println!("skipped: the device runs no compute shaders");
+        return;
+    }
     let source = phantogram::render::SCENE_WGSL;
     let (begin, end) = ("// BEGIN cube_depth", "// END cube_depth");
     let function = &source[source.find(begin).expect(begin)..source.find(end).expect(end)];
