@@ -19,8 +19,15 @@ impl Gpu {
     /// A device without any window, on the first adapter that works: hardware first, then a
     /// software fallback.
     pub fn headless() -> Result<Self, RenderError> {
+        Self::headless_using(wgpu::Features::all())
+    }
+
+    /// [`Self::headless`], turning on of the optional features the renderer uses where offered
+    /// (timestamp queries; ASTC, BC and ETC2 blocks) only those in `optional`: how the tests take
+    /// each block format's path on an adapter that offers several.
+    pub fn headless_using(optional: wgpu::Features) -> Result<Self, RenderError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle_from_env());
-        Self::with_instance(instance, None)
+        Self::open(instance, None, optional)
     }
 
     /// A window of any display as a surface target for this device's instance.
@@ -50,6 +57,14 @@ impl Gpu {
 
     /// A device on `instance` whose adapter can present to `surface` (if given).
     pub fn with_instance(instance: wgpu::Instance, surface: Option<&wgpu::Surface<'_>>) -> Result<Self, RenderError> {
+        Self::open(instance, surface, wgpu::Features::all())
+    }
+
+    fn open(
+        instance: wgpu::Instance,
+        surface: Option<&wgpu::Surface<'_>>,
+        optional: wgpu::Features,
+    ) -> Result<Self, RenderError> {
         let mut adapter = None;
         for force_fallback_adapter in [false, true] {
             let found = pollster::block_on(instance.request_adapter(&wgpu::RequestAdapterOptions {
@@ -69,7 +84,9 @@ impl Gpu {
             label: Some("phantogram"),
             // Timestamp queries where offered: the frame budget of big scans follows GPU time.
             // Block-compressed textures where offered: a quarter of RGBA8's memory.
-            required_features: adapter.features() & (wgpu::Features::TIMESTAMP_QUERY | crate::block_textures::FEATURES),
+            required_features: adapter.features()
+                & optional
+                & (wgpu::Features::TIMESTAMP_QUERY | crate::block_textures::FEATURES),
             required_limits: limits_for(
                 &adapter.limits(),
                 std::env::var_os("PHANTOGRAM_GPU_LIMITS").is_some_and(|v| v == "gles3"),
