@@ -184,7 +184,8 @@ fn main() {
     // step costs against a triangle (the chooser's `impostor_step_triangles`).
     let budget = phantogram::budget::ResourceBudget::PHONE.memory_bytes;
     let left = budget.saturating_sub(phantogram::budget::model_bytes(&big));
-    let mut baker = phantogram::impostors::ImpostorBaker::plan_for(&big, left, &mut detail);
+    let opengl = renderer.gpu().is_opengl();
+    let mut baker = phantogram::impostors::ImpostorBaker::plan_for(&big, left, opengl, &mut detail);
     let planned = baker.pending();
     // As the engine learns it: from a choice (unbound here) with the impostors planned.
     detail.choose_within(&input.eyes_drawn(Method::DuboisRedCyan), input.offset, None, u64::MAX);

@@ -34,13 +34,16 @@ pub const MAX_TEXELS: u32 = 128;
 pub const BAKED_PER_FRAME: usize = 4;
 
 /// Texels per side for `parts` impostors within `memory_bytes`, or `None` when they would be
-/// coarser than [`MIN_TEXELS`].
-pub fn texels_for(parts: usize, memory_bytes: u64) -> Option<u32> {
+/// coarser than [`MIN_TEXELS`]: six maps each, seven on OpenGL (ES) (`opengl`: its spare layer,
+/// [`crate::budget::array_layers`]).
+pub fn texels_for(parts: usize, memory_bytes: u64, opengl: bool) -> Option<u32> {
     if parts == 0 {
         return None;
     }
     let per_part = memory_bytes.min(IMPOSTOR_MEMORY_BYTES) / parts as u64;
-    let side = ((per_part / (6 * phantogram_render::impostor::BYTES_PER_TEXEL)) as f64).sqrt() as u32;
+    // Square maps: the layers do not depend on the side.
+    let maps = u64::from(crate::budget::array_layers(1, 1, 6, opengl));
+    let side = ((per_part / (maps * phantogram_render::impostor::BYTES_PER_TEXEL)) as f64).sqrt() as u32;
     let texels = if side == 0 {
         0
     } else {
@@ -60,21 +63,21 @@ pub struct ImpostorBaker {
 
 impl ImpostorBaker {
     /// The parts of `model` (primitives with levels of detail) and their boxes, within
-    /// `memory_bytes` of GPU memory, each announced to `detail` as planned (not baked), so that
-    /// the chooser can say which are worth baking.
-    pub fn plan_for(model: &Model, memory_bytes: u64, detail: &mut Detail) -> Self {
-        let baker = Self::plan(model, memory_bytes);
+    /// `memory_bytes` of GPU memory on OpenGL (ES) (`opengl`) or another backend, each announced
+    /// to `detail` as planned (not baked), so that the chooser can say which are worth baking.
+    pub fn plan_for(model: &Model, memory_bytes: u64, opengl: bool, detail: &mut Detail) -> Self {
+        let baker = Self::plan(model, memory_bytes, opengl);
         baker.announce(detail);
         baker
     }
 
     /// The parts of `model` (primitives with levels of detail) and their boxes, within
-    /// `memory_bytes` of GPU memory.
-    fn plan(model: &Model, memory_bytes: u64) -> Self {
+    /// `memory_bytes` of GPU memory (on OpenGL (ES) where `opengl`).
+    fn plan(model: &Model, memory_bytes: u64, opengl: bool) -> Self {
         let parts: Vec<usize> = (0..model.primitives.len())
             .filter(|&i| !model.primitives[i].lods.is_empty() && !model.primitives[i].is_floor)
             .collect();
-        let Some(texels) = texels_for(parts.len(), memory_bytes) else {
+        let Some(texels) = texels_for(parts.len(), memory_bytes, opengl) else {
             return Self::default();
         };
         let mut planned = vec![None; model.primitives.len()];
@@ -187,13 +190,21 @@ mod tests {
     #[test]
     fn impostors_share_their_memory_in_powers_of_two() {
         // 128 parts in 32 MiB: 52 texels would fit, 32 are made.
-        assert_eq!(texels_for(128, u64::MAX), Some(32));
+        assert_eq!(texels_for(128, u64::MAX, false), Some(32));
         let taken = ImpostorBox::around([Vec3::ZERO, Vec3::ONE], 32).map(|b| b.bytes());
         assert!(taken.is_some_and(|b| 128 * b <= IMPOSTOR_MEMORY_BYTES), "{taken:?}");
         // A few parts: capped.
-        assert_eq!(texels_for(2, u64::MAX), Some(MAX_TEXELS));
+        assert_eq!(texels_for(2, u64::MAX, false), Some(MAX_TEXELS));
         // Little memory left by the model: none, rather than impostors too coarse to use.
-        assert_eq!(texels_for(128, 1 << 20), None);
-        assert_eq!(texels_for(0, u64::MAX), None);
+        assert_eq!(texels_for(128, 1 << 20, false), None);
+        assert_eq!(texels_for(0, u64::MAX, false), None);
+        // 67 parts: 64 texels fit six maps each, not OpenGL's seven.
+        assert_eq!(texels_for(67, u64::MAX, false), Some(64));
+        assert_eq!(texels_for(67, u64::MAX, true), Some(32));
+        for opengl in [false, true] {
+            let texels = texels_for(67, u64::MAX, opengl).expect("texels");
+            let taken = ImpostorBox::around([Vec3::ZERO, Vec3::ONE], texels).map(|b| b.bytes_on(opengl));
+            assert!(taken.is_some_and(|b| 67 * b <= IMPOSTOR_MEMORY_BYTES), "{taken:?}");
+        }
     }
 }

@@ -70,6 +70,17 @@ impl ResourceBudget {
     }
 }
 
+/// Layers a device allocates for a 2D array texture of `layers` layers of `width × height` that a
+/// shader reads as an array (`texture_2d_array`): `layers`, except on OpenGL (ES) (`opengl`),
+/// where wgpu makes a texture of one layer a plain 2D texture and one of a multiple of six square
+/// layers a cube map, neither of which reads as an array there: one more layer, never read,
+/// keeps it one. The renderer allocates by this; the budget charges with `opengl` set (the most
+/// any backend takes), as it is made without knowing the device.
+pub fn array_layers(width: u32, height: u32, layers: u32, opengl: bool) -> u32 {
+    let plain_or_cube = layers == 1 || (width == height && layers.is_multiple_of(6));
+    if opengl && plain_or_cube { layers + 1 } else { layers }
+}
+
 /// Bytes `model` takes in memory, as the loader charged them: vertices, indices (every level
 /// of detail's too), textures with their mip chains (and the KTX 2.0 files kept beside them), and what the GPU's layer texture arrays
 /// take beyond those textures ([`crate::model::LayerArrays::extra_bytes`]).
@@ -212,6 +223,23 @@ impl Spending {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// OpenGL's spare layer: for one layer and for six (or twelve) square ones, nowhere else.
+    #[test]
+    fn opengl_arrays_that_would_be_plain_or_cube_take_a_spare_layer() {
+        for (w, h, layers, on_gl) in [
+            (64, 64, 1, 2),
+            (64, 32, 1, 2),
+            (64, 64, 2, 2),
+            (64, 64, 6, 7),
+            (64, 64, 12, 13),
+            (64, 32, 6, 6),
+            (64, 64, 7, 7),
+        ] {
+            assert_eq!(array_layers(w, h, layers, true), on_gl, "{w}×{h}×{layers}");
+            assert_eq!(array_layers(w, h, layers, false), layers);
+        }
+    }
 
     #[test]
     fn charges_add_up_and_the_error_names_the_limit() {

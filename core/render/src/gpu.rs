@@ -109,9 +109,12 @@ impl Gpu {
     /// square layers a cube map, neither of which a `sampler2DArray` can read (it reads zeros):
     /// there one more layer, never read, keeps it an array.
     pub(crate) fn array_layers(&self, width: u32, height: u32, layers: u32) -> u32 {
-        let gl = self.adapter.get_info().backend == wgpu::Backend::Gl;
-        let plain_or_cube = layers == 1 || (width == height && layers.is_multiple_of(6));
-        if gl && plain_or_cube { layers + 1 } else { layers }
+        phantogram_assets::budget::array_layers(width, height, layers, self.is_opengl())
+    }
+
+    /// Whether the device is OpenGL (ES): Android's fallback, with its own texture rules.
+    pub fn is_opengl(&self) -> bool {
+        self.adapter.get_info().backend == wgpu::Backend::Gl
     }
 
     /// The adapter's name and backend, for logs.

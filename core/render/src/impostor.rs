@@ -116,9 +116,16 @@ impl ImpostorBox {
         worst
     }
 
-    /// GPU memory of the three maps, bytes.
+    /// GPU memory of the three maps, bytes, on a backend other than OpenGL (ES).
     pub fn bytes(&self) -> u64 {
-        6 * u64::from(self.texels) * u64::from(self.texels) * BYTES_PER_TEXEL
+        self.bytes_on(false)
+    }
+
+    /// GPU memory of the three maps, bytes, on OpenGL (ES) (`opengl`: a seventh, spare layer,
+    /// [`phantogram_assets::budget::array_layers`]) or another backend.
+    pub fn bytes_on(&self, opengl: bool) -> u64 {
+        let layers = phantogram_assets::budget::array_layers(self.texels, self.texels, 6, opengl);
+        u64::from(layers) * u64::from(self.texels) * u64::from(self.texels) * BYTES_PER_TEXEL
     }
 
     /// Box coordinates q = (p − lo) / extent of mesh point `p` (0 to 1 inside).
@@ -400,7 +407,7 @@ impl crate::Renderer {
             let Some(baked) = crate::checked(&device, "an impostor", || self.bake_one(source, bounds))? else {
                 continue;
             };
-            bytes += baked.bounds.bytes();
+            bytes += baked.bounds.bytes_on(self.gpu.is_opengl());
             if self.model.impostors.len() <= source {
                 self.model.impostors.resize_with(source + 1, || None);
             }

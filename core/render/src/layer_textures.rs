@@ -48,7 +48,7 @@ pub(crate) fn upload_all(gpu: &Gpu, model: &Model) -> (Vec<Option<GpuLayerTextur
             })
         })
         .collect();
-    (materials, plan.bytes())
+    (materials, plan.bytes_on(gpu.is_opengl()))
 }
 
 /// The texture of `material`'s first slot that has a layer.

@@ -6,17 +6,18 @@ use crate::artifacts::{LoadStatus, ModelInfo};
 use crate::containment::ContainmentSmoother;
 
 /// The impostors planned for `model` and announced to its `detail` (none without levels of
-/// detail): within what the artifact's memory budget leaves of it.
+/// detail): within what the artifact's memory budget leaves of it, on `renderer`'s device.
 pub(super) fn impostors_for(
     model: &crate::model::Model,
     detail: Option<&mut phantogram_detail::Detail>,
     memory_bytes: u64,
+    renderer: &crate::render::Renderer,
 ) -> crate::impostors::ImpostorBaker {
     let Some(detail) = detail else {
         return Default::default();
     };
     let left = memory_bytes.saturating_sub(crate::budget::model_bytes(model));
-    crate::impostors::ImpostorBaker::plan_for(model, left, detail)
+    crate::impostors::ImpostorBaker::plan_for(model, left, renderer.gpu().is_opengl(), detail)
 }
 
 pub(super) fn load_error(e: crate::artifacts::LoadError) -> EngineError {
@@ -172,8 +173,12 @@ impl Engine {
                     d.set_target(self.frame_target_s);
                     d
                 });
-                self.impostors =
-                    impostors_for(&prepared.model, self.detail.as_mut(), self.loader.budget().memory_bytes);
+                self.impostors = impostors_for(
+                    &prepared.model,
+                    self.detail.as_mut(),
+                    self.loader.budget().memory_bytes,
+                    &self.renderer,
+                );
                 // The best scan taking over from its preview is the same artifact: what was
                 // seen of it stays seen.
                 let same_artifact = self.model_info.preview

@@ -539,7 +539,7 @@ impl Engine {
         };
         let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
         let mut detail = detail;
-        let impostors = impostors_for(&model, detail.as_mut(), budget.memory_bytes);
+        let impostors = impostors_for(&model, detail.as_mut(), budget.memory_bytes, &renderer);
         let (appearances, appearance_warning) =
             crate::appearances::AppearanceStore::open(config.library_dir.as_ref().map(|d| d.join("appearances.json")));
         renderer.appearance = appearances.get(&appearance_key(&model_info));

@@ -38,9 +38,17 @@ pub struct LayerArray {
 }
 
 impl LayerArray {
-    /// Bytes it takes on the GPU, with every layer's mip chain.
+    /// Bytes it takes on the GPU, with every layer's mip chain, on the backend that takes the
+    /// most (OpenGL's spare layer: [`crate::budget::array_layers`]).
     pub fn bytes(&self) -> u64 {
-        (self.images.len() as u64).saturating_mul(crate::budget::ResourceBudget::texture_bytes(self.width, self.height))
+        self.bytes_on(true)
+    }
+
+    /// Bytes it takes on the GPU, with every layer's mip chain, on OpenGL (ES) (`opengl`) or
+    /// another backend.
+    pub fn bytes_on(&self, opengl: bool) -> u64 {
+        let layers = crate::budget::array_layers(self.width, self.height, self.images.len() as u32, opengl);
+        u64::from(layers).saturating_mul(crate::budget::ResourceBudget::texture_bytes(self.width, self.height))
     }
 }
 
@@ -107,9 +115,18 @@ impl LayerArrays {
         plan
     }
 
-    /// Bytes every array takes on the GPU.
+    /// Bytes every array takes on the GPU, on the backend that takes the most
+    /// ([`LayerArray::bytes`]).
     pub fn bytes(&self) -> u64 {
-        self.arrays.iter().map(LayerArray::bytes).fold(0, u64::saturating_add)
+        self.bytes_on(true)
+    }
+
+    /// Bytes every array takes on the GPU on OpenGL (ES) (`opengl`) or another backend.
+    pub fn bytes_on(&self, opengl: bool) -> u64 {
+        self.arrays
+            .iter()
+            .map(|a| a.bytes_on(opengl))
+            .fold(0, u64::saturating_add)
     }
 
     /// Bytes the arrays take beyond the decoded images they stand for: all of them, less the
@@ -250,8 +267,13 @@ mod tests {
         // The second material reads image 0 where the first put it.
         assert_eq!(plan.materials[1].expect("has layers").layer_of_slot[0], Some(0));
         assert_eq!(plan.materials[1].expect("has layers").layer_of_slot[10], Some(2));
-        // Every image once, each at its own size: nothing beyond the images themselves.
-        assert_eq!(plan.extra_bytes(&materials, &images), 0);
+        // Every image once, each at its own size: nothing beyond the images themselves, but
+        // the spare layer OpenGL gives the array of one layer (8²), charged on every backend.
+        assert_eq!(
+            plan.extra_bytes(&materials, &images),
+            ResourceBudget::texture_bytes(8, 8)
+        );
+        assert_eq!(plan.bytes_on(false), plan.bytes() - ResourceBudget::texture_bytes(8, 8));
     }
 
     #[test]
