@@ -277,17 +277,28 @@ fn run(cli: Cli) -> Result<()> {
                 Some(path) => Some(sensorlog::read_all(&path, open_events(&path)?)?),
                 None => None,
             };
-            // The calibration is the user's, kept where the desktop tools keep it.
-            let engine = scene.engine(anaglyph, phantogram::calibration::Calibration::default_path(), true)?;
-            viewer::run(viewer::ViewerArgs {
-                engine,
-                log,
-                frames,
-                lifecycle_test,
-                calibration,
-                menu,
-                linger_s,
-            })
+            // The calibration is the user's, kept where the desktop tools keep it. The window's
+            // event loop is made with the engine, once its files are read.
+            let mut event_loop = None;
+            let engine = scene.engine(
+                anaglyph,
+                phantogram::calibration::Calibration::default_path(),
+                true,
+                Some(&mut event_loop),
+            )?;
+            let event_loop = event_loop.context("the engine opened no window display")?;
+            viewer::run(
+                event_loop,
+                viewer::ViewerArgs {
+                    engine,
+                    log,
+                    frames,
+                    lifecycle_test,
+                    calibration,
+                    menu,
+                    linger_s,
+                },
+            )
         }
         Command::Render {
             scene,

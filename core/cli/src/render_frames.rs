@@ -72,7 +72,7 @@ pub fn render_command(args: RenderArgs) -> Result<()> {
         bail!("--out {}: exists and is not a folder", out_dir.display());
     }
     // The frames are the defaults' (no calibration file): reproducible on any machine.
-    let mut engine = scene.engine(method, None, false)?;
+    let mut engine = scene.engine(method, None, false, None)?;
     std::fs::create_dir_all(out_dir).with_context(|| format!("creating {}", out_dir.display()))?;
     // The frames go to a folder of their own inside `out_dir` and replace an earlier run's only
     // once all are written: a run that fails (a GPU error, a full disk) leaves the earlier frames

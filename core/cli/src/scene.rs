@@ -8,6 +8,7 @@ use anyhow::{Result, bail};
 use phantogram::anaglyph::Method;
 use phantogram::engine::{Engine, EngineConfig};
 use phantogram::model::{DioramaFit, Placement};
+use winit::event_loop::EventLoop;
 
 /// What is shown, and how: shared by `view` and `render`, so that the window previews exactly
 /// what the frames will hold.
@@ -83,7 +84,17 @@ impl SceneArgs {
     /// one is reported at once, with or without a GPU). Prints what was loaded and on what.
     /// `interactive`: someone looks at it (the viewer: hints toward unseen sides), rather than a
     /// recording being made (`render`).
-    pub fn engine(&self, method: Method, calibration_path: Option<PathBuf>, interactive: bool) -> Result<Engine> {
+    ///
+    /// `window`: for the viewer, where its event loop goes, made once the files are read and
+    /// before the device, which is opened for its display (OpenGL presents to no window
+    /// otherwise); none for offscreen work.
+    pub fn engine(
+        &self,
+        method: Method,
+        calibration_path: Option<PathBuf>,
+        interactive: bool,
+        window: Option<&mut Option<EventLoop<()>>>,
+    ) -> Result<Engine> {
         if !(0.0..=1.0).contains(&self.protrude) {
             bail!("--protrude must be a fraction between 0 and 1, got {}", self.protrude);
         }
@@ -134,7 +145,19 @@ impl SceneArgs {
             side_hints: interactive,
             ..EngineConfig::default()
         };
-        let mut engine = Engine::new(config)?;
+        let mut engine = match window {
+            Some(slot) => Engine::with_gpu_from(
+                || {
+                    let event_loop = crate::viewer::event_loop()
+                        .map_err(|e| phantogram::render::RenderError::Device(format!("{e:#}")))?;
+                    let display = Box::new(event_loop.owned_display_handle());
+                    *slot = Some(event_loop);
+                    phantogram::render::Gpu::for_display(display, None)
+                },
+                config,
+            )?,
+            None => Engine::new(config)?,
+        };
         match self.lamp {
             Some(LampArg::Raking) => engine.set_lamp(Some(phantogram::lamp::LampSetting::raking())),
             Some(LampArg::Torch) => engine.set_lamp(Some(phantogram::lamp::LampSetting::torch())),

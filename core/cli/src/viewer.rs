@@ -397,10 +397,13 @@ impl ApplicationHandler for App {
     }
 }
 
-/// Runs the viewer until the window closes (or `frames` are presented).
-pub fn run(args: ViewerArgs) -> Result<()> {
-    let event_loop =
-        EventLoop::new().context("no display to open a window on (set DISPLAY, or use `phantogram render`)")?;
+/// The viewer's event loop: the display its windows open on.
+pub fn event_loop() -> Result<EventLoop<()>> {
+    EventLoop::new().context("no display to open a window on (set DISPLAY, or use `phantogram render`)")
+}
+
+/// Runs the viewer on `event_loop` until the window closes (or `frames` are presented).
+pub fn run(event_loop: EventLoop<()>, args: ViewerArgs) -> Result<()> {
     event_loop.set_control_flow(ControlFlow::Poll);
     eprintln!(
         "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, c calibration screens, a artifacts menu (or click once), s save the view (anaglyph and stereo pair), Esc quit"

@@ -40,16 +40,24 @@ impl Gpu {
 
     /// A device able to present to windows of `display` (a winit event loop or window, an
     /// Android or iOS display handle): the instance keeps the display connection, and the adapter
-    /// is chosen to present to `probe`, a window of that display.
+    /// is chosen to present to `probe`, a window of that display, if given.
+    ///
+    /// **Important**: on OpenGL (wgpu's EGL) only a device made this way presents to a desktop
+    /// window: without the display, Mesa's EGL opens its surfaceless platform, whose surfaces
+    /// offer no format. (Android's EGL has one display, and a headless device presents there.)
     pub fn for_display(
         display: Box<dyn wgpu::wgt::WgpuHasDisplayHandle>,
-        probe: std::sync::Arc<dyn wgpu::DisplayAndWindowHandle>,
+        probe: Option<std::sync::Arc<dyn wgpu::DisplayAndWindowHandle>>,
     ) -> Result<Self, RenderError> {
         let instance = wgpu::Instance::new(wgpu::InstanceDescriptor::new_with_display_handle_from_env(display));
-        let surface = instance
-            .create_surface(window_target(probe, true))
-            .map_err(|e| RenderError::Device(format!("cannot create a surface for the window: {e}")))?;
-        let mut gpu = Self::with_instance(instance.clone(), Some(&surface))?;
+        let surface = probe
+            .map(|probe| {
+                instance
+                    .create_surface(window_target(probe, true))
+                    .map_err(|e| RenderError::Device(format!("cannot create a surface for the window: {e}")))
+            })
+            .transpose()?;
+        let mut gpu = Self::with_instance(instance.clone(), surface.as_ref())?;
         gpu.instance_has_display = true;
         drop(surface);
         Ok(gpu)

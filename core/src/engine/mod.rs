@@ -430,11 +430,10 @@ impl Engine {
     /// short-lived thread that computes the renderer's lighting tables meanwhile (once per
     /// process, [`crate::render::prepare_lighting_tables`]).
     ///
-    /// Files (model, environment, calibration) are read before the device is opened, so that a
-    /// bad one is reported as such even where no GPU can be found.
+    /// The calibration and environment files are read before the device is opened, so that a
+    /// bad one is reported as such even where no GPU can be found; the model after it (its
+    /// budget takes the device's largest texture).
     pub fn new(config: EngineConfig) -> Result<Self, EngineError> {
-        // Opening the device and loading the model overlap the renderer's lighting tables.
-        crate::render::prepare_lighting_tables_in_background(config.environment_path.is_none());
         Self::with_gpu_from(Gpu::headless, config)
     }
 
@@ -443,10 +442,14 @@ impl Engine {
         Self::with_gpu_from(|| Ok(gpu), config)
     }
 
-    fn with_gpu_from(
+    /// As [`Self::new`] on the device `gpu` opens once the files are read (a window's display:
+    /// [`Gpu::for_display`]).
+    pub fn with_gpu_from(
         gpu: impl FnOnce() -> Result<Gpu, RenderError>,
         config: EngineConfig,
     ) -> Result<Self, EngineError> {
+        // Opening the device and loading the model overlap the renderer's lighting tables.
+        crate::render::prepare_lighting_tables_in_background(config.environment_path.is_none());
         let screen = Screen::new(config.panel, config.rotation)?;
         let protrude = config.fit.protrude_fraction;
         if !(0.0..=1.0).contains(&protrude) {
@@ -479,7 +482,12 @@ impl Engine {
             },
             ..config.fit
         };
-        // The GPU first: the model's budget takes the device's texture limit.
+        // The environment before the device, so that a bad file is named as such whether or not
+        // a device opens; the model after it: its budget takes the device's texture limit.
+        let environment = match &config.environment_path {
+            Some(path) => Some(crate::ibl::Environment::load(path)?),
+            None => None,
+        };
         let gpu = gpu()?;
         let budget = crate::budget::ResourceBudget {
             max_image_side_px: crate::budget::ResourceBudget::PHONE
@@ -533,10 +541,6 @@ impl Engine {
             seen,
         } = prepared;
         let seen = config.side_hints.then_some(seen);
-        let environment = match &config.environment_path {
-            Some(path) => Some(crate::ibl::Environment::load(path)?),
-            None => None,
-        };
         let mut renderer = Renderer::with_environment(gpu, &model, environment.as_ref())?;
         let mut detail = detail;
         let impostors = impostors_for(&model, detail.as_mut(), budget.memory_bytes, &renderer);
