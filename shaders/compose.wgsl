@@ -1,6 +1,10 @@
 // Composition pass: tone-maps each eye's linear HDR image (Khronos PBR Neutral, with exposure) and
-// combines the two with the anaglyph matrices in linear light. The target is an sRGB texture, so
-// the hardware applies the sRGB transfer function on write.
+// combines the two with the anaglyph matrices in linear light. On an sRGB target the hardware
+// applies the sRGB transfer function on write; on another (a window whose surface offers no sRGB
+// format, as an OpenGL ES surface without EGL_KHR_gl_colorspace) the shader does
+// (`ENCODE_SRGB`, set by the pipeline).
+
+override ENCODE_SRGB: bool = false;
 
 struct Compose {
     // Rows of the left and right 3×3 matrices (xyz used).
@@ -54,5 +58,16 @@ fn fs_main(@builtin(position) frag: vec4<f32>) -> @location(0) vec4<f32> {
         dot(compose.left[1].xyz, l) + dot(compose.right[1].xyz, r),
         dot(compose.left[2].xyz, l) + dot(compose.right[2].xyz, r),
     );
-    return vec4<f32>(clamp(out, vec3<f32>(0.0), vec3<f32>(1.0)), 1.0);
+    let linear = clamp(out, vec3<f32>(0.0), vec3<f32>(1.0));
+    if (ENCODE_SRGB) {
+        return vec4<f32>(srgb_encode(linear), 1.0);
+    }
+    return vec4<f32>(linear, 1.0);
+}
+
+// The sRGB transfer function (IEC 61966-2-1), as an sRGB target applies it on write.
+fn srgb_encode(c: vec3<f32>) -> vec3<f32> {
+    let low = c * 12.92;
+    let high = 1.055 * pow(c, vec3<f32>(1.0 / 2.4)) - vec3<f32>(0.055);
+    return select(high, low, c <= vec3<f32>(0.0031308));
 }

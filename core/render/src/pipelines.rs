@@ -222,7 +222,17 @@ pub(crate) fn create_compose_pipeline(
     layout: &wgpu::PipelineLayout,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
-    create_fullscreen_pipeline(device, "compose", module, layout, "fs_main", format)
+    // A target that does not encode sRGB on write has the shader do it.
+    let encode = if format.is_srgb() { 0.0 } else { 1.0 };
+    create_fullscreen_pipeline_with(
+        device,
+        "compose",
+        module,
+        layout,
+        "fs_main",
+        format,
+        &[("ENCODE_SRGB", encode)],
+    )
 }
 
 /// Records a pass that clears `target` to black and draws one triangle over it with `pipeline`
@@ -265,6 +275,19 @@ pub(crate) fn create_fullscreen_pipeline(
     fragment_entry: &str,
     format: wgpu::TextureFormat,
 ) -> wgpu::RenderPipeline {
+    create_fullscreen_pipeline_with(device, label, module, layout, fragment_entry, format, &[])
+}
+
+/// [`create_fullscreen_pipeline`] with the fragment stage's pipeline constants `constants`.
+fn create_fullscreen_pipeline_with(
+    device: &wgpu::Device,
+    label: &str,
+    module: &wgpu::ShaderModule,
+    layout: &wgpu::PipelineLayout,
+    fragment_entry: &str,
+    format: wgpu::TextureFormat,
+    constants: &[(&str, f64)],
+) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),
         layout: Some(layout),
@@ -280,7 +303,10 @@ pub(crate) fn create_fullscreen_pipeline(
         fragment: Some(wgpu::FragmentState {
             module,
             entry_point: Some(fragment_entry),
-            compilation_options: Default::default(),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..Default::default()
+            },
             targets: &[Some(format.into())],
         }),
         multiview_mask: None,

@@ -259,6 +259,56 @@ fn gpu_composition_matches_the_cpu_reference() {
     }
 }
 
+/// A window whose surface offers no sRGB format (an OpenGL ES surface without
+/// `EGL_KHR_gl_colorspace`) shows the frame the offscreen sRGB target does: the composition
+/// encodes sRGB itself there. Written to an `Rgba8Unorm` texture, the default artifact's anaglyph
+/// frame is within a code of the usual one; without the encoding its mid-tones are far darker
+/// (checked: 74 codes).
+#[test]
+fn a_target_without_srgb_encoding_shows_the_same_frame() {
+    use phantogram::wgpu;
+    let Some(gpu) = gpu() else { return };
+    let view = oblique_view();
+    let input = phantogram::engine::frame_input(&view, Vec3::ZERO);
+    let mut renderer = Renderer::new(gpu, &default_model()).unwrap();
+    let method = Method::DuboisRedCyan;
+    let srgb = renderer.render(&input, method, W, H).unwrap();
+    let format = wgpu::TextureFormat::Rgba8Unorm;
+    let target = renderer.gpu().device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("unorm window"),
+        size: wgpu::Extent3d {
+            width: W,
+            height: H,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    });
+    let view_of_target = target.create_view(&Default::default());
+    renderer
+        .render_to_view(&input, method, &view_of_target, format, W, H)
+        .unwrap();
+    let unorm = phantogram::render::read_texture_level(renderer.gpu(), &target, 0).unwrap();
+    assert_eq!(unorm.len(), srgb.len());
+    let worst = srgb
+        .iter()
+        .zip(&unorm)
+        .map(|(a, b)| (i16::from(*a) - i16::from(*b)).abs())
+        .max()
+        .unwrap_or(0);
+    let mid_tones = srgb.chunks(4).filter(|p| (64..192).contains(&p[0])).count();
+    println!(
+        "largest difference {worst} codes over {} pixels ({mid_tones} with red in mid-tones)",
+        W * H
+    );
+    assert!(mid_tones > 100, "the frame shows mid-tones: {mid_tones}");
+    assert!(worst <= 1, "largest difference {worst} codes");
+}
+
 /// A floor at z = −30 mm seen straight on, with a cube above it or resting on it, lit obliquely.
 fn shadow_scene(cube_centre: Vec3, half: f32, shadows: bool) -> Option<(Vec<u8>, OffAxisProjection)> {
     let mut mesh = Mesh::default();
