@@ -65,6 +65,7 @@ impl Halver {
             &pipeline_layout,
             "fs_copy",
             HDR_FORMAT,
+            &[],
         );
         let halve = create_fullscreen_pipeline(
             device,
@@ -73,6 +74,7 @@ impl Halver {
             &pipeline_layout,
             "fs_halve",
             HDR_FORMAT,
+            &[],
         );
         Self {
             copy,

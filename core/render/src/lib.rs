@@ -110,8 +110,8 @@ use frame::{FADE_ENTRIES_AT_FIRST, fade_instance_buffer};
 use gpu_model::*;
 pub use lights::*;
 use pipelines::*;
-pub use targets::read_texture_level;
 use targets::*;
+pub use targets::{read_texture_level, target_texture};
 use uniforms::*;
 
 /// The wgpu this crate is built on, for shells that hand it window handles.

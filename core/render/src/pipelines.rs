@@ -224,7 +224,7 @@ pub(crate) fn create_compose_pipeline(
 ) -> wgpu::RenderPipeline {
     // A target that does not encode sRGB on write has the shader do it.
     let encode = if format.is_srgb() { 0.0 } else { 1.0 };
-    create_fullscreen_pipeline_with(
+    create_fullscreen_pipeline(
         device,
         "compose",
         module,
@@ -266,20 +266,8 @@ pub(crate) fn draw_fullscreen(
 
 /// A pipeline that draws one triangle over its whole target (`module`'s `vs_main`, three
 /// vertices, no buffers) with `module`'s `fragment_entry` into `format`, without depth or
-/// blending.
+/// blending; the fragment stage's pipeline constants `constants`.
 pub(crate) fn create_fullscreen_pipeline(
-    device: &wgpu::Device,
-    label: &str,
-    module: &wgpu::ShaderModule,
-    layout: &wgpu::PipelineLayout,
-    fragment_entry: &str,
-    format: wgpu::TextureFormat,
-) -> wgpu::RenderPipeline {
-    create_fullscreen_pipeline_with(device, label, module, layout, fragment_entry, format, &[])
-}
-
-/// [`create_fullscreen_pipeline`] with the fragment stage's pipeline constants `constants`.
-fn create_fullscreen_pipeline_with(
     device: &wgpu::Device,
     label: &str,
     module: &wgpu::ShaderModule,

@@ -23,6 +23,31 @@ pub(crate) struct Offscreen {
     pub(crate) padded_row: u32,
 }
 
+/// A `width × height` texture of `format` to draw a frame into and read back (the offscreen
+/// output; in tests, a window's surface texture).
+pub fn target_texture(
+    device: &wgpu::Device,
+    label: &str,
+    width: u32,
+    height: u32,
+    format: wgpu::TextureFormat,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &[],
+    })
+}
+
 impl Offscreen {
     /// Bytes per row of the read-back buffer: RGBA8, padded to wgpu's copy alignment.
     pub(crate) fn padded_row(width: u32) -> u64 {
@@ -31,20 +56,7 @@ impl Offscreen {
     }
 
     pub(crate) fn new(device: &wgpu::Device, width: u32, height: u32) -> Self {
-        let output = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("output"),
-            size: wgpu::Extent3d {
-                width,
-                height,
-                depth_or_array_layers: 1,
-            },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: OUTPUT_FORMAT,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-            view_formats: &[],
-        });
+        let output = target_texture(device, "output", width, height, OUTPUT_FORMAT);
         let output_view = output.create_view(&Default::default());
         // At most 4 × max_texture_dimension_2d, checked before (`targets`).
         let padded_row = Self::padded_row(width) as u32;

@@ -24,20 +24,7 @@ fn eye_reflection_targets_are_drawn_where_the_geometry_puts_them() {
     let (w, h) = (screen.width_px() / 2, screen.height_px() / 2);
     let k = w as f32 / screen.width_px() as f32;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
-    let texture = gpu.device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("calibration test"),
-        size: wgpu::Extent3d {
-            width: w,
-            height: h,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let texture = phantogram::render::target_texture(&gpu.device, "calibration test", w, h, format);
     let view = texture.create_view(&Default::default());
     // The frame underneath: black.
     let mut encoder = gpu.device.create_command_encoder(&Default::default());

@@ -274,20 +274,7 @@ fn a_target_without_srgb_encoding_shows_the_same_frame() {
     let method = Method::DuboisRedCyan;
     let srgb = renderer.render(&input, method, W, H).unwrap();
     let format = wgpu::TextureFormat::Rgba8Unorm;
-    let target = renderer.gpu().device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("unorm window"),
-        size: wgpu::Extent3d {
-            width: W,
-            height: H,
-            depth_or_array_layers: 1,
-        },
-        mip_level_count: 1,
-        sample_count: 1,
-        dimension: wgpu::TextureDimension::D2,
-        format,
-        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
-        view_formats: &[],
-    });
+    let target = phantogram::render::target_texture(&renderer.gpu().device, "unorm window", W, H, format);
     let view_of_target = target.create_view(&Default::default());
     renderer
         .render_to_view(&input, method, &view_of_target, format, W, H)
