@@ -280,13 +280,16 @@ fn run(cli: Cli) -> Result<()> {
             // The calibration is the user's, kept where the desktop tools keep it. The window's
             // event loop is made with the engine, once its files are read.
             let mut event_loop = None;
-            let engine = scene.engine(
+            let mut engine = scene.engine(
                 anaglyph,
                 phantogram::calibration::Calibration::default_path(),
                 true,
                 Some(&mut event_loop),
             )?;
             let event_loop = event_loop.context("the engine opened no window display")?;
+            // A device lost while the window is open is opened again for its display.
+            let display = event_loop.owned_display_handle();
+            engine.set_device_reopener(move || phantogram::render::Gpu::for_display(Box::new(display.clone()), None));
             viewer::run(
                 event_loop,
                 viewer::ViewerArgs {

@@ -1,5 +1,14 @@
 //! The device: instance, adapter, device and queue, headless (as on the phones) or for a display,
 //! and window surface targets.
+//!
+//! **Important**: a device can be lost (a driver reset, a GPU hang, Android reclaiming it):
+//! [`Gpu::is_lost`] says so, from wgpu's callback, and from then on nothing made on it draws.
+//! What was made on it must be made again on a new device (the engine does:
+//! `Engine::draw`). wgpu's errors outside an error scope still panic, as wgpu's own handler does
+//! (a bug to be found), except on a lost device, where every call fails and each is only counted.
+
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
 use super::RenderError;
 
@@ -13,6 +22,10 @@ pub struct Gpu {
     /// Whether the instance holds a display connection ([`Self::for_display`]); without one
     /// ([`Self::headless`], what the phones use) each window brings its own display handle.
     instance_has_display: bool,
+    /// Set by wgpu's device-lost callback.
+    lost: Arc<AtomicBool>,
+    /// wgpu's errors outside any error scope after the device was lost.
+    errors_after_loss: Arc<AtomicU64>,
 }
 
 impl Gpu {
@@ -102,13 +115,46 @@ impl Gpu {
             ..Default::default()
         }))
         .map_err(|e| RenderError::Device(e.to_string()))?;
+        let lost = Arc::new(AtomicBool::new(false));
+        let errors_after_loss = Arc::new(AtomicU64::new(0));
+        let flag = Arc::clone(&lost);
+        device.set_device_lost_callback(move |_reason, _message| flag.store(true, Ordering::SeqCst));
+        let (flag, count) = (Arc::clone(&lost), Arc::clone(&errors_after_loss));
+        device.on_uncaptured_error(Arc::new(move |error| {
+            if flag.load(Ordering::SeqCst) {
+                count.fetch_add(1, Ordering::Relaxed);
+            } else {
+                // wgpu's own handler's behaviour: an error nobody scoped is a bug.
+                panic!("wgpu error: {error}");
+            }
+        }));
         Ok(Self {
             instance,
             adapter,
             device,
             queue,
             instance_has_display: false,
+            lost,
+            errors_after_loss,
         })
+    }
+
+    /// Whether the device is known to be lost: nothing made on it draws any more (see the
+    /// module docs). wgpu tells of a loss when it next looks at the device: [`Self::poll_lost`].
+    pub fn is_lost(&self) -> bool {
+        self.lost.load(Ordering::SeqCst)
+    }
+
+    /// Lets wgpu look at the device without waiting (it runs its callbacks, the device-lost one
+    /// included), then [`Self::is_lost`]: once a frame, before anything is drawn.
+    pub fn poll_lost(&self) -> bool {
+        let _ = self.device.poll(wgpu::PollType::Poll);
+        self.is_lost()
+    }
+
+    /// wgpu's errors on this device since it was lost (each call on a lost device fails).
+    pub fn errors_after_loss(&self) -> u64 {
+        self.errors_after_loss.load(Ordering::Relaxed)
     }
 
     /// How many layers to allocate for a 2D array texture of `layers` layers of `width` ×

@@ -77,6 +77,16 @@ impl SurfaceHost {
         }
     }
 
+    /// The window drawn into, while there is one.
+    pub fn window(&self) -> Option<Arc<dyn wgpu::DisplayAndWindowHandle>> {
+        self.window.clone()
+    }
+
+    /// The size the surface was last configured at, physical pixels.
+    pub fn size(&self) -> Option<(u32, u32)> {
+        self.config.as_ref().map(|c| (c.width, c.height))
+    }
+
     pub fn stats(&self) -> SurfaceStats {
         self.stats
     }

@@ -86,8 +86,13 @@ impl Engine {
     }
 
     /// Draws one frame that will be on screen at `display_t_ns` (sensor clock; `None`: for the
-    /// newest sensor state, no prediction).
+    /// newest sensor state, no prediction). A GPU device that was lost is replaced first, with
+    /// the scene made again on the new one (`device_loss`; counted in
+    /// [`EngineStats::devices_recovered`](super::EngineStats)).
     pub fn draw(&mut self, display_t_ns: Option<i64>) -> Result<DrawOutcome, EngineError> {
+        if self.renderer.gpu().poll_lost() {
+            self.recover_lost_device()?;
+        }
         if let Some(prepared) = self.loader.poll() {
             self.install(prepared);
         }
@@ -408,15 +413,20 @@ impl Engine {
             let ctx = screens.ctx.clone();
             let overlay = &mut screens.overlay;
             let mut paint = |gpu: &Gpu, view: &wgpu::TextureView, format: wgpu::TextureFormat, size: [u32; 2]| {
-                overlay.paint(gpu, &ctx, &mut output, view, format, size);
+                // egui's painter panics on a device lost since the frame began; the next frame
+                // draws on a new one.
+                if !gpu.is_lost() {
+                    overlay.paint(gpu, &ctx, &mut output, view, format, size);
+                }
             };
             self.present(input, Some(&mut paint))
         };
         // Also after a failed draw: what it did not upload is kept for the next frame.
-        if screens.overlay.end(&mut output) {
-            screens.ctx = egui::Context::default();
-        }
+        let fresh_context = screens.overlay.end(&mut output);
         self.screens = Some(screens);
+        if fresh_context {
+            self.fresh_screens_context();
+        }
         let outcome = drawn?;
         for action in calibration_actions {
             self.apply_calibration_action(action);

@@ -67,6 +67,7 @@ use crate::wgpu;
 use crate::{Session, SessionConfig, SessionError};
 
 mod calibration_flow;
+mod device_loss;
 mod drawing;
 mod lighting;
 mod loading;
@@ -292,12 +293,20 @@ pub struct EngineStats {
     pub room_light_updates: u64,
     pub room_light_coverage: f32,
     pub room_light_gain: Option<f32>,
+    /// GPU devices lost and replaced ([`Engine::draw`]).
+    pub devices_recovered: u64,
 }
 
 /// What a shell embeds; see the module docs.
 pub struct Engine {
     session: Session,
     renderer: Renderer,
+    /// The CPU's copy of the artifact on screen (the Diorama keeps its own): what a new device
+    /// is given when one is lost ([`device_loss`]). The budget counts the artifact twice for it.
+    model: Arc<crate::model::Model>,
+    /// Opens a new device when the one drawing was lost: as the first was opened
+    /// ([`Engine::set_device_reopener`]).
+    reopen_gpu: Box<dyn Fn() -> Result<Gpu, RenderError> + Send + Sync>,
     model_info: ModelInfo,
     bounds: Aabb,
     /// A big scan's levels of detail and their per-frame choice ([`phantogram_detail`]); `None`
@@ -595,6 +604,8 @@ impl Engine {
         let mut engine = Self {
             session,
             renderer,
+            model: Arc::new(model),
+            reopen_gpu: Box::new(Gpu::headless),
             model_info,
             bounds,
             detail,

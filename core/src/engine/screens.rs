@@ -391,11 +391,14 @@ impl Engine {
     pub(super) fn take_thumbnails(&mut self) {
         let renderer = &mut self.renderer;
         let new = self.thumbnails.poll(|posed| crate::thumbnails::render(renderer, posed));
-        if new.is_empty() {
-            return;
-        }
+        self.load_thumbnail_textures(new);
+    }
+
+    /// The gallery's pictures `ids` (made already) into egui textures of the screens' context.
+    #[cfg(feature = "ui")]
+    fn load_thumbnail_textures(&mut self, ids: Vec<String>) {
         let size = crate::thumbnails::THUMBNAIL_PX as usize;
-        for id in new {
+        for id in ids {
             let Some(image) = self
                 .thumbnails
                 .get(&id)
@@ -412,6 +415,19 @@ impl Engine {
             }
             screens.thumbnail_textures.insert(id, texture);
         }
+    }
+
+    /// A fresh egui context for the screens, with the gallery's pictures loaded into it again:
+    /// a new painter (a new target format, a new device) lacks its predecessor's textures, and
+    /// only a fresh context sends them all (the fonts included) again.
+    #[cfg(feature = "ui")]
+    pub(super) fn fresh_screens_context(&mut self) {
+        let Some(screens) = self.screens.as_deref_mut() else {
+            return;
+        };
+        screens.ctx = egui::Context::default();
+        let ids: Vec<String> = screens.thumbnail_textures.drain().map(|(id, _)| id).collect();
+        self.load_thumbnail_textures(ids);
     }
 
     /// The centre of a control of the screen showing, in the last frame drawn, in physical

@@ -14,6 +14,7 @@ mod block_textures;
 mod calibration_ui;
 mod containment_sweep;
 mod detail;
+mod device_loss;
 mod diorama;
 mod eyetrack;
 mod face;
