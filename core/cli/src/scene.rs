@@ -146,16 +146,27 @@ impl SceneArgs {
             ..EngineConfig::default()
         };
         let mut engine = match window {
-            Some(slot) => Engine::with_gpu_from(
-                || {
-                    let event_loop = crate::viewer::event_loop()
-                        .map_err(|e| phantogram::render::RenderError::Device(format!("{e:#}")))?;
-                    let display = Box::new(event_loop.owned_display_handle());
-                    *slot = Some(event_loop);
-                    phantogram::render::Gpu::for_display(display, None)
-                },
-                config,
-            )?,
+            Some(slot) => {
+                // A missing display is said as such, not as a device that failed to open.
+                let mut no_display = None;
+                let engine = Engine::with_gpu_from(
+                    || {
+                        let event_loop = crate::viewer::event_loop().map_err(|e| {
+                            let said = phantogram::render::RenderError::Device(format!("{e:#}"));
+                            no_display = Some(e);
+                            said
+                        })?;
+                        let display = Box::new(event_loop.owned_display_handle());
+                        *slot = Some(event_loop);
+                        phantogram::render::Gpu::for_display(display, None)
+                    },
+                    config,
+                );
+                match (engine, no_display) {
+                    (Err(_), Some(e)) => return Err(e),
+                    (engine, _) => engine?,
+                }
+            }
             None => Engine::new(config)?,
         };
         match self.lamp {
