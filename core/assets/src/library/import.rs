@@ -123,7 +123,8 @@ fn copy(from: &mut impl Read, to: &mut std::fs::File) -> std::io::Result<u64> {
 }
 
 /// The model an unpacked folder holds: the shallowest Voyager scene's folder, else its only
-/// `.glb`/`.gltf`/`.stl`/`.ply`/`.obj`/`.xyz`/`.pts` file.
+/// `.glb`/`.gltf`/`.stl`/`.ply`/`.obj`/`.xyz`/`.pts` file, else one of the variants of one glTF
+/// model laid out as the Khronos samples are ([`khronos_variant`]).
 pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> {
     let mut scenes = Vec::new();
     let mut models = Vec::new();
@@ -148,6 +149,9 @@ pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> 
         // The scene's folder: the loader picks its best scan present.
         return Ok(scene.parent().unwrap_or(folder).to_path_buf());
     }
+    if let Some(variant) = khronos_variant(&models) {
+        return Ok(variant);
+    }
     match models.len() {
         1 => Ok(models.remove(0)),
         0 => Err(LibraryError::NoModel {
@@ -168,9 +172,85 @@ pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> 
     }
 }
 
+/// Variant folders of the Khronos glTF samples, most preferred first: one file, then the plain
+/// JSON and its buffers, then buffers inlined. Others (`glTF-Draco`, `glTF-Quantized`,
+/// `glTF-KTX-BasisU`, …) come after these, by name.
+const PREFERRED_VARIANTS: [&str; 3] = ["gltf-binary", "gltf", "gltf-embedded"];
+
+/// Where `models` are all the same glTF model in the Khronos samples' variant folders (each a
+/// `.glb`/`.gltf` of one file name, in a folder named `glTF` or `glTF-…`, the folders side by
+/// side): the preferred variant. `None` for anything else (two different models stay an error).
+fn khronos_variant(models: &[PathBuf]) -> Option<PathBuf> {
+    let first = models.first()?;
+    let stem = |p: &Path| p.file_stem().map(|s| s.to_string_lossy().to_ascii_lowercase());
+    let folder = |p: &Path| {
+        p.parent()
+            .and_then(Path::file_name)
+            .map(|f| f.to_string_lossy().to_ascii_lowercase())
+    };
+    let grandparent = |p: &Path| p.parent().and_then(Path::parent).map(Path::to_path_buf);
+    let is_gltf = |p: &Path| {
+        let name = p.to_string_lossy().to_ascii_lowercase();
+        name.ends_with(".glb") || name.ends_with(".gltf")
+    };
+    let variant = |p: &Path| folder(p).filter(|f| f == "gltf" || f.starts_with("gltf-"));
+    let same = models.len() > 1
+        && models.iter().all(|m| {
+            is_gltf(m) && variant(m).is_some() && stem(m) == stem(first) && grandparent(m) == grandparent(first)
+        });
+    if !same {
+        return None;
+    }
+    models
+        .iter()
+        .min_by_key(|m| {
+            let name = variant(m).unwrap_or_default();
+            let rank = PREFERRED_VARIANTS
+                .iter()
+                .position(|v| *v == name)
+                .unwrap_or(PREFERRED_VARIANTS.len());
+            (rank, name)
+        })
+        .cloned()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A Khronos sample's folder (Box: glTF, glTF-Binary, glTF-Draco) gives its binary variant;
+    /// without it, the plain one; two different models, or a variant beside an unrelated model,
+    /// stay an error.
+    #[test]
+    fn a_khronos_samples_variants_give_one_model() {
+        let dir = phantogram_testkit::Scratch::new("khronos-variants");
+        let write = |rel: &str| {
+            let path = dir.join(rel);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(&path, b"{}").unwrap();
+        };
+        write("Box/glTF/Box.gltf");
+        write("Box/glTF/Box0.bin");
+        write("Box/glTF-Draco/Box.gltf");
+        write("Box/glTF-Binary/Box.glb");
+        write("Box/screenshot/screenshot.png");
+        let found = find_model(&dir.join("Box"), "Box").unwrap();
+        assert!(found.ends_with("glTF-Binary/Box.glb"), "{}", found.display());
+        std::fs::remove_file(dir.join("Box/glTF-Binary/Box.glb")).unwrap();
+        let found = find_model(&dir.join("Box"), "Box").unwrap();
+        assert!(found.ends_with("glTF/Box.gltf"), "{}", found.display());
+        write("Box/glTF/Other.gltf");
+        assert!(matches!(
+            find_model(&dir.join("Box"), "Box"),
+            Err(LibraryError::SeveralModels { .. })
+        ));
+        write("Two/a/Box.gltf");
+        write("Two/b/Box.gltf");
+        assert!(matches!(
+            find_model(&dir.join("Two"), "Two"),
+            Err(LibraryError::SeveralModels { .. })
+        ));
+    }
 
     #[test]
     fn formats_are_told_by_their_first_bytes() {
