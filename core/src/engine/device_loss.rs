@@ -1,8 +1,8 @@
 //! A lost GPU device replaced (a driver reset, a GPU hang, the system reclaiming it): a new
 //! device, and on it everything the old one held made again from the CPU's copies — the
 //! artifact (or the Diorama's scene), its impostors (planned again, baked a few a frame as at
-//! first), the window's surface, the screens' painter — with the appearance, the lamp and the
-//! lighting as they were. The room's live light comes back with its worker's next update.
+//! first), the window's surface, the screens' painter — with the appearance, the lamp, the
+//! lighting and the room's live light (its last update, while it is on) as they were.
 //!
 //! Called by [`Engine::draw`] on the render thread when [`Gpu::is_lost`]; a device that cannot
 //! be opened again is an error of that draw, tried again at the next.
@@ -45,6 +45,12 @@ impl Engine {
             self.target = Target::Window(Box::new(fresh));
         }
         self.renderer = renderer;
+        if self.room_light_on()
+            && let Some(update) = self.room_light_shown.take()
+        {
+            self.light_with_room(&update);
+            self.room_light_shown = Some(update);
+        }
         // The screens' painter was on the old device; a fresh egui context sends every texture
         // (fonts, the gallery's pictures) again, so the next frame shows them whole.
         #[cfg(feature = "ui")]

@@ -85,14 +85,20 @@ impl Engine {
             self.stats.room_light_updates += 1;
             self.stats.room_light_coverage = update.coverage;
             self.stats.room_light_gain = Some(update.gain);
-            // A failed upload keeps the light there was; the next update tries again.
-            let _ = match &update.specular {
-                crate::room_light::Specular::Upload(upload) => self.renderer.set_environment_upload(upload, &update.sh),
-                crate::room_light::Specular::Levels(levels) => {
-                    self.renderer.set_prefiltered_environment(levels, &update.sh)
-                }
-            };
+            self.light_with_room(&update);
+            self.room_light_shown = Some(update);
         }
+    }
+
+    /// Lights the scene with the room light `update`. A failed upload keeps the light there was;
+    /// the next update tries again.
+    pub(super) fn light_with_room(&mut self, update: &crate::room_light::RoomLightUpdate) {
+        let _ = match &update.specular {
+            crate::room_light::Specular::Upload(upload) => self.renderer.set_environment_upload(upload, &update.sh),
+            crate::room_light::Specular::Levels(levels) => {
+                self.renderer.set_prefiltered_environment(levels, &update.sh)
+            }
+        };
     }
 
     /// Shows `appearance` on the artifact on screen without remembering it (the command line's

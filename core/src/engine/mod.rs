@@ -378,6 +378,9 @@ pub struct Engine {
     appearances: crate::appearances::AppearanceStore,
     /// The live room light's worker, when [`EngineConfig::room_light`] is on.
     room_light: Option<Arc<crate::room_light::RoomLightWorker>>,
+    /// The room light's update the scene was last lit by, kept to light a new device with
+    /// ([`device_loss`]).
+    room_light_shown: Option<crate::room_light::RoomLightUpdate>,
     /// The light when the room's is off: [`EngineConfig::environment_path`]'s, or the studio's.
     static_environment: Option<crate::ibl::Environment>,
     /// A lamp the visitor placed (in place of the room's light), and the finger moving it.
@@ -655,6 +658,7 @@ impl Engine {
             thumbnails,
             appearances,
             room_light,
+            room_light_shown: None,
             static_environment: environment,
             lamp: None,
             lamp_finger: None,

@@ -369,6 +369,17 @@ fn the_engine_is_lit_by_the_room_its_camera_sweeps() {
             );
         }
         golden::check(&format!("room-light-{name}"), w, h, &lit, 3, 0.003);
+        // A lost device: the new one is lit by the room as the old one was (before, by the
+        // studio or the configured file until the worker's next update).
+        engine.renderer().gpu().device.destroy();
+        engine.draw(Some(0)).expect("draw");
+        assert_eq!(engine.stats().devices_recovered, 1);
+        let relit = engine.last_frame().expect("frame").2.to_vec();
+        assert_eq!(
+            phantogram_integration::differing_pixels(&lit, &relit),
+            0,
+            "{name}: relit"
+        );
         // The settings' "Light: the studio's": the frame is lit as before the sweep again, and
         // camera frames are no longer taken.
         engine.set_room_light(false);
