@@ -408,19 +408,11 @@ pub fn run(event_loop: EventLoop<()>, args: ViewerArgs) -> Result<()> {
     eprintln!(
         "drag to tilt the phone; keys: 1-8 anaglyph method, m mono/stereo, f flat angle here, r reset it, l re-tie the light, c calibration screens, a artifacts menu (or click once), s save the view (anaglyph and stereo pair), Esc quit"
     );
-    let ViewerArgs {
-        mut engine,
-        log,
-        frames,
-        lifecycle_test,
-        calibration,
-        menu,
-        linger_s,
-    } = args;
-    if calibration {
+    let mut engine = args.engine;
+    if args.calibration {
         engine.open_calibration();
     }
-    if menu {
+    if args.menu {
         engine.open_menu();
         // Its pictures before the first frame, so the first one shows the menu complete.
         engine.wait_for_thumbnails(std::time::Duration::from_secs(30));
@@ -430,11 +422,11 @@ pub fn run(event_loop: EventLoop<()>, args: ViewerArgs) -> Result<()> {
     let mut app = App {
         inbox: engine.inbox(),
         engine,
-        log,
-        frames,
-        linger_s,
+        log: args.log,
+        frames: args.frames,
+        linger_s: args.linger_s,
         linger_until: None,
-        lifecycle_test,
+        lifecycle_test: args.lifecycle_test,
         lifecycle_steps_done: 0,
         window: None,
         phone: VirtualPhone {
