@@ -853,9 +853,6 @@ fn pipelines_that_skip_missing_textures_draw_the_same_picture() {
     assert!(d <= 1, "specialised and general pipelines differ by {d} levels");
 }
 
-/// Runs `shader`'s compute entry point `main` (workgroups of 64) over `queries` and returns its
-/// `results`, `per_query` f32s a query. Its group 0 holds `leading` at bindings 0, 1, …, then
-/// the queries (`array<vec4<f32>>`, read-only storage) and the results (read-write storage).
 /// Whether `gpu` runs the compute shaders of [`run_compute`] (64 invocations, storage buffers):
 /// an OpenGL ES 3.0 device, or any under `PHANTOGRAM_GPU_LIMITS=gles3`, does not.
 fn computes(gpu: &Gpu) -> bool {
@@ -869,6 +866,9 @@ fn computes(gpu: &Gpu) -> bool {
         && limits.max_compute_invocations_per_workgroup >= 64
 }
 
+/// Runs `shader`'s compute entry point `main` (workgroups of 64) over `queries` and returns its
+/// `results`, `per_query` f32s a query. Its group 0 holds `leading` at bindings 0, 1, …, then
+/// the queries (`array<vec4<f32>>`, read-only storage) and the results (read-write storage).
 fn run_compute(
     gpu: &Gpu,
     shader: &str,
