@@ -34,16 +34,16 @@ pub const MAX_TEXELS: u32 = 128;
 pub const BAKED_PER_FRAME: usize = 4;
 
 /// Texels per side for `parts` impostors within `memory_bytes`, or `None` when they would be
-/// coarser than [`MIN_TEXELS`]: six maps each, seven on OpenGL (ES) (`opengl`: its spare layer,
-/// [`crate::budget::array_layers`]).
+/// coarser than [`MIN_TEXELS`]: the maps on OpenGL (ES) (`opengl`: a spare layer) or another
+/// backend ([`phantogram_render::impostor::maps_bytes`]).
 pub fn texels_for(parts: usize, memory_bytes: u64, opengl: bool) -> Option<u32> {
     if parts == 0 {
         return None;
     }
     let per_part = memory_bytes.min(IMPOSTOR_MEMORY_BYTES) / parts as u64;
-    // Square maps: the layers do not depend on the side.
-    let maps = u64::from(crate::budget::array_layers(1, 1, 6, opengl));
-    let side = ((per_part / (maps * phantogram_render::impostor::BYTES_PER_TEXEL)) as f64).sqrt() as u32;
+    // The maps' bytes grow with the side squared: those of one texel a side, per texel.
+    let per_texel = phantogram_render::impostor::maps_bytes(1, opengl);
+    let side = ((per_part / per_texel) as f64).sqrt() as u32;
     let texels = if side == 0 {
         0
     } else {

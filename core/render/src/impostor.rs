@@ -48,6 +48,13 @@ pub const BYTES_PER_TEXEL: u64 = 4 + 8 + 8;
 /// What an empty texel's depth holds: beyond the box, so no point is behind it.
 pub(crate) const EMPTY_DEPTH: f32 = 2.0;
 
+/// GPU memory of an impostor's three maps at `texels` per side, bytes: six views, on OpenGL (ES)
+/// (`opengl`) a seventh, spare layer ([`phantogram_assets::budget::array_layers`]).
+pub fn maps_bytes(texels: u32, opengl: bool) -> u64 {
+    let layers = phantogram_assets::budget::array_layers(texels, texels, 6, opengl);
+    u64::from(layers) * u64::from(texels) * u64::from(texels) * BYTES_PER_TEXEL
+}
+
 /// An impostor's box and resolution (GPU-free).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ImpostorBox {
@@ -121,11 +128,10 @@ impl ImpostorBox {
         self.bytes_on(false)
     }
 
-    /// GPU memory of the three maps, bytes, on OpenGL (ES) (`opengl`: a seventh, spare layer,
-    /// [`phantogram_assets::budget::array_layers`]) or another backend.
+    /// GPU memory of the three maps, bytes, on OpenGL (ES) (`opengl`) or another backend:
+    /// [`maps_bytes`].
     pub fn bytes_on(&self, opengl: bool) -> u64 {
-        let layers = phantogram_assets::budget::array_layers(self.texels, self.texels, 6, opengl);
-        u64::from(layers) * u64::from(self.texels) * u64::from(self.texels) * BYTES_PER_TEXEL
+        maps_bytes(self.texels, opengl)
     }
 
     /// Box coordinates q = (p − lo) / extent of mesh point `p` (0 to 1 inside).

@@ -7,6 +7,7 @@
 //! Called by [`Engine::draw`] on the render thread when [`Gpu::is_lost`]; a device that cannot
 //! be opened again is an error of that draw, tried again at the next.
 
+use super::lighting::light_with_room;
 use super::{Engine, EngineError, Target, impostors_for};
 use crate::render::{Gpu, RenderError, Renderer};
 use crate::surface::SurfaceHost;
@@ -23,7 +24,7 @@ impl Engine {
         let gpu = (self.reopen_gpu)()?;
         let model = match self.diorama.as_deref() {
             Some(scene) => scene.model(),
-            None => &*self.model,
+            None => &self.model,
         };
         let mut renderer = Renderer::with_environment(gpu, model, self.static_environment.as_ref())?;
         renderer.lighting = self.renderer.lighting;
@@ -46,10 +47,9 @@ impl Engine {
         }
         self.renderer = renderer;
         if self.room_light_on()
-            && let Some(update) = self.room_light_shown.take()
+            && let Some(update) = &self.room_light_shown
         {
-            self.light_with_room(&update);
-            self.room_light_shown = Some(update);
+            light_with_room(&mut self.renderer, update);
         }
         // The screens' painter was on the old device; a fresh egui context sends every texture
         // (fonts, the gallery's pictures) again, so the next frame shows them whole.

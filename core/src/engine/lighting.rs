@@ -85,20 +85,9 @@ impl Engine {
             self.stats.room_light_updates += 1;
             self.stats.room_light_coverage = update.coverage;
             self.stats.room_light_gain = Some(update.gain);
-            self.light_with_room(&update);
+            light_with_room(&mut self.renderer, &update);
             self.room_light_shown = Some(update);
         }
-    }
-
-    /// Lights the scene with the room light `update`. A failed upload keeps the light there was;
-    /// the next update tries again.
-    pub(super) fn light_with_room(&mut self, update: &crate::room_light::RoomLightUpdate) {
-        let _ = match &update.specular {
-            crate::room_light::Specular::Upload(upload) => self.renderer.set_environment_upload(upload, &update.sh),
-            crate::room_light::Specular::Levels(levels) => {
-                self.renderer.set_prefiltered_environment(levels, &update.sh)
-            }
-        };
     }
 
     /// Shows `appearance` on the artifact on screen without remembering it (the command line's
@@ -111,4 +100,13 @@ impl Engine {
     pub fn appearance(&self) -> crate::render::Appearance {
         self.renderer.appearance
     }
+}
+
+/// Lights `renderer`'s scene with the room light `update`. A failed upload keeps the light there
+/// was; the next update tries again.
+pub(super) fn light_with_room(renderer: &mut crate::render::Renderer, update: &crate::room_light::RoomLightUpdate) {
+    let _ = match &update.specular {
+        crate::room_light::Specular::Upload(upload) => renderer.set_environment_upload(upload, &update.sh),
+        crate::room_light::Specular::Levels(levels) => renderer.set_prefiltered_environment(levels, &update.sh),
+    };
 }

@@ -192,7 +192,7 @@ impl Engine {
                 self.model_info = prepared.info;
                 self.renderer.appearance = self.appearances.get(&appearance_key(&self.model_info));
                 self.smoother = ContainmentSmoother::default();
-                self.model = std::sync::Arc::new(prepared.model);
+                self.model = prepared.model;
                 true
             }
             Err(e) => {

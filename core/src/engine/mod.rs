@@ -303,7 +303,7 @@ pub struct Engine {
     renderer: Renderer,
     /// The CPU's copy of the artifact on screen (the Diorama keeps its own): what a new device
     /// is given when one is lost ([`device_loss`]). The budget counts the artifact twice for it.
-    model: Arc<crate::model::Model>,
+    model: crate::model::Model,
     /// Opens a new device when the one drawing was lost: as the first was opened
     /// ([`Engine::set_device_reopener`]).
     reopen_gpu: Box<dyn Fn() -> Result<Gpu, RenderError> + Send + Sync>,
@@ -607,7 +607,7 @@ impl Engine {
         let mut engine = Self {
             session,
             renderer,
-            model: Arc::new(model),
+            model,
             reopen_gpu: Box::new(Gpu::headless),
             model_info,
             bounds,
