@@ -125,7 +125,12 @@ fn damaged_objs_are_named_errors() {
     ] {
         let dir = folder("damaged", &[("scan.obj", text.as_bytes())]);
         match load(&dir) {
-            Err(ModelError::Parse { message, .. }) => assert!(message.contains(expected), "{text}: {message}"),
+            Err(ModelError::Parse { format, message, .. }) => {
+                assert!(
+                    format == "OBJ" && message.contains(expected),
+                    "{text}: {format} {message}"
+                )
+            }
             other => panic!("{text}: {other:?}"),
         }
     }

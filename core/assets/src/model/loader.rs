@@ -62,8 +62,14 @@ pub enum ModelError {
     /// (`anyhow`'s `{:#}`) would show it twice, and the shells show the message alone.
     #[error("{}: {error}", path.display())]
     Io { path: PathBuf, error: std::io::Error },
-    #[error("{}: not a valid glTF file: {message}", path.display())]
-    Parse { path: PathBuf, message: String },
+    /// The file is not one of its format (`format`: "glTF", "STL", "PLY", "OBJ", "point
+    /// cloud") as written.
+    #[error("{}: not a valid {format} file: {message}", path.display())]
+    Parse {
+        path: PathBuf,
+        format: &'static str,
+        message: String,
+    },
     #[error(
             "{}: requires the glTF extension {name}, which is not supported (supported: {})",
             path.display(),
@@ -359,6 +365,7 @@ fn data_uri(uri: &str) -> Option<Result<Vec<u8>, base64::DecodeError>> {
 fn load_uri(path: &Path, uri: &str, max_bytes: u64) -> Result<Vec<u8>, ModelError> {
     if let Some(decoded) = data_uri(uri) {
         return decoded.map_err(|e| ModelError::Parse {
+            format: "glTF",
             path: path.to_path_buf(),
             message: format!("bad data URI: {e}"),
         });
@@ -1385,6 +1392,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     let bytes = read_model_file(path, &spending)?;
     read.step(0.5).map_err(cancelled)?;
     let gltf = gltf::Gltf::from_slice_without_validation(&bytes).map_err(|e| ModelError::Parse {
+        format: "glTF",
         path: path.to_path_buf(),
         // A glTF 1.0 file fails here on its different layout: say so rather than how.
         message: not_gltf2(&bytes).unwrap_or_else(|| e.to_string()),
@@ -1400,11 +1408,13 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     // scene) can also parse into an empty glTF 2.0 document: "no triangles to draw".
     if let Some(message) = not_gltf2_version(&doc.as_json().asset.version) {
         return Err(ModelError::Parse {
+            format: "glTF",
             path: path.to_path_buf(),
             message,
         });
     }
     check_structure(doc.as_json()).map_err(|message| ModelError::Parse {
+        format: "glTF",
         path: path.to_path_buf(),
         message,
     })?;
@@ -1418,6 +1428,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         }
         let data = match b.source() {
             gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| ModelError::Parse {
+                format: "glTF",
                 path: path.to_path_buf(),
                 message: "buffer refers to a GLB binary chunk that is missing".into(),
             })?,
@@ -1425,6 +1436,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
         };
         if data.len() < b.length() {
             return Err(ModelError::Parse {
+                format: "glTF",
                 path: path.to_path_buf(),
                 message: format!(
                     "buffer {} is {} bytes, shorter than its declared {}",
@@ -1656,6 +1668,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     while let Some((node, parent)) = stack.pop() {
         if std::mem::replace(&mut visited[node.index()], true) {
             return Err(ModelError::Parse {
+                format: "glTF",
                 path: path.to_path_buf(),
                 message: format!(
                     "node {} is reached twice in the scene's hierarchy (a cycle, or a node with two parents)",

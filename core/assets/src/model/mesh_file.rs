@@ -96,6 +96,16 @@ impl MeshFormat {
         xyz::recognises(bytes).then_some(MeshFormat::Xyz)
     }
 
+    /// What the format is called in messages to the user.
+    pub fn name(self) -> &'static str {
+        match self {
+            MeshFormat::Stl => "STL",
+            MeshFormat::Ply => "PLY",
+            MeshFormat::Obj => "OBJ",
+            MeshFormat::Xyz => "point cloud",
+        }
+    }
+
     pub fn extension(self) -> &'static str {
         match self {
             MeshFormat::Stl => "stl",
@@ -127,6 +137,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     drop(bytes);
     let mut soup = parsed.map_err(|message| ModelError::Parse {
         path: path.to_path_buf(),
+        format: format.name(),
         message,
     })?;
     progress.step(0.5).map_err(cancelled)?;

@@ -20,7 +20,7 @@ use std::path::Path;
 
 use super::encoded_image::Encoded;
 use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file, resolve_inside};
-use super::mesh_file::scan_colour;
+use super::mesh_file::{MeshFormat, scan_colour};
 use super::{AlphaMode, Image, Material, Mesh, Model, Primitive, TextureRef, Vertex};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
@@ -65,6 +65,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
     drop(bytes);
     let (meshes, materials) = parsed.map_err(|message| ModelError::Parse {
         path: path.to_path_buf(),
+        format: MeshFormat::Obj.name(),
         message,
     })?;
     let mut warnings = warnings.into_inner();
