@@ -41,8 +41,9 @@ pub struct ResourceBudget {
     /// Largest texture side, pixels: the GPU's `max_texture_dimension_2d`. Larger images (up to
     /// [`MAX_DECODED_SIDE_PX`]) are scaled down to it on load.
     pub max_image_side_px: u32,
-    /// Most primitives drawn (meshes × the nodes that instance them): each is a draw call per
-    /// eye and pass.
+    /// Most primitives drawn (meshes × the nodes that instance them, after the small ones that
+    /// share a material are joined: [`crate::model::join`]): each is a draw call per eye and
+    /// pass. A file may declare up to [`READ_PRIMITIVES_PER_DRAWN`] times as many.
     pub max_primitives: u64,
 }
 
@@ -124,6 +125,13 @@ pub struct OverBudget {
     pub unit: &'static str,
 }
 
+/// Most primitives a file may declare for each one drawn. Small primitives that share a material
+/// are joined after loading ([`crate::model::join`]), so a file of many parts (a CAD export of
+/// 20 000 pieces) can still be drawn within [`ResourceBudget::max_primitives`]; but each primitive
+/// read costs its own allocations and bookkeeping before it is joined, so a file declaring more
+/// than this many per draw is refused while it is read. 16 admits 65 536 on a phone.
+pub const READ_PRIMITIVES_PER_DRAWN: u64 = 16;
+
 /// The running account of one load.
 #[derive(Debug)]
 pub struct Spending {
@@ -172,19 +180,36 @@ impl Spending {
         Ok(())
     }
 
-    /// Charges one drawn primitive.
+    /// Charges one primitive read, before joining ([`READ_PRIMITIVES_PER_DRAWN`]).
     pub fn charge_primitive(&mut self, what: impl FnOnce() -> String) -> Result<(), OverBudget> {
-        if self.primitives >= self.budget.max_primitives {
+        let limit = self.budget.max_primitives.saturating_mul(READ_PRIMITIVES_PER_DRAWN);
+        if self.primitives >= limit {
             return Err(OverBudget {
                 what: what(),
                 needed: self.primitives + 1,
                 left: 0,
+                limit,
+                limit_name: "ResourceBudget::max_primitives × READ_PRIMITIVES_PER_DRAWN",
+                unit: "primitives read",
+            });
+        }
+        self.primitives += 1;
+        Ok(())
+    }
+
+    /// Checks the primitives a loaded model draws (`drawn`, after joining) against
+    /// [`ResourceBudget::max_primitives`]; `what` names the model.
+    pub fn check_drawn_primitives(&self, what: impl FnOnce() -> String, drawn: u64) -> Result<(), OverBudget> {
+        if drawn > self.budget.max_primitives {
+            return Err(OverBudget {
+                what: what(),
+                needed: drawn,
+                left: self.budget.max_primitives,
                 limit: self.budget.max_primitives,
                 limit_name: "ResourceBudget::max_primitives",
                 unit: "drawn primitives",
             });
         }
-        self.primitives += 1;
         Ok(())
     }
 
@@ -257,9 +282,15 @@ mod tests {
             e.to_string().contains("mesh 3") && e.to_string().contains("ResourceBudget::memory_bytes"),
             "{e}"
         );
-        s.charge_primitive(|| "p".into()).unwrap();
-        s.charge_primitive(|| "p".into()).unwrap();
-        assert!(s.charge_primitive(|| "p".into()).is_err());
+        // Two drawn, so 32 read (before joining).
+        for _ in 0..2 * READ_PRIMITIVES_PER_DRAWN {
+            s.charge_primitive(|| "p".into()).unwrap();
+        }
+        let e = s.charge_primitive(|| "p".into()).unwrap_err();
+        assert!(e.to_string().contains("33 primitives read"), "{e}");
+        assert!(s.check_drawn_primitives(|| "m".into(), 2).is_ok());
+        let e = s.check_drawn_primitives(|| "the model".into(), 3).unwrap_err();
+        assert!(e.to_string().contains("the model needs 3 drawn primitives"), "{e}");
         let e = s.charge_image(|| "image 0".into(), 20000, 1).unwrap_err();
         assert!(e.to_string().contains("MAX_DECODED_SIDE_PX"), "{e}");
         // 8×8 RGBA with mips: 256 + 85 = 341 bytes of the 400 left; a second does not fit.

@@ -191,7 +191,7 @@ fn an_image_header_claiming_too_many_pixels_is_refused_before_decoding() {
 }
 
 /// Instancing multiplies: forty nodes drawing one mesh are forty meshes in memory, and a
-/// thousands-of-nodes tree is thousands of draw calls.
+/// thousands-of-nodes tree is thousands of primitives to read (joined into few draws after).
 #[test]
 fn instances_and_nodes_are_charged_per_drawn_primitive() {
     let dir = Scratch::new("hostile-instances");
@@ -221,13 +221,27 @@ fn instances_and_nodes_are_charged_per_drawn_primitive() {
     };
     let err = load_gltf_within(&path, budget).unwrap_err().to_string();
     assert!(err.contains("memory_bytes") && err.contains("primitive 0"), "{err}");
+    // The forty are read (each charged), then joined into one draw: one material, 8 000
+    // triangles. A budget of two draws reads at most 32 primitives.
     let budget = ResourceBudget {
-        max_primitives: 39,
+        max_primitives: 2,
         ..ResourceBudget::PHONE
     };
     let err = load_gltf_within(&path, budget).unwrap_err().to_string();
-    assert!(err.contains("max_primitives"), "{err}");
-    assert_eq!(load_gltf(&path).unwrap().primitives.len(), 40);
+    assert!(
+        err.contains("max_primitives") && err.contains("33 primitives read"),
+        "{err}"
+    );
+    let model = load_gltf_within(
+        &path,
+        ResourceBudget {
+            max_primitives: 3,
+            ..ResourceBudget::PHONE
+        },
+    )
+    .map_err(|e| e.to_string());
+    let primitives = model.map(|m| (m.primitives.len(), m.triangle_count()));
+    assert_eq!(primitives, Ok((1, 40 * 200)));
 }
 
 /// Attribute accessors of the wrong shape (a scalar or matrix `COLOR_0`, a scalar `POSITION`, a

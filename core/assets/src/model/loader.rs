@@ -1897,5 +1897,16 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
             path: path.to_path_buf(),
         });
     }
+    join_and_check_draws(&mut model, path, &ctx.spending.borrow())?;
     Ok(model)
+}
+
+/// Joins `model`'s small primitives that share a material ([`super::join`]) and checks what is
+/// then drawn against the budget's primitives.
+pub(super) fn join_and_check_draws(model: &mut Model, path: &Path, spending: &Spending) -> Result<(), ModelError> {
+    // Not a warning: nothing the file asked for is lost.
+    model.join_small_primitives();
+    spending
+        .check_drawn_primitives(|| "the model".to_owned(), model.primitives.len() as u64)
+        .map_err(|e| over_budget(path, e))
 }

@@ -797,6 +797,7 @@ pub use mesh_file::MeshFormat;
 mod encoded_image;
 pub mod gpu_blocks;
 mod instancing;
+pub mod join;
 pub mod layer_arrays;
 pub mod layer_textures;
 pub mod layers;

@@ -19,7 +19,9 @@ use std::cell::RefCell;
 use std::path::Path;
 
 use super::encoded_image::Encoded;
-use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file, resolve_inside};
+use super::loader::{
+    MAX_COORDINATE, ModelError, join_and_check_draws, model_name, over_budget, read_model_file, resolve_inside,
+};
 use super::mesh_file::{MeshFormat, scan_colour};
 use super::{AlphaMode, Image, Material, Mesh, Model, Primitive, TextureRef, Vertex};
 use crate::budget::{ResourceBudget, Spending};
@@ -152,7 +154,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
         });
     }
     progress.step(0.9).map_err(cancelled)?;
-    let model = Model {
+    let mut model = Model {
         name: model_name(path),
         primitives,
         materials: model_materials,
@@ -165,6 +167,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
             path: path.to_path_buf(),
         });
     }
+    join_and_check_draws(&mut model, path, &spending)?;
     Ok(model)
 }
 
