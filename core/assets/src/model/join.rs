@@ -16,8 +16,8 @@
 //!
 //! Invariants: every triangle and vertex keeps its value (positions are already in the model's
 //! frame); a joined primitive stands where its first member stood in [`Model::primitives`], the
-//! others keep their order. Nothing here panics; the work is linear in the vertices plus a sort
-//! of the primitives.
+//! others keep their order. Nothing here panics; the work is linear in the vertices, plus sorting
+//! the primitives of a material once per level of halving.
 
 use glam::Vec3;
 
