@@ -38,7 +38,7 @@ impl Model {
             return 0;
         }
         let groups = groups(&self.primitives, &joinable);
-        // `leader[i]`: the group primitive i leads (its first member in file order), if any.
+        // `leader[i]`: the group primitive i leads (its first member in `Model::primitives`), if any.
         let mut leader = vec![None; before];
         let mut member = vec![false; before];
         for (g, group) in groups.iter().enumerate() {
