@@ -310,17 +310,20 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativePushSensor<'local>
     })
 }
 
-/// A front-camera frame (CameraX `ImageProxy` in `YUV_420_888`): its Y plane (`planes[0]`, a
+/// A camera frame (CameraX `ImageProxy` in `YUV_420_888`) of the front (`camera` 0: face tracking
+/// and the room light) or the rear camera (1: the room light): its Y plane (`planes[0]`, a
 /// direct buffer, pixel stride 1) and, for the room light's colour, its Cb and Cr planes
 /// (`planes[1]`, `planes[2]`, direct buffers with their shared row and pixel strides; both null
 /// for luma only). Copied before returning, so the caller may close the image at once; the core
-/// converts to colour on its own thread. Returns `false` when face tracking is off.
+/// converts to colour on its own thread. Returns `false` when nothing took it (front: face
+/// tracking off; rear: the room light off).
 #[unsafe(no_mangle)]
 #[allow(clippy::too_many_arguments)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local>(
     mut env: EnvUnowned<'local>,
     _class: JClass<'local>,
     handle: jlong,
+    camera: jint,
     luma: JByteBuffer<'local>,
     width: jint,
     height: jint,
@@ -338,6 +341,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
 ) -> jboolean {
     run(&mut env, |env| {
         let engine = engine(handle)?;
+        let facing = camera_facing(camera)?;
         let (width, height) = size(width, height)?;
         let stride = |what: &str, value: jint| {
             usize::try_from(value).map_err(|_| {
@@ -396,8 +400,21 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
                 ));
             }
         };
-        Ok(engine.camera_frame(frame)?)
+        Ok(engine.camera_frame(facing, frame)?)
     })
+}
+
+/// The camera of a bridge code (0 front, 1 rear), or `IllegalArgumentException`.
+fn camera_facing(code: jint) -> Result<phantogram::camera::CameraFacing, Thrown> {
+    u32::try_from(code)
+        .ok()
+        .and_then(phantogram::camera::CameraFacing::from_code)
+        .ok_or_else(|| {
+            fail(
+                Kind::IllegalArgument,
+                format!("camera must be 0 (front) or 1 (rear), got {code}"),
+            )
+        })
 }
 
 /// The bytes of a direct buffer, borrowed for the call.
@@ -434,25 +451,29 @@ unsafe fn direct_bytes<'a>(env: &mut Env<'_>, buffer: &JByteBuffer<'_>, what: &s
     Ok(unsafe { std::slice::from_raw_parts(address, capacity) })
 }
 
-/// The exposure of the camera frame captured at `timestampNs` (Camera2's capture result:
-/// `SENSOR_EXPOSURE_TIME` in nanoseconds and `SENSOR_SENSITIVITY` as ISO), which arrives apart
-/// from the image; the room light matches it to its frame. Unknown values (0, negative) are
-/// ignored (returns `false`).
+/// The exposure of the `camera`'s (0 front, 1 rear) frame captured at `timestampNs` (Camera2's
+/// capture result: `SENSOR_EXPOSURE_TIME` in nanoseconds, `SENSOR_SENSITIVITY` as ISO and
+/// `LENS_APERTURE` as an f-number, NaN when not reported), which arrives apart from the image;
+/// the room light matches it to its frame. Unknown values (0, negative) are ignored (returns
+/// `false`).
 #[unsafe(no_mangle)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraExposure<'local>(
     mut env: EnvUnowned<'local>,
     _class: JClass<'local>,
     handle: jlong,
+    camera: jint,
     timestamp_ns: jlong,
     exposure_time_ns: jlong,
     iso: jint,
+    aperture: jfloat,
 ) -> jboolean {
     run(&mut env, |_| {
         let engine = engine(handle)?;
+        let facing = camera_facing(camera)?;
         Ok(
             match phantogram::camera::Exposure::new(exposure_time_ns as f32 * 1e-9, iso as f32) {
                 Some(exposure) => {
-                    engine.camera_exposure(timestamp_ns, exposure);
+                    engine.camera_exposure(facing, timestamp_ns, exposure.with_f_number(aperture));
                     true
                 }
                 None => false,
@@ -925,7 +946,9 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeOpenMenu<'local>(
 /// The oldest request of the core's screens not yet taken: 0 none, 1 open a file (start
 /// `ACTION_OPEN_DOCUMENT`, then `nativeImportArtifactFd`), 2 ask for the camera permission
 /// (the core has shown why), 3 or 4 share the view (`nativeSnapshotPng` kind 0 or 1 through
-/// the share sheet). Call after each frame.
+/// the share sheet), 5 or 6 run the rear camera beside the front one where the device can, or
+/// stop it (the room light was switched on or off; asked at start too when it is on). Call after
+/// each frame.
 #[unsafe(no_mangle)]
 pub extern "system" fn Java_org_phantogram_NativeBridge_nativeTakeShellRequest<'local>(
     mut env: EnvUnowned<'local>,

@@ -26,9 +26,18 @@
 //! whose synthetic camera looks into the configured environment itself gets its level back (a
 //! gain of about 1 once most of it is seen).
 //!
+//! **Two cameras**: frames come from the front camera, and from the rear one where the platform
+//! runs both at once ([`CameraFacing`]); each is placed with its own camera's pose on the device
+//! ([`DeviceCameras`]) into the one map. Held as phantograms are, nearly flat, the front camera
+//! sees the ceiling and the room behind the viewer while the rear one sees the floor and the room
+//! in front: the floor, otherwise seen last and least, is seen from the start. Each camera has its
+//! own slot for the frame waiting, and while both wait the worker takes them in turn, so neither
+//! starves the other.
+//!
 //! **Threading**: [`RoomLightWorker::submit`], [`RoomLightWorker::note_exposure`] and
-//! [`RoomLightWorker::set_orientation`] from any thread, never waiting for the worker (a frame arriving while one is being blended replaces the
-//! one waiting: the newest view of the room matters most); [`RoomLightWorker::take_update`] on
+//! [`RoomLightWorker::set_orientation`] from any thread, never waiting for the worker (a frame
+//! arriving while one of the same camera waits replaces it: the newest view of the room matters
+//! most); [`RoomLightWorker::take_update`] on
 //! the render thread. The worker stops when the handle drops. **Orientation**: the render
 //! thread publishes each frame's fused device → world orientation; a camera frame is placed with
 //! the newest one published (a frame or two old at 60 fps; while the phone turns fast that
@@ -41,13 +50,14 @@ use glam::Quat;
 use phantogram_assets::ibl::{Environment, IrradianceSh, PrefilterSources, prefilter_base, prefiltered_levels};
 use phantogram_render::prefilter_gpu::PrefilterUpload;
 use phantogram_roomlight::{CaptureFrame, CaptureParams, RoomCapture, world_from_buffer_camera};
-use phantogram_sensing::camera::{CameraPose, Exposure, OwnedFrame};
+use phantogram_sensing::camera::{CameraFacing, DeviceCameras, Exposure, OwnedFrame};
 
 /// Camera time between two updates of the image-based light: twice a second.
 pub const UPDATE_INTERVAL_NS: i64 = 500_000_000;
 
-/// Exposures reported apart from their frames that are kept to be matched (a second at 30 fps).
-const EXPOSURES_KEPT: usize = 32;
+/// Exposures reported apart from their frames that are kept to be matched (a second at 30 fps
+/// from each camera).
+const EXPOSURES_KEPT: usize = 64;
 
 /// A new image-based light made from the room map.
 pub struct RoomLightUpdate {
@@ -82,14 +92,18 @@ struct Pending {
 
 #[derive(Default)]
 struct Shared {
-    pending: Option<Pending>,
-    /// Exposures reported by capture time, newest last.
-    exposures: std::collections::VecDeque<(i64, Exposure)>,
+    /// The frame waiting from each camera ([`CameraFacing::index`]).
+    pending: [Option<Pending>; 2],
+    /// The camera whose frame was taken last (the other goes next while both wait).
+    last_taken: Option<CameraFacing>,
+    /// Exposures reported by camera and capture time, newest last.
+    exposures: std::collections::VecDeque<(CameraFacing, i64, Exposure)>,
     world_from_device: Option<Quat>,
     update: Option<RoomLightUpdate>,
     refused: u64,
-    /// Frames blended and updates made, for waiting in tests and tools.
+    /// Frames blended (from each camera) and updates made, for waiting in tests and tools.
     blended: u64,
+    blended_from: [u64; 2],
     updates: u64,
     /// The share of the sphere seen, after the newest frame.
     coverage: f32,
@@ -111,11 +125,11 @@ pub struct RoomLightWorker {
 }
 
 impl RoomLightWorker {
-    /// Starts the worker for a camera at `pose` on the device. `level`: the mean luminance
+    /// Starts the worker for the device's `cameras`. `level`: the mean luminance
     /// ([`Environment::mean_luminance`]) each update's map is scaled to — the level of the light
     /// it replaces (see the module docs, **Level**) — or `None` to keep the camera's own.
     pub fn spawn(
-        pose: CameraPose,
+        cameras: DeviceCameras,
         params: CaptureParams,
         base_width: usize,
         level: Option<f32>,
@@ -124,7 +138,7 @@ impl RoomLightWorker {
         let inner = shared.clone();
         let thread = std::thread::Builder::new()
             .name("room light".into())
-            .spawn(move || run(&inner, pose, params, base_width, level))?;
+            .spawn(move || run(&inner, cameras, params, base_width, level))?;
         Ok(Self {
             shared,
             thread: Some(thread),
@@ -135,32 +149,32 @@ impl RoomLightWorker {
         self.shared.0.lock().unwrap_or_else(|p| p.into_inner())
     }
 
-    /// Hands a camera frame to the worker (RGBA, YUV or luma; its exposure with it when the
-    /// platform reports it so), replacing one not yet started.
+    /// Hands a frame of the `facing` camera to the worker (RGBA, YUV or luma; its exposure with
+    /// it when the platform reports it so), replacing one of that camera not yet started.
     /// Returns whether it was taken (not while the worker is off).
-    pub fn submit(&self, frame: OwnedFrame) -> bool {
-        self.submit_oriented(frame, None)
+    pub fn submit(&self, frame: OwnedFrame, facing: CameraFacing) -> bool {
+        self.submit_oriented(frame, facing, None)
     }
 
-    /// The exposure of the frame captured at `capture_t_ns` (sensor clock), reported apart from
-    /// it; used for that frame when it comes without one.
-    pub fn note_exposure(&self, capture_t_ns: i64, exposure: Exposure) {
+    /// The exposure of the `facing` camera's frame captured at `capture_t_ns` (sensor clock),
+    /// reported apart from it; used for that frame when it comes without one.
+    pub fn note_exposure(&self, facing: CameraFacing, capture_t_ns: i64, exposure: Exposure) {
         let mut s = self.lock();
         if s.exposures.len() == EXPOSURES_KEPT {
             s.exposures.pop_front();
         }
-        s.exposures.push_back((capture_t_ns, exposure));
+        s.exposures.push_back((facing, capture_t_ns, exposure));
     }
 
     /// As [`Self::submit`], with the device's orientation when the frame was taken (a desktop
     /// replay; a platform that tracks the camera's pose per frame), used instead of the newest
     /// published one.
-    pub fn submit_oriented(&self, frame: OwnedFrame, world_from_device: Option<Quat>) -> bool {
+    pub fn submit_oriented(&self, frame: OwnedFrame, facing: CameraFacing, world_from_device: Option<Quat>) -> bool {
         let mut s = self.lock();
         if s.off {
             return false;
         }
-        s.pending = Some(Pending {
+        s.pending[facing.index()] = Some(Pending {
             frame,
             world_from_device,
         });
@@ -175,7 +189,7 @@ impl RoomLightWorker {
         let mut s = self.lock();
         s.off = !on;
         if !on {
-            s.pending = None;
+            s.pending = [None, None];
             s.update = None;
         }
         drop(s);
@@ -218,13 +232,18 @@ impl RoomLightWorker {
         (s.blended, s.refused, s.updates)
     }
 
+    /// Frames of the `facing` camera blended so far.
+    pub fn blended_from(&self, facing: CameraFacing) -> u64 {
+        self.lock().blended_from[facing.index()]
+    }
+
     /// Waits up to `timeout` until every frame handed over has been blended (none waiting, none
     /// being blended) and `updates` updates were made (for tests and the desktop tools).
     /// Returns whether that happened.
     pub fn wait_until(&self, updates: u64, timeout: std::time::Duration) -> bool {
         let deadline = std::time::Instant::now() + timeout;
         let mut s = self.lock();
-        while s.pending.is_some() || s.busy || s.updates < updates {
+        while s.pending.iter().any(Option::is_some) || s.busy || s.updates < updates {
             let now = std::time::Instant::now();
             if now >= deadline {
                 return false;
@@ -250,7 +269,7 @@ impl Drop for RoomLightWorker {
 
 fn run(
     shared: &(Mutex<Shared>, Condvar),
-    pose: CameraPose,
+    cameras: DeviceCameras,
     params: CaptureParams,
     base_width: usize,
     level: Option<f32>,
@@ -261,7 +280,7 @@ fn run(
     loop {
         let (pending, orientation) = {
             let mut s = lock();
-            while s.pending.is_none() && !s.stop {
+            while s.pending.iter().all(Option::is_none) && !s.stop {
                 s = match shared.1.wait(s) {
                     Ok(g) => g,
                     Err(p) => p.into_inner(),
@@ -271,16 +290,27 @@ fn run(
                 return;
             }
             s.busy = true;
-            let pending = s.pending.take().map(|mut p| {
-                if p.frame.exposure.is_none() {
-                    let t = p.frame.capture_t_ns;
-                    p.frame.exposure = s.exposures.iter().rev().find(|(at, _)| *at == t).map(|(_, e)| *e);
-                }
-                p
-            });
-            (pending, s.world_from_device)
+            // Both waiting: the camera not taken last goes first.
+            let facing = match (&s.pending, s.last_taken) {
+                ([Some(_), Some(_)], Some(CameraFacing::Front)) | ([None, Some(_)], _) => CameraFacing::Rear,
+                _ => CameraFacing::Front,
+            };
+            s.last_taken = Some(facing);
+            let mut pending = s.pending[facing.index()].take();
+            if let Some(p) = &mut pending
+                && p.frame.exposure.is_none()
+            {
+                let t = p.frame.capture_t_ns;
+                p.frame.exposure = s
+                    .exposures
+                    .iter()
+                    .rev()
+                    .find(|(from, at, _)| *from == facing && *at == t)
+                    .map(|(_, _, e)| *e);
+            }
+            (pending.map(|p| (facing, p)), s.world_from_device)
         };
-        let Some(p) = pending else {
+        let Some((facing, p)) = pending else {
             lock().busy = false;
             continue;
         };
@@ -297,12 +327,14 @@ fn run(
         let image = p.frame.into_colour();
         let frame = CaptureFrame {
             image: image.as_frame(),
-            world_from_camera: world_from_buffer_camera(q, &pose, image.rotation_cw_deg),
+            world_from_camera: world_from_buffer_camera(q, cameras.pose(facing), image.rotation_cw_deg),
             exposure: image.exposure.map(Exposure::relative),
         };
         let added = capture.add(&frame).is_ok();
         let t = image.capture_t_ns;
-        let due = added && last_update_t_ns.is_none_or(|last| t.saturating_sub(last) >= UPDATE_INTERVAL_NS || t < last);
+        // Either way: the two cameras' frames interleave a few milliseconds apart, and a clock
+        // that went back (a camera restarted) must not stop the updates.
+        let due = added && last_update_t_ns.is_none_or(|last| t.abs_diff(last) >= UPDATE_INTERVAL_NS as u64);
         let on_gpu = lock().prefilter_on_gpu;
         let update = due.then(|| {
             last_update_t_ns = Some(t);
@@ -335,6 +367,7 @@ fn run(
         s.busy = false;
         if added {
             s.blended += 1;
+            s.blended_from[facing.index()] += 1;
         } else {
             s.refused += 1;
         }
@@ -368,7 +401,14 @@ fn level_gain(level: f32, mean: f32) -> f32 {
 mod tests {
     use super::*;
     use glam::Vec3;
-    use phantogram_sensing::camera::{Intrinsics, PixelFormat};
+    use phantogram_sensing::camera::{CameraPose, Intrinsics, PixelFormat};
+
+    fn cameras() -> DeviceCameras {
+        DeviceCameras {
+            front: CameraPose::front(Vec3::ZERO),
+            rear: CameraPose::rear(Vec3::ZERO),
+        }
+    }
 
     fn grey(t_ns: i64, code: u8) -> OwnedFrame {
         let (w, h) = (64u32, 48u32);
@@ -388,16 +428,15 @@ mod tests {
 
     #[test]
     fn frames_become_updates_twice_a_second_of_camera_time() {
-        let worker =
-            RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64, None).expect("thread");
+        let worker = RoomLightWorker::spawn(cameras(), CaptureParams::default(), 64, None).expect("thread");
         // Without an orientation a frame cannot be placed.
-        worker.submit(grey(0, 118));
+        worker.submit(grey(0, 118), CameraFacing::Front);
         assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
         assert_eq!(worker.counts(), (0, 1, 0));
         worker.set_orientation(Quat::IDENTITY);
         let mut made = 0;
         for k in 0..6i64 {
-            worker.submit(grey(k * 200_000_000, 118));
+            worker.submit(grey(k * 200_000_000, 118), CameraFacing::Front);
             assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
             if let Some(u) = worker.take_update() {
                 made += 1;
@@ -427,14 +466,15 @@ mod tests {
         // and 100 times too short: the map's own level spans 10 000, the light handed on does not.
         let level = 0.18;
         let light = |time_s: f32| {
-            let worker =
-                RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64, Some(level))
-                    .expect("thread");
+            let worker = RoomLightWorker::spawn(cameras(), CaptureParams::default(), 64, Some(level)).expect("thread");
             worker.set_orientation(Quat::IDENTITY);
-            worker.submit(OwnedFrame {
-                exposure: Exposure::new(time_s, 100.0),
-                ..grey(5, 118)
-            });
+            worker.submit(
+                OwnedFrame {
+                    exposure: Exposure::new(time_s, 100.0),
+                    ..grey(5, 118)
+                },
+                CameraFacing::Front,
+            );
             assert!(worker.wait_until(1, std::time::Duration::from_secs(10)));
             let update = worker.take_update().expect("an update");
             assert_eq!(worker.gain(), Some(update.gain));
@@ -473,13 +513,14 @@ mod tests {
         // its exposure (twice as long) reported apart with a neighbour's: the second room is
         // half as bright, so the noted exposure was used, and only the one of its own time.
         let light = |frame: OwnedFrame, notes: &[(i64, Exposure)]| {
-            let worker = RoomLightWorker::spawn(CameraPose::front(Vec3::ZERO), CaptureParams::default(), 64, None)
-                .expect("thread");
+            let worker = RoomLightWorker::spawn(cameras(), CaptureParams::default(), 64, None).expect("thread");
             worker.set_orientation(Quat::IDENTITY);
             for (t, e) in notes {
-                worker.note_exposure(*t, *e);
+                worker.note_exposure(CameraFacing::Front, *t, *e);
             }
-            worker.submit(frame);
+            // The rear camera's exposure at the same time is not the front's.
+            worker.note_exposure(CameraFacing::Rear, 5, Exposure::new(32.0, 100.0).expect("valid"));
+            worker.submit(frame, CameraFacing::Front);
             assert!(worker.wait_until(1, std::time::Duration::from_secs(10)));
             worker.take_update().expect("an update").sh.irradiance(Vec3::NEG_Z)[0]
         };
@@ -500,5 +541,72 @@ mod tests {
             (estimated / reported - 1.0).abs() < 0.01,
             "{estimated} against {reported}"
         );
+    }
+
+    /// An upright frame whose top half has code `top` and bottom half `bottom`.
+    fn halves(t_ns: i64, top: u8, bottom: u8) -> OwnedFrame {
+        let mut f = grey(t_ns, bottom);
+        let half = f.data.len() / 2;
+        f.data[..half].fill(top);
+        f
+    }
+
+    #[test]
+    fn each_cameras_frames_light_the_room_from_its_own_side() {
+        // The phone lies face up, its top to the north (device = world: x east, y north, z up).
+        // The front camera sees a dark ceiling; the rear one a bright floor, brighter still
+        // towards the phone's top (its image's top half). Both are handed over before the
+        // worker takes either: each camera keeps its own frame waiting.
+        let worker = RoomLightWorker::spawn(cameras(), CaptureParams::default(), 64, None).expect("thread");
+        worker.set_orientation(Quat::IDENTITY);
+        let (front, rear) = (grey(0, 20), halves(1, 240, 120));
+        assert!(worker.submit(front, CameraFacing::Front) && worker.submit(rear, CameraFacing::Rear));
+        assert!(worker.wait_until(1, std::time::Duration::from_secs(10)));
+        assert_eq!(worker.blended_from(CameraFacing::Front), 1);
+        assert_eq!(worker.blended_from(CameraFacing::Rear), 1);
+        // Updates come by camera time, every half second: the second frame (1 ns later) made
+        // none; so a further one lights the whole map.
+        assert!(worker.submit(halves(UPDATE_INTERVAL_NS + 2, 240, 120), CameraFacing::Rear));
+        assert!(worker.wait_until(2, std::time::Duration::from_secs(10)));
+        let mut sh = None;
+        while let Some(u) = worker.take_update() {
+            sh = Some(u.sh);
+        }
+        let sh = sh.expect("an update");
+        let e = |n: Vec3| phantogram_geometry::srgb::luminance(sh.irradiance(n.normalize()));
+        assert!(
+            e(Vec3::NEG_Z) > 4.0 * e(Vec3::Z),
+            "{} from below, {} from above",
+            e(Vec3::NEG_Z),
+            e(Vec3::Z)
+        );
+        let (north, south) = (e(Vec3::new(0.0, 1.0, -1.0)), e(Vec3::new(0.0, -1.0, -1.0)));
+        // (The cosine lobe over a 70° view of the floor and the filled rest smooth the halves'
+        // 4.6:1 in linear light to about 1.15:1; an image upside down would give about 1:1.15.)
+        assert!(
+            north > 1.08 * south,
+            "the image's top is the phone's top: {north} north, {south} south"
+        );
+        let (east, west) = (e(Vec3::new(1.0, 0.0, -1.0)), e(Vec3::new(-1.0, 0.0, -1.0)));
+        assert!((east / west - 1.0).abs() < 0.05, "{east} east, {west} west");
+    }
+
+    #[test]
+    fn with_both_cameras_waiting_they_are_taken_in_turn() {
+        // The worker is kept busy by frames from both cameras, handed over faster than it can
+        // blend them: neither camera is starved.
+        let worker = RoomLightWorker::spawn(cameras(), CaptureParams::default(), 64, None).expect("thread");
+        worker.set_orientation(Quat::IDENTITY);
+        for k in 0..40i64 {
+            worker.submit(grey(2 * k, 118), CameraFacing::Front);
+            worker.submit(grey(2 * k + 1, 118), CameraFacing::Rear);
+        }
+        assert!(worker.wait_until(0, std::time::Duration::from_secs(10)));
+        let (front, rear) = (
+            worker.blended_from(CameraFacing::Front),
+            worker.blended_from(CameraFacing::Rear),
+        );
+        assert!(front >= 1 && rear >= 1, "{front} front, {rear} rear");
+        assert!(front.abs_diff(rear) <= 1, "{front} front, {rear} rear");
     }
 }

@@ -198,20 +198,24 @@ enum PgStatus pg_push_device_motion(const struct PgEngine *engine,
                                     double y,
                                     double z);
 
-// One front-camera frame (`kCVPixelFormatType_420YpCbCr8BiPlanarFullRange`): its luma plane
+// One frame of the front (`camera` 0: face tracking and the room light) or the rear camera (1:
+// the room light, where `AVCaptureMultiCamSession` runs both)
+// (`kCVPixelFormatType_420YpCbCr8BiPlanarFullRange`): its luma plane
 // (plane 0), `width × height` bytes with `row_stride` bytes per row, and for the room light's
 // colour its interleaved CbCr plane (plane 1, `cbcr_row_stride` bytes per row; null for luma
 // only); turned clockwise by `rotation_cw_deg` to be upright in portrait, with the intrinsics
 // of the buffer as delivered (`kCMSampleBufferAttachmentKey_CameraIntrinsicMatrix`: fx, fy, cx,
-// cy in pixels), the exposure (the buffer's EXIF `ExposureTime` in seconds and
-// `ISOSpeedRatings`; NaN or 0 when unknown) and the capture time in seconds. The bytes are
+// cy in pixels), the exposure (the buffer's EXIF `ExposureTime` in seconds, `ISOSpeedRatings`
+// and `FNumber`; NaN or 0 when unknown) and the capture time in seconds. The bytes are
 // copied; the tracker and the room light run on their own threads. Returns `Unsupported`
-// (harmless) when the engine was made without face models.
+// (harmless) when nothing took the frame: a front frame in an engine made without face
+// models, a rear frame while the room light is off.
 //
 // # Safety
 // `engine` is a live handle; `luma` is valid for reads of `row_stride × height` bytes; `cbcr`
 // is null or valid for reads of `cbcr_row_stride × ⌈height / 2⌉` bytes.
 enum PgStatus pg_camera_frame(const struct PgEngine *engine,
+                              uint32_t camera,
                               const uint8_t *luma,
                               uint32_t width,
                               uint32_t height,
@@ -225,6 +229,7 @@ enum PgStatus pg_camera_frame(const struct PgEngine *engine,
                               float cy_px,
                               double exposure_time_s,
                               double iso,
+                              double f_number,
                               double timestamp_s);
 
 // One touch (`UITouch`): `phase` 0 began, 1 moved, 2 ended, 3 cancelled; `pointer` a stable id
@@ -382,8 +387,9 @@ enum PgStatus pg_camera_permission_needed(const struct PgEngine *engine);
 // receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj` or `.zip`, then
 // `pg_import_artifact`), 2 (ask for the camera permission: the core's camera page has said
 // why; start the camera when granted), 3 or 4 (share the view: `pg_snapshot_png` of kind 0,
-// the anaglyph, or 1, the side-by-side pair, through the system's share sheet). Call after
-// each `pg_draw`.
+// the anaglyph, or 1, the side-by-side pair, through the system's share sheet), 5 or 6 (the
+// room light was switched on or off: run the rear camera beside the front one where the device
+// can, or stop it; asked at start too when the light is on). Call after each `pg_draw`.
 //
 // # Safety
 // `engine` is a live handle; `request` is valid for a write.

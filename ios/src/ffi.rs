@@ -24,7 +24,7 @@ use std::panic::AssertUnwindSafe;
 use std::path::PathBuf;
 
 use phantogram::anaglyph::Method;
-use phantogram::camera::{ChromaPlanes, Exposure, Intrinsics, OwnedFrame};
+use phantogram::camera::{CameraFacing, ChromaPlanes, Exposure, Intrinsics, OwnedFrame};
 use phantogram::engine::{Engine, EngineConfig, EngineError, ErrorKind, SharedEngine};
 use phantogram::gesture::{Gesture, TouchPhase};
 use phantogram::glam::Vec3;
@@ -475,15 +475,18 @@ pub unsafe extern "C" fn pg_push_device_motion(
     })
 }
 
-/// One front-camera frame (`kCVPixelFormatType_420YpCbCr8BiPlanarFullRange`): its luma plane
+/// One frame of the front (`camera` 0: face tracking and the room light) or the rear camera (1:
+/// the room light, where `AVCaptureMultiCamSession` runs both)
+/// (`kCVPixelFormatType_420YpCbCr8BiPlanarFullRange`): its luma plane
 /// (plane 0), `width × height` bytes with `row_stride` bytes per row, and for the room light's
 /// colour its interleaved CbCr plane (plane 1, `cbcr_row_stride` bytes per row; null for luma
 /// only); turned clockwise by `rotation_cw_deg` to be upright in portrait, with the intrinsics
 /// of the buffer as delivered (`kCMSampleBufferAttachmentKey_CameraIntrinsicMatrix`: fx, fy, cx,
-/// cy in pixels), the exposure (the buffer's EXIF `ExposureTime` in seconds and
-/// `ISOSpeedRatings`; NaN or 0 when unknown) and the capture time in seconds. The bytes are
+/// cy in pixels), the exposure (the buffer's EXIF `ExposureTime` in seconds, `ISOSpeedRatings`
+/// and `FNumber`; NaN or 0 when unknown) and the capture time in seconds. The bytes are
 /// copied; the tracker and the room light run on their own threads. Returns `Unsupported`
-/// (harmless) when the engine was made without face models.
+/// (harmless) when nothing took the frame: a front frame in an engine made without face
+/// models, a rear frame while the room light is off.
 ///
 /// # Safety
 /// `engine` is a live handle; `luma` is valid for reads of `row_stride × height` bytes; `cbcr`
@@ -491,6 +494,7 @@ pub unsafe extern "C" fn pg_push_device_motion(
 #[unsafe(no_mangle)]
 pub unsafe extern "C" fn pg_camera_frame(
     engine: *const PgEngine,
+    camera: u32,
     luma: *const u8,
     width: u32,
     height: u32,
@@ -504,11 +508,18 @@ pub unsafe extern "C" fn pg_camera_frame(
     cy_px: f32,
     exposure_time_s: f64,
     iso: f64,
+    f_number: f64,
     timestamp_s: f64,
 ) -> PgStatus {
     guard(|| {
         // SAFETY: forwarded caller promise.
         let engine = unsafe { engine_ref(engine) }?;
+        let facing = CameraFacing::from_code(camera).ok_or_else(|| {
+            Failure::new(
+                PgStatus::InvalidArgument,
+                format!("camera must be 0 (front) or 1 (rear), got {camera}"),
+            )
+        })?;
         if luma.is_null() {
             return Err(Failure::new(PgStatus::NullPointer, "`luma` is null"));
         }
@@ -547,12 +558,15 @@ pub unsafe extern "C" fn pg_camera_frame(
             )
             .map_err(|e| Failure::new(PgStatus::InvalidArgument, e.to_string()))?
         };
-        let frame = frame.with_exposure(Exposure::new(exposure_time_s as f32, iso as f32));
-        match engine.shared.camera_frame(frame)? {
+        let exposure = Exposure::new(exposure_time_s as f32, iso as f32).map(|e| e.with_f_number(f_number as f32));
+        match engine.shared.camera_frame(facing, frame.with_exposure(exposure))? {
             true => Ok(()),
             false => Err(Failure::new(
                 PgStatus::Unsupported,
-                "face tracking is off in this engine",
+                match facing {
+                    CameraFacing::Front => "face tracking is off in this engine",
+                    CameraFacing::Rear => "the room light is off: rear-camera frames are not used",
+                },
             )),
         }
     })
@@ -925,8 +939,9 @@ pub unsafe extern "C" fn pg_camera_permission_needed(engine: *const PgEngine) ->
 /// receives 0 (nothing), 1 (show the document picker for a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj` or `.zip`, then
 /// `pg_import_artifact`), 2 (ask for the camera permission: the core's camera page has said
 /// why; start the camera when granted), 3 or 4 (share the view: `pg_snapshot_png` of kind 0,
-/// the anaglyph, or 1, the side-by-side pair, through the system's share sheet). Call after
-/// each `pg_draw`.
+/// the anaglyph, or 1, the side-by-side pair, through the system's share sheet), 5 or 6 (the
+/// room light was switched on or off: run the rear camera beside the front one where the device
+/// can, or stop it; asked at start too when the light is on). Call after each `pg_draw`.
 ///
 /// # Safety
 /// `engine` is a live handle; `request` is valid for a write.

@@ -135,11 +135,11 @@ public final class RandomCalls {
             case 0: NativeBridge.nativePushSensor(h, random.nextInt(40) - 2, anyTime(), anyFloat(), anyFloat(), anyFloat(), anyFloat()); break;
             case 1: {
                 int w = anyInt(64), hh = anyInt(48);
-                NativeBridge.nativeCameraFrame(h, anyBuffer(4096), w, hh, anyInt(80), anyBuffer(2048), anyBuffer(2048),
+                NativeBridge.nativeCameraFrame(h, anyInt(3), anyBuffer(4096), w, hh, anyInt(80), anyBuffer(2048), anyBuffer(2048),
                         anyInt(80), anyInt(3), anyInt(360), anyFloat(), anyFloat(), anyFloat(), anyFloat(), anyTime());
                 break;
             }
-            case 2: NativeBridge.nativeCameraExposure(h, anyTime(), anyTime(), anyInt(6400)); break;
+            case 2: NativeBridge.nativeCameraExposure(h, anyInt(3), anyTime(), anyTime(), anyInt(6400), anyFloat()); break;
             case 3: NativeBridge.nativeCameraIntrinsics(anyInts(5, 4000), anyInts(5, 4000), anyInts(3, 4000), anyFloats(3),
                     anyFloat(), anyFloats(6), anyInt(640), anyInt(480)); break;
             case 4: NativeBridge.nativeTouch(h, anyInt(4), anyInt(5), anyFloat(), anyFloat(), anyTime()); break;

@@ -143,28 +143,38 @@ public final class ReplayThroughJni {
             // CameraX's usual chroma: two views of one interleaved plane, pixel stride 2.
             java.nio.ByteBuffer cb = java.nio.ByteBuffer.allocateDirect(64 * 24 - 1);
             java.nio.ByteBuffer cr = java.nio.ByteBuffer.allocateDirect(64 * 24 - 1);
-            if (NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, null, null, 0, 0, 270, 50f, 50f, 32f, 24f, last)) {
+            if (NativeBridge.nativeCameraFrame(h, NativeBridge.CAMERA_FRONT, luma, 64, 48, 64, null, null, 0, 0, 270, 50f, 50f, 32f, 24f, last)) {
                 throw new AssertionError("face tracking is off: the frame must not be taken");
             }
-            if (NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, cr, 64, 2, 270, 50f, 50f, 32f, 24f, last)) {
+            if (NativeBridge.nativeCameraFrame(h, NativeBridge.CAMERA_FRONT, luma, 64, 48, 64, cb, cr, 64, 2, 270, 50f, 50f, 32f, 24f, last)) {
                 throw new AssertionError("face tracking is off: the colour frame must not be taken");
             }
             expect(IllegalArgumentException.class, "camera frame",
-                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, null, null, 0, 0, 45, 50f, 50f, 32f, 24f, end));
+                    () -> NativeBridge.nativeCameraFrame(h, NativeBridge.CAMERA_FRONT, luma, 64, 48, 64, null, null, 0, 0, 45, 50f, 50f, 32f, 24f, end));
             expect(IllegalArgumentException.class, "Cb row stride",
-                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, cr, 64, 4, 270, 50f, 50f, 32f, 24f, end));
+                    () -> NativeBridge.nativeCameraFrame(h, NativeBridge.CAMERA_FRONT, luma, 64, 48, 64, cb, cr, 64, 4, 270, 50f, 50f, 32f, 24f, end));
             expect(IllegalArgumentException.class, "chroma planes",
-                    () -> NativeBridge.nativeCameraFrame(h, luma, 64, 48, 64, cb, null, 64, 2, 270, 50f, 50f, 32f, 24f, end));
+                    () -> NativeBridge.nativeCameraFrame(h, NativeBridge.CAMERA_FRONT, luma, 64, 48, 64, cb, null, 64, 2, 270, 50f, 50f, 32f, 24f, end));
             // A heap buffer has no address to read (was a "Rust error" RuntimeException).
             expect(IllegalArgumentException.class, "not a direct buffer",
-                    () -> NativeBridge.nativeCameraFrame(h, java.nio.ByteBuffer.allocate(64 * 48), 64, 48, 64, null, null, 0, 0,
+                    () -> NativeBridge.nativeCameraFrame(h, NativeBridge.CAMERA_FRONT, java.nio.ByteBuffer.allocate(64 * 48), 64, 48, 64, null, null, 0, 0,
                             270, 50f, 50f, 32f, 24f, end));
             // The room light is off in this engine, but an exposure is taken (for when it is on);
             // an unknown one is not.
-            if (!NativeBridge.nativeCameraExposure(h, last, 10_000_000L, 200)
-                    || NativeBridge.nativeCameraExposure(h, last, 0L, 200)) {
+            if (!NativeBridge.nativeCameraExposure(h, NativeBridge.CAMERA_FRONT, last, 10_000_000L, 200, 2.2f)
+                    || !NativeBridge.nativeCameraExposure(h, NativeBridge.CAMERA_REAR, last, 10_000_000L, 200, Float.NaN)
+                    || NativeBridge.nativeCameraExposure(h, NativeBridge.CAMERA_FRONT, last, 0L, 200, 2.2f)) {
                 throw new AssertionError("camera exposure");
             }
+            // The rear camera feeds the room light alone, which is off here.
+            if (NativeBridge.nativeCameraFrame(h, NativeBridge.CAMERA_REAR, luma, 64, 48, 64, cb, cr, 64, 2, 90, 50f, 50f,
+                    32f, 24f, last)) {
+                throw new AssertionError("the room light is off: the rear frame must not be taken");
+            }
+            expect(IllegalArgumentException.class, "camera must be 0",
+                    () -> NativeBridge.nativeCameraFrame(h, 2, luma, 64, 48, 64, null, null, 0, 0, 90, 50f, 50f, 32f, 24f, end));
+            expect(IllegalArgumentException.class, "camera must be 0",
+                    () -> NativeBridge.nativeCameraExposure(h, -1, end, 10_000_000L, 200, 2f));
             NativeBridge.nativeSurfaceChanged(h, width / 2, height / 2);
             NativeBridge.nativeSurfaceDestroyed(h);
             if (NativeBridge.nativeDrawFrame(h, last)) {

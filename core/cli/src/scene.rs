@@ -42,6 +42,10 @@ pub struct SceneArgs {
     /// room light replayed on the desktop, captured before the first frame.
     #[arg(long, value_name = "LOG", requires = "environment")]
     environment_from_camera: Option<PathBuf>,
+    /// With --environment-from-camera: the phone's rear camera looks into the room too, at the
+    /// same time as the front one (as phones that run both cameras at once do).
+    #[arg(long, requires = "environment_from_camera")]
+    rear_camera: bool,
     /// A lamp in place of the room's light: raking (a spot light low at the screen's left edge,
     /// fixed in the room: for reading inscriptions) or torch (held by the phone above its top
     /// edge).
@@ -114,7 +118,7 @@ impl SceneArgs {
         };
         let material = self.material.as_deref().map(material_preset).transpose()?;
         let sweep = match (&self.environment_from_camera, &self.environment) {
-            (Some(log), Some(room)) => Some(crate::room_capture::RoomSweep::prepare(room, log)?),
+            (Some(log), Some(room)) => Some(crate::room_capture::RoomSweep::prepare(room, log, self.rear_camera)?),
             _ => None,
         };
         let config = EngineConfig {

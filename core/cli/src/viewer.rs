@@ -370,6 +370,8 @@ impl ApplicationHandler for App {
                         }
                         // The desktop asks no permission (the viewer never reports one missing).
                         phantogram::engine::ShellRequest::CameraPermission => {}
+                        // No cameras on the desktop.
+                        phantogram::engine::ShellRequest::RearCamera(_) => {}
                         // The desktop's share sheet is the working folder: both pictures, as `s`.
                         phantogram::engine::ShellRequest::Share(_) => self.save_snapshots(),
                     }

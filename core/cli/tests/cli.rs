@@ -143,6 +143,7 @@ fn bad_input_is_a_clear_error() {
         (&["--environment", "/nonexistent/sky.hdr"], "/nonexistent/sky.hdr"),
         (&["--material", "velvet"], "--material \"velvet\" is not a preset"),
         (&["--environment-from-camera", "/nonexistent/log"], "--environment"),
+        (&["--rear-camera"], "--environment-from-camera"),
         (
             &[
                 "--environment-from-camera",
@@ -838,4 +839,27 @@ fn render_takes_a_material_and_a_room_seen_by_the_camera() {
         "{stderr}"
     );
     assert!(differing(&read("plain"), &read("room")) > 1000);
+    // The rear camera too: twice the frames, more of the room seen, another light.
+    let seen = |stderr: &str| -> f32 {
+        let before = stderr.split(" % of the room seen").next().unwrap_or_default();
+        before
+            .rsplit(", ")
+            .next()
+            .and_then(|v| v.trim().parse().ok())
+            .unwrap_or(f32::NAN)
+    };
+    let both = render_default_log(
+        &[
+            "--environment",
+            room.to_str().unwrap(),
+            "--environment-from-camera",
+            log.to_str().unwrap(),
+            "--rear-camera",
+        ],
+        "100000",
+        &dir.join("both"),
+    );
+    assert!(both.contains(" front, ") && both.contains(" rear)"), "{both}");
+    assert!(seen(&both) > seen(&stderr) + 10.0, "{stderr}\n{both}");
+    assert!(differing(&read("room"), &read("both")) > 100);
 }

@@ -54,6 +54,21 @@ impl SyntheticCamera {
         }
     }
 
+    /// A phone's main rear camera as Android delivers it in portrait: a 320 × 240 landscape
+    /// buffer turned 90° clockwise to upright (the rear sensor is mounted the other way round from
+    /// the front one), 67° across its long side (a 26 mm-equivalent lens on a 4:3 sensor).
+    pub fn phone_rear() -> Self {
+        let (width, height) = (320, 240);
+        Self {
+            width,
+            height,
+            intrinsics: Intrinsics::from_horizontal_fov(width, height, 67f32.to_radians()),
+            rotation_cw_deg: 90,
+            pose: CameraPose::rear(Vec3::new(0.0, 0.06, 0.0)),
+            middle_grey: 0.18,
+        }
+    }
+
     /// World from the buffer's camera frame (x along rows, y down, z along the optical axis).
     pub fn world_from_camera(&self, world_from_device: Quat) -> Quat {
         world_from_buffer_camera(world_from_device, &self.pose, self.rotation_cw_deg)

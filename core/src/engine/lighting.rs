@@ -20,21 +20,27 @@ impl Engine {
             })
     }
 
-    /// Hands a camera frame to the live room light (RGBA, YUV or luma; with its exposure when the
-    /// platform reports it); from any thread through [`SharedEngine::camera_frame`](super::SharedEngine::camera_frame) too.
-    /// Returns `false` when the room light is off ([`EngineConfig::room_light`](super::EngineConfig::room_light)).
-    pub fn room_light_frame(&self, frame: crate::camera::OwnedFrame) -> bool {
+    /// Hands a frame of the `facing` camera to the live room light (RGBA, YUV or luma; with its
+    /// exposure when the platform reports it); from any thread through
+    /// [`SharedEngine::camera_frame`](super::SharedEngine::camera_frame) too. Returns `false` when
+    /// the room light is off ([`EngineConfig::room_light`](super::EngineConfig::room_light)).
+    pub fn room_light_frame(&self, frame: crate::camera::OwnedFrame, facing: crate::camera::CameraFacing) -> bool {
         match &self.room_light {
-            Some(worker) => worker.submit(frame),
+            Some(worker) => worker.submit(frame, facing),
             None => false,
         }
     }
 
     /// As [`Self::room_light_frame`], with the device's orientation (device → world) when the
     /// frame was taken: a desktop replay whose camera follows a log of its own.
-    pub fn room_light_frame_oriented(&self, frame: crate::camera::OwnedFrame, world_from_device: glam::Quat) -> bool {
+    pub fn room_light_frame_oriented(
+        &self,
+        frame: crate::camera::OwnedFrame,
+        facing: crate::camera::CameraFacing,
+        world_from_device: glam::Quat,
+    ) -> bool {
         match &self.room_light {
-            Some(worker) => worker.submit_oriented(frame, Some(world_from_device)),
+            Some(worker) => worker.submit_oriented(frame, facing, Some(world_from_device)),
             None => false,
         }
     }
@@ -46,6 +52,9 @@ impl Engine {
         let Some(worker) = &self.room_light else { return };
         let was_on = worker.is_on();
         worker.set_on(on);
+        if was_on != on {
+            self.requests.push(super::ShellRequest::RearCamera(on));
+        }
         if was_on && !on && self.stats.room_light_updates > 0 {
             // A failed upload keeps the room's light; the next switch tries again.
             let _ = self

@@ -136,7 +136,8 @@ pub struct EngineConfig {
     pub calibration_path: Option<PathBuf>,
     /// Light the artifact with the room itself, as the camera sees it
     /// ([`crate::room_light`]): camera frames ([`Engine::room_light_frame`], or every frame the
-    /// shell forwards, in colour when it forwards the chroma planes) are blended into a map of the
+    /// shell forwards, in colour when it forwards the chroma planes, from the rear camera too where
+    /// the platform runs both cameras at once) are blended into a map of the
     /// room whose light replaces the studio's (or [`Self::environment_path`]'s) once the first
     /// update is made. This is the start-up default; the calibration file's choice (the settings
     /// screen's "Light" switch, [`Engine::set_room_light`]) overrides it. Off by default: on a
@@ -403,6 +404,11 @@ pub enum ShellRequest {
     /// Share the view through the system's share sheet: take [`Engine::snapshot_png`] of this
     /// kind and hand the PNG over.
     Share(Snapshot),
+    /// Run the rear camera beside the front one where the platform can (`true`: the room light
+    /// was switched on, or is on at start) or stop it (`false`: switched off), so that a second
+    /// camera costs power only while its frames are used. The shell starts with the front
+    /// camera alone.
+    RearCamera(bool),
 }
 
 impl ShellRequest {
@@ -413,6 +419,8 @@ impl ShellRequest {
             Self::CameraPermission => 2,
             Self::Share(Snapshot::Composed) => 3,
             Self::Share(Snapshot::SideBySide) => 4,
+            Self::RearCamera(true) => 5,
+            Self::RearCamera(false) => 6,
         }
     }
 }
@@ -585,8 +593,14 @@ impl Engine {
             || crate::ibl::Environment::studio().mean_luminance(),
             |e| e.mean_luminance(),
         );
+        // Where on the back the rear camera sits does not matter to a map of the room's light at
+        // infinity; only which way it looks.
+        let cameras = crate::camera::DeviceCameras {
+            front: camera_pose,
+            rear: crate::camera::CameraPose::rear(camera_pose.position_m),
+        };
         let room_light = match crate::room_light::RoomLightWorker::spawn(
-            camera_pose,
+            cameras,
             phantogram_roomlight::CaptureParams::default(),
             crate::render::PREFILTERED_BASE_WIDTH,
             Some(level),
@@ -665,6 +679,9 @@ impl Engine {
             last_device_to_world: None,
         };
         engine.apply_calibration();
+        if engine.room_light_on() {
+            engine.requests.push(ShellRequest::RearCamera(true));
+        }
         if config.model_path.is_none()
             && config
                 .artifact

@@ -36,16 +36,23 @@ impl SharedEngine {
         self.inbox.push(event)
     }
 
-    /// From any thread, without waiting for inference: hands the frame to the face tracker
-    /// (replacing one not yet started), and to the live room light when it is on. `Ok(false)`
-    /// when face tracking is off.
+    /// From any thread, without waiting for inference: hands a front-camera frame to the face
+    /// tracker (replacing one not yet started), and to the live room light when it is on; a
+    /// rear-camera frame to the room light alone. `Ok(false)` when nothing took it: face
+    /// tracking off (front), the room light off (rear).
     #[cfg(feature = "face")]
-    pub fn camera_frame(&self, frame: crate::face::OwnedFrame) -> Result<bool, EngineError> {
+    pub fn camera_frame(
+        &self,
+        facing: crate::camera::CameraFacing,
+        frame: crate::face::OwnedFrame,
+    ) -> Result<bool, EngineError> {
         crate::face::UprightImage::new(frame.as_frame())?;
-        if let Some(room) = &self.room_light
-            && room.is_on()
-        {
-            room.submit(frame.clone());
+        let room = self.room_light.as_ref().filter(|room| room.is_on());
+        if facing == crate::camera::CameraFacing::Rear {
+            return Ok(room.is_some_and(|room| room.submit(frame, facing)));
+        }
+        if let Some(room) = room {
+            room.submit(frame.clone(), facing);
         }
         match &self.face {
             Some(worker) => {
@@ -57,12 +64,17 @@ impl SharedEngine {
         }
     }
 
-    /// From any thread: the exposure of the camera frame captured at `capture_t_ns`, where the
-    /// platform reports it apart from the frame (Camera2's capture results); the room light
-    /// matches it to its frame. Ignored when the room light is off.
-    pub fn camera_exposure(&self, capture_t_ns: i64, exposure: crate::camera::Exposure) {
+    /// From any thread: the exposure of the `facing` camera's frame captured at `capture_t_ns`,
+    /// where the platform reports it apart from the frame (Camera2's capture results); the room
+    /// light matches it to its frame. Ignored when the room light is off.
+    pub fn camera_exposure(
+        &self,
+        facing: crate::camera::CameraFacing,
+        capture_t_ns: i64,
+        exposure: crate::camera::Exposure,
+    ) {
         if let Some(room) = &self.room_light {
-            room.note_exposure(capture_t_ns, exposure);
+            room.note_exposure(facing, capture_t_ns, exposure);
         }
     }
 

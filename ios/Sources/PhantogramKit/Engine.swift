@@ -106,6 +106,9 @@ public final class Engine {
         case cameraPermission
         /// The share sheet with a snapshot of the view: the anaglyph, or the stereo pair.
         case share(pair: Bool)
+        /// Run the rear camera beside the front one where the device can (the room light is on),
+        /// or stop it (off).
+        case rearCamera(on: Bool)
     }
 
     /// The oldest request of the core's screens, or nil; call after each frame.
@@ -117,6 +120,8 @@ public final class Engine {
         case 2: return .cameraPermission
         case 3: return .share(pair: false)
         case 4: return .share(pair: true)
+        case 5: return .rearCamera(on: true)
+        case 6: return .rearCamera(on: false)
         default: return nil
         }
     }

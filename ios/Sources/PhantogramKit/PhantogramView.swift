@@ -15,6 +15,8 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
     private let engine: Engine
     private let motion: MotionSource
     private var camera: CameraSource?
+    /// The core asks for the rear camera while the room light is on; kept for the camera's start.
+    private var wantRear = false
     private var link: CADisplayLink?
     private var resumed = false
     private lazy var screenReader = ScreenReader(view: self, engine: engine)
@@ -65,7 +67,7 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
             contentScaleFactor = window.screen.nativeScale
             (layer as? CAMetalLayer)?.contentsScale = window.screen.nativeScale
             foreground()
-            if camera == nil { camera = CameraSource.startIfAllowed(engine: engine) }
+            if camera == nil { camera = CameraSource.startIfAllowed(engine: engine, withRear: wantRear) }
         } else {
             background()
         }
@@ -121,6 +123,9 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
         case .openFile?: presentDocumentPicker()
         case .cameraPermission?: camera?.requestAccess()
         case .share(let pair)?: presentShareSheet(pair: pair)
+        case .rearCamera(let on)?:
+            wantRear = on
+            camera?.setRear(on)
         case nil: break
         }
         // VoiceOver reads the core's screens as elements of this view.

@@ -147,14 +147,19 @@ int main(int argc, char **argv) {
     uint8_t luma[64 * 48] = {0};
     uint8_t cbcr[64 * 24] = {0};
     double t = (double)last * 1e-9;
-    check(pg_camera_frame(engine, luma, 64, 48, 64, NULL, 0, 270, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, t),
+    check(pg_camera_frame(engine, 0, luma, 64, 48, 64, NULL, 0, 270, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, NAN, t),
           PG_STATUS_UNSUPPORTED, "camera frame without face tracking", "face tracking is off");
-    check(pg_camera_frame(engine, luma, 64, 48, 64, cbcr, 64, 270, 50.0f, 50.0f, 32.0f, 24.0f, 0.01, 200.0, t),
+    check(pg_camera_frame(engine, 0, luma, 64, 48, 64, cbcr, 64, 270, 50.0f, 50.0f, 32.0f, 24.0f, 0.01, 200.0, 2.2, t),
           PG_STATUS_UNSUPPORTED, "colour camera frame without face tracking", "face tracking is off");
-    check(pg_camera_frame(engine, luma, 64, 48, 64, NULL, 0, 45, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, t),
+    check(pg_camera_frame(engine, 0, luma, 64, 48, 64, NULL, 0, 45, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, NAN, t),
           PG_STATUS_INVALID_ARGUMENT, "camera frame turned 45 degrees", "rotation");
-    check(pg_camera_frame(engine, luma, 64, 48, 64, cbcr, 32, 270, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, t),
+    check(pg_camera_frame(engine, 0, luma, 64, 48, 64, cbcr, 32, 270, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, NAN, t),
           PG_STATUS_INVALID_ARGUMENT, "CbCr rows narrower than the frame", "Cb row stride");
+    /* The rear camera feeds the room light alone, off in this engine; cameras are 0 or 1. */
+    check(pg_camera_frame(engine, 1, luma, 64, 48, 64, cbcr, 64, 90, 50.0f, 50.0f, 32.0f, 24.0f, 0.01, 200.0, 1.8, t),
+          PG_STATUS_UNSUPPORTED, "rear camera frame without the room light", "room light is off");
+    check(pg_camera_frame(engine, 2, luma, 64, 48, 64, NULL, 0, 90, 50.0f, 50.0f, 32.0f, 24.0f, NAN, NAN, NAN, t),
+          PG_STATUS_INVALID_ARGUMENT, "a third camera", "camera must be 0");
     check(pg_resize(engine, width / 2, height / 2), PG_STATUS_OK, "resize", NULL);
     check(pg_suspend(engine), PG_STATUS_OK, "suspend", NULL);
     size_t needed = 0;

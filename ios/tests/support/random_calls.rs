@@ -102,6 +102,7 @@ pub unsafe fn run(e: *const PgEngine, data: &[u8]) {
                     };
                     check(pg_camera_frame(
                         e,
+                        b.small(3),
                         luma.as_ptr(),
                         w,
                         h,
@@ -113,6 +114,7 @@ pub unsafe fn run(e: *const PgEngine, data: &[u8]) {
                         b.f32(),
                         b.f32(),
                         b.f32(),
+                        b.f64(),
                         b.f64(),
                         b.f64(),
                         b.f64(),

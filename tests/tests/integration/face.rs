@@ -796,7 +796,11 @@ fn camera_frames_through_the_engine_move_the_eyes_to_the_camera() {
         f.capture_t_ns = t - 30_000_000;
         let producer = {
             let shared = Arc::clone(&shared);
-            std::thread::spawn(move || shared.camera_frame(f).expect("a valid frame"))
+            std::thread::spawn(move || {
+                shared
+                    .camera_frame(phantogram::camera::CameraFacing::Front, f)
+                    .expect("a valid frame")
+            })
         };
         assert!(producer.join().expect("the camera thread"), "face tracking is on");
         let worker = shared.lock().face_worker().expect("face tracking is on");

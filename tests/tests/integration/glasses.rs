@@ -387,7 +387,12 @@ fn the_engine_reports_the_glasses_of_a_colour_camera_frame() {
     for t_ns in [5_000_000, 6_000_000] {
         let mut yuv = yuv.clone();
         yuv.capture_t_ns = t_ns;
-        assert!(shared.camera_frame(yuv).expect("a valid frame"), "face tracking is on");
+        assert!(
+            shared
+                .camera_frame(phantogram::camera::CameraFacing::Front, yuv)
+                .expect("a valid frame"),
+            "face tracking is on"
+        );
         while worker.newest().is_none_or(|o| o.capture_t_ns != t_ns) {
             assert!(std::time::Instant::now() < deadline, "the frame was never processed");
             std::thread::sleep(std::time::Duration::from_millis(10));

@@ -158,6 +158,52 @@ impl CameraFrame<'_> {
     }
 }
 
+/// Which of the device's cameras a frame comes from (Android's `LENS_FACING`, AVFoundation's
+/// `AVCaptureDevice.Position`). The front camera feeds the face tracker and the room light; the
+/// rear camera, where the platform runs both at once, only the room light.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum CameraFacing {
+    /// On the screen's side, looking at the viewer (and the room behind them).
+    Front,
+    /// On the back, looking where the screen's back faces (the room in front of the viewer).
+    Rear,
+}
+
+impl CameraFacing {
+    /// The bridges' code: 0 front, 1 rear; `None` for any other.
+    pub fn from_code(code: u32) -> Option<Self> {
+        match code {
+            0 => Some(Self::Front),
+            1 => Some(Self::Rear),
+            _ => None,
+        }
+    }
+
+    /// 0 front, 1 rear: an index for per-camera state.
+    pub fn index(self) -> usize {
+        match self {
+            Self::Front => 0,
+            Self::Rear => 1,
+        }
+    }
+}
+
+/// The device's two cameras, where each sits and looks.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DeviceCameras {
+    pub front: CameraPose,
+    pub rear: CameraPose,
+}
+
+impl DeviceCameras {
+    pub fn pose(&self, facing: CameraFacing) -> &CameraPose {
+        match facing {
+            CameraFacing::Front => &self.front,
+            CameraFacing::Rear => &self.rear,
+        }
+    }
+}
+
 /// Where the camera sits in the device frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraPose {
@@ -176,28 +222,65 @@ impl CameraPose {
             device_from_camera: Quat::from_rotation_z(std::f32::consts::PI),
         }
     }
+
+    /// A rear camera at `position_m` looking out of the device's back: image right is the
+    /// device's +x, image down is −y, the optical axis is −z. That is a half turn about x.
+    pub fn rear(position_m: Vec3) -> Self {
+        Self {
+            position_m,
+            device_from_camera: Quat::from_rotation_x(std::f32::consts::PI),
+        }
+    }
 }
 
 /// A frame's exposure as the platform reports it (Camera2's `SENSOR_EXPOSURE_TIME` and
 /// `SENSOR_SENSITIVITY`; the EXIF `ExposureTime` and `ISOSpeedRatings` of an AVFoundation
 /// buffer): what turns its pixel values back into relative radiance.
+///
+/// The lens's f-number (Camera2's `LENS_APERTURE`, EXIF `FNumber`) matters where two cameras
+/// light one map: a phone's rear lens (f/1.5–1.9) gathers 1.5–2 times the light of its front
+/// one (f/2.0–2.4) at the same time and gain. A camera's aperture is fixed on almost every
+/// phone, so with one camera it only scales the map, which the room light's level removes.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Exposure {
     pub time_s: f32,
     /// Sensor gain as an ISO speed (100 = unity on most phones).
     pub iso: f32,
+    /// The lens's f-number, where reported.
+    pub f_number: Option<f32>,
 }
+
+/// The f-number [`Exposure::relative`] takes for a lens that does not report its own: a
+/// typical phone camera's, so that a camera reporting it and one not differ by little.
+pub const TYPICAL_F_NUMBER: f32 = 2.0;
 
 impl Exposure {
     /// `None` unless both are finite and positive (platforms report 0 or leave a field out when
-    /// they do not know).
+    /// they do not know). No f-number: [`Self::with_f_number`].
     pub fn new(time_s: f32, iso: f32) -> Option<Self> {
-        (time_s.is_finite() && time_s > 0.0 && iso.is_finite() && iso > 0.0).then_some(Self { time_s, iso })
+        (time_s.is_finite() && time_s > 0.0 && iso.is_finite() && iso > 0.0).then_some(Self {
+            time_s,
+            iso,
+            f_number: None,
+        })
     }
 
-    /// Exposure time × gain (seconds at ISO 100): pixel value ∝ radiance × this.
+    /// With the lens's f-number, when it is finite and positive (else as it was: platforms
+    /// report 0 or NaN when they do not know).
+    pub fn with_f_number(self, f_number: f32) -> Self {
+        Self {
+            f_number: (f_number.is_finite() && f_number > 0.0)
+                .then_some(f_number)
+                .or(self.f_number),
+            ..self
+        }
+    }
+
+    /// Exposure time × gain × the aperture's light relative to f/[`TYPICAL_F_NUMBER`] (seconds
+    /// at ISO 100 and f/2): pixel value ∝ radiance × this.
     pub fn relative(self) -> f32 {
-        self.time_s * self.iso / 100.0
+        let aperture = self.f_number.map_or(1.0, |n| (TYPICAL_F_NUMBER / n).powi(2));
+        self.time_s * self.iso / 100.0 * aperture
     }
 }
 
@@ -415,5 +498,58 @@ impl OwnedFrame {
                 .filter(|_| self.format == PixelFormat::Luma8)
                 .map(ChromaPlanes::view),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn each_camera_looks_out_of_its_own_side_with_its_image_upright() {
+        // Device frame: x right, y up the screen, z out of the screen towards the viewer.
+        let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-6;
+        let front = CameraPose::front(Vec3::ZERO).device_from_camera;
+        assert!(close(front * Vec3::Z, Vec3::Z), "the front camera looks at the viewer");
+        assert!(
+            close(front * Vec3::Y, Vec3::NEG_Y),
+            "its image's down is the device's down"
+        );
+        assert!(
+            close(front * Vec3::X, Vec3::NEG_X),
+            "facing the viewer, its right is the device's left"
+        );
+        let rear = CameraPose::rear(Vec3::ZERO).device_from_camera;
+        assert!(
+            close(rear * Vec3::Z, Vec3::NEG_Z),
+            "the rear camera looks out of the back"
+        );
+        assert!(
+            close(rear * Vec3::Y, Vec3::NEG_Y),
+            "its image's down is the device's down"
+        );
+        assert!(
+            close(rear * Vec3::X, Vec3::X),
+            "looking the way the viewer does, its right is theirs"
+        );
+        let cameras = DeviceCameras {
+            front: CameraPose::front(Vec3::ZERO),
+            rear: CameraPose::rear(Vec3::ZERO),
+        };
+        assert_eq!(cameras.pose(CameraFacing::Rear).device_from_camera, rear);
+        assert_eq!(CameraFacing::from_code(1), Some(CameraFacing::Rear));
+        assert_eq!(CameraFacing::from_code(2), None);
+    }
+
+    #[test]
+    fn a_wider_aperture_is_a_longer_exposure() {
+        let e = Exposure::new(0.01, 400.0).expect("valid");
+        assert!((e.relative() - 0.04).abs() < 1e-7);
+        // f/2 is the default: the same; f/1.4 lets in twice the light of f/2.
+        assert_eq!(e.with_f_number(2.0).relative(), e.relative());
+        assert!((e.with_f_number(2.0 / 2f32.sqrt()).relative() / e.relative() - 2.0).abs() < 1e-5);
+        // Unknown f-numbers are ignored, keeping one reported before.
+        assert_eq!(e.with_f_number(f32::NAN), e);
+        assert_eq!(e.with_f_number(1.8).with_f_number(0.0).f_number, Some(1.8));
     }
 }

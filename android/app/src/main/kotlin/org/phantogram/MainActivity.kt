@@ -42,8 +42,11 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         onOpenFile = { runOnUiThread { openDocument.launch(MODEL_TYPES) } },
         // The core's camera page said why and the user wants the camera: the system's request.
         onCameraPermission = { runOnUiThread { askCamera.launch(Manifest.permission.CAMERA) } },
-        onShare = { png, pair -> runOnUiThread { share(png, pair) } }
+        onShare = { png, pair -> runOnUiThread { share(png, pair) } },
+        // The room light's camera wish, kept for when the camera starts (UI thread).
+        onRearCamera = { on -> runOnUiThread { wantRear = on; camera?.setRear(on) } }
     )
+    private var wantRear = false
     private lateinit var sensors: SensorForwarder
     private var camera: CameraForwarder? = null
     private var surfaceReady = false
@@ -229,7 +232,7 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         }
 
     private fun startCamera() {
-        if (camera == null) camera = CameraForwarder(this) { render.engine }.also { it.start(this) }
+        if (camera == null) camera = CameraForwarder(this) { render.engine }.also { it.start(this, wantRear) }
     }
 
     /** The panel in its natural orientation: the current metrics, turned back by the rotation. */

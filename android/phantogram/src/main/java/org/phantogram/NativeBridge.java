@@ -61,20 +61,28 @@ public final class NativeBridge {
     public static native boolean nativePushSensor(long handle, int sensorType, long timestampNs,
             float x, float y, float z, float w);
 
+    /** The front camera: face tracking and the room light. */
+    public static final int CAMERA_FRONT = 0;
+    /** The rear camera, where the device runs both at once: the room light. */
+    public static final int CAMERA_REAR = 1;
+
     /**
-     * A front-camera YUV_420_888 frame: the Y plane (direct buffer, pixel stride 1) and the Cb and
-     * Cr planes (direct buffers with their row and pixel strides; both null for luma only); all
-     * copied before returning. Returns false when face tracking is off.
+     * A YUV_420_888 frame of the camera (CAMERA_FRONT or CAMERA_REAR): the Y plane (direct buffer,
+     * pixel stride 1) and the Cb and Cr planes (direct buffers with their row and pixel strides;
+     * both null for luma only); all copied before returning. Returns false when nothing took it
+     * (front: face tracking off; rear: the room light off).
      */
-    public static native boolean nativeCameraFrame(long handle, ByteBuffer luma, int width, int height,
+    public static native boolean nativeCameraFrame(long handle, int camera, ByteBuffer luma, int width, int height,
             int rowStride, ByteBuffer cb, ByteBuffer cr, int chromaRowStride, int chromaPixelStride,
             int rotationDegrees, float fx, float fy, float cx, float cy, long timestampNs);
 
     /**
-     * The exposure of the frame captured at timestampNs, from its capture result
-     * (SENSOR_EXPOSURE_TIME in ns, SENSOR_SENSITIVITY); matched to the frame by the core.
+     * The exposure of the camera's frame captured at timestampNs, from its capture result
+     * (SENSOR_EXPOSURE_TIME in ns, SENSOR_SENSITIVITY, LENS_APERTURE or NaN); matched to the
+     * frame by the core.
      */
-    public static native boolean nativeCameraExposure(long handle, long timestampNs, long exposureTimeNs, int iso);
+    public static native boolean nativeCameraExposure(long handle, int camera, long timestampNs, long exposureTimeNs,
+            int iso, float aperture);
 
     /**
      * [fx, fy, cx, cy] of a width × height output image from Camera2's characteristics as
@@ -129,6 +137,10 @@ public final class NativeBridge {
     public static final int REQUEST_SHARE_PICTURE = 3;
     /** Share the view as a side-by-side stereo pair: nativeSnapshotPng(handle, 1). */
     public static final int REQUEST_SHARE_PAIR = 4;
+    /** The room light is on: run the rear camera beside the front one where the device can. */
+    public static final int REQUEST_REAR_CAMERA_ON = 5;
+    /** The room light is off: the front camera alone (the rear one would cost power for nothing). */
+    public static final int REQUEST_REAR_CAMERA_OFF = 6;
 
     /** The system's font scale (Configuration.fontScale): the core's screens scale their text
      *  and controls by it (0.85 to 2). IllegalArgumentException for a non-positive scale. */

@@ -23,7 +23,9 @@ class RenderLoop(
     /** The core's camera page: the user wants the camera (called on the render thread). */
     private val onCameraPermission: () -> Unit,
     /** The core's menu: share this PNG of the view, a stereo pair if `pair` (render thread). */
-    private val onShare: (png: ByteArray, pair: Boolean) -> Unit
+    private val onShare: (png: ByteArray, pair: Boolean) -> Unit,
+    /** The room light was switched on or off: run the rear camera or stop it (render thread). */
+    private val onRearCamera: (on: Boolean) -> Unit
 ) : Choreographer.FrameCallback {
     private val thread = HandlerThread("phantogram-render").apply { start() }
     private val handler = Handler(thread.looper)
@@ -136,6 +138,8 @@ class RenderLoop(
                     // Taken here, on the thread that owns the engine, without the menu drawn over it.
                     NativeBridge.REQUEST_SHARE_PICTURE -> onShare(NativeBridge.nativeSnapshotPng(engine, 0), false)
                     NativeBridge.REQUEST_SHARE_PAIR -> onShare(NativeBridge.nativeSnapshotPng(engine, 1), true)
+                    NativeBridge.REQUEST_REAR_CAMERA_ON -> onRearCamera(true)
+                    NativeBridge.REQUEST_REAR_CAMERA_OFF -> onRearCamera(false)
                 }
                 val generation = NativeBridge.nativeAccessibilityGeneration(engine)
                 if (generation != accessibilityGeneration) {
