@@ -28,7 +28,7 @@ import java.io.File
 
 /**
  * The whole Android shell: one full-screen SurfaceView. It forwards the surface (holder
- * callbacks), sensors, front-camera frames, touches, lifecycle and display metrics to the Rust
+ * callbacks), sensors, camera frames, touches, lifecycle and display metrics to the Rust
  * core through NativeBridge; everything else happens there.
  *
  * Lifecycle: onResume starts sensors and frames, onPause stops them; the surface follows the
