@@ -43,28 +43,24 @@ impl SyntheticCamera {
     /// A phone's front camera as Android delivers it in portrait: a 320 × 240 landscape buffer
     /// turned 270° clockwise to upright, 70° across its long side.
     pub fn phone_front() -> Self {
-        let (width, height) = (320, 240);
-        Self {
-            width,
-            height,
-            intrinsics: Intrinsics::from_horizontal_fov(width, height, 70f32.to_radians()),
-            rotation_cw_deg: 270,
-            pose: CameraPose::front(Vec3::new(0.0, 0.07, 0.0)),
-            middle_grey: 0.18,
-        }
+        Self::phone_320x240(70.0, 270, CameraPose::front(Vec3::new(0.0, 0.07, 0.0)))
     }
 
     /// A phone's main rear camera as Android delivers it in portrait: a 320 × 240 landscape
     /// buffer turned 90° clockwise to upright (the rear sensor is mounted the other way round from
     /// the front one), 67° across its long side (a 26 mm-equivalent lens on a 4:3 sensor).
     pub fn phone_rear() -> Self {
+        Self::phone_320x240(67.0, 90, CameraPose::rear(Vec3::new(0.0, 0.06, 0.0)))
+    }
+
+    fn phone_320x240(hfov_deg: f32, rotation_cw_deg: u32, pose: CameraPose) -> Self {
         let (width, height) = (320, 240);
         Self {
             width,
             height,
-            intrinsics: Intrinsics::from_horizontal_fov(width, height, 67f32.to_radians()),
-            rotation_cw_deg: 90,
-            pose: CameraPose::rear(Vec3::new(0.0, 0.06, 0.0)),
+            intrinsics: Intrinsics::from_horizontal_fov(width, height, hfov_deg.to_radians()),
+            rotation_cw_deg,
+            pose,
             middle_grey: 0.18,
         }
     }

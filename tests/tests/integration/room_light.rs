@@ -11,7 +11,10 @@
 //! 80 % seen with the map's level set as the renderer sets it (its mean luminance made the
 //! room's: `RoomLightWorker` scales each map to the light it replaces).
 //!
-//! Needs the external data (`PHANTOGRAM_DATA`); without it the test prints a notice and returns.
+//! The same sweep with a rear camera's frames beside the front one's (where a phone runs both at
+//! once) sees the room sooner and is within the goal turns sooner.
+//!
+//! Needs the external data (`PHANTOGRAM_DATA`); without it the tests print a notice and return.
 //!
 //! And the engine lit by two live rooms (generated here, so without the data too): a camera
 //! sweep into each through `Engine::room_light_frame_oriented` lights the frames drawn after it
@@ -107,15 +110,7 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
         let name = path.file_name().unwrap_or_default().to_string_lossy().into_owned();
         let env = Environment::load(path).expect("environment");
         let want = IrradianceSh::from_environment(&env);
-        // A sun brighter than the short exposure can hold (peak over mean luminance beyond
-        // 0.9 / (middle grey × the bracket's floor)) is clipped in every frame, as on a phone.
-        let luminance = |c: &[f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
-        let mean = env.texels.iter().map(luminance).sum::<f32>() / env.texels.len() as f32;
-        let peak = env.texels.iter().flat_map(|c| c.iter().copied()).fold(0.0f32, f32::max);
-        let Metering::Highlights { min_ratio } = BRACKET else {
-            unreachable!()
-        };
-        let beyond_reach = peak / mean > 0.9 / (camera.middle_grey * min_ratio);
+        let beyond_reach = beyond_the_brackets_reach(&env, &camera);
         let mut line = Vec::new();
         for bracketed in [true, false] {
             let mut capture = RoomCapture::new(CaptureParams::default());
@@ -196,7 +191,7 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
             }
         }
         let reach = if beyond_reach {
-            format!(" [peak {:.0}× the mean: beyond the bracket]", peak / mean)
+            " [beyond the bracket's reach]".to_string()
         } else {
             String::new()
         };
@@ -234,6 +229,34 @@ fn a_camera_sweep_reconstructs_each_rooms_diffuse_light() {
     );
 }
 
+/// Whether `env` has a sun brighter than `camera`'s short exposure can hold (peak over mean
+/// luminance beyond 0.9 / (middle grey × the bracket's floor)): clipped in every frame, as on a
+/// phone.
+fn beyond_the_brackets_reach(env: &Environment, camera: &SyntheticCamera) -> bool {
+    // The plain mean over texels, as this was first judged (not weighted by solid angle).
+    let luminance = |c: &[f32; 3]| 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    let mean = env.texels.iter().map(luminance).sum::<f32>() / env.texels.len() as f32;
+    let peak = env.texels.iter().flat_map(|c| c.iter().copied()).fold(0.0f32, f32::max);
+    let Metering::Highlights { min_ratio } = BRACKET else {
+        unreachable!()
+    };
+    peak / mean > 0.9 / (camera.middle_grey * min_ratio)
+}
+
+/// The `k`th frame of a bracketed sweep (every other frame the short one, exposures reported)
+/// that `camera` takes of `env` with the device at `pose`, added to `capture`.
+fn add_bracketed(capture: &mut RoomCapture, camera: &SyntheticCamera, env: &Environment, pose: Quat, k: usize) {
+    let metering = if k % 2 == 1 { BRACKET } else { Metering::Average };
+    let (frame, exposure) = camera.capture(env, pose, metering, k as i64 * 33_000_000);
+    capture
+        .add(&CaptureFrame {
+            image: frame.as_frame(),
+            world_from_camera: camera.world_from_camera(pose),
+            exposure: Some(exposure),
+        })
+        .expect("frame");
+}
+
 /// What a sweep with `cameras` (each camera's frame taken at every pose) made of a room: after
 /// each turn of the sweep (24 poses at one tilt), the share seen and the irradiance error.
 fn sweep_with(
@@ -246,16 +269,7 @@ fn sweep_with(
     let mut turns = Vec::new();
     for (k, pose) in sweep().into_iter().enumerate() {
         for camera in cameras {
-            // Bracketed, exposures reported, as in the sweep above.
-            let metering = if k % 2 == 1 { BRACKET } else { Metering::Average };
-            let (frame, exposure) = camera.capture(env, pose, metering, k as i64 * 33_000_000);
-            capture
-                .add(&CaptureFrame {
-                    image: frame.as_frame(),
-                    world_from_camera: camera.world_from_camera(pose),
-                    exposure: Some(exposure),
-                })
-                .expect("frame");
+            add_bracketed(&mut capture, camera, env, pose, k);
         }
         if (k + 1) % 24 == 0 {
             let got = IrradianceSh::from_environment(&capture.environment());
@@ -268,7 +282,8 @@ fn sweep_with(
 /// Issue 20: "the rear camera where the platform allows both at once". The same sweep as above
 /// (held nearly flat first, then raised through upright, the floor last), with the rear camera's
 /// frames beside the front one's: after every turn at least as much of the room is seen, and the
-/// light is within the goal's 5 % turns sooner and stays there. (Not turn by turn nearer the
+/// light is within the goal's 5 % (or just over the capture's own floor in that room, where that
+/// is higher) turns sooner and stays there. (Not turn by turn nearer the
 /// truth: early on, with the ceiling and floor seen and the walls not, two rooms are a few
 /// points further off than with the ceiling alone. At 80 % seen the two are not alike either:
 /// with both cameras the unseen fifth then is the band round the horizon, where a room's windows
@@ -305,18 +320,28 @@ fn the_rear_camera_beside_the_front_one_sees_the_room_sooner() {
                 ));
             }
         }
-        // The first turn from which the light stays within 5 %.
+        // The first turn from which the light stays within the goal's 5 %, or within a tenth
+        // over what the capture reaches in that room once the front camera alone has seen it
+        // all, if that is more: at some starts the esplanade's sun, clipped in the frames that
+        // catch it near their edge, leaves it 5.0 % off with the whole sphere seen, whichever
+        // cameras saw it.
+        let floor = alone.last().map_or(0.0, |(_, error)| *error);
+        let bound = 0.05f32.max(1.1 * floor);
         let within = |turns: &[(f32, f32)]| {
             turns
                 .iter()
-                .rposition(|(_, error)| *error > 0.05)
+                .rposition(|(_, error)| *error > bound)
                 .map_or(1, |last_over| last_over + 2)
         };
         let (turn_alone, turn_both) = (within(&alone), within(&both));
-        println!("{name}: within 5 % from turn {turn_both} with both, {turn_alone} with the front camera alone");
+        println!(
+            "{name}: within {:.1} % from turn {turn_both} with both, {turn_alone} with the front camera alone",
+            bound * 100.0
+        );
         if turn_both >= turn_alone {
             failures.push(format!(
-                "{name}: within 5 % from turn {turn_both} with both, {turn_alone} alone"
+                "{name}: within {:.1} % from turn {turn_both} with both, {turn_alone} alone",
+                bound * 100.0
             ));
         }
     }
@@ -520,15 +545,7 @@ fn a_tiny_bright_lamp_anywhere_is_captured() {
         let want = IrradianceSh::from_environment(&room);
         let mut capture = RoomCapture::new(CaptureParams::default());
         for (k, pose) in sweep().into_iter().enumerate() {
-            let metering = if k % 2 == 1 { BRACKET } else { Metering::Average };
-            let (frame, exposure) = camera.capture(&room, pose, metering, k as i64 * 33_000_000);
-            capture
-                .add(&CaptureFrame {
-                    image: frame.as_frame(),
-                    world_from_camera: camera.world_from_camera(pose),
-                    exposure: Some(exposure),
-                })
-                .expect("frame");
+            add_bracketed(&mut capture, &camera, &room, pose, k);
         }
         let got = IrradianceSh::from_environment(&capture.environment());
         let err = relative_rms(&got, &want, 1.0, &normals);
