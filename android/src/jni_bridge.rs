@@ -341,7 +341,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
 ) -> jboolean {
     run(&mut env, |env| {
         let engine = engine(handle)?;
-        let facing = camera_facing(camera)?;
+        let facing = phantogram::engine::camera_facing(camera.into())?;
         let (width, height) = size(width, height)?;
         let stride = |what: &str, value: jint| {
             usize::try_from(value).map_err(|_| {
@@ -404,19 +404,6 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraFrame<'local
     })
 }
 
-/// The camera of a bridge code (0 front, 1 rear), or `IllegalArgumentException`.
-fn camera_facing(code: jint) -> Result<phantogram::camera::CameraFacing, Thrown> {
-    u32::try_from(code)
-        .ok()
-        .and_then(phantogram::camera::CameraFacing::from_code)
-        .ok_or_else(|| {
-            fail(
-                Kind::IllegalArgument,
-                format!("camera must be 0 (front) or 1 (rear), got {code}"),
-            )
-        })
-}
-
 /// The bytes of a direct buffer, borrowed for the call.
 ///
 /// # Safety
@@ -469,7 +456,7 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCameraExposure<'lo
 ) -> jboolean {
     run(&mut env, |_| {
         let engine = engine(handle)?;
-        let facing = camera_facing(camera)?;
+        let facing = phantogram::engine::camera_facing(camera.into())?;
         Ok(
             match phantogram::camera::Exposure::new(exposure_time_ns as f32 * 1e-9, iso as f32) {
                 Some(exposure) => {

@@ -514,12 +514,7 @@ pub unsafe extern "C" fn pg_camera_frame(
     guard(|| {
         // SAFETY: forwarded caller promise.
         let engine = unsafe { engine_ref(engine) }?;
-        let facing = CameraFacing::from_code(camera).ok_or_else(|| {
-            Failure::new(
-                PgStatus::InvalidArgument,
-                format!("camera must be 0 (front) or 1 (rear), got {camera}"),
-            )
-        })?;
+        let facing = phantogram::engine::camera_facing(camera.into())?;
         if luma.is_null() {
             return Err(Failure::new(PgStatus::NullPointer, "`luma` is null"));
         }

@@ -434,6 +434,15 @@ impl std::fmt::Debug for Engine {
     }
 }
 
+/// The camera of a bridge's code (0 front, 1 rear: [`crate::camera::CameraFacing::from_code`]),
+/// or the one error both bridges report for any other.
+pub fn camera_facing(code: i64) -> Result<crate::camera::CameraFacing, EngineError> {
+    u32::try_from(code)
+        .ok()
+        .and_then(crate::camera::CameraFacing::from_code)
+        .ok_or_else(|| EngineError::InvalidArgument(format!("camera must be 0 (front) or 1 (rear), got {code}")))
+}
+
 fn check_size(width: u32, height: u32) -> Result<(), EngineError> {
     if width > MAX_SIDE_PX || height > MAX_SIDE_PX {
         return Err(EngineError::InvalidArgument(format!(
