@@ -511,6 +511,22 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                     );
                 put(&format!("{name}.glb"), &glb(json.as_bytes(), &bin))?;
             }
+            // A laser scan: 50 points as LAZ (`core/assets/tests/data/las`), and its header marked
+            // uncompressed over 50 point records of zeros, as plain LAS.
+            let laz = std::fs::read(workspace_root().join("core/assets/tests/data/las/sphere-50.laz"))
+                .context("reading the test cloud sphere-50.laz")?;
+            put("sphere-50.laz", &laz)?;
+            let mut las = laz.clone();
+            if let Some(format) = las.get_mut(104) {
+                *format &= 0x3f; // the compression bits cleared
+            }
+            let offset = las
+                .get(96..100)
+                .and_then(|b| b.try_into().ok())
+                .map_or(0, |b: [u8; 4]| u32::from_le_bytes(b) as usize);
+            las.truncate(offset);
+            las.resize(offset + 50 * 26, 0);
+            put("zeros-50.las", &las)?;
             // A tetrahedron as binary STL (its header begins "solid", as many do), as ASCII STL,
             // and as binary PLY with a colour per vertex.
             let corners = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];

@@ -396,7 +396,8 @@ pub struct Engine {
 /// calls (for a file: [`Engine::import_artifact`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShellRequest {
-    /// Show the system's document picker for a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj`, `.xyz`, `.pts` or `.zip`.
+    /// Show the system's document picker for a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj`, `.xyz`, `.pts`,
+    /// `.las`, `.laz` or `.zip`.
     OpenFile,
     /// Show the system's camera permission request (the user has read why, on the core's
     /// camera page, and wants it): see [`Engine::camera_permission_needed`].

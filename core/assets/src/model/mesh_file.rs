@@ -1,5 +1,6 @@
 //! Scans published as meshes rather than glTF: STL (`stl`) and PLY (`ply`), and point clouds as
-//! text (`.xyz`, `.pts`: `xyz`, metres with +Z up), loaded into a [`Model`] of one primitive;
+//! text (`.xyz`, `.pts`: `xyz`, metres with +Z up) or in LAS/LAZ (`las`, the same frame), loaded
+//! into a [`Model`] of one primitive;
 //! OBJ with its materials is `obj`'s, reached through the same [`MeshFormat`].
 //!
 //! **Conventions** (neither format states them): STL is read as millimetres with +Z up, as 3D
@@ -23,7 +24,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file};
-use super::{Material, Mesh, Model, Primitive, Vertex, ply, point_cloud, stl, xyz};
+use super::{Material, Mesh, Model, Primitive, Vertex, las, ply, point_cloud, stl, xyz};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
 
@@ -58,6 +59,8 @@ pub enum MeshFormat {
     Obj,
     /// A point cloud as text, a point a line: `.xyz` or Leica's `.pts` (the `xyz` module).
     Xyz,
+    /// A point cloud in ASPRS LAS or its compressed form LAZ (the `las` module).
+    Las,
 }
 
 impl MeshFormat {
@@ -69,6 +72,7 @@ impl MeshFormat {
             "ply" => Some(MeshFormat::Ply),
             "obj" => Some(MeshFormat::Obj),
             "xyz" | "pts" => Some(MeshFormat::Xyz),
+            "las" | "laz" => Some(MeshFormat::Las),
             _ => None,
         }
     }
@@ -79,6 +83,9 @@ impl MeshFormat {
     pub fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
         if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
             return Some(MeshFormat::Ply);
+        }
+        if las::recognises(bytes) {
+            return Some(MeshFormat::Las);
         }
         if stl::recognises(bytes) {
             return Some(MeshFormat::Stl);
@@ -103,6 +110,7 @@ impl MeshFormat {
             MeshFormat::Ply => "PLY",
             MeshFormat::Obj => "OBJ",
             MeshFormat::Xyz => "point cloud",
+            MeshFormat::Las => "LAS",
         }
     }
 
@@ -112,6 +120,8 @@ impl MeshFormat {
             MeshFormat::Ply => "ply",
             MeshFormat::Obj => "obj",
             MeshFormat::Xyz => "xyz",
+            // LAZ too: the header, not the name, says whether the points are compressed.
+            MeshFormat::Las => "las",
         }
     }
 }
@@ -129,12 +139,28 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     let mut spending = Spending::new(budget);
     let bytes = read_model_file(path, &spending)?;
     progress.step(0.1).map_err(cancelled)?;
+    // The file's bytes are let go as soon as they are parsed (a LAS reader takes them whole).
     let parsed = match format {
-        MeshFormat::Stl => stl::parse(&bytes),
-        MeshFormat::Xyz => xyz::parse(&bytes),
-        _ => ply::parse(&bytes),
+        // Decoding a large LAZ takes seconds: its share of the progress is reported as it goes.
+        MeshFormat::Las => match las::parse(bytes, |share| progress.step(0.1 + 0.4 * share as f32).is_ok()) {
+            Ok(Some(soup)) => Ok(soup),
+            Ok(None) => {
+                return Err(ModelError::Cancelled {
+                    path: path.to_path_buf(),
+                });
+            }
+            Err(message) => Err(message),
+        },
+        _ => {
+            let parsed = match format {
+                MeshFormat::Stl => stl::parse(&bytes),
+                MeshFormat::Xyz => xyz::parse(&bytes),
+                _ => ply::parse(&bytes),
+            };
+            drop(bytes);
+            parsed
+        }
     };
-    drop(bytes);
     let mut soup = parsed.map_err(|message| ModelError::Parse {
         path: path.to_path_buf(),
         format: format.name(),
@@ -187,7 +213,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
             mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(0.001)))
         }
         // Metres, +Z up, as scanners write them.
-        MeshFormat::Xyz => mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        MeshFormat::Xyz | MeshFormat::Las => mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
         _ => {}
     }
     // Checked in the model's frame, as glTF's vertices are after their node transforms.

@@ -798,6 +798,7 @@ mod encoded_image;
 pub mod gpu_blocks;
 mod instancing;
 pub mod join;
+mod las;
 pub mod layer_arrays;
 pub mod layer_textures;
 pub mod layers;

@@ -307,7 +307,8 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         const val BUNDLED = "artifacts"
         /** What the document picker offers: glTF binary and JSON, STL, PLY and OBJ (under the types
          *  apps report them as), point clouds as text (.xyz and .pts: reported as plain text, or
-         *  as the molecule format that shares the .xyz name), zip (Voyager downloads), and
+         *  as the molecule format that shares the .xyz name), laser scans (.las, .laz), zip (Voyager
+         *  downloads), and
          *  octet-stream, as which many providers report a .glb or .stl. The core recognises
          *  each by its bytes. */
         val MODEL_TYPES = arrayOf(
@@ -315,6 +316,7 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
             "model/stl", "model/x.stl-binary", "model/x.stl-ascii", "application/sla", "application/vnd.ms-pki.stl",
             "application/ply", "model/ply", "model/obj",
             "text/plain", "chemical/x-xyz",
+            "application/vnd.las", "application/vnd.laszip",
             "application/zip", "application/octet-stream"
         )
     }

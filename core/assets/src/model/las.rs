@@ -1,0 +1,505 @@
+//! Point clouds in ASPRS LAS (versions 1.0–1.4, every point format) and in LAZ, LASzip's
+//! compressed form of it: what laser scanners and photogrammetry tools export besides PLY and
+//! text. Decoded by the `las` crate (LAZ through its `laz` port of LASzip); this module picks
+//! the points and turns them into a [`Soup`].
+//!
+//! * **Points kept**: a scan may hold hundreds of millions. Every `stride`-th point is kept, the
+//!   stride chosen from the header's count so that at most [`RAW_POINTS_KEPT`] remain (four
+//!   times the discs a cloud may become, so that `point_cloud::kept` still has room to thin them
+//!   evenly in space). Points the file classifies as noise (ASPRS classes 7 and 18) are left out.
+//! * **Frame**: metres (the header's scale and offset applied) with +Z up, turned by the caller
+//!   into glTF's +Y up, and taken about the centre of the kept points' bounds in double precision
+//!   before they become `f32`: a georeferenced scan's coordinates (hundreds of kilometres east)
+//!   keep their millimetres. A file in US feet (named only by its coordinate system's record) is
+//!   read as metres; the artifact is fitted to the diorama, so only its true size is off.
+//! * **Colour**: the RGB of point formats 2, 3, 5, 7, 8 and 10 (sRGB). LAS asks for 16-bit
+//!   values, but many writers store 8-bit ones: when no kept channel exceeds 255 they are taken
+//!   as 8-bit; when every one is zero, the fields were never filled and the cloud has no colour.
+//!   A cloud without colour but with an intensity is shaded by it: a laser's return
+//!   grows with the surface's reflectance, so the intensity over its 99th percentile is taken as
+//!   the linear albedo (intensities have no fixed scale, and a few glints would otherwise darken
+//!   the rest). Shown as raw codes instead, as some scanner software does, an aerial test scan's
+//!   median return drew at a tenth of white: near black once lit. With neither, the caller's plain
+//!   material.
+//!
+//! **Budget**: the caller read the file within the budget; points are decoded in chunks of at
+//! most [`CHUNK_BYTES`], so a header that claims more points than the file holds costs no more
+//! than that (the read fails at the file's end), and at most [`RAW_POINTS_KEPT`] points are
+//! held (32 bytes each: about 19 MB) whatever the file's size. What the decoders would allocate
+//! on a header's word alone is checked first (`check_header`). **Progress**: `keep_going` is told the share
+//! decoded after each chunk and stops the work by returning `false`. **Panics**: none; the LAZ
+//! decoder's own on a damaged chunk table are caught and reported as the file's error.
+
+use std::io::Cursor;
+
+use las::{PointDataBuilder, Reader};
+use phantogram_geometry::srgb::from_linear;
+
+use super::mesh_file::Soup;
+use super::point_cloud::MAX_SURFELS;
+
+/// The most points kept from one file (see the module docs).
+pub const RAW_POINTS_KEPT: u64 = 4 * MAX_SURFELS as u64;
+
+/// The most bytes of decoded records held at once.
+pub const CHUNK_BYTES: usize = 8 << 20;
+
+/// ASPRS classes "low point (noise)" and "high noise" (LAS 1.4, table 17).
+const NOISE_CLASSES: [u8; 2] = [7, 18];
+
+/// Whether `bytes` begin as a LAS or LAZ file does (its signature, "LASF").
+pub fn recognises(bytes: &[u8]) -> bool {
+    bytes.starts_with(b"LASF")
+}
+
+/// The cloud in `bytes` (see the module docs); `Ok(None)` when `keep_going` stopped it.
+pub fn parse(bytes: Vec<u8>, keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
+    parse_keeping(bytes, RAW_POINTS_KEPT, keep_going)
+}
+
+/// [`parse`], keeping at most `most` points.
+fn parse_keeping(bytes: Vec<u8>, most: u64, keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
+    check_header(&bytes)?;
+    // The LAZ decoder indexes its chunk table without checking it against the chunks it meets
+    // (a damaged table panics; found by fuzzing): that is this file's error, not the app's end.
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(bytes, most, keep_going)))
+        .map_err(|_| "the LAS/LAZ decoder failed on damaged data".to_owned())?
+}
+
+/// The points of a file whose header passed [`check_header`], as [`parse_keeping`] returns them.
+fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
+    let mut reader = Reader::new(Cursor::new(bytes)).map_err(|e| e.to_string())?;
+    let header = reader.header();
+    let total = header.number_of_points();
+    let stride = total.div_ceil(most.max(1)).max(1);
+    let record_len = usize::from(header.point_format().len()).max(1);
+    let chunk = (CHUNK_BYTES / record_len).max(1) as u64;
+    let mut data = PointDataBuilder::new().for_header(header).build();
+    let mut positions: Vec<[f64; 3]> = Vec::new();
+    let mut colours: Vec<[u16; 3]> = Vec::new();
+    let mut intensities: Vec<u16> = Vec::new();
+    let mut index = 0u64;
+    loop {
+        let n = reader.fill_points(chunk, &mut data).map_err(|e| e.to_string())?;
+        if n == 0 {
+            break;
+        }
+        let mut rgb = data.rgb();
+        let columns = data
+            .x()
+            .zip(data.y())
+            .zip(data.z())
+            .zip(data.classification())
+            .zip(data.intensity());
+        for ((((x, y), z), class), intensity) in columns {
+            let colour = rgb.as_mut().and_then(Iterator::next);
+            let at = index;
+            index += 1;
+            if !at.is_multiple_of(stride) || NOISE_CLASSES.contains(&class) {
+                continue;
+            }
+            if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+                return Err(format!(
+                    "point {at} lies at ({x}, {y}, {z}): the header's scale or offset is not a number"
+                ));
+            }
+            positions.push([x, y, z]);
+            if let Some((r, g, b)) = colour {
+                colours.push([r, g, b]);
+            }
+            intensities.push(intensity);
+        }
+        if !keep_going(index as f64 / total.max(1) as f64) {
+            return Ok(None);
+        }
+    }
+    if positions.is_empty() {
+        return Err(if index == 0 {
+            "no points".to_owned()
+        } else {
+            "every point is classified as noise".to_owned()
+        });
+    }
+    let (low, high) = positions
+        .iter()
+        .fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
+            (
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            )
+        });
+    let centre: [f64; 3] = std::array::from_fn(|k| (low[k] + high[k]) * 0.5);
+    // A format with colour fields that the writer left at zero (common: an aerial test scan of
+    // format 3 has nothing else) has no colour.
+    let coloured = colours.len() == positions.len() && colours.iter().any(|c| *c != [0; 3]);
+    let colors = if coloured {
+        Some(rgb_colours(&colours))
+    } else {
+        intensity_greys(&intensities)
+    };
+    Ok(Some(Soup {
+        positions: positions
+            .iter()
+            .map(|p| std::array::from_fn(|k| (p[k] - centre[k]) as f32))
+            .collect(),
+        normals: None,
+        colors,
+        indices: Vec::new(),
+    }))
+}
+
+/// Refuses what the `las` and `laz` crates would take on trust from a file (they were written for
+/// files, not for hostile input; each case below was an abort, two of them found by fuzzing): a
+/// point count whose records' end overflows 64 bits (added and multiplied unchecked), an extended
+/// record (LAS 1.4) longer than what follows it in the file, and a LAZ chunk table of more chunks
+/// than the file could hold (both allocated at the length stated before anything is read). Each
+/// LAZ chunk begins with one point stored whole, so a file holds at most its length over the
+/// record length of chunks.
+fn check_header(bytes: &[u8]) -> Result<(), String> {
+    let u16_at = |at: usize| bytes.get(at..at + 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
+    let u32_at = |at: usize| {
+        bytes
+            .get(at..at + 4)
+            .and_then(|b| b.try_into().ok())
+            .map(u32::from_le_bytes)
+    };
+    let u64_at = |at: usize| {
+        bytes
+            .get(at..at + 8)
+            .and_then(|b| b.try_into().ok())
+            .map(u64::from_le_bytes)
+    };
+    let cut = || "the header is cut short".to_owned();
+    let minor = *bytes.get(25).ok_or_else(cut)?;
+    let header_size = u16_at(94).ok_or_else(cut)?;
+    let offset_to_points = u32_at(96).ok_or_else(cut)?;
+    let record_len = u16_at(105).ok_or_else(cut)?;
+    let legacy_count = u32_at(107).ok_or_else(cut)?;
+    // LAS 1.4's header (375 bytes) adds the extended records' place and a 64-bit point count.
+    let extended = minor >= 4 && header_size >= 375;
+    let count = match (legacy_count, extended) {
+        (0, true) => u64_at(247).ok_or_else(cut)?,
+        (n, _) => u64::from(n),
+    };
+    count
+        .checked_mul(u64::from(record_len))
+        .and_then(|b| b.checked_add(u64::from(offset_to_points)))
+        .ok_or_else(|| format!("the header claims {count} points, more than any file holds"))?;
+    let compressed = bytes.get(104).is_some_and(|format| format & 0xC0 != 0);
+    if compressed {
+        // LASzip's chunk table: its offset (8 bytes) opens the point data, or, where the writer
+        // could not go back to set it, closes the file; the table holds a version and a count.
+        let start = u64::from(offset_to_points);
+        let table = usize::try_from(start)
+            .ok()
+            .and_then(u64_at)
+            .filter(|&at| at > start)
+            .or_else(|| u64_at(bytes.len().saturating_sub(8)).filter(|&at| at > start));
+        let chunks = table
+            .and_then(|at| usize::try_from(at).ok())
+            .and_then(|at| at.checked_add(4))
+            .and_then(u32_at);
+        let most = bytes.len() as u64 / u64::from(record_len.max(1));
+        if let Some(chunks) = chunks
+            && u64::from(chunks) > most
+        {
+            return Err(format!(
+                "its compressed points claim {chunks} chunks; a file of {} bytes holds at most {most}",
+                bytes.len()
+            ));
+        }
+    }
+    if extended {
+        let start = u64_at(235).ok_or_else(cut)?;
+        let records = u32_at(243).ok_or_else(cut)?;
+        // The crate reads the first extended record where both are set; its length is 20 bytes in.
+        let length = usize::try_from(start)
+            .ok()
+            .and_then(|start| start.checked_add(20))
+            .and_then(u64_at);
+        if start > 0
+            && records > 0
+            && let Some(length) = length
+        {
+            let room = (bytes.len() as u64).saturating_sub(start.saturating_add(60));
+            if length > room {
+                return Err(format!(
+                    "an extended record at byte {start} claims {length} bytes; the file has {room} after it"
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The points' RGB as sRGB 0–1: 16-bit values, or 8-bit ones where none exceeds 255.
+fn rgb_colours(colours: &[[u16; 3]]) -> Vec<[f32; 4]> {
+    let eight_bit = colours.iter().flatten().all(|&c| c <= 255);
+    let full = if eight_bit { 255.0 } else { 65535.0 };
+    colours
+        .iter()
+        .map(|c| [c[0], c[1], c[2]].map(|v| f32::from(v) / full))
+        .map(|[r, g, b]| [r, g, b, 1.0])
+        .collect()
+}
+
+/// Grey (sRGB) from each point's intensity as linear albedo, the 99th percentile white; `None`
+/// where every intensity is zero (the file has none).
+fn intensity_greys(intensities: &[u16]) -> Option<Vec<[f32; 4]>> {
+    let mut sorted = intensities.to_vec();
+    let at = (sorted.len() - 1).min(sorted.len() * 99 / 100);
+    let (_, &mut white, _) = sorted.select_nth_unstable(at);
+    let white = if white == 0 { *intensities.iter().max()? } else { white };
+    (white > 0).then(|| {
+        intensities
+            .iter()
+            .map(|&i| {
+                let g = from_linear((f32::from(i) / f32::from(white)).min(1.0));
+                [g, g, g, 1.0]
+            })
+            .collect()
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A LAS 1.2 file written byte by byte from the specification (not by the crate that reads
+    /// it): point format 2 (with RGB) or 0, `scale` and `offset` per axis, each point's integer
+    /// coordinates, class, intensity and colour.
+    pub(crate) fn las_bytes(
+        with_rgb: bool,
+        scale: [f64; 3],
+        offset: [f64; 3],
+        points: &[([i32; 3], u8, u16, [u16; 3])],
+    ) -> Vec<u8> {
+        let record_len: u16 = if with_rgb { 26 } else { 20 };
+        let mut b = Vec::new();
+        b.extend_from_slice(b"LASF");
+        b.extend_from_slice(&[0; 4]); // file source id, global encoding
+        b.extend_from_slice(&[0; 16]); // project GUID
+        b.extend_from_slice(&[1, 2]); // version 1.2
+        b.extend_from_slice(&[0; 64]); // system identifier, generating software
+        b.extend_from_slice(&[1, 0, 0xEA, 0x07]); // day 1 of 2026
+        b.extend_from_slice(&227u16.to_le_bytes()); // header size
+        b.extend_from_slice(&227u32.to_le_bytes()); // offset to point data
+        b.extend_from_slice(&0u32.to_le_bytes()); // variable-length records
+        b.push(if with_rgb { 2 } else { 0 });
+        b.extend_from_slice(&record_len.to_le_bytes());
+        b.extend_from_slice(&(points.len() as u32).to_le_bytes());
+        b.extend_from_slice(&(points.len() as u32).to_le_bytes()); // first returns
+        b.extend_from_slice(&[0; 16]); // other returns
+        for s in scale {
+            b.extend_from_slice(&s.to_le_bytes());
+        }
+        for o in offset {
+            b.extend_from_slice(&o.to_le_bytes());
+        }
+        for k in 0..3 {
+            let world = |p: &([i32; 3], u8, u16, [u16; 3])| f64::from(p.0[k]) * scale[k] + offset[k];
+            let max = points.iter().map(world).fold(f64::NEG_INFINITY, f64::max);
+            let min = points.iter().map(world).fold(f64::INFINITY, f64::min);
+            b.extend_from_slice(&max.to_le_bytes());
+            b.extend_from_slice(&min.to_le_bytes());
+        }
+        assert_eq!(b.len(), 227);
+        for (xyz, class, intensity, rgb) in points {
+            for v in xyz {
+                b.extend_from_slice(&v.to_le_bytes());
+            }
+            b.extend_from_slice(&intensity.to_le_bytes());
+            b.push(0b0000_1001); // return 1 of 1
+            b.push(*class);
+            b.extend_from_slice(&[0, 0, 0, 0]); // scan angle, user data, point source id
+            if with_rgb {
+                for c in rgb {
+                    b.extend_from_slice(&c.to_le_bytes());
+                }
+            }
+        }
+        b
+    }
+
+    fn all(bytes: Vec<u8>) -> Result<Soup, String> {
+        parse(bytes, |_| true).map(|s| s.expect("not stopped"))
+    }
+
+    #[test]
+    fn georeferenced_millimetres_survive_and_colours_are_read() {
+        // 500 km east, 4000 km north, millimetre steps: f32 alone would round to 0.25 / 0.5 m.
+        let points = [
+            ([0, 0, 0], 1, 100, [65535, 0, 0]),
+            ([1, 2, 3], 2, 200, [0, 32768, 0]),
+            ([1000, 1000, 1000], 2, 300, [0, 0, 65535]),
+        ];
+        let soup = all(las_bytes(true, [0.001; 3], [500_000.0, 4_000_000.0, 100.0], &points)).unwrap();
+        assert_eq!(soup.positions.len(), 3);
+        let d = |a: usize, b: usize, k: usize| soup.positions[b][k] - soup.positions[a][k];
+        for (k, want) in [0.001f32, 0.002, 0.003].into_iter().enumerate() {
+            assert!((d(0, 1, k) - want).abs() < 1e-6, "axis {k}: {}", d(0, 1, k));
+        }
+        // About the bounds' centre.
+        assert!((soup.positions[0][0] + 0.5).abs() < 1e-6 && (soup.positions[2][2] - 0.5).abs() < 1e-6);
+        let colors = soup.colors.expect("format 2 has RGB");
+        assert_eq!(colors[0], [1.0, 0.0, 0.0, 1.0]);
+        assert!((colors[1][1] - 0.5).abs() < 1e-4);
+        assert!(soup.indices.is_empty() && soup.normals.is_none());
+    }
+
+    #[test]
+    fn eight_bit_colours_in_sixteen_bit_fields_are_taken_as_eight_bit() {
+        let points = [([0, 0, 0], 1, 0, [255, 128, 0]), ([1, 0, 0], 1, 0, [0, 0, 255])];
+        let colors = all(las_bytes(true, [0.01; 3], [0.0; 3], &points))
+            .unwrap()
+            .colors
+            .unwrap();
+        assert_eq!(colors[0][0], 1.0);
+        assert!((colors[0][1] - 128.0 / 255.0).abs() < 1e-6);
+        assert_eq!(colors[1][2], 1.0);
+    }
+
+    #[test]
+    fn without_colour_the_intensity_shades_the_points_and_noise_is_left_out() {
+        // 200 points of intensity 1000 and one glint of 60000: the glint does not set white.
+        let mut points: Vec<([i32; 3], u8, u16, [u16; 3])> =
+            (0..200).map(|i| ([i, i % 7, 0], 2, 1000, [0; 3])).collect();
+        points.push(([5, 5, 5], 1, 60000, [0; 3]));
+        points.push(([6, 6, 6], 1, 250, [0; 3])); // a quarter of white, as linear albedo
+        points.push(([9000, 9000, 9000], 7, 500, [0; 3])); // low noise, far away
+        points.push(([-9000, 0, 0], 18, 500, [0; 3])); // high noise
+        let soup = all(las_bytes(false, [0.01; 3], [0.0; 3], &points)).unwrap();
+        assert_eq!(soup.positions.len(), 202, "the two noise points are left out");
+        let colors = soup.colors.expect("greys from the intensity");
+        assert!(
+            (colors[0][0] - 1.0).abs() < 1e-6,
+            "the 99th percentile is white: {:?}",
+            colors[0]
+        );
+        assert!((colors[200][0] - 1.0).abs() < 1e-6, "brighter than that is clipped");
+        let quarter = colors[201][0];
+        assert!((quarter - 0.537).abs() < 0.002, "linear 0.25 is sRGB 0.537: {quarter}");
+        // Colour fields left at zero are no colour: the intensity shades the points.
+        let unfilled = all(las_bytes(true, [0.01; 3], [0.0; 3], &points)).unwrap();
+        assert_eq!(unfilled.colors.as_ref(), Some(&colors));
+        // Without intensities either: no colours at all.
+        let dark: Vec<_> = points.iter().map(|&(p, c, _, rgb)| (p, c, 0, rgb)).collect();
+        assert!(
+            all(las_bytes(false, [0.01; 3], [0.0; 3], &dark))
+                .unwrap()
+                .colors
+                .is_none()
+        );
+    }
+
+    #[test]
+    fn a_large_cloud_is_strided_to_the_points_kept() {
+        let points: Vec<_> = (0..1000).map(|i| ([i, 0, i % 3], 1, 10, [0; 3])).collect();
+        let bytes = las_bytes(false, [0.01; 3], [0.0; 3], &points);
+        // At most 100 of 1000: every tenth, from the first.
+        let strided = parse_keeping(bytes.clone(), 100, |_| true).unwrap().unwrap();
+        assert_eq!(strided.positions.len(), 100);
+        let x0 = strided.positions[0][0];
+        assert!(
+            (strided.positions[1][0] - x0 - 0.1).abs() < 1e-5,
+            "{:?}",
+            &strided.positions[..2]
+        );
+        // Within RAW_POINTS_KEPT the file is read whole, and the work can be stopped.
+        assert_eq!(all(bytes.clone()).unwrap().positions.len(), 1000);
+        assert!(parse(bytes, |_| false).unwrap().is_none());
+    }
+
+    #[test]
+    fn damaged_files_are_errors() {
+        let points: Vec<_> = (0..10).map(|i| ([i, 0, 0], 1, 10, [0; 3])).collect();
+        let good = las_bytes(true, [0.01; 3], [0.0; 3], &points);
+        // Cut inside the points, the header's count is more than the file holds.
+        assert!(all(good[..good.len() - 13].to_vec()).is_err());
+        // Cut inside the header.
+        assert!(all(good[..100].to_vec()).is_err());
+        // No points, and only noise.
+        assert_eq!(all(las_bytes(true, [0.01; 3], [0.0; 3], &[])).unwrap_err(), "no points");
+        let noise: Vec<_> = (0..10).map(|i| ([i, 0, 0], 7, 10, [0; 3])).collect();
+        assert!(
+            all(las_bytes(true, [0.01; 3], [0.0; 3], &noise))
+                .unwrap_err()
+                .contains("noise")
+        );
+        // A scale that is not a number.
+        let nan = las_bytes(true, [f64::NAN, 0.01, 0.01], [0.0; 3], &points);
+        assert!(all(nan).is_err());
+    }
+
+    /// `bytes` (a LAS 1.2 file of [`las_bytes`]) as LAS 1.4: its header grown to 375 bytes, with
+    /// `count` as the 64-bit point count (the legacy one zero) and, where given, an extended
+    /// record after the points that states `evlr_length` bytes.
+    fn as_las_1_4(bytes: &[u8], count: u64, evlr_length: Option<u64>) -> Vec<u8> {
+        let mut b = bytes[..227].to_vec();
+        b[25] = 4;
+        b[94..96].copy_from_slice(&375u16.to_le_bytes());
+        b[96..100].copy_from_slice(&375u32.to_le_bytes());
+        b[107..111].copy_from_slice(&0u32.to_le_bytes());
+        b[111..131].copy_from_slice(&[0; 20]);
+        let points = &bytes[227..];
+        let evlr_at = 375 + points.len() as u64;
+        b.extend_from_slice(&0u64.to_le_bytes()); // waveform data
+        b.extend_from_slice(&evlr_length.map_or(0, |_| evlr_at).to_le_bytes());
+        b.extend_from_slice(&u32::from(evlr_length.is_some()).to_le_bytes());
+        b.extend_from_slice(&count.to_le_bytes());
+        b.extend_from_slice(&[0; 120]); // points by return
+        assert_eq!(b.len(), 375);
+        b.extend_from_slice(points);
+        if let Some(length) = evlr_length {
+            b.extend_from_slice(&[0; 20]); // reserved, user id, record id
+            b.extend_from_slice(&length.to_le_bytes());
+            b.extend_from_slice(&[0; 32]); // description
+            b.extend_from_slice(&[7; 16]); // 16 bytes of data
+        }
+        b
+    }
+
+    #[test]
+    fn hostile_headers_are_errors_not_aborts() {
+        let points: Vec<_> = (0..10).map(|i| ([i, 0, 0], 1, 10, [0; 3])).collect();
+        let v12 = las_bytes(true, [0.01; 3], [0.0; 3], &points);
+        // The same file as LAS 1.4 reads alike, with or without an honest extended record.
+        assert_eq!(all(as_las_1_4(&v12, 10, None)).unwrap().positions.len(), 10);
+        assert_eq!(all(as_las_1_4(&v12, 10, Some(16))).unwrap().positions.len(), 10);
+        // An extended record stating far more than the file holds: the crate would allocate it.
+        let err = all(as_las_1_4(&v12, 10, Some(1 << 60))).unwrap_err();
+        assert!(err.contains("extended record"), "{err}");
+        // A point count whose records' end overflows 64 bits.
+        let err = all(as_las_1_4(&v12, u64::MAX / 8, None)).unwrap_err();
+        assert!(err.contains("more than any file holds"), "{err}");
+    }
+
+    #[test]
+    fn a_laz_chunk_table_claiming_more_chunks_than_the_file_holds_is_an_error() {
+        let laz = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/las/sphere-50.laz")).unwrap();
+        assert_eq!(all(laz.clone()).unwrap().positions.len(), 50);
+        let points_at = u32::from_le_bytes(laz[96..100].try_into().unwrap()) as usize;
+        let table = i64::from_le_bytes(laz[points_at..points_at + 8].try_into().unwrap()) as usize;
+        let mut forged = laz.clone();
+        forged[table + 4..table + 8].copy_from_slice(&0x7fff_ffffu32.to_le_bytes());
+        let err = all(forged).unwrap_err();
+        assert!(err.contains("chunks"), "{err}");
+    }
+
+    #[test]
+    fn a_damaged_chunk_table_that_panicked_the_decoder_is_an_error() {
+        let found = std::fs::read(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/las/damaged-chunk-table.laz"
+        ))
+        .unwrap();
+        let err = all(found).unwrap_err();
+        assert!(err.contains("damaged"), "{err}");
+    }
+
+    #[test]
+    fn a_las_file_is_recognised_by_its_signature() {
+        assert!(recognises(&las_bytes(true, [0.01; 3], [0.0; 3], &[])));
+        assert!(!recognises(b"ply\nformat ascii 1.0\n"));
+    }
+}
