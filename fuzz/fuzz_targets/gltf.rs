@@ -1,7 +1,7 @@
 //! The model loader on any bytes, as a `.glb`, a `.gltf`, a `scene.svx.json`, a `.ply`, an
-//! `.stl`, an `.obj`, a point cloud as text, `.xyz`, or a LAS/LAZ scan (by the first bytes),
-//! beside a small valid buffer and PNG that URIs and material libraries may name. Within the
-//! phone budget: an input may fail, never panic, hang or take more than the budget.
+//! `.stl`, an `.obj`, a point cloud as text, `.xyz`, or a LAS/LAZ or E57 scan (by the first
+//! bytes), beside a small valid buffer and PNG that URIs and material libraries may name. Within
+//! the phone budget: an input may fail, never panic, hang or take more than the budget.
 #![no_main]
 
 #[path = "scratch.rs"]
@@ -34,8 +34,44 @@ fn tolerate_caught_decoder_panics() {
     });
 }
 
+/// An E57 file is 1024-byte pages, each ending in the CRC-32C of its other 1020 bytes (stored
+/// big-endian), and the reader refuses a page whose sum does not match: nearly every mutation
+/// would stop there. Inputs that begin as E57 are padded to whole pages and their sums set, so
+/// that mutations reach the XML and the point data behind them.
+fn with_e57_checksums(data: &[u8]) -> Option<Vec<u8>> {
+    const PAGE: usize = 1024;
+    if !data.starts_with(b"ASTM-E57") {
+        return None;
+    }
+    let mut pages = data.to_vec();
+    pages.resize(data.len().div_ceil(PAGE) * PAGE, 0);
+    for page in pages.chunks_exact_mut(PAGE) {
+        let (payload, sum) = page.split_at_mut(PAGE - 4);
+        sum.copy_from_slice(&crc32c(payload).to_be_bytes());
+    }
+    Some(pages)
+}
+
+/// CRC-32C (Castagnoli, reflected polynomial 0x82F63B78), bit by bit: inputs are small.
+fn crc32c(bytes: &[u8]) -> u32 {
+    let mut crc = !0u32;
+    for &b in bytes {
+        crc ^= u32::from(b);
+        for _ in 0..8 {
+            crc = if crc & 1 != 0 {
+                (crc >> 1) ^ 0x82F6_3B78
+            } else {
+                crc >> 1
+            };
+        }
+    }
+    !crc
+}
+
 fuzz_target!(|data: &[u8]| {
     tolerate_caught_decoder_panics();
+    let paged = with_e57_checksums(data);
+    let data = paged.as_deref().unwrap_or(data);
     heap_limit::input_begins();
     let dir = scratch::dir("gltf");
     if !dir.join("tri.bin").exists() {
@@ -56,6 +92,7 @@ fuzz_target!(|data: &[u8]| {
         Some(b's') => "model.stl",
         Some(b'0'..=b'9' | b'-' | b'+' | b'.') => "model.xyz",
         Some(b'L') => "model.las",
+        Some(b'A') => "model.e57",
         _ => "model.glb",
     };
     let path = scratch::write(dir, name, data);

@@ -527,6 +527,10 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             las.truncate(offset);
             las.resize(offset + 50 * 26, 0);
             put("zeros-50.las", &las)?;
+            // And as E57: two scans, each placed by its pose (`core/assets/tests/data/e57`).
+            let e57 = std::fs::read(workspace_root().join("core/assets/tests/data/e57/sphere-50.e57"))
+                .context("reading the test scan sphere-50.e57")?;
+            put("sphere-50.e57", &e57)?;
             // A tetrahedron as binary STL (its header begins "solid", as many do), as ASCII STL,
             // and as binary PLY with a colour per vertex.
             let corners = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];

@@ -417,3 +417,164 @@ fn a_las_or_laz_scan_is_drawn_as_discs_the_right_way_up() {
     let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
     assert!((top[0] - 0.578).abs() < 0.01 && bottom[0] < 0.1, "{top:?} {bottom:?}");
 }
+
+/// The sphere of [`las_sphere`] as an E57 file of two scans written by the `e57` crate's writer:
+/// the top half (+z) and the bottom half, each in its own scanner's frame with its pose (a
+/// translation) placing it, intensity 0.5, colour as the LAS sphere's.
+fn e57_sphere(points: &[Vec3]) -> Vec<u8> {
+    use e57::{Quaternion, Record, RecordDataType, RecordName, RecordValue, Transform, Translation};
+    let (east, north) = (512_345.678, 5_412_345.678);
+    let mut cursor = std::io::Cursor::new(Vec::new());
+    {
+        let mut writer = e57::E57Writer::new(&mut cursor, "sphere").expect("writer");
+        for (k, top) in [true, false].into_iter().enumerate() {
+            // Each scanner stands 3 m from the sphere's centre, to its side.
+            let scanner = [east + if top { 3.0 } else { -3.0 }, north, 200.0];
+            let double = || RecordDataType::Double { min: None, max: None };
+            let byte = || RecordDataType::Integer { min: 0, max: 255 };
+            let prototype = vec![
+                Record {
+                    name: RecordName::CartesianX,
+                    data_type: double(),
+                },
+                Record {
+                    name: RecordName::CartesianY,
+                    data_type: double(),
+                },
+                Record {
+                    name: RecordName::CartesianZ,
+                    data_type: double(),
+                },
+                Record {
+                    name: RecordName::ColorRed,
+                    data_type: byte(),
+                },
+                Record {
+                    name: RecordName::ColorGreen,
+                    data_type: byte(),
+                },
+                Record {
+                    name: RecordName::ColorBlue,
+                    data_type: byte(),
+                },
+            ];
+            let mut scan = writer.add_pointcloud(&format!("scan-{k}"), prototype).expect("scan");
+            scan.set_transform(Some(Transform {
+                rotation: Quaternion {
+                    w: 1.0,
+                    x: 0.0,
+                    y: 0.0,
+                    z: 0.0,
+                },
+                translation: Translation {
+                    x: scanner[0],
+                    y: scanner[1],
+                    z: scanner[2],
+                },
+            }));
+            for p in points.iter().filter(|p| (p.z > 0.0) == top) {
+                let world = [
+                    east + 0.1 * f64::from(p.x),
+                    north + 0.1 * f64::from(p.y),
+                    200.0 + 0.1 * f64::from(p.z),
+                ];
+                let red = if top { 200 } else { 40 };
+                let mut values: Vec<RecordValue> = (0..3).map(|i| RecordValue::Double(world[i] - scanner[i])).collect();
+                values.extend([red, 90, 60].map(RecordValue::Integer));
+                scan.add_point(values).expect("point");
+            }
+            scan.finalize().expect("scan written");
+        }
+        writer.finalize().expect("file written");
+    }
+    cursor.into_inner()
+}
+
+/// A terrestrial scanner's E57 of two registered scans (each in its own frame, placed by its
+/// pose): drawn as one sphere of discs in glTF's frame about its centre, coloured by the file,
+/// whatever its name; a damaged one is a named error.
+#[test]
+fn an_e57_scan_is_drawn_as_discs_the_right_way_up() {
+    let points = phantogram_geometry::sphere::fibonacci(2000);
+    let file = e57_sphere(&points);
+    let model = load("e57-cloud", "scan.e57", &file).expect("loads");
+    let mesh = &model.primitives[0].mesh;
+    assert_eq!(mesh.vertices.len(), points.len() * 6, "a hexagon per point");
+    let bounds = mesh.bounds().expect("bounds");
+    for k in 0..3 {
+        assert!(
+            (bounds.max[k] - 0.1).abs() < 0.01 && (bounds.min[k] + 0.1).abs() < 0.01,
+            "the two scans meet about the centre: {bounds:?}"
+        );
+    }
+    let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
+    assert!((top[0] - 0.578).abs() < 0.01, "sRGB 200 on top: {top:?}");
+    assert!(bottom[0] < 0.1, "{bottom:?}");
+    let dir = Scratch::new("mesh-files-e57-library");
+    let lib = Library::new(Some(dir.to_path_buf()), None);
+    let imported = lib
+        .import("document.bin", &file, ResourceBudget::PHONE, &Progress::new())
+        .expect("imported");
+    assert_eq!(imported.model.triangle_count(), points.len() * 4);
+    let err = load("e57-cloud-bad", "cut.e57", &file[..file.len() / 2])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("not a valid E57 file"), "{err}");
+    // An E57 written once by an earlier version of the writer (`tests/data/e57/README.md`).
+    let kept = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/e57/sphere-50.e57")).expect("read");
+    let model = load("e57-cloud-kept", "sphere-50.e57", &kept).expect("loads");
+    let mesh = &model.primitives[0].mesh;
+    assert_eq!(mesh.vertices.len(), 50 * 6);
+    let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
+    assert!((top[0] - 0.578).abs() < 0.01 && bottom[0] < 0.1, "{top:?} {bottom:?}");
+}
+
+/// Scans of one sphere written by other programs (`tests/data/reference_scans.py`: E57 by
+/// libE57Format, LAS 1.4 format 7 by laspy, LAZ by the reference LASzip): every point lands where
+/// the script put it (to a tenth of a millimetre, in glTF's frame about the sphere's centre), in
+/// the file's colour.
+#[test]
+fn scans_written_by_other_programs_read_alike() {
+    let n = 200;
+    let expected: Vec<Vec3> = (0..n)
+        .map(|i| {
+            let i = f64::from(i) + 0.5;
+            let phi = (1.0 - 2.0 * i / f64::from(n)).acos();
+            let theta = std::f64::consts::PI * (1.0 + 5f64.sqrt()) * i;
+            let (x, y, z) = (theta.cos() * phi.sin(), theta.sin() * phi.sin(), phi.cos());
+            // +Z up in the file, +Y up in glTF.
+            Vec3::new(x as f32, z as f32, -y as f32) * 0.1
+        })
+        .collect();
+    let (lo, hi) = expected
+        .iter()
+        .fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        });
+    let centre = (lo + hi) * 0.5;
+    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data");
+    for file in [
+        "las/reference-sphere-200.las",
+        "las/reference-sphere-200.laz",
+        "e57/reference-sphere-200.e57",
+    ] {
+        let model = phantogram_assets::model::load_model(std::path::Path::new(&format!("{data}/{file}")))
+            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        let mesh = &model.primitives[0].mesh;
+        let discs: Vec<(Vec3, [f32; 4])> = mesh
+            .vertices
+            .chunks(6)
+            .map(|d| (d.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0, d[0].color))
+            .collect();
+        assert_eq!(discs.len(), n as usize, "{file}");
+        for p in &expected {
+            let (at, colour) = discs
+                .iter()
+                .min_by(|a, b| a.0.distance(*p - centre).total_cmp(&b.0.distance(*p - centre)))
+                .expect("discs");
+            assert!(at.distance(*p - centre) < 1e-4, "{file}: {p} read at {at}");
+            let red = if p.y > 0.0 { 0.578 } else { 0.021 };
+            assert!((colour[0] - red).abs() < 0.01, "{file}: {colour:?} at {p}");
+        }
+    }
+}

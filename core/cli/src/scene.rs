@@ -16,7 +16,7 @@ use winit::event_loop::EventLoop;
 pub struct SceneArgs {
     /// A glTF 2.0 model (.gltf or .glb), a Smithsonian Voyager folder or its scene.svx.json
     /// (its best scan present), an .stl, .ply or .obj scan, a point cloud as text (.xyz, .pts), or a laser scan
-    /// (.las, .laz);
+    /// (.las, .laz, .e57);
     /// the default artifact when omitted.
     model: Option<PathBuf>,
     /// One of the built-in artifacts instead: amphora (the default), medal or tablet; or the

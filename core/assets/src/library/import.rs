@@ -1,6 +1,6 @@
 //! Turning bytes the user opened (a file picker's document, an "Open with" intent, a share) into a
 //! folder of the library: a `.glb`, a self-contained `.gltf`, an `.stl`, `.ply` or `.obj` scan,
-//! a point cloud as text (`.xyz`, `.pts`) or a laser scan (`.las`, `.laz`),
+//! a point cloud as text (`.xyz`, `.pts`) or a laser scan (`.las`, `.laz`, `.e57`),
 //! or a zip holding one of those (an OBJ with its materials and textures comes as one) or a
 //! Smithsonian Voyager download (`scene.svx.json` beside its scans).
 //!
@@ -24,7 +24,7 @@ pub enum Format {
     Glb,
     GltfJson,
     Zip,
-    /// STL, PLY, OBJ, a point cloud as text, or LAS/LAZ.
+    /// STL, PLY, OBJ, a point cloud as text, or a LAS/LAZ or E57 scan.
     Mesh(MeshFormat),
 }
 
@@ -123,7 +123,7 @@ fn copy(from: &mut impl Read, to: &mut std::fs::File) -> std::io::Result<u64> {
 }
 
 /// The model an unpacked folder holds: the shallowest Voyager scene's folder, else its only
-/// `.glb`/`.gltf`/`.stl`/`.ply`/`.obj`/`.xyz`/`.pts`/`.las`/`.laz` file, else one of the variants of one glTF
+/// `.glb`/`.gltf`/`.stl`/`.ply`/`.obj`/`.xyz`/`.pts`/`.las`/`.laz`/`.e57` file, else one of the variants of one glTF
 /// model laid out as the Khronos samples are ([`khronos_variant`]).
 pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> {
     let mut scenes = Vec::new();

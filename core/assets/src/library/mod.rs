@@ -53,14 +53,14 @@ pub enum LibraryError {
     #[error("{message}")]
     Invalid { message: String, error: Box<ModelError> },
     #[error(
-        "{name}: not a model this app opens (a .glb, .gltf, .stl, .ply or .obj, a point cloud as .xyz, .pts, .las or .laz, or a .zip holding one)"
+        "{name}: not a model this app opens (a .glb, .gltf, .stl, .ply or .obj, a point cloud as .xyz, .pts, .las, .laz or .e57, or a .zip holding one)"
     )]
     UnknownFormat { name: String },
     #[error("{name}: a damaged or unsupported zip archive: {message}")]
     Archive { name: String, message: String },
     #[error("{name}: larger than the {} MiB an artifact may take on this device", max_bytes >> 20)]
     TooLarge { name: String, max_bytes: u64 },
-    #[error("{name}: holds no model (.glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las or .laz) or Voyager scene")]
+    #[error("{name}: holds no model (.glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las, .laz or .e57) or Voyager scene")]
     NoModel { name: String },
     #[error("{name}: holds several models ({}); open one of them", models.join(", "))]
     SeveralModels { name: String, models: Vec<String> },

@@ -8,38 +8,29 @@
 //!   times the discs a cloud may become, so that `point_cloud::kept` still has room to thin them
 //!   evenly in space). Points the file classifies as noise (ASPRS classes 7 and 18) are left out.
 //! * **Frame**: metres (the header's scale and offset applied) with +Z up, turned by the caller
-//!   into glTF's +Y up, and taken about the centre of the kept points' bounds in double precision
-//!   before they become `f32`: a georeferenced scan's coordinates (hundreds of kilometres east)
-//!   keep their millimetres. A file in US feet (named only by its coordinate system's record) is
-//!   read as metres; the artifact is fitted to the diorama, so only its true size is off.
+//!   into glTF's +Y up, and taken about their centre (`scan_points`). A file in US feet (named
+//!   only by its coordinate system's record) is read as metres; the artifact is fitted to the
+//!   diorama, so only its true size is off.
 //! * **Colour**: the RGB of point formats 2, 3, 5, 7, 8 and 10 (sRGB). LAS asks for 16-bit
 //!   values, but many writers store 8-bit ones: when no kept channel exceeds 255 they are taken
-//!   as 8-bit; when every one is zero, the fields were never filled and the cloud has no colour.
-//!   A cloud without colour but with an intensity is shaded by it: a laser's return
-//!   grows with the surface's reflectance, so the intensity over its 99th percentile is taken as
-//!   the linear albedo (intensities have no fixed scale, and a few glints would otherwise darken
-//!   the rest). Shown as raw codes instead, as some scanner software does, an aerial test scan's
-//!   median return drew at a tenth of white: near black once lit. With neither, the caller's plain
-//!   material.
+//!   as 8-bit. Without colour (or with colour fields left at zero), the intensity shades the
+//!   points (`scan_points`).
 //!
 //! **Budget**: the caller read the file within the budget; points are decoded in chunks of at
 //! most [`CHUNK_BYTES`], so a header that claims more points than the file holds costs no more
 //! than that (the read fails at the file's end), and at most [`RAW_POINTS_KEPT`] points are
 //! held (32 bytes each: about 19 MB) whatever the file's size. What the decoders would allocate
-//! on a header's word alone is checked first (`check_header`). **Progress**: `keep_going` is told the share
-//! decoded after each chunk and stops the work by returning `false`. **Panics**: none; the LAZ
-//! decoder's own on a damaged chunk table are caught and reported as the file's error.
+//! on a header's word alone is checked first (`check_header`). **Progress**: `keep_going` is
+//! told the share decoded after each chunk and stops the work by returning `false`.
+//! **Panics**: none; the LAZ decoder's own on a damaged chunk table are caught and reported as
+//! the file's error.
 
 use std::io::Cursor;
 
 use las::{PointDataBuilder, Reader};
-use phantogram_geometry::srgb::from_linear;
 
 use super::mesh_file::Soup;
-use super::point_cloud::MAX_SURFELS;
-
-/// The most points kept from one file (see the module docs).
-pub const RAW_POINTS_KEPT: u64 = 4 * MAX_SURFELS as u64;
+use super::scan_points::{RAW_POINTS_KEPT, ScanPoints};
 
 /// The most bytes of decoded records held at once.
 pub const CHUNK_BYTES: usize = 8 << 20;
@@ -120,32 +111,15 @@ fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) ->
             "every point is classified as noise".to_owned()
         });
     }
-    let (low, high) = positions
-        .iter()
-        .fold(([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]), |(lo, hi), p| {
-            (
-                std::array::from_fn(|k| lo[k].min(p[k])),
-                std::array::from_fn(|k| hi[k].max(p[k])),
-            )
-        });
-    let centre: [f64; 3] = std::array::from_fn(|k| (low[k] + high[k]) * 0.5);
-    // A format with colour fields that the writer left at zero (common: an aerial test scan of
-    // format 3 has nothing else) has no colour.
-    let coloured = colours.len() == positions.len() && colours.iter().any(|c| *c != [0; 3]);
-    let colors = if coloured {
-        Some(rgb_colours(&colours))
-    } else {
-        intensity_greys(&intensities)
-    };
-    Ok(Some(Soup {
-        positions: positions
-            .iter()
-            .map(|p| std::array::from_fn(|k| (p[k] - centre[k]) as f32))
-            .collect(),
-        normals: None,
-        colors,
-        indices: Vec::new(),
-    }))
+    let coloured = colours.len() == positions.len();
+    Ok(Some(
+        ScanPoints {
+            positions,
+            colours: if coloured { rgb_colours(&colours) } else { Vec::new() },
+            intensities: intensities.into_iter().map(f32::from).collect(),
+        }
+        .into_soup(),
+    ))
 }
 
 /// Refuses what the `las` and `laz` crates would take on trust from a file (they were written for
@@ -233,32 +207,10 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
 }
 
 /// The points' RGB as sRGB 0–1: 16-bit values, or 8-bit ones where none exceeds 255.
-fn rgb_colours(colours: &[[u16; 3]]) -> Vec<[f32; 4]> {
+fn rgb_colours(colours: &[[u16; 3]]) -> Vec<[f32; 3]> {
     let eight_bit = colours.iter().flatten().all(|&c| c <= 255);
     let full = if eight_bit { 255.0 } else { 65535.0 };
-    colours
-        .iter()
-        .map(|c| [c[0], c[1], c[2]].map(|v| f32::from(v) / full))
-        .map(|[r, g, b]| [r, g, b, 1.0])
-        .collect()
-}
-
-/// Grey (sRGB) from each point's intensity as linear albedo, the 99th percentile white; `None`
-/// where every intensity is zero (the file has none).
-fn intensity_greys(intensities: &[u16]) -> Option<Vec<[f32; 4]>> {
-    let mut sorted = intensities.to_vec();
-    let at = (sorted.len() - 1).min(sorted.len() * 99 / 100);
-    let (_, &mut white, _) = sorted.select_nth_unstable(at);
-    let white = if white == 0 { *intensities.iter().max()? } else { white };
-    (white > 0).then(|| {
-        intensities
-            .iter()
-            .map(|&i| {
-                let g = from_linear((f32::from(i) / f32::from(white)).min(1.0));
-                [g, g, g, 1.0]
-            })
-            .collect()
-    })
+    colours.iter().map(|c| c.map(|v| f32::from(v) / full)).collect()
 }
 
 #[cfg(test)]

@@ -1,7 +1,7 @@
 //! Scans published as meshes rather than glTF: STL (`stl`) and PLY (`ply`), and point clouds as
-//! text (`.xyz`, `.pts`: `xyz`, metres with +Z up) or in LAS/LAZ (`las`, the same frame), loaded
-//! into a [`Model`] of one primitive;
-//! OBJ with its materials is `obj`'s, reached through the same [`MeshFormat`].
+//! text (`.xyz`, `.pts`: `xyz`, metres with +Z up) or laser scans in LAS/LAZ (`las`) or E57
+//! (`e57`, the same frame), loaded into a [`Model`] of one primitive; OBJ with its materials is
+//! `obj`'s, reached through the same [`MeshFormat`].
 //!
 //! **Conventions** (neither format states them): STL is read as millimetres with +Z up, as 3D
 //! printing writes it (Scan the World's museum scans, museums' "download for printing"), and
@@ -24,7 +24,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file};
-use super::{Material, Mesh, Model, Primitive, Vertex, las, ply, point_cloud, stl, xyz};
+use super::{Material, Mesh, Model, Primitive, Vertex, e57, las, ply, point_cloud, stl, xyz};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
 
@@ -61,6 +61,8 @@ pub enum MeshFormat {
     Xyz,
     /// A point cloud in ASPRS LAS or its compressed form LAZ (the `las` module).
     Las,
+    /// Laser scans in ASTM E57 (the `e57` module).
+    E57,
 }
 
 impl MeshFormat {
@@ -73,6 +75,7 @@ impl MeshFormat {
             "obj" => Some(MeshFormat::Obj),
             "xyz" | "pts" => Some(MeshFormat::Xyz),
             "las" | "laz" => Some(MeshFormat::Las),
+            "e57" => Some(MeshFormat::E57),
             _ => None,
         }
     }
@@ -86,6 +89,9 @@ impl MeshFormat {
         }
         if las::recognises(bytes) {
             return Some(MeshFormat::Las);
+        }
+        if e57::recognises(bytes) {
+            return Some(MeshFormat::E57);
         }
         if stl::recognises(bytes) {
             return Some(MeshFormat::Stl);
@@ -111,6 +117,7 @@ impl MeshFormat {
             MeshFormat::Obj => "OBJ",
             MeshFormat::Xyz => "point cloud",
             MeshFormat::Las => "LAS",
+            MeshFormat::E57 => "E57",
         }
     }
 
@@ -122,6 +129,7 @@ impl MeshFormat {
             MeshFormat::Xyz => "xyz",
             // LAZ too: the header, not the name, says whether the points are compressed.
             MeshFormat::Las => "las",
+            MeshFormat::E57 => "e57",
         }
     }
 }
@@ -141,16 +149,24 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     progress.step(0.1).map_err(cancelled)?;
     // The file's bytes are let go as soon as they are parsed (a LAS reader takes them whole).
     let parsed = match format {
-        // Decoding a large LAZ takes seconds: its share of the progress is reported as it goes.
-        MeshFormat::Las => match las::parse(bytes, |share| progress.step(0.1 + 0.4 * share as f32).is_ok()) {
-            Ok(Some(soup)) => Ok(soup),
-            Ok(None) => {
-                return Err(ModelError::Cancelled {
-                    path: path.to_path_buf(),
-                });
+        // Decoding a large scan takes seconds: its share of the progress is reported as it goes.
+        MeshFormat::Las | MeshFormat::E57 => {
+            let keep_going = |share: f64| progress.step(0.1 + 0.4 * share as f32).is_ok();
+            let read = if format == MeshFormat::Las {
+                las::parse(bytes, keep_going)
+            } else {
+                e57::parse(bytes, keep_going)
+            };
+            match read {
+                Ok(Some(soup)) => Ok(soup),
+                Ok(None) => {
+                    return Err(ModelError::Cancelled {
+                        path: path.to_path_buf(),
+                    });
+                }
+                Err(message) => Err(message),
             }
-            Err(message) => Err(message),
-        },
+        }
         _ => {
             let parsed = match format {
                 MeshFormat::Stl => stl::parse(&bytes),
@@ -213,7 +229,9 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
             mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2) * Mat4::from_scale(Vec3::splat(0.001)))
         }
         // Metres, +Z up, as scanners write them.
-        MeshFormat::Xyz | MeshFormat::Las => mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2)),
+        MeshFormat::Xyz | MeshFormat::Las | MeshFormat::E57 => {
+            mesh.transform(Mat4::from_rotation_x(-std::f32::consts::FRAC_PI_2))
+        }
         _ => {}
     }
     // Checked in the model's frame, as glTF's vertices are after their node transforms.

@@ -794,6 +794,7 @@ pub use loader::{
 };
 pub use mesh_file::MeshFormat;
 
+mod e57;
 mod encoded_image;
 pub mod gpu_blocks;
 mod instancing;
@@ -809,6 +810,7 @@ mod nearest;
 mod obj;
 mod ply;
 mod point_cloud;
+mod scan_points;
 mod skin;
 mod spec_gloss;
 mod split;

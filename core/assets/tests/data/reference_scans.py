@@ -1,0 +1,39 @@
+# Scans of a sphere of radius 0.1 m (200 Fibonacci points, +z red) written by other programs'
+# writers, so that the loader is checked against files its own crates did not write: E57 by the
+# reference library libE57Format (PyPI pye57 0.4.19), LAS 1.4 point format 7 by laspy 2.7.0 and
+# its LAZ by the reference LASzip (PyPI laszip 0.3.0). Georeferenced: 512 345.678 m east,
+# 5 412 345.678 m north, 200 m up. Run once, 2026-12-06, in a throwaway virtual environment
+# (never a dependency of the project):
+#   python3 -m venv /tmp/v && /tmp/v/bin/pip install pye57==0.4.19 "laspy[laszip]==2.7.0"
+#   /tmp/v/bin/python reference_scans.py .   # then move the files into las/ and e57/
+# Read by `scans_written_by_other_programs_read_alike` in core/assets/tests/mesh_files.rs.
+import sys, numpy as np, pye57, laspy
+n = 200
+i = np.arange(n) + 0.5
+phi = np.arccos(1 - 2 * i / n); theta = np.pi * (1 + 5 ** 0.5) * i
+x, y, z = np.cos(theta) * np.sin(phi), np.sin(theta) * np.sin(phi), np.cos(phi)
+east, north, up = 512345.678, 5412345.678, 200.0
+out = sys.argv[1]
+# E57: two scans (top and bottom half), each in its scanner's frame 3 m to a side, posed.
+e = pye57.E57(f"{out}/reference-sphere-200.e57", mode="w")
+for top in (True, False):
+    m = (z > 0) == top
+    s = np.array([east + (3 if top else -3), north, up])
+    k = int(m.sum())
+    e.write_scan_raw({
+        "cartesianX": east + 0.1 * x[m] - s[0], "cartesianY": north + 0.1 * y[m] - s[1],
+        "cartesianZ": up + 0.1 * z[m] - s[2],
+        "colorRed": np.full(k, 200 if top else 40, dtype=np.uint8),
+        "colorGreen": np.full(k, 90, dtype=np.uint8), "colorBlue": np.full(k, 60, dtype=np.uint8),
+    }, rotation=np.array([1.0, 0, 0, 0]), translation=s)
+e.close()
+# LAS 1.4, point format 7 (16-bit colour), and the same as LAZ.
+h = laspy.LasHeader(point_format=7, version="1.4")
+h.offsets = [east, north, up]; h.scales = [0.0001] * 3
+las = laspy.LasData(h)
+las.x, las.y, las.z = east + 0.1 * x, north + 0.1 * y, up + 0.1 * z
+las.red = np.where(z > 0, 200 * 256, 40 * 256).astype(np.uint16)
+las.green = np.full(n, 90 * 256, dtype=np.uint16); las.blue = np.full(n, 60 * 256, dtype=np.uint16)
+las.classification = np.full(n, 2, dtype=np.uint8)
+las.write(f"{out}/reference-sphere-200.las")
+las.write(f"{out}/reference-sphere-200.laz", laz_backend=laspy.LazBackend.Laszip)
