@@ -207,6 +207,35 @@ fn colour_where(mesh: &phantogram_assets::model::Mesh, at: impl Fn(f32) -> bool)
         .expect("a vertex there")
 }
 
+/// `model` as a cloud of `n` points on a sphere of radius 0.1 m whose top half (+z in the file)
+/// is sRGB 200 red and the rest dark: a disc per point, about the sphere's centre, the file's +z
+/// as glTF's +y, in the file's colours.
+fn assert_is_the_red_topped_sphere(what: &str, model: &Model, n: usize) {
+    let mesh = &model.primitives[0].mesh;
+    assert_eq!(mesh.vertices.len(), n * 6, "{what}: a hexagon per point");
+    let bounds = mesh.bounds().expect("bounds");
+    for k in 0..3 {
+        assert!(
+            (bounds.max[k] - 0.1).abs() < 0.01 && (bounds.min[k] + 0.1).abs() < 0.01,
+            "{what}: about its centre, {bounds:?}"
+        );
+    }
+    let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
+    assert!((top[0] - 0.578).abs() < 0.01, "{what}: sRGB 200 on top: {top:?}");
+    assert!(bottom[0] < 0.1, "{what}: {bottom:?}");
+}
+
+/// `bytes` opened on a phone as a share without a name: kept in the library and loaded as a
+/// cloud of `n` discs (four triangles each).
+fn assert_imports_from_a_share(test: &str, bytes: &[u8], n: usize) {
+    let dir = Scratch::new(&format!("mesh-files-{test}-library"));
+    let lib = Library::new(Some(dir.to_path_buf()), None);
+    let imported = lib
+        .import("document.bin", bytes, ResourceBudget::PHONE, &Progress::new())
+        .expect("imported");
+    assert_eq!(imported.model.triangle_count(), n * 4);
+}
+
 /// A scanner's point cloud: a PLY of coloured vertices on a sphere of radius 0.1 m, no faces.
 fn point_cloud_ply(n: usize) -> String {
     let mut text = format!(
@@ -306,26 +335,9 @@ fn a_point_cloud_as_text_is_drawn_as_discs_the_right_way_up() {
     }
     for (name, text) in [("scan.xyz", &xyz), ("scan.pts", &pts)] {
         let model = load("text-cloud", name, text.as_bytes()).expect("loads");
-        let mesh = &model.primitives[0].mesh;
-        assert_eq!(mesh.vertices.len(), points.len() * 6, "{name}: a hexagon per point");
-        let bounds = mesh.bounds().expect("bounds");
-        for k in 0..3 {
-            assert!(
-                (bounds.max[k] - 0.1).abs() < 0.01 && (bounds.min[k] + 0.1).abs() < 0.01,
-                "{name}: about its centre, {bounds:?}"
-            );
-        }
-        // The file's +z (red) is glTF's +y.
-        let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
-        assert!((top[0] - 0.578).abs() < 0.01, "{name}: sRGB 200 on top: {top:?}");
-        assert!(bottom[0] < 0.1, "{name}: {bottom:?}");
+        assert_is_the_red_topped_sphere(name, &model, points.len());
     }
-    let dir = Scratch::new("mesh-files-text-cloud-library");
-    let lib = Library::new(Some(dir.to_path_buf()), None);
-    let imported = lib
-        .import("document.bin", xyz.as_bytes(), ResourceBudget::PHONE, &Progress::new())
-        .expect("imported");
-    assert_eq!(imported.model.triangle_count(), points.len() * 4);
+    assert_imports_from_a_share("text-cloud", xyz.as_bytes(), points.len());
     // A line that is not a point is named.
     let err = load("text-cloud-bad", "bad.xyz", b"0 0 0\n1 1 one\n")
         .unwrap_err()
@@ -385,25 +397,9 @@ fn a_las_or_laz_scan_is_drawn_as_discs_the_right_way_up() {
         ("laz-named.las", &laz_file),
     ] {
         let model = load("las-cloud", name, bytes).expect("loads");
-        let mesh = &model.primitives[0].mesh;
-        assert_eq!(mesh.vertices.len(), points.len() * 6, "{name}: a hexagon per point");
-        let bounds = mesh.bounds().expect("bounds");
-        for k in 0..3 {
-            assert!(
-                (bounds.max[k] - 0.1).abs() < 0.01 && (bounds.min[k] + 0.1).abs() < 0.01,
-                "{name}: about its centre, {bounds:?}"
-            );
-        }
-        let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
-        assert!((top[0] - 0.578).abs() < 0.01, "{name}: sRGB 200 on top: {top:?}");
-        assert!(bottom[0] < 0.1, "{name}: {bottom:?}");
+        assert_is_the_red_topped_sphere(name, &model, points.len());
     }
-    let dir = Scratch::new("mesh-files-las-library");
-    let lib = Library::new(Some(dir.to_path_buf()), None);
-    let imported = lib
-        .import("document.bin", &laz_file, ResourceBudget::PHONE, &Progress::new())
-        .expect("imported");
-    assert_eq!(imported.model.triangle_count(), points.len() * 4);
+    assert_imports_from_a_share("las-cloud", &laz_file, points.len());
     // Cut short: the header promises points the file does not hold.
     let err = load("las-cloud-bad", "cut.laz", &laz_file[..laz_file.len() * 2 / 3])
         .unwrap_err()
@@ -412,10 +408,7 @@ fn a_las_or_laz_scan_is_drawn_as_discs_the_right_way_up() {
     // A LAZ written once by an earlier version of the encoder (`tests/data/las/README.md`).
     let kept = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/las/sphere-50.laz")).expect("read");
     let model = load("las-cloud-kept", "sphere-50.laz", &kept).expect("loads");
-    let mesh = &model.primitives[0].mesh;
-    assert_eq!(mesh.vertices.len(), 50 * 6);
-    let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
-    assert!((top[0] - 0.578).abs() < 0.01 && bottom[0] < 0.1, "{top:?} {bottom:?}");
+    assert_is_the_red_topped_sphere("sphere-50.laz", &model, 50);
 }
 
 /// The sphere of [`las_sphere`] as an E57 file of two scans written by the `e57` crate's writer:
@@ -498,24 +491,8 @@ fn an_e57_scan_is_drawn_as_discs_the_right_way_up() {
     let points = phantogram_geometry::sphere::fibonacci(2000);
     let file = e57_sphere(&points);
     let model = load("e57-cloud", "scan.e57", &file).expect("loads");
-    let mesh = &model.primitives[0].mesh;
-    assert_eq!(mesh.vertices.len(), points.len() * 6, "a hexagon per point");
-    let bounds = mesh.bounds().expect("bounds");
-    for k in 0..3 {
-        assert!(
-            (bounds.max[k] - 0.1).abs() < 0.01 && (bounds.min[k] + 0.1).abs() < 0.01,
-            "the two scans meet about the centre: {bounds:?}"
-        );
-    }
-    let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
-    assert!((top[0] - 0.578).abs() < 0.01, "sRGB 200 on top: {top:?}");
-    assert!(bottom[0] < 0.1, "{bottom:?}");
-    let dir = Scratch::new("mesh-files-e57-library");
-    let lib = Library::new(Some(dir.to_path_buf()), None);
-    let imported = lib
-        .import("document.bin", &file, ResourceBudget::PHONE, &Progress::new())
-        .expect("imported");
-    assert_eq!(imported.model.triangle_count(), points.len() * 4);
+    assert_is_the_red_topped_sphere("scan.e57", &model, points.len());
+    assert_imports_from_a_share("e57-cloud", &file, points.len());
     let err = load("e57-cloud-bad", "cut.e57", &file[..file.len() / 2])
         .unwrap_err()
         .to_string();
@@ -523,10 +500,7 @@ fn an_e57_scan_is_drawn_as_discs_the_right_way_up() {
     // An E57 written once by an earlier version of the writer (`tests/data/e57/README.md`).
     let kept = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/e57/sphere-50.e57")).expect("read");
     let model = load("e57-cloud-kept", "sphere-50.e57", &kept).expect("loads");
-    let mesh = &model.primitives[0].mesh;
-    assert_eq!(mesh.vertices.len(), 50 * 6);
-    let (top, bottom) = (colour_where(mesh, |y| y > 0.09), colour_where(mesh, |y| y < -0.09));
-    assert!((top[0] - 0.578).abs() < 0.01 && bottom[0] < 0.1, "{top:?} {bottom:?}");
+    assert_is_the_red_topped_sphere("sphere-50.e57", &model, 50);
 }
 
 /// Scans of one sphere written by other programs (`tests/data/reference_scans.py`: E57 by
