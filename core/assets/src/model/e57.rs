@@ -11,8 +11,9 @@
 //!   counts so that at most [`RAW_POINTS_KEPT`] remain, as for LAS.
 //! * **Frame**: metres, with +Z up for a levelled scanner (the standard's convention), turned by
 //!   the caller into glTF's +Y up, and taken about their centre (`scan_points`).
-//! * **Colour**: the points' colour, scaled by the file's colour limits; without colour, their
-//!   intensity (scaled by its limits) shades them (`scan_points`).
+//! * **Colour**: the points' colour, scaled by the file's colour limits, where every scan has
+//!   colour (a scan without would otherwise read as black); else their intensity (scaled by its
+//!   limits) shades them (`scan_points`).
 //!
 //! **Budget**: the caller read the file within the budget; the reader holds a page and a packet
 //! at a time, and at most [`RAW_POINTS_KEPT`] points are kept (40 bytes each) whatever the

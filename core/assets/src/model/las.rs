@@ -108,7 +108,7 @@ fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) ->
         return Err(if index == 0 {
             "no points".to_owned()
         } else {
-            "every point is classified as noise".to_owned()
+            "the points read are all classified as noise".to_owned()
         });
     }
     let coloured = colours.len() == positions.len();
@@ -123,7 +123,7 @@ fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) ->
 }
 
 /// Refuses what the `las` and `laz` crates would take on trust from a file (they were written for
-/// files, not for hostile input; each case below was an abort, two of them found by fuzzing): a
+/// files, not for hostile input; each case below was an abort, the last found by fuzzing): a
 /// point count whose records' end overflows 64 bits (added and multiplied unchecked), an extended
 /// record (LAS 1.4) longer than what follows it in the file, and a LAZ chunk table of more chunks
 /// than the file could hold (both allocated at the length stated before anything is read). Each
