@@ -163,12 +163,14 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
     if compressed {
         // LASzip's chunk table: its offset (8 bytes) opens the point data, or, where the writer
         // could not go back to set it, closes the file; the table holds a version and a count.
-        let start = u64::from(offset_to_points);
-        let table = usize::try_from(start)
-            .ok()
-            .and_then(u64_at)
-            .filter(|&at| at > start)
-            .or_else(|| u64_at(bytes.len().saturating_sub(8)).filter(|&at| at > start));
+        // Read as `laz` reads it: signed, and taken from the file's end when not past the start.
+        let start = i64::from(offset_to_points);
+        let signed_at = |at: usize| u64_at(at).map(|v| v as i64);
+        let table = match usize::try_from(start).ok().and_then(signed_at) {
+            Some(at) if at > start => Some(at),
+            Some(_) => signed_at(bytes.len().saturating_sub(8)).filter(|&at| at > start),
+            None => None,
+        };
         let chunks = table
             .and_then(|at| usize::try_from(at).ok())
             .and_then(|at| at.checked_add(4))
@@ -434,7 +436,14 @@ mod tests {
         let table = i64::from_le_bytes(laz[points_at..points_at + 8].try_into().unwrap()) as usize;
         let mut forged = laz.clone();
         forged[table + 4..table + 8].copy_from_slice(&0x7fff_ffffu32.to_le_bytes());
-        let err = all(forged).unwrap_err();
+        let err = all(forged.clone()).unwrap_err();
+        assert!(err.contains("chunks"), "{err}");
+        // The same table found through the file's last 8 bytes, where a writer that could not
+        // go back puts its offset (the first one then negative).
+        let mut from_the_end = forged;
+        from_the_end[points_at..points_at + 8].copy_from_slice(&(-1i64).to_le_bytes());
+        from_the_end.extend_from_slice(&(table as i64).to_le_bytes());
+        let err = all(from_the_end).unwrap_err();
         assert!(err.contains("chunks"), "{err}");
     }
 
