@@ -130,19 +130,11 @@ fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) ->
 /// LAZ chunk begins with one point stored whole, so a file holds at most its length over the
 /// record length of chunks.
 fn check_header(bytes: &[u8]) -> Result<(), String> {
-    let u16_at = |at: usize| bytes.get(at..at + 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
-    let u32_at = |at: usize| {
-        bytes
-            .get(at..at + 4)
-            .and_then(|b| b.try_into().ok())
-            .map(u32::from_le_bytes)
-    };
-    let u64_at = |at: usize| {
-        bytes
-            .get(at..at + 8)
-            .and_then(|b| b.try_into().ok())
-            .map(u64::from_le_bytes)
-    };
+    // Offsets come from the file: the end of a field is added checked.
+    let field = |at: usize, len: usize| bytes.get(at..at.checked_add(len)?);
+    let u16_at = |at: usize| field(at, 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
+    let u32_at = |at: usize| field(at, 4).and_then(|b| b.try_into().ok()).map(u32::from_le_bytes);
+    let u64_at = |at: usize| field(at, 8).and_then(|b| b.try_into().ok()).map(u64::from_le_bytes);
     let cut = || "the header is cut short".to_owned();
     let minor = *bytes.get(25).ok_or_else(cut)?;
     let header_size = u16_at(94).ok_or_else(cut)?;
@@ -426,6 +418,10 @@ mod tests {
         // A point count whose records' end overflows 64 bits.
         let err = all(as_las_1_4(&v12, u64::MAX / 8, None)).unwrap_err();
         assert!(err.contains("more than any file holds"), "{err}");
+        // An extended record placed at the very end of the address space: no field there.
+        let mut far = as_las_1_4(&v12, 10, Some(16));
+        far[235..243].copy_from_slice(&(u64::MAX - 25).to_le_bytes());
+        assert!(all(far).is_err());
     }
 
     #[test]
