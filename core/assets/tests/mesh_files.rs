@@ -207,6 +207,13 @@ fn colour_where(mesh: &phantogram_assets::model::Mesh, at: impl Fn(f32) -> bool)
         .expect("a vertex there")
 }
 
+/// A file of `core/assets/tests/data` (its READMEs say where each came from).
+fn test_data(file: &str) -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data")
+        .join(file)
+}
+
 /// `model` as a cloud of `n` points on a sphere of radius 0.1 m whose top half (+z in the file)
 /// is sRGB 200 red and the rest dark: a disc per point, about the sphere's centre, the file's +z
 /// as glTF's +y, in the file's colours.
@@ -406,8 +413,7 @@ fn a_las_or_laz_scan_is_drawn_as_discs_the_right_way_up() {
         .to_string();
     assert!(err.contains("not a valid LAS file"), "{err}");
     // A LAZ written once by an earlier version of the encoder (`tests/data/las/README.md`).
-    let kept = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/las/sphere-50.laz")).expect("read");
-    let model = load("las-cloud-kept", "sphere-50.laz", &kept).expect("loads");
+    let model = load_model(&test_data("las/sphere-50.laz")).expect("loads");
     assert_is_the_red_topped_sphere("sphere-50.laz", &model, 50);
 }
 
@@ -498,8 +504,7 @@ fn an_e57_scan_is_drawn_as_discs_the_right_way_up() {
         .to_string();
     assert!(err.contains("not a valid E57 file"), "{err}");
     // An E57 written once by an earlier version of the writer (`tests/data/e57/README.md`).
-    let kept = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/e57/sphere-50.e57")).expect("read");
-    let model = load("e57-cloud-kept", "sphere-50.e57", &kept).expect("loads");
+    let model = load_model(&test_data("e57/sphere-50.e57")).expect("loads");
     assert_is_the_red_topped_sphere("sphere-50.e57", &model, 50);
 }
 
@@ -526,14 +531,12 @@ fn scans_written_by_other_programs_read_alike() {
             (lo.min(p), hi.max(p))
         });
     let centre = (lo + hi) * 0.5;
-    let data = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data");
     for file in [
         "las/reference-sphere-200.las",
         "las/reference-sphere-200.laz",
         "e57/reference-sphere-200.e57",
     ] {
-        let model = phantogram_assets::model::load_model(std::path::Path::new(&format!("{data}/{file}")))
-            .unwrap_or_else(|e| panic!("{file}: {e}"));
+        let model = load_model(&test_data(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
         let mesh = &model.primitives[0].mesh;
         let discs: Vec<(Vec3, [f32; 4])> = mesh
             .vertices

@@ -147,41 +147,23 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
     let mut spending = Spending::new(budget);
     let bytes = read_model_file(path, &spending)?;
     progress.step(0.1).map_err(cancelled)?;
-    // The file's bytes are let go as soon as they are parsed (a LAS reader takes them whole).
-    let parsed = match format {
-        // Decoding a large scan takes seconds: its share of the progress is reported as it goes.
-        MeshFormat::Las | MeshFormat::E57 => {
-            let keep_going = |share: f64| progress.step(0.1 + 0.4 * share as f32).is_ok();
-            let read = if format == MeshFormat::Las {
-                las::parse(bytes, keep_going)
-            } else {
-                e57::parse(bytes, keep_going)
-            };
-            match read {
-                Ok(Some(soup)) => Ok(soup),
-                Ok(None) => {
-                    return Err(ModelError::Cancelled {
-                        path: path.to_path_buf(),
-                    });
-                }
-                Err(message) => Err(message),
-            }
+    // Decoding a large scan takes seconds: its share of the progress is reported as it goes.
+    let keep_going = |share: f64| progress.step(0.1 + 0.4 * share as f32).is_ok();
+    let mut soup = match parse(format, bytes, keep_going) {
+        Ok(Some(soup)) => soup,
+        Ok(None) => {
+            return Err(ModelError::Cancelled {
+                path: path.to_path_buf(),
+            });
         }
-        _ => {
-            let parsed = match format {
-                MeshFormat::Stl => stl::parse(&bytes),
-                MeshFormat::Xyz => xyz::parse(&bytes),
-                _ => ply::parse(&bytes),
-            };
-            drop(bytes);
-            parsed
+        Err(message) => {
+            return Err(ModelError::Parse {
+                path: path.to_path_buf(),
+                format: format.name(),
+                message,
+            });
         }
     };
-    let mut soup = parsed.map_err(|message| ModelError::Parse {
-        path: path.to_path_buf(),
-        format: format.name(),
-        message,
-    })?;
     progress.step(0.5).map_err(cancelled)?;
     if format == MeshFormat::Stl {
         soup = weld(soup);
@@ -262,6 +244,19 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
         materials: vec![material],
         ..Model::default()
     })
+}
+
+/// The soup in a file's `bytes` (STL, PLY, a cloud as text, LAS/LAZ or E57); `Ok(None)` when a
+/// scan's decoding was stopped by `keep_going`. The bytes are let go when this returns, before
+/// the mesh is built.
+fn parse(format: MeshFormat, bytes: Vec<u8>, keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
+    match format {
+        MeshFormat::Las => las::parse(bytes, keep_going),
+        MeshFormat::E57 => e57::parse(bytes, keep_going),
+        MeshFormat::Stl => stl::parse(&bytes).map(Some),
+        MeshFormat::Xyz => xyz::parse(&bytes).map(Some),
+        _ => ply::parse(&bytes).map(Some),
+    }
 }
 
 /// Corners at exactly the same position become one vertex (an STL soup's triangles share none).
