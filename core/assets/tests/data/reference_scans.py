@@ -5,7 +5,7 @@
 # 5 412 345.678 m north, 200 m up. Run once, 2026-12-06, in a throwaway virtual environment
 # (never a dependency of the project):
 #   python3 -m venv /tmp/v && /tmp/v/bin/pip install pye57==0.4.19 "laspy[laszip]==2.7.0"
-#   /tmp/v/bin/python reference_scans.py .   # then move the files into las/ and e57/
+#   /tmp/v/bin/python reference_scans.py .   # then move the files into las/ and e57/ (--big: below)
 # Read by `scans_written_by_other_programs_read_alike` in core/assets/tests/mesh_files.rs.
 import sys, numpy as np, pye57, laspy
 n = 200
@@ -37,3 +37,18 @@ las.green = np.full(n, 90 * 256, dtype=np.uint16); las.blue = np.full(n, 60 * 25
 las.classification = np.full(n, 2, dtype=np.uint8)
 las.write(f"{out}/reference-sphere-200.las")
 las.write(f"{out}/reference-sphere-200.laz", laz_backend=laspy.LazBackend.Laszip)
+# With `--big` also a 5-million-point LAZ (a bumpy sphere, colour by height; 48 MB, not kept in
+# the repository) for timing the loader: `phantogram render --log assets/logs/tilt-sweep.pglog
+# --every 20000 --anaglyph mono --out OUT big5m.laz` (the closing note of 2026-12-06).
+if "--big" in sys.argv:
+    m = 5_000_000
+    v = np.random.default_rng(1).normal(size=(m, 3))
+    v /= np.linalg.norm(v, axis=1)[:, None]
+    p = v * (0.1 * (1 + 0.05 * np.sin(20 * v[:, 0]) * np.cos(15 * v[:, 1])))[:, None]
+    hb = laspy.LasHeader(point_format=7, version="1.4")
+    hb.offsets = [500000, 4000000, 100]; hb.scales = [1e-5] * 3
+    big = laspy.LasData(hb)
+    big.x, big.y, big.z = 500000 + p[:, 0], 4000000 + p[:, 1], 100 + p[:, 2]
+    c = ((v[:, 2] + 1) * 0.5 * 65535).astype(np.uint16)
+    big.red, big.green, big.blue = c, 65535 - c, np.full(m, 20000, dtype=np.uint16)
+    big.write(f"{out}/big5m.laz", laz_backend=laspy.LazBackend.Laszip)
