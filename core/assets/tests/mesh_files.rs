@@ -356,33 +356,129 @@ fn a_point_cloud_as_text_is_drawn_as_discs_the_right_way_up() {
 }
 
 /// A georeferenced sphere of radius 0.1 m (its top, +z, red) as LAS point format 2, written by
-/// the `las` crate's writer, LAZ-compressed or not.
+/// the `las` crate's writer, LAZ-compressed or not, in metres (no coordinate system named).
 fn las_sphere(points: &[Vec3], compressed: bool) -> Vec<u8> {
-    let (east, north) = (512_345.678, 5_412_345.678);
+    let (east, north, up) = (512_345.678, 5_412_345.678, 200.0);
+    las_sphere_in(
+        points,
+        compressed,
+        ([east, north, up], [0.0001; 3]),
+        |p| [east + 0.1 * p[0], north + 0.1 * p[1], up + 0.1 * p[2]],
+        Vec::new(),
+    )
+}
+
+/// The sphere of [`las_sphere`] with each point at `at(point on the unit sphere)` in the file's
+/// own units, stored about `offset` to `scale`, with `records` (a coordinate system's).
+fn las_sphere_in(
+    points: &[Vec3],
+    compressed: bool,
+    (offset, scale): ([f64; 3], [f64; 3]),
+    at: impl Fn([f64; 3]) -> [f64; 3],
+    records: Vec<las::Vlr>,
+) -> Vec<u8> {
     let mut builder = las::Builder::from((1, 2));
     builder.point_format = las::point::Format::new(2).expect("format 2");
     builder.point_format.is_compressed = compressed;
-    let axis = |offset: f64| las::Transform { scale: 0.0001, offset };
+    builder.vlrs = records;
+    let axis = |k: usize| las::Transform {
+        scale: scale[k],
+        offset: offset[k],
+    };
     builder.transforms = las::Vector {
-        x: axis(east),
-        y: axis(north),
-        z: axis(200.0),
+        x: axis(0),
+        y: axis(1),
+        z: axis(2),
     };
     let header = builder.into_header().expect("header");
     let mut writer = las::Writer::new(std::io::Cursor::new(Vec::new()), header).expect("writer");
     for p in points {
         let red = if p.z > 0.0 { 200 << 8 } else { 40 << 8 };
+        let [x, y, z] = at(p.as_dvec3().to_array());
         writer
             .write_point(las::Point {
-                x: east + 0.1 * f64::from(p.x),
-                y: north + 0.1 * f64::from(p.y),
-                z: 200.0 + 0.1 * f64::from(p.z),
+                x,
+                y,
+                z,
                 color: Some(las::Color::new(red, 90 << 8, 60 << 8)),
                 ..las::Point::default()
             })
             .expect("point");
     }
     writer.into_inner().expect("written").into_inner()
+}
+
+/// A coordinate system's record of a LAS file.
+fn crs_record(record_id: u16, data: Vec<u8>) -> las::Vlr {
+    las::Vlr {
+        user_id: "LASF_Projection".to_owned(),
+        record_id,
+        description: String::new(),
+        data,
+    }
+}
+
+/// A scan in Oregon's state-plane feet (a compound system as WKT, its heights in US survey feet)
+/// or in degrees of longitude and latitude (GeoTIFF keys) comes out in metres: the same discs as
+/// the scan in metres, to 0.2 mm (each file rounds its points to 0.05 mm at most).
+#[test]
+fn a_las_scan_in_feet_or_degrees_comes_out_in_metres() {
+    let points = phantogram_geometry::sphere::fibonacci(500);
+    let metres = load("las-units", "metres.las", &las_sphere(&points, false)).expect("loads");
+    let (foot_m, us_foot_m) = (0.3048, 1200.0 / 3937.0);
+    let wkt = "COMPD_CS[\"NAD83 / Oregon GIC Lambert (ft) + NAVD88 height (ftUS)\",PROJCS[\"NAD83 / Oregon GIC Lambert (ft)\",GEOGCS[\"NAD83\",DATUM[\"North_American_Datum_1983\",SPHEROID[\"GRS 1980\",6378137,298.257222101]],PRIMEM[\"Greenwich\",0],UNIT[\"degree\",0.0174532925199433]],PROJECTION[\"Lambert_Conformal_Conic_2SP\"],PARAMETER[\"false_easting\",1312335.958],UNIT[\"foot\",0.3048],AXIS[\"Easting\",EAST],AXIS[\"Northing\",NORTH]],VERT_CS[\"NAVD88 height (ftUS)\",VERT_DATUM[\"North American Vertical Datum 1988\",2005],UNIT[\"US survey foot\",0.304800609601219],AXIS[\"Gravity-related height\",UP]]]";
+    let (east_ft, north_ft, up_ft) = (1_680_000.0, 870_000.0, 400.0);
+    let feet = las_sphere_in(
+        &points,
+        true,
+        ([east_ft, north_ft, up_ft], [0.0001; 3]),
+        |p| {
+            [
+                east_ft + 0.1 * p[0] / foot_m,
+                north_ft + 0.1 * p[1] / foot_m,
+                up_ft + 0.1 * p[2] / us_foot_m,
+            ]
+        },
+        vec![crs_record(2112, format!("{wkt}\0").into_bytes())],
+    );
+    // Geographic (model type 2), in degrees (9102); metres per degree at 45° N on WGS 84 from
+    // the series for a degree's length, independent of the loader's radii of curvature.
+    let keys: Vec<u16> = vec![1, 1, 0, 2, 1024, 0, 1, 2, 2054, 0, 1, 9102];
+    let (lon, lat, up) = (-120.5, 45.0, 200.0);
+    let (east_m_per_degree, north_m_per_degree) = (78_846.81, 111_131.75);
+    let degrees = las_sphere_in(
+        &points,
+        false,
+        ([lon, lat, up], [1e-10, 1e-10, 0.0001]),
+        |p| {
+            [
+                lon + 0.1 * p[0] / east_m_per_degree,
+                lat + 0.1 * p[1] / north_m_per_degree,
+                up + 0.1 * p[2],
+            ]
+        },
+        vec![crs_record(34735, keys.iter().flat_map(|k| k.to_le_bytes()).collect())],
+    );
+    // Each point's disc (a hexagon), by its centre: the discs' turn follows normals estimated
+    // from the neighbours, which the files' rounding moves a little.
+    let centres = |model: &Model| -> Vec<Vec3> {
+        let vertices = &model.primitives[0].mesh.vertices;
+        vertices
+            .chunks_exact(6)
+            .map(|disc| disc.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0)
+            .collect()
+    };
+    let want = centres(&metres);
+    for (name, bytes) in [("feet.laz", feet), ("degrees.las", degrees)] {
+        let model = load("las-units", name, &bytes).expect("loads");
+        assert_is_the_red_topped_sphere(name, &model, points.len());
+        let worst = centres(&model)
+            .iter()
+            .zip(&want)
+            .map(|(g, w)| g.distance(*w))
+            .fold(0.0, f32::max);
+        assert!(worst < 2e-4, "{name}: a point {worst} m from the scan in metres");
+    }
 }
 
 /// A laser scan as LAS and as LAZ (metres with +Z up, georeferenced, 16-bit colours): drawn as
@@ -514,6 +610,32 @@ fn an_e57_scan_is_drawn_as_discs_the_right_way_up() {
 /// the file's colour.
 #[test]
 fn scans_written_by_other_programs_read_alike() {
+    for file in [
+        "las/reference-sphere-200.las",
+        "las/reference-sphere-200.laz",
+        "e57/reference-sphere-200.e57",
+    ] {
+        assert_is_the_reference_sphere(file);
+    }
+}
+
+/// The same sphere in Oregon's state-plane feet with US survey feet up (LAZ, PROJ's WKT2 of the
+/// compound system) and in degrees (LAS 1.2, GeoTIFF keys; longitude and latitude by PROJ's
+/// inverse azimuthal projection): read in metres, each point where the script put it.
+#[test]
+fn scans_in_feet_or_degrees_by_other_programs_read_in_metres() {
+    for file in [
+        "las/reference-sphere-200-feet.laz",
+        "las/reference-sphere-200-degrees.las",
+    ] {
+        assert_is_the_reference_sphere(file);
+    }
+}
+
+/// `file` (in `tests/data`) as the reference script's sphere: 200 Fibonacci points of radius
+/// 0.1 m, +z red, each read within 0.1 mm of where the script put it in metres (glTF's frame,
+/// about the sphere's centre), in its colour.
+fn assert_is_the_reference_sphere(file: &str) {
     let n = 200;
     let expected: Vec<Vec3> = (0..n)
         .map(|i| {
@@ -531,27 +653,21 @@ fn scans_written_by_other_programs_read_alike() {
             (lo.min(p), hi.max(p))
         });
     let centre = (lo + hi) * 0.5;
-    for file in [
-        "las/reference-sphere-200.las",
-        "las/reference-sphere-200.laz",
-        "e57/reference-sphere-200.e57",
-    ] {
-        let model = load_model(&test_data(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
-        let mesh = &model.primitives[0].mesh;
-        let discs: Vec<(Vec3, [f32; 4])> = mesh
-            .vertices
-            .chunks(6)
-            .map(|d| (d.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0, d[0].color))
-            .collect();
-        assert_eq!(discs.len(), n as usize, "{file}");
-        for p in &expected {
-            let (at, colour) = discs
-                .iter()
-                .min_by(|a, b| a.0.distance(*p - centre).total_cmp(&b.0.distance(*p - centre)))
-                .expect("discs");
-            assert!(at.distance(*p - centre) < 1e-4, "{file}: {p} read at {at}");
-            let red = if p.y > 0.0 { 0.578 } else { 0.021 };
-            assert!((colour[0] - red).abs() < 0.01, "{file}: {colour:?} at {p}");
-        }
+    let model = load_model(&test_data(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let mesh = &model.primitives[0].mesh;
+    let discs: Vec<(Vec3, [f32; 4])> = mesh
+        .vertices
+        .chunks(6)
+        .map(|d| (d.iter().map(|v| Vec3::from(v.position)).sum::<Vec3>() / 6.0, d[0].color))
+        .collect();
+    assert_eq!(discs.len(), n as usize, "{file}");
+    for p in &expected {
+        let (at, colour) = discs
+            .iter()
+            .min_by(|a, b| a.0.distance(*p - centre).total_cmp(&b.0.distance(*p - centre)))
+            .expect("discs");
+        assert!(at.distance(*p - centre) < 1e-4, "{file}: {p} read at {at}");
+        let red = if p.y > 0.0 { 0.578 } else { 0.021 };
+        assert!((colour[0] - red).abs() < 0.01, "{file}: {colour:?} at {p}");
     }
 }

@@ -7,10 +7,9 @@
 //!   stride chosen from the header's count so that at most [`RAW_POINTS_KEPT`] remain (four
 //!   times the discs a cloud may become, so that `point_cloud::kept` still has room to thin them
 //!   evenly in space). Points the file classifies as noise (ASPRS classes 7 and 18) are left out.
-//! * **Frame**: metres (the header's scale and offset applied) with +Z up, turned by the caller
-//!   into glTF's +Y up, and taken about their centre (`scan_points`). A file in US feet (named
-//!   only by its coordinate system's record) is read as metres; the artifact is fitted to the
-//!   diorama, so only its true size is off.
+//! * **Frame**: the header's scale and offset applied, then metres in the units of the file's
+//!   coordinate system (feet, degrees: `las_crs`), with +Z up, turned by the caller into glTF's
+//!   +Y up, and taken about their centre (`scan_points`).
 //! * **Colour**: the RGB of point formats 2, 3, 5, 7, 8 and 10 (sRGB). LAS asks for 16-bit
 //!   values, but many writers store 8-bit ones: when no kept channel exceeds 255 they are taken
 //!   as 8-bit. Without colour (or with colour fields left at zero), the intensity shades the
@@ -29,6 +28,7 @@ use std::io::Cursor;
 
 use las::{PointDataBuilder, Reader};
 
+use super::las_crs::Units;
 use super::mesh_file::Soup;
 use super::scan_points::{RAW_POINTS_KEPT, ScanPoints};
 
@@ -61,6 +61,7 @@ fn parse_keeping(bytes: Vec<u8>, most: u64, keep_going: impl FnMut(f64) -> bool)
 fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
     let mut reader = Reader::new(Cursor::new(bytes)).map_err(|e| e.to_string())?;
     let header = reader.header();
+    let units = Units::of(header);
     let total = header.number_of_points();
     let stride = total.div_ceil(most.max(1)).max(1);
     let record_len = usize::from(header.point_format().len()).max(1);
@@ -111,6 +112,7 @@ fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) ->
             "the points read are all classified as noise".to_owned()
         });
     }
+    units.to_metres(&mut positions);
     let coloured = colours.len() == positions.len();
     Ok(Some(
         ScanPoints {

@@ -800,6 +800,7 @@ pub mod gpu_blocks;
 mod instancing;
 pub mod join;
 mod las;
+mod las_crs;
 pub mod layer_arrays;
 pub mod layer_textures;
 pub mod layers;
@@ -817,6 +818,7 @@ mod split;
 mod stl;
 mod texture_info;
 mod topology;
+mod wkt;
 mod xyz;
 
 #[cfg(test)]

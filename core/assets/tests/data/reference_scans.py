@@ -4,10 +4,12 @@
 # its LAZ by the reference LASzip (PyPI laszip 0.3.0). Georeferenced: 512 345.678 m east,
 # 5 412 345.678 m north, 200 m up. Run once, 2026-12-06, in a throwaway virtual environment
 # (never a dependency of the project):
-#   python3 -m venv /tmp/v && /tmp/v/bin/pip install pye57==0.4.19 "laspy[laszip]==2.7.0"
+#   python3 -m venv /tmp/v && /tmp/v/bin/pip install pye57==0.4.19 "laspy[laszip]==2.7.0" pyproj==3.7.2
 #   /tmp/v/bin/python reference_scans.py .   # then move the files into las/ and e57/ (--big: below)
-# Read by `scans_written_by_other_programs_read_alike` in core/assets/tests/mesh_files.rs.
-import sys, numpy as np, pye57, laspy
+# Read by `scans_written_by_other_programs_read_alike` in core/assets/tests/mesh_files.rs. The two
+# in feet and in degrees (below, added later the same day with pyproj 3.7.2 / PROJ 9.5.1) are read
+# by `scans_in_feet_or_degrees_by_other_programs_read_in_metres`.
+import sys, numpy as np, pye57, laspy, pyproj
 n = 200
 i = np.arange(n) + 0.5
 phi = np.arccos(1 - 2 * i / n); theta = np.pi * (1 + 5 ** 0.5) * i
@@ -37,6 +39,41 @@ las.green = np.full(n, 90 * 256, dtype=np.uint16); las.blue = np.full(n, 60 * 25
 las.classification = np.full(n, 2, dtype=np.uint8)
 las.write(f"{out}/reference-sphere-200.las")
 las.write(f"{out}/reference-sphere-200.laz", laz_backend=laspy.LazBackend.Laszip)
+# The same sphere in other units, each with its coordinate system as PROJ names it. In feet: LAS
+# 1.4 format 7 (LAZ) with PROJ's WKT2 of EPSG 2992 + 6360 (Oregon GIC Lambert in international
+# feet, NAVD88 heights in US survey feet), its WKT flag set.
+ft, us_ft = 0.3048, 1200 / 3937
+east_ft, north_ft, up_ft = 1680000.0, 870000.0, 400.0
+hf = laspy.LasHeader(point_format=7, version="1.4")
+hf.offsets = [east_ft, north_ft, up_ft]; hf.scales = [0.0001] * 3
+hf.global_encoding.wkt = True
+hf.vlrs.append(laspy.vlrs.known.WktCoordinateSystemVlr(pyproj.CRS("EPSG:2992+6360").to_wkt("WKT2_2019")))
+feet = laspy.LasData(hf)
+feet.x, feet.y, feet.z = east_ft + 0.1 * x / ft, north_ft + 0.1 * y / ft, up_ft + 0.1 * z / us_ft
+feet.red, feet.green, feet.blue = las.red, las.green, las.blue
+feet.write(f"{out}/reference-sphere-200-feet.laz", laz_backend=laspy.LazBackend.Laszip)
+# In degrees: LAS 1.2 format 3 with GeoTIFF keys (geographic model, EPSG 4326, degrees), the
+# points' longitude and latitude from metres east and north of 120.5° W 45° N by PROJ's inverse
+# azimuthal equidistant projection on WGS 84 (true distances from that centre).
+lon0, lat0 = -120.5, 45.0
+local = pyproj.Transformer.from_crs(
+    f"+proj=aeqd +lat_0={lat0} +lon_0={lon0} +ellps=WGS84 +units=m", "EPSG:4326", always_xy=True)
+lon, lat = local.transform(0.1 * x, 0.1 * y)
+hd = laspy.LasHeader(point_format=3, version="1.2")
+hd.offsets = [lon0, lat0, up]; hd.scales = [1e-10, 1e-10, 0.0001]
+keys = laspy.vlrs.known.GeoKeyDirectoryVlr()
+keys.geo_keys_header.key_directory_version, keys.geo_keys_header.key_revision = 1, 1
+keys.geo_keys_header.minor_revision, keys.geo_keys_header.number_of_keys = 0, 3
+keys.geo_keys = []
+for key, value in ((1024, 2), (2048, 4326), (2054, 9102)):
+    entry = laspy.vlrs.known.GeoKeyEntryStruct()
+    entry.id, entry.tiff_tag_location, entry.count, entry.value_offset = key, 0, 1, value
+    keys.geo_keys.append(entry)
+hd.vlrs.append(keys)
+degrees = laspy.LasData(hd)
+degrees.x, degrees.y, degrees.z = lon, lat, up + 0.1 * z
+degrees.red, degrees.green, degrees.blue = las.red, las.green, las.blue
+degrees.write(f"{out}/reference-sphere-200-degrees.las")
 # With `--big` also a 5-million-point LAZ (a bumpy sphere, colour by height; 48 MB, not kept in
 # the repository) for timing the loader: `phantogram render --log assets/logs/tilt-sweep.pglog
 # --every 20000 --anaglyph mono --out OUT big5m.laz` (the closing note of 2026-12-06).
