@@ -8,7 +8,7 @@ use std::path::Path;
 
 use anyhow::{Result, bail};
 use phantogram::budget::ResourceBudget;
-use phantogram::library::{Library, Origin};
+use phantogram::library::{Library, MODEL_FILE_TYPES, Origin};
 use phantogram::progress::Progress;
 
 use crate::output::outln;
@@ -34,7 +34,7 @@ pub fn check_artifacts_command(folder: &Path) -> Result<()> {
     for name in names {
         if !entries.iter().any(|e| e.id.key == name) {
             problems.push(format!(
-                "{name}: not a model file (.glb, .gltf, .stl, .ply, .obj), nor a folder holding one or a \
+                "{name}: not a model file ({MODEL_FILE_TYPES}), nor a folder holding one or a \
                  Voyager scene (a model with files beside it, such as an .obj with its .mtl and \
                  textures, goes in a folder of its own)"
             ));
@@ -45,7 +45,7 @@ pub fn check_artifacts_command(folder: &Path) -> Result<()> {
             Ok(loaded) => {
                 let m = &loaded.model;
                 outln!(
-                    "ok {}: {} ({} triangles, {} images{})",
+                    "ok {}: {} ({} triangles, {} images{}){}",
                     e.id.key,
                     e.title,
                     m.triangle_count(),
@@ -54,7 +54,10 @@ pub fn check_artifacts_command(folder: &Path) -> Result<()> {
                         String::new()
                     } else {
                         format!(", {} annotations", m.annotations.len())
-                    }
+                    },
+                    m.bounds_of(|p| !p.is_floor)
+                        .map(|b| format!(", {} as in the file", size_text(b.max - b.min)))
+                        .unwrap_or_default()
                 );
                 for w in &m.warnings {
                     outln!("   warning: {w}");
@@ -76,4 +79,44 @@ pub fn check_artifacts_command(folder: &Path) -> Result<()> {
         );
     }
     Ok(())
+}
+
+/// A model's extent (metres, glTF's frame: +x right, +y up, +z towards the viewer) as a curator
+/// reads it, width × height × depth, in millimetres up to 10 m and in metres beyond: a scan read
+/// in the wrong unit shows at once (a vase of 1 070 mm that should be 330).
+fn size_text(extent_m: phantogram::glam::Vec3) -> String {
+    if extent_m.max_element() >= 10.0 {
+        format!(
+            "{:.1} × {:.1} × {:.1} m wide, tall and deep",
+            extent_m.x, extent_m.y, extent_m.z
+        )
+    } else {
+        let mm = extent_m * 1000.0;
+        let precision = if mm.max_element() < 10.0 { 1 } else { 0 };
+        format!(
+            "{:.precision$} × {:.precision$} × {:.precision$} mm wide, tall and deep",
+            mm.x, mm.y, mm.z
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_read_in_millimetres_or_metres() {
+        assert_eq!(
+            size_text(phantogram::glam::Vec3::new(0.33, 0.5204, 0.1)),
+            "330 × 520 × 100 mm wide, tall and deep"
+        );
+        assert_eq!(
+            size_text(phantogram::glam::Vec3::new(0.0042, 0.001, 0.0)),
+            "4.2 × 1.0 × 0.0 mm wide, tall and deep"
+        );
+        assert_eq!(
+            size_text(phantogram::glam::Vec3::new(1500.0, 12.34, 300.0)),
+            "1500.0 × 12.3 × 300.0 m wide, tall and deep"
+        );
+    }
 }

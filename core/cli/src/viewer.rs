@@ -366,7 +366,10 @@ impl ApplicationHandler for App {
                 while let Some(request) = self.engine.take_shell_request() {
                     match request {
                         phantogram::engine::ShellRequest::OpenFile => {
-                            eprintln!("drop a .glb, .gltf, .stl, .ply, .obj or .zip file on the window to open it")
+                            eprintln!(
+                                "drop a {} file, or a .zip holding one, on the window to open it",
+                                phantogram::library::MODEL_FILE_TYPES
+                            )
                         }
                         // The desktop asks no permission (the viewer never reports one missing).
                         phantogram::engine::ShellRequest::CameraPermission => {}

@@ -745,7 +745,8 @@ fn check_artifacts_names_every_entry_that_would_not_show() {
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(run.status.success(), "{}", String::from_utf8_lossy(&run.stderr));
     assert!(
-        stdout.contains("ok votive.glb: Votive (4 triangles") && stdout.contains("ok scan:"),
+        stdout.contains("ok votive.glb: Votive (4 triangles, 0 images), 100 × 100 × 100 mm wide, tall and deep")
+            && stdout.contains("ok scan:"),
         "{stdout}"
     );
 

@@ -130,10 +130,18 @@ pub fn of_scene_file(path: &Path) -> Metadata {
 /// first letter upper-case ("sea_turtle-150k.glb" → "Sea turtle 150k").
 pub fn title_from_name(name: &str) -> String {
     let lower = name.to_ascii_lowercase();
-    let stem = [".glb", ".gltf", ".zip", ".svx.json", ".stl", ".ply", ".obj"]
+    // Two-part extensions first (a Voyager scene, a cloud-optimised LAZ), then any a model file
+    // has (`is_model_name`), so that a format added there is never shown in a title.
+    let stem = [".svx.json", ".copc.laz", ".zip"]
         .iter()
         .find(|e| lower.ends_with(*e))
-        .map_or(name, |e| &name[..name.len() - e.len()]);
+        .map(|e| &name[..name.len() - e.len()])
+        .or_else(|| {
+            super::is_model_name(name)
+                .then(|| name.rsplit_once('.').map(|(stem, _)| stem))
+                .flatten()
+        })
+        .unwrap_or(name);
     let words: Vec<&str> = stem.split(['_', '-', ' ']).filter(|w| !w.is_empty()).collect();
     let joined = words.join(" ");
     let mut chars = joined.chars();
@@ -187,5 +195,13 @@ mod tests {
         assert_eq!(title_from_name("scan.obj"), "Scan");
         assert_eq!(title_from_name("émail.gltf"), "Émail");
         assert_eq!(title_from_name(".glb"), "Untitled");
+        // Every format the library opens, scans included.
+        assert_eq!(title_from_name("nave_scan.E57"), "Nave scan");
+        assert_eq!(title_from_name("autzen.copc.laz"), "Autzen");
+        assert_eq!(title_from_name("fresco-2024.las"), "Fresco 2024");
+        assert_eq!(title_from_name("cloud.pts"), "Cloud");
+        assert_eq!(title_from_name("museum.svx.json"), "Museum");
+        // Not a model's extension: kept.
+        assert_eq!(title_from_name("notes.txt"), "Notes.txt");
     }
 }

@@ -60,7 +60,7 @@ pub enum LibraryError {
     Archive { name: String, message: String },
     #[error("{name}: larger than the {} MiB an artifact may take on this device", max_bytes >> 20)]
     TooLarge { name: String, max_bytes: u64 },
-    #[error("{name}: holds no model (.glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las, .laz or .e57) or Voyager scene")]
+    #[error("{name}: holds no model ({MODEL_FILE_TYPES}) or Voyager scene")]
     NoModel { name: String },
     #[error("{name}: holds several models ({}); open one of them", models.join(", "))]
     SeveralModels { name: String, models: Vec<String> },
@@ -512,7 +512,11 @@ fn names_in(dir: &Path) -> Vec<String> {
     names
 }
 
-/// A file name the model loader opens: glTF, STL or PLY.
+/// The kinds of model file the library opens, by extension, as messages to the user name them
+/// (each one [`is_model_name`] accepts; a zip holding one is opened too).
+pub const MODEL_FILE_TYPES: &str = ".glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las, .laz or .e57";
+
+/// A file name the model loader opens: glTF, or a format of `model::MeshFormat`.
 pub(crate) fn is_model_name(name: &str) -> bool {
     let lower = name.to_ascii_lowercase();
     lower.ends_with(".glb") || lower.ends_with(".gltf") || crate::model::MeshFormat::of(Path::new(&lower)).is_some()

@@ -260,3 +260,24 @@ fn a_voyager_folder_offers_its_lightest_scan_as_a_preview() {
             .is_none()
     );
 }
+
+/// Every kind of file the messages name is one the library opens, whatever its case; others
+/// are not.
+#[test]
+fn the_model_file_types_named_are_those_opened() {
+    let named: Vec<&str> = MODEL_FILE_TYPES
+        .split([',', ' '])
+        .filter(|word| word.starts_with('.'))
+        .collect();
+    assert_eq!(named.len(), 10, "{MODEL_FILE_TYPES}");
+    for extension in named {
+        assert!(is_model_name(&format!("scan{extension}")), "{extension}");
+        assert!(
+            is_model_name(&format!("SCAN{}", extension.to_uppercase())),
+            "{extension}"
+        );
+    }
+    for other in ["notes.txt", "scan.fbx", "scan.zip", "glb", "scan.glb.bak"] {
+        assert!(!is_model_name(other), "{other}");
+    }
+}
