@@ -527,6 +527,13 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             las.truncate(offset);
             las.resize(offset + 50 * 26, 0);
             put("zeros-50.las", &las)?;
+            // Scans naming their coordinate system, as PROJ writes it: WKT2 of a compound system
+            // (in feet; LAZ) and GeoTIFF keys (in degrees; LAS) (`model::las_crs`).
+            for name in ["reference-sphere-200-feet.laz", "reference-sphere-200-degrees.las"] {
+                let bytes = std::fs::read(workspace_root().join("core/assets/tests/data/las").join(name))
+                    .with_context(|| format!("reading the test cloud {name}"))?;
+                put(name, &bytes)?;
+            }
             // And as E57: two scans, each placed by its pose (`core/assets/tests/data/e57`).
             let e57 = std::fs::read(workspace_root().join("core/assets/tests/data/e57/sphere-50.e57"))
                 .context("reading the test scan sphere-50.e57")?;

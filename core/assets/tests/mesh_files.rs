@@ -503,11 +503,16 @@ fn a_las_or_laz_scan_is_drawn_as_discs_the_right_way_up() {
         assert_is_the_red_topped_sphere(name, &model, points.len());
     }
     assert_imports_from_a_share("las-cloud", &laz_file, points.len());
-    // Cut short: the header promises points the file does not hold.
-    let err = load("las-cloud-bad", "cut.laz", &laz_file[..laz_file.len() * 2 / 3])
-        .unwrap_err()
-        .to_string();
-    assert!(err.contains("not a valid LAS file"), "{err}");
+    // Cut short: the header promises points the file does not hold, compressed or not.
+    for (name, bytes) in [("cut.laz", &laz_file), ("cut.las", &las_file)] {
+        let err = load("las-cloud-bad", name, &bytes[..bytes.len() * 2 / 3])
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("not a valid LAS file") && err.contains("the file is cut short"),
+            "{name}: {err}"
+        );
+    }
     // A LAZ written once by an earlier version of the encoder (`tests/data/las/README.md`).
     let model = load_model(&test_data("las/sphere-50.laz")).expect("loads");
     assert_is_the_red_topped_sphere("sphere-50.laz", &model, 50);
@@ -595,10 +600,21 @@ fn an_e57_scan_is_drawn_as_discs_the_right_way_up() {
     let model = load("e57-cloud", "scan.e57", &file).expect("loads");
     assert_is_the_red_topped_sphere("scan.e57", &model, points.len());
     assert_imports_from_a_share("e57-cloud", &file, points.len());
+    // Cut short, and whole but with a byte changed (its page's checksum fails): named apart.
     let err = load("e57-cloud-bad", "cut.e57", &file[..file.len() / 2])
         .unwrap_err()
         .to_string();
-    assert!(err.contains("not a valid E57 file"), "{err}");
+    assert!(
+        err.contains("not a valid E57 file") && err.contains("the file is cut short"),
+        "{err}"
+    );
+    let mut damaged = file.clone();
+    damaged[file.len() / 2] ^= 0x55;
+    let err = load("e57-cloud-bad", "damaged.e57", &damaged).unwrap_err().to_string();
+    assert!(
+        err.contains("not a valid E57 file") && !err.contains("cut short"),
+        "{err}"
+    );
     // An E57 written once by an earlier version of the writer (`tests/data/e57/README.md`).
     let model = load_model(&test_data("e57/sphere-50.e57")).expect("loads");
     assert_is_the_red_topped_sphere("sphere-50.e57", &model, 50);

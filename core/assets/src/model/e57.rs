@@ -26,7 +26,7 @@ use std::io::Cursor;
 use e57::{CartesianCoordinate, E57Reader};
 
 use super::mesh_file::Soup;
-use super::scan_points::{RAW_POINTS_KEPT, ScanPoints};
+use super::scan_points::{CUT_SHORT, RAW_POINTS_KEPT, ScanPoints};
 
 /// The signature an E57 file begins with.
 const SIGNATURE: &[u8] = b"ASTM-E57";
@@ -46,6 +46,20 @@ pub fn parse(bytes: Vec<u8>, keep_going: impl FnMut(f64) -> bool) -> Result<Opti
 
 /// [`parse`], keeping at most `most` points.
 fn parse_keeping(bytes: Vec<u8>, most: u64, keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
+    // The header's physical length (bytes 16–24): a file shorter than it was cut short, which
+    // the reader reports only as pages it cannot check.
+    let stated = bytes
+        .get(16..24)
+        .and_then(|b| b.try_into().ok())
+        .map(u64::from_le_bytes);
+    if let Some(stated) = stated
+        && stated > bytes.len() as u64
+    {
+        return Err(format!(
+            "{CUT_SHORT}: its header counts {stated} bytes, the file has {}",
+            bytes.len()
+        ));
+    }
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(bytes, most, keep_going)))
         .map_err(|_| "the E57 reader failed on damaged data".to_owned())?
 }

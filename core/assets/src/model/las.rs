@@ -17,7 +17,8 @@
 //!
 //! **Budget**: the caller read the file within the budget; points are decoded in chunks of at
 //! most [`CHUNK_BYTES`], so a header that claims more points than the file holds costs no more
-//! than that (the read fails at the file's end), and at most [`RAW_POINTS_KEPT`] points are
+//! than that (a plain LAS is refused before decoding, a LAZ fails at the file's end: both are
+//! named as cut short), and at most [`RAW_POINTS_KEPT`] points are
 //! held (32 bytes each: about 19 MB) whatever the file's size. What the decoders would allocate
 //! on a header's word alone is checked first (`check_header`). **Progress**: `keep_going` is
 //! told the share decoded after each chunk and stops the work by returning `false`.
@@ -30,7 +31,7 @@ use las::{PointDataBuilder, Reader};
 
 use super::las_crs::Units;
 use super::mesh_file::Soup;
-use super::scan_points::{RAW_POINTS_KEPT, ScanPoints};
+use super::scan_points::{CUT_SHORT, RAW_POINTS_KEPT, ScanPoints};
 
 /// The most bytes of decoded records held at once.
 pub const CHUNK_BYTES: usize = 8 << 20;
@@ -59,7 +60,7 @@ fn parse_keeping(bytes: Vec<u8>, most: u64, keep_going: impl FnMut(f64) -> bool)
 
 /// The points of a file whose header passed [`check_header`], as [`parse_keeping`] returns them.
 fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
-    let mut reader = Reader::new(Cursor::new(bytes)).map_err(|e| e.to_string())?;
+    let mut reader = Reader::new(Cursor::new(bytes)).map_err(|e| decoding_error(&e, None))?;
     let header = reader.header();
     let units = Units::of(header);
     let total = header.number_of_points();
@@ -72,7 +73,9 @@ fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) ->
     let mut intensities: Vec<u16> = Vec::new();
     let mut index = 0u64;
     loop {
-        let n = reader.fill_points(chunk, &mut data).map_err(|e| e.to_string())?;
+        let n = reader
+            .fill_points(chunk, &mut data)
+            .map_err(|e| decoding_error(&e, Some(total)))?;
         if n == 0 {
             break;
         }
@@ -149,11 +152,17 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
         (0, true) => u64_at(247).ok_or_else(cut)?,
         (n, _) => u64::from(n),
     };
-    count
+    let end = count
         .checked_mul(u64::from(record_len))
         .and_then(|b| b.checked_add(u64::from(offset_to_points)))
         .ok_or_else(|| format!("the header claims {count} points, more than any file holds"))?;
     let compressed = bytes.get(104).is_some_and(|format| format & 0xC0 != 0);
+    if !compressed && end > bytes.len() as u64 {
+        return Err(format!(
+            "{CUT_SHORT}: its {count} points end at byte {end}, the file at byte {}",
+            bytes.len()
+        ));
+    }
     if compressed {
         // LASzip's chunk table: its offset (8 bytes) opens the point data, or, where the writer
         // could not go back to set it, closes the file; the table holds a version and a count.
@@ -200,6 +209,25 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
         }
     }
     Ok(())
+}
+
+/// A decoder's error as the user reads it: running out of bytes is a file cut short (the header's
+/// check finds that before decoding for plain LAS, so this is LAZ's compressed points).
+/// `points` is the header's count, where it was read.
+fn decoding_error(error: &las::Error, points: Option<u64>) -> String {
+    let io = match error {
+        las::Error::Io(e) | las::Error::LasZipError(laz::LasZipError::IoError(e)) => Some(e),
+        _ => None,
+    };
+    match (io.map(std::io::Error::kind), points) {
+        (Some(std::io::ErrorKind::UnexpectedEof), Some(n)) => {
+            format!("{CUT_SHORT}: its compressed points end before the {n} its header counts")
+        }
+        (Some(std::io::ErrorKind::UnexpectedEof), None) => {
+            format!("{CUT_SHORT}: it ends before the records its header points to")
+        }
+        _ => error.to_string(),
+    }
 }
 
 /// The points' RGB as sRGB 0–1: 16-bit values, or 8-bit ones where none exceeds 255.

@@ -24,6 +24,9 @@ use super::point_cloud::MAX_SURFELS;
 /// that `point_cloud::kept` still has room to thin them evenly in space.
 pub const RAW_POINTS_KEPT: u64 = 4 * MAX_SURFELS as u64;
 
+/// How a scanner's file that ends before its header says it does is named to the user.
+pub const CUT_SHORT: &str = "the file is cut short (a download or copy that stopped early?)";
+
 /// See the module docs.
 #[derive(Debug, Default)]
 pub struct ScanPoints {
