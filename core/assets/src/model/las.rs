@@ -128,12 +128,13 @@ fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) ->
 }
 
 /// Refuses what the `las` and `laz` crates would take on trust from a file (they were written for
-/// files, not for hostile input; each case below was an abort, the last found by fuzzing): a
-/// point count whose records' end overflows 64 bits (added and multiplied unchecked), an extended
-/// record (LAS 1.4) longer than what follows it in the file, and a LAZ chunk table of more chunks
-/// than the file could hold (both allocated at the length stated before anything is read). Each
-/// LAZ chunk begins with one point stored whole, so a file holds at most its length over the
-/// record length of chunks.
+/// files, not for hostile input; each case below was an abort, two found by fuzzing): a point
+/// count whose records' end overflows 64 bits (added and multiplied unchecked), an extended
+/// record (LAS 1.4) longer than what follows it in the file, a LAZ chunk table of more chunks
+/// than the file could hold (both allocated at the length stated before anything is read), and
+/// a LAZ chunk whose layers run past the file's end (each allocated at its stated size:
+/// `laz_layers`). Each LAZ chunk begins with one point stored whole, so a file holds at most its
+/// length over the record length of chunks. A plain LAS shorter than its points is cut short.
 fn check_header(bytes: &[u8]) -> Result<(), String> {
     // Offsets come from the file: the end of a field is added checked.
     let field = |at: usize, len: usize| bytes.get(at..at.checked_add(len)?);
@@ -178,6 +179,8 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
             .and_then(|at| usize::try_from(at).ok())
             .and_then(|at| at.checked_add(4))
             .and_then(u32_at);
+        // The layers of each chunk (point formats 6–10), allocated at their stated sizes.
+        super::laz_layers::check(bytes, u64::from(offset_to_points), count)?;
         let most = bytes.len() as u64 / u64::from(record_len.max(1));
         if let Some(chunks) = chunks
             && u64::from(chunks) > most
@@ -471,6 +474,29 @@ mod tests {
         from_the_end.extend_from_slice(&(table as i64).to_le_bytes());
         let err = all(from_the_end).unwrap_err();
         assert!(err.contains("chunks"), "{err}");
+    }
+
+    /// A layered LAZ (point format 7) whose first chunk's first layer claims 4 GiB: refused
+    /// before the decoder allocates it (without the check, 4 GiB is allocated and the read then
+    /// fails as a file cut short). The fuzzer's input that took 1.5 GiB likewise.
+    #[test]
+    fn a_laz_layer_claiming_more_than_the_file_holds_is_an_error() {
+        let laz = std::fs::read(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/tests/data/las/reference-sphere-200.laz"
+        ))
+        .unwrap();
+        assert_eq!(all(laz.clone()).unwrap().positions.len(), 200);
+        let points_at = u32::from_le_bytes(laz[96..100].try_into().unwrap()) as usize;
+        // After the table's offset (8), the first point stored whole (36) and the count (4).
+        let sizes_at = points_at + 8 + 36 + 4;
+        let mut forged = laz;
+        forged[sizes_at..sizes_at + 4].copy_from_slice(&0xFFFF_FFF0u32.to_le_bytes());
+        let err = all(forged).unwrap_err();
+        assert!(err.contains("claims layers of"), "{err}");
+        let found = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/las/huge-layer.laz")).unwrap();
+        let err = all(found).unwrap_err();
+        assert!(err.contains("claims layers of"), "{err}");
     }
 
     #[test]
