@@ -513,7 +513,7 @@ fn names_in(dir: &Path) -> Vec<String> {
 }
 
 /// The kinds of model file the library opens, by extension, as messages to the user name them
-/// (each one [`is_model_name`] accepts; a zip holding one is opened too).
+/// (each one `is_model_name` accepts; a zip holding one is opened too).
 pub const MODEL_FILE_TYPES: &str = ".glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las, .laz or .e57";
 
 /// A file name the model loader opens: glTF, or a format of `model::MeshFormat`.
