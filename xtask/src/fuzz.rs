@@ -527,9 +527,15 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             las.truncate(offset);
             las.resize(offset + 50 * 26, 0);
             put("zeros-50.las", &las)?;
-            // Scans naming their coordinate system, as PROJ writes it: WKT2 of a compound system
-            // (in feet; LAZ) and GeoTIFF keys (in degrees; LAS) (`model::las_crs`).
-            for name in ["reference-sphere-200-feet.laz", "reference-sphere-200-degrees.las"] {
+            // Files other programs wrote: a layered LAZ (point format 7, by the reference
+            // LASzip: `model::laz_layers`), and scans naming their coordinate system as PROJ
+            // writes it: WKT2 of a compound system (in feet; LAZ) and GeoTIFF keys (in degrees;
+            // LAS) (`model::las_crs`).
+            for name in [
+                "reference-sphere-200.laz",
+                "reference-sphere-200-feet.laz",
+                "reference-sphere-200-degrees.las",
+            ] {
                 let bytes = std::fs::read(workspace_root().join("core/assets/tests/data/las").join(name))
                     .with_context(|| format!("reading the test cloud {name}"))?;
                 put(name, &bytes)?;
@@ -538,6 +544,10 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             let e57 = std::fs::read(workspace_root().join("core/assets/tests/data/e57/sphere-50.e57"))
                 .context("reading the test scan sphere-50.e57")?;
             put("sphere-50.e57", &e57)?;
+            // The same by the reference library, libE57Format (its own section layout).
+            let e57 = std::fs::read(workspace_root().join("core/assets/tests/data/e57/reference-sphere-200.e57"))
+                .context("reading the test scan reference-sphere-200.e57")?;
+            put("reference-sphere-200.e57", &e57)?;
             // A tetrahedron as binary STL (its header begins "solid", as many do), as ASCII STL,
             // and as binary PLY with a colour per vertex.
             let corners = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];

@@ -28,52 +28,84 @@ pub fn check(bytes: &[u8], offset_to_points: u64, points: u64) -> Result<(), Str
     let Some(vlr) = laszip_record(bytes) else {
         return Ok(());
     };
-    let Some((first_point, layers)) = layout(vlr.items()) else {
+    let Some(layout) = layout(vlr.items()) else {
         return Ok(());
     };
     let len = bytes.len() as u64;
-    let u32_at = |at: u64| -> Option<u64> {
-        let at = usize::try_from(at).ok()?;
-        let b = bytes.get(at..at.checked_add(4)?)?;
-        Some(u64::from(u32::from_le_bytes(b.try_into().ok()?)))
-    };
     // The chunk table's offset (8 bytes) opens the point data.
     let mut at = offset_to_points.saturating_add(8);
     let mut left = points;
     while left > 0 {
-        let count_at = at.saturating_add(first_point);
-        let sizes_at = count_at.saturating_add(4);
-        let sizes_end = sizes_at.saturating_add(4 * layers);
-        if sizes_end > len {
+        let end = match chunk_end(bytes, at, layout, len) {
+            ChunkEnd::Fits(end) => end,
             // The decoder fails reading these, before it allocates a layer.
-            return Ok(());
-        }
-        let mut total = 0u64;
-        for k in 0..layers {
-            // In the file: sizes_end ≤ len.
-            total = total.saturating_add(u32_at(sizes_at + 4 * k).unwrap_or(0));
-        }
-        let room = len - sizes_end;
-        if total > room {
-            return Err(format!(
-                "its compressed chunk at byte {at} claims layers of {total} bytes; the file has {room} after them"
-            ));
-        }
-        at = sizes_end + total;
+            ChunkEnd::SizesCut => return Ok(()),
+            ChunkEnd::Overruns { claimed, room } => {
+                return Err(format!(
+                    "its compressed chunk at byte {at} claims layers of {claimed} bytes; the file has {room} after them"
+                ));
+            }
+        };
         // A chunk holds its stated count (variable-sized chunks) or the record's chunk size.
         let in_chunk = if vlr.uses_variable_size_chunks() {
-            u32_at(count_at).unwrap_or(0)
+            u32_at(bytes, at.saturating_add(layout.first_point)).unwrap_or(0)
         } else {
             u64::from(vlr.chunk_size())
         };
+        at = end;
         left = left.saturating_sub(in_chunk.max(1));
     }
     Ok(())
 }
 
+/// A layered chunk's shape: the bytes of its first point stored whole and its number of layers.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layout {
+    pub first_point: u64,
+    pub layers: u64,
+}
+
+/// Where a layered chunk's layers end, by its stated sizes.
+#[derive(Debug, PartialEq)]
+pub enum ChunkEnd {
+    /// At this byte, within the limit.
+    Fits(u64),
+    /// The sizes themselves run past the limit.
+    SizesCut,
+    /// The layers claim more than the limit leaves after the sizes.
+    Overruns { claimed: u64, room: u64 },
+}
+
+/// Where the layers of the chunk at `at` end, read from `bytes` no further than `limit` (at most
+/// `bytes`' length).
+pub fn chunk_end(bytes: &[u8], at: u64, layout: Layout, limit: u64) -> ChunkEnd {
+    let limit = limit.min(bytes.len() as u64);
+    // Its first point, its point count (4), then a size (4) a layer.
+    let sizes_at = at.saturating_add(layout.first_point).saturating_add(4);
+    let sizes_end = sizes_at.saturating_add(layout.layers.saturating_mul(4));
+    if sizes_end > limit {
+        return ChunkEnd::SizesCut;
+    }
+    let claimed = (0..layout.layers)
+        .map(|k| u32_at(bytes, sizes_at + 4 * k).unwrap_or(0))
+        .fold(0u64, u64::saturating_add);
+    let room = limit - sizes_end;
+    if claimed > room {
+        ChunkEnd::Overruns { claimed, room }
+    } else {
+        ChunkEnd::Fits(sizes_end + claimed)
+    }
+}
+
+fn u32_at(bytes: &[u8], at: u64) -> Option<u64> {
+    let at = usize::try_from(at).ok()?;
+    let b = bytes.get(at..at.checked_add(4)?)?;
+    Some(u64::from(u32::from_le_bytes(b.try_into().ok()?)))
+}
+
 /// The LASzip record among the header's records (not the extended ones, which LASzip does not
 /// use), parsed by `laz`.
-fn laszip_record(bytes: &[u8]) -> Option<LazVlr> {
+pub fn laszip_record(bytes: &[u8]) -> Option<LazVlr> {
     let u16_at = |at: usize| Some(u16::from_le_bytes(bytes.get(at..at.checked_add(2)?)?.try_into().ok()?));
     let u32_at = |at: usize| Some(u32::from_le_bytes(bytes.get(at..at.checked_add(4)?)?.try_into().ok()?));
     let mut at = usize::from(u16_at(94)?);
@@ -94,25 +126,34 @@ fn laszip_record(bytes: &[u8]) -> Option<LazVlr> {
     None
 }
 
-/// The bytes of a chunk's first point and its number of layers, for layered items (versions 3
-/// and 4, as the decoder chooses by the first item); `None` for point-wise ones. The sizes are
-/// the decoder's own for each field, not the record's word for them.
-fn layout(items: &[laz::LazItem]) -> Option<(u64, u64)> {
+/// The shape of a chunk of `items`, where they are layered (versions 3 and 4, as the decoder
+/// chooses by the first item); `None` for point-wise ones. The sizes are the decoder's own for
+/// each field, not the record's word for them.
+pub fn layout(items: &[laz::LazItem]) -> Option<Layout> {
     if !matches!(items.first()?.version(), 3 | 4) {
         return None;
     }
-    items.iter().try_fold((0u64, 0u64), |(bytes, layers), item| {
-        let (b, l) = match item.item_type() {
-            LazItemType::Point14 => (30, 9),
-            LazItemType::RGB14 => (6, 1),
-            LazItemType::RGBNIR14 => (8, 2),
-            LazItemType::WavePacket14 => (29, 1),
-            LazItemType::Byte14(n) => (u64::from(n), u64::from(n)),
-            // Not a layered item: the decoder refuses the file.
-            _ => return None,
-        };
-        Some((bytes + b, layers + l))
-    })
+    items.iter().try_fold(
+        Layout {
+            first_point: 0,
+            layers: 0,
+        },
+        |sum, item| {
+            let (first_point, layers) = match item.item_type() {
+                LazItemType::Point14 => (30, 9),
+                LazItemType::RGB14 => (6, 1),
+                LazItemType::RGBNIR14 => (8, 2),
+                LazItemType::WavePacket14 => (29, 1),
+                LazItemType::Byte14(n) => (u64::from(n), u64::from(n)),
+                // Not a layered item: the decoder refuses the file.
+                _ => return None,
+            };
+            Some(Layout {
+                first_point: sum.first_point + first_point,
+                layers: sum.layers + layers,
+            })
+        },
+    )
 }
 
 #[cfg(test)]
@@ -146,7 +187,14 @@ mod tests {
             let (offset, count) = header(&bytes);
             assert_eq!(count, 200);
             let vlr = laszip_record(&bytes).expect("the LASzip record");
-            assert_eq!(layout(vlr.items()), Some((36, 10)), "{file}");
+            assert_eq!(
+                layout(vlr.items()),
+                Some(Layout {
+                    first_point: 36,
+                    layers: 10
+                }),
+                "{file}"
+            );
             assert_eq!(check(&bytes, offset, count), Ok(()), "{file}");
         }
         // Point-wise (format 2): nothing to check.

@@ -804,6 +804,7 @@ mod las_crs;
 pub mod layer_arrays;
 pub mod layer_textures;
 pub mod layers;
+mod laz_chunks;
 mod laz_layers;
 mod loader;
 mod mesh_file;
