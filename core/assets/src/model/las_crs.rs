@@ -7,10 +7,11 @@
 //!   for; WKT1, ESRI's variant or WKT2, parsed by `wkt`), else its GeoTIFF keys (records
 //!   34735–34737): the model type (projected, geographic, geocentric) and the linear, angular and
 //!   vertical unit keys. A unit is taken from the text's own factor (WKT) or from the EPSG unit
-//!   codes in [`linear_unit_m`] and [`angular_unit_rad`] (GeoTIFF). A system named only by its
-//!   EPSG code, with no unit key (which would need the EPSG database, megabytes on a phone), an
-//!   unknown unit code, or a record that does not parse is read as metres, as before: the
-//!   artifact is fitted to the diorama, so only its true size is off.
+//!   codes in [`linear_unit_m`] and [`angular_unit_rad`] (GeoTIFF); a projected or vertical
+//!   system named only by its EPSG code, with no unit key, has its unit from `epsg_units` (the
+//!   990 EPSG systems not in metres, 13 kB of source, rather than the EPSG database's megabytes
+//!   on a phone). An unknown unit code or a record that does not parse is read as metres, as
+//!   before: the artifact is fitted to the diorama, so only its true size is off.
 //! * **Heights**: in the vertical system's unit where the file names one; else, for a projected
 //!   system, in its linear unit (files in state-plane feet have their heights in feet), and for a
 //!   geographic one, in metres.
@@ -24,6 +25,7 @@
 
 use las::crs::{GeoTiffCrs, GeoTiffData};
 
+use super::epsg_units;
 use super::wkt::{self, Node};
 
 /// How a LAS file's horizontal coordinates become metres.
@@ -223,8 +225,10 @@ const GEOG_LINEAR_UNITS: u16 = 2052;
 const GEOG_LINEAR_UNIT_SIZE: u16 = 2053;
 const GEOG_ANGULAR_UNITS: u16 = 2054;
 const GEOG_ANGULAR_UNIT_SIZE: u16 = 2055;
+const PROJECTED_CRS: u16 = 3072;
 const PROJ_LINEAR_UNITS: u16 = 3076;
 const PROJ_LINEAR_UNIT_SIZE: u16 = 3077;
+const VERTICAL_CRS: u16 = 4096;
 const VERTICAL_UNITS: u16 = 4099;
 /// GeoTIFF's code for "user-defined": the size key then gives the unit.
 const USER_DEFINED: u16 = 32767;
@@ -249,7 +253,9 @@ pub fn from_geotiff(keys: &GeoTiffCrs) -> Option<Units> {
             code => linear_unit_m(code),
         })
     };
-    let vertical = linear(VERTICAL_UNITS, 0);
+    // A system named by its EPSG code alone: its unit from the EPSG table (`epsg_units`).
+    let by_code = |id: u16| short(id).and_then(epsg_units::metres_per_unit);
+    let vertical = linear(VERTICAL_UNITS, 0).or_else(|| by_code(VERTICAL_CRS));
     match short(GT_MODEL_TYPE) {
         Some(2) => {
             let angle = short(GEOG_ANGULAR_UNITS).and_then(|code| match code {
@@ -269,7 +275,7 @@ pub fn from_geotiff(keys: &GeoTiffCrs) -> Option<Units> {
             })
         }
         model => {
-            let m = linear(PROJ_LINEAR_UNITS, PROJ_LINEAR_UNIT_SIZE);
+            let m = linear(PROJ_LINEAR_UNITS, PROJ_LINEAR_UNIT_SIZE).or_else(|| by_code(PROJECTED_CRS));
             (model == Some(1) || m.is_some()).then(|| {
                 let m = m.unwrap_or(1.0);
                 Units {
@@ -439,9 +445,21 @@ mod tests {
         assert!(close(linear(from_geotiff(&us_feet_metres_up)), (US_SURVEY_FOOT_M, 1.0)));
         let user_defined = keys(&[(1024, U16(1)), (3076, U16(32767)), (3077, Doubles(vec![0.25]))]);
         assert!(close(linear(from_geotiff(&user_defined)), (0.25, 0.25)));
-        // A projected system named by its code alone, or with a unit code not known: metres.
-        let code_only = keys(&[(1024, U16(1)), (3072, U16(25832)), (4096, U16(5941))]);
-        assert!(close(linear(from_geotiff(&code_only)), (1.0, 1.0)));
+        // A projected system named by its code alone: its unit from the EPSG table, heights in
+        // it too unless the vertical system's code names another.
+        let utm = keys(&[(1024, U16(1)), (3072, U16(25832)), (4096, U16(5941))]);
+        assert!(close(linear(from_geotiff(&utm)), (1.0, 1.0)));
+        let oregon_ft = keys(&[(1024, U16(1)), (3072, U16(2992))]);
+        assert!(close(linear(from_geotiff(&oregon_ft)), (0.3048, 0.3048)));
+        let oregon_ft_navd88_ftus = keys(&[(1024, U16(1)), (3072, U16(2992)), (4096, U16(6360))]);
+        assert!(close(
+            linear(from_geotiff(&oregon_ft_navd88_ftus)),
+            (0.3048, US_SURVEY_FOOT_M)
+        ));
+        // An explicit unit key wins over the code's table.
+        let explicit = keys(&[(1024, U16(1)), (3072, U16(2992)), (3076, U16(9001))]);
+        assert!(close(linear(from_geotiff(&explicit)), (1.0, 1.0)));
+        // A unit code not known: metres.
         let unknown = keys(&[(1024, U16(1)), (3076, U16(9004))]);
         assert!(close(linear(from_geotiff(&unknown)), (1.0, 1.0)));
         let geographic = keys(&[(1024, U16(2)), (2048, U16(4326)), (4099, U16(9003))]);
@@ -460,6 +478,28 @@ mod tests {
         let geocentric = keys(&[(1024, U16(3)), (2052, U16(9036))]);
         assert!(close(linear(from_geotiff(&geocentric)), (1000.0, 1000.0)));
         assert_eq!(from_geotiff(&keys(&[(1025, U16(1))])), None);
+    }
+
+    /// The EPSG table (`epsg_units`, generated from PROJ's database) on systems whose units are
+    /// in their names: state-plane systems in US survey feet and in international feet, a height
+    /// in US survey feet; systems in metres are not in it.
+    #[test]
+    fn epsg_codes_name_their_units() {
+        let in_us_feet =
+            |code: u16| epsg_units::metres_per_unit(code).is_some_and(|m| (m - US_SURVEY_FOOT_M).abs() < 1e-12);
+        // NAD83 / California zone 3 (ftUS), NAD83 / New York Long Island (ftUS), and the height
+        // NAVD88 height (ftUS).
+        for code in [2227, 2263, 6360] {
+            assert!(in_us_feet(code), "{code}");
+        }
+        // NAD83(HARN) / Oregon Lambert (ft), NAD83 / Oregon GIC Lambert (ft).
+        assert_eq!(epsg_units::metres_per_unit(2994), Some(0.3048));
+        assert_eq!(epsg_units::metres_per_unit(2992), Some(0.3048));
+        // WGS 84 / UTM zone 10N, WGS 84 / Pseudo-Mercator, OSGB36 / British National Grid,
+        // ETRS89 / UTM zone 32N, a geographic system (WGS 84), and no system.
+        for code in [32610, 3857, 27700, 25832, 4326, 0, 1] {
+            assert_eq!(epsg_units::metres_per_unit(code), None, "{code}");
+        }
     }
 
     #[test]

@@ -796,6 +796,7 @@ pub use mesh_file::MeshFormat;
 
 mod e57;
 mod encoded_image;
+mod epsg_units;
 pub mod gpu_blocks;
 mod instancing;
 pub mod join;
