@@ -6,7 +6,8 @@
 //! * **Points kept**: a scan may hold hundreds of millions. Every `stride`-th point is kept, the
 //!   stride chosen from the header's count so that at most [`RAW_POINTS_KEPT`] remain (four
 //!   times the discs a cloud may become, so that `point_cloud::kept` still has room to thin them
-//!   evenly in space). Points the file classifies as noise (ASPRS classes 7 and 18) are left out.
+//!   evenly in space). Points the file classifies as noise (ASPRS classes 7 and 18) or flags as
+//!   withheld (deleted) are left out.
 //! * **Frame**: the header's scale and offset applied, then metres in the units of the file's
 //!   coordinate system (feet, degrees: `las_crs`), with +Z up, turned by the caller into glTF's
 //!   +Y up, and taken about their centre (`scan_points`).
@@ -161,7 +162,7 @@ struct Picked {
 
 impl Picked {
     /// Keeps every `stride`-th of `data`'s records (the file's `first`, `first` + 1, …) that is
-    /// not noise.
+    /// neither noise nor withheld.
     fn take(&mut self, data: &PointData, first: u64, stride: u64) -> Result<(), String> {
         let mut rgb = data.rgb();
         let columns = data
@@ -169,10 +170,11 @@ impl Picked {
             .zip(data.y())
             .zip(data.z())
             .zip(data.classification())
-            .zip(data.intensity());
-        for (at, ((((x, y), z), class), intensity)) in (first..).zip(columns) {
+            .zip(data.intensity())
+            .zip(withheld(data));
+        for (at, (((((x, y), z), class), intensity), withheld)) in (first..).zip(columns) {
             let colour = rgb.as_mut().and_then(Iterator::next);
-            if !at.is_multiple_of(stride) || NOISE_CLASSES.contains(&class) {
+            if !at.is_multiple_of(stride) || NOISE_CLASSES.contains(&class) || withheld {
                 continue;
             }
             if !(x.is_finite() && y.is_finite() && z.is_finite()) {
@@ -286,6 +288,20 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
     Ok(())
 }
 
+/// Each record's "withheld" flag: the point is to be treated as deleted (LAS 1.4, tables 7 and
+/// 15). Bit 7 of the classification byte in point formats 0–5, bit 2 of the classification
+/// flags in 6–10 (byte 15 of the record either way); `PointData` has no column for it.
+fn withheld(data: &PointData) -> impl Iterator<Item = bool> + '_ {
+    let mask = if data.format().is_extended {
+        0b0000_0100
+    } else {
+        0b1000_0000
+    };
+    data.raw_bytes()
+        .chunks_exact(data.record_len().max(1))
+        .map(move |record| record.get(15).is_some_and(|&flags| flags & mask != 0))
+}
+
 /// A decoder's error as the user reads it: running out of bytes is a file cut short (the header's
 /// check finds that before decoding for plain LAS, so this is LAZ's compressed points).
 /// `points` is the header's count, where it was read.
@@ -345,6 +361,34 @@ pub(crate) mod tests {
                 .expect("point");
         }
         writer.into_inner().expect("written").into_inner()
+    }
+
+    /// Withheld points (deleted) are left out whichever way the format stores the flag: the
+    /// classification byte's bit 7 (format 3) or the classification flags' bit 2 (format 7).
+    #[test]
+    fn withheld_points_are_left_out_in_every_format() {
+        for format in [3, 7] {
+            let mut builder = las::Builder::from((1, if format >= 6 { 4 } else { 2 }));
+            builder.point_format = las::point::Format::new(format).expect("format");
+            let mut writer =
+                las::Writer::new(Cursor::new(Vec::new()), builder.into_header().expect("header")).expect("writer");
+            for i in 0..10 {
+                writer
+                    .write_point(las::Point {
+                        x: f64::from(i),
+                        y: f64::from(i % 3),
+                        is_withheld: i % 4 == 1,
+                        color: Some(las::Color::new(100, 100, 100)),
+                        gps_time: Some(0.0),
+                        ..las::Point::default()
+                    })
+                    .expect("point");
+            }
+            let bytes = writer.into_inner().expect("written").into_inner();
+            let soup = all(bytes).unwrap();
+            // Points 1, 5 and 9 withheld.
+            assert_eq!(soup.positions.len(), 7, "format {format}");
+        }
     }
 
     /// Decoding a LAZ's chunks on several threads gives exactly the points (and the progress
@@ -500,8 +544,13 @@ pub(crate) mod tests {
         points.push(([6, 6, 6], 1, 250, [0; 3])); // a quarter of white, as linear albedo
         points.push(([9000, 9000, 9000], 7, 500, [0; 3])); // low noise, far away
         points.push(([-9000, 0, 0], 18, 500, [0; 3])); // high noise
+        points.push(([0, -9000, 0], 0x80 | 2, 500, [0; 3])); // ground, but withheld (deleted)
         let soup = all(las_bytes(false, [0.01; 3], [0.0; 3], &points)).unwrap();
-        assert_eq!(soup.positions.len(), 202, "the two noise points are left out");
+        assert_eq!(
+            soup.positions.len(),
+            202,
+            "the two noise points and the withheld one are left out"
+        );
         let colors = soup.colors.expect("greys from the intensity");
         assert!(
             (colors[0][0] - 1.0).abs() < 1e-6,
