@@ -134,7 +134,7 @@ fn decode(
         return Err(if read == 0 {
             "no points".to_owned()
         } else {
-            "the points read are all classified as noise".to_owned()
+            "the points read are all classified as noise or withheld (deleted)".to_owned()
         });
     }
     units.to_metres(&mut positions);
