@@ -253,8 +253,6 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
             .and_then(|at| usize::try_from(at).ok())
             .and_then(|at| at.checked_add(4))
             .and_then(u32_at);
-        // The layers of each chunk (point formats 6–10), allocated at their stated sizes.
-        super::laz_layers::check(bytes, u64::from(offset_to_points), count)?;
         let most = bytes.len() as u64 / u64::from(record_len.max(1));
         if let Some(chunks) = chunks
             && u64::from(chunks) > most
@@ -264,6 +262,9 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
                 bytes.len()
             ));
         }
+        // The layers of each chunk (point formats 6–10), allocated at their stated sizes; after
+        // the table's count is known to be sound, as this reads the table.
+        super::laz_layers::check(bytes, u64::from(offset_to_points), count)?;
     }
     if extended {
         let start = u64_at(235).ok_or_else(cut)?;

@@ -13,8 +13,8 @@
 //!
 //! **Panics**: none (every read and sum is checked). Cost: a few bytes read a chunk.
 
-use laz::LazItemType;
-use laz::LazVlr;
+use laz::laszip::ChunkTable;
+use laz::{LazItemType, LazVlr};
 
 /// The LASzip record's user and number.
 const LASZIP_USER: &[u8] = b"laszip encoded";
@@ -23,7 +23,9 @@ const LASZIP_RECORD: u16 = 22204;
 /// Refuses (with the reason) a LAZ whose layered chunks claim layers longer than what follows
 /// them in `bytes`. `offset_to_points` and `points` are the header's; the LASzip record is found
 /// among the header's records. A file that is not layered, or whose records do not parse (the
-/// decoder's to report), passes.
+/// decoder's to report), passes. **Important**: the chunk table's count must have been checked
+/// against the file's length first (`las::check_header`): the table is read here, and `laz`
+/// allocates it at the count it states.
 pub fn check(bytes: &[u8], offset_to_points: u64, points: u64) -> Result<(), String> {
     let Some(vlr) = laszip_record(bytes) else {
         return Ok(());
@@ -32,9 +34,21 @@ pub fn check(bytes: &[u8], offset_to_points: u64, points: u64) -> Result<(), Str
         return Ok(());
     };
     let len = bytes.len() as u64;
+    // Variable-sized chunks hold the counts the chunk table gives, as the decoder reads them
+    // (each chunk's own count only where the table cannot be read).
+    let table: Option<Vec<u64>> = if vlr.uses_variable_size_chunks() {
+        let mut source = std::io::Cursor::new(bytes);
+        source.set_position(offset_to_points);
+        ChunkTable::read_from(&mut source, &vlr)
+            .ok()
+            .map(|table| table.as_ref().iter().map(|entry| entry.point_count).collect())
+    } else {
+        None
+    };
     // The chunk table's offset (8 bytes) opens the point data.
     let mut at = offset_to_points.saturating_add(8);
     let mut left = points;
+    let mut chunk = 0usize;
     while left > 0 {
         let end = match chunk_end(bytes, at, layout, len) {
             ChunkEnd::Fits(end) => end,
@@ -46,13 +60,15 @@ pub fn check(bytes: &[u8], offset_to_points: u64, points: u64) -> Result<(), Str
                 ));
             }
         };
-        // A chunk holds its stated count (variable-sized chunks) or the record's chunk size.
-        let in_chunk = if vlr.uses_variable_size_chunks() {
-            u32_at(bytes, at.saturating_add(layout.first_point)).unwrap_or(0)
-        } else {
-            u64::from(vlr.chunk_size())
+        // A chunk holds the record's chunk size, or (variable-sized chunks) the table's count
+        // for it, else its own.
+        let in_chunk = match &table {
+            _ if !vlr.uses_variable_size_chunks() => u64::from(vlr.chunk_size()),
+            Some(counts) => counts.get(chunk).copied().unwrap_or(0),
+            None => u32_at(bytes, at.saturating_add(layout.first_point)).unwrap_or(0),
         };
         at = end;
+        chunk += 1;
         left = left.saturating_sub(in_chunk.max(1));
     }
     Ok(())
