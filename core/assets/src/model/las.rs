@@ -392,6 +392,128 @@ pub(crate) mod tests {
         }
     }
 
+    /// How [`recompressed`] cuts the points into chunks.
+    pub(crate) enum Chunking {
+        /// Chunks of these many points (the last: the rest), as COPC and LASzip's `-chunk_size
+        /// 0` write them: the chunk table holds each chunk's count.
+        Variable(Vec<usize>),
+        /// Chunks of this many points.
+        Fixed(u32),
+    }
+
+    /// The plain (uncompressed) LAS `plain`, of no records beyond its header's, as a LAZ cut into
+    /// chunks as `chunking` says, compressed by `laz`'s own compressor: the LASzip record added
+    /// after the header's records, the point data's offset and the compressed flag set.
+    pub(crate) fn recompressed(plain: &[u8], chunking: Chunking) -> Vec<u8> {
+        let u32_at = |at: usize| u32::from_le_bytes(plain[at..at + 4].try_into().unwrap());
+        let offset = u32_at(96) as usize;
+        let format = plain[104];
+        let record_len = usize::from(u16::from_le_bytes(plain[105..107].try_into().unwrap()));
+        let records = &plain[offset..];
+        assert_eq!(records.len() % record_len, 0);
+        let builder = laz::LazVlrBuilder::default().with_point_format(format, 0).unwrap();
+        let vlr = match &chunking {
+            Chunking::Variable(_) => builder.with_variable_chunk_size(),
+            Chunking::Fixed(n) => builder.with_fixed_chunk_size(*n),
+        }
+        .build();
+        let mut payload = Vec::new();
+        vlr.write_to(&mut payload).unwrap();
+        let mut out = plain[..offset].to_vec();
+        out.extend_from_slice(&[0; 2]);
+        out.extend_from_slice(b"laszip encoded\0\0");
+        out.extend_from_slice(&22204u16.to_le_bytes());
+        out.extend_from_slice(&(payload.len() as u16).to_le_bytes());
+        out.extend_from_slice(&[0; 32]);
+        out.extend_from_slice(&payload);
+        let records_at = out.len() as u32;
+        out[96..100].copy_from_slice(&records_at.to_le_bytes());
+        out[100..104].copy_from_slice(&(u32_at(100) + 1).to_le_bytes());
+        out[104] = format | 0x80;
+        let mut stream = Cursor::new(out);
+        stream.set_position(u64::from(records_at));
+        let mut compressor = laz::LasZipCompressor::new(stream, vlr).unwrap();
+        match chunking {
+            Chunking::Variable(counts) => {
+                let mut at = 0usize;
+                for n in counts {
+                    let end = records.len().min(at + n * record_len);
+                    compressor.compress_many(&records[at..end]).unwrap();
+                    compressor.finish_current_chunk().unwrap();
+                    at = end;
+                }
+                // The rest: `done` ends the last chunk.
+                compressor.compress_many(&records[at..]).unwrap();
+            }
+            Chunking::Fixed(_) => compressor.compress_many(records).unwrap(),
+        }
+        compressor.done().unwrap();
+        compressor.into_inner().into_inner()
+    }
+
+    /// LAZ files of chunks cut other ways than the `las` writer's (variable-sized, as COPC writes
+    /// them, and fixed chunks of 1 000): decoded in parallel and in order, every point as in the
+    /// plain file, point-wise (format 3) and layered (format 6).
+    #[test]
+    fn chunks_of_every_size_decode_alike() {
+        for (format, version) in [(3u8, 2u8), (6, 4)] {
+            let mut builder = las::Builder::from((1, version));
+            builder.point_format = las::point::Format::new(format).expect("format");
+            let mut writer =
+                las::Writer::new(Cursor::new(Vec::new()), builder.into_header().expect("header")).expect("writer");
+            for i in 0..5_000u32 {
+                let t = f64::from(i) * 1e-2;
+                writer
+                    .write_point(las::Point {
+                        x: t.cos(),
+                        y: t.sin(),
+                        z: t * 0.01,
+                        intensity: (i % 1000) as u16,
+                        color: (format == 3).then(|| las::Color::new((i * 13) as u16, 7, 9)),
+                        gps_time: Some(t),
+                        ..las::Point::default()
+                    })
+                    .expect("point");
+            }
+            let plain = writer.into_inner().expect("written").into_inner();
+            let expected = all(plain.clone()).unwrap();
+            assert_eq!(expected.positions.len(), 5_000);
+            for (chunking, counts) in [
+                (
+                    Chunking::Variable(vec![1_000, 2_500, 700]),
+                    vec![1_000, 2_500, 700, 800],
+                ),
+                (Chunking::Fixed(1_000), vec![1_000; 5]),
+            ] {
+                let laz = recompressed(&plain, chunking);
+                let offset = u64::from(u32::from_le_bytes(laz[96..100].try_into().unwrap()));
+                let plan = laz_chunks::plan(
+                    &laz,
+                    offset,
+                    5_000,
+                    usize::from(u16::from_le_bytes(laz[105..107].try_into().unwrap())),
+                )
+                .expect("a trusted chunk table");
+                assert_eq!(
+                    plan.chunks.iter().map(|c| c.points).collect::<Vec<_>>(),
+                    counts,
+                    "format {format}"
+                );
+                for in_parallel in [true, false] {
+                    let soup = decode(laz.clone(), RAW_POINTS_KEPT, |_| true, in_parallel)
+                        .unwrap()
+                        .unwrap();
+                    assert_eq!(
+                        soup.positions, expected.positions,
+                        "format {format}, {counts:?}, parallel {in_parallel}"
+                    );
+                    assert_eq!(soup.colors, expected.colors, "format {format}, {counts:?}");
+                }
+                assert_eq!(check_header(&laz), Ok(()));
+            }
+        }
+    }
+
     /// Decoding a LAZ's chunks on several threads gives exactly the points (and the progress
     /// and stopping) of decoding it in order: point-wise and layered, several chunks with the
     /// last one short, a stride (7) that does not divide the chunks, and the reference encoder's file.
