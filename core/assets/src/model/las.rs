@@ -394,8 +394,8 @@ pub(crate) mod tests {
 
     /// How [`recompressed`] cuts the points into chunks.
     pub(crate) enum Chunking {
-        /// Chunks of these many points (the last: the rest), as COPC and LASzip's `-chunk_size
-        /// 0` write them: the chunk table holds each chunk's count.
+        /// Chunks of these many points, then one of the rest, as COPC files have them: the
+        /// chunk table holds each chunk's count.
         Variable(Vec<usize>),
         /// Chunks of this many points.
         Fixed(u32),
