@@ -527,11 +527,13 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             las.truncate(offset);
             las.resize(offset + 50 * 26, 0);
             put("zeros-50.las", &las)?;
-            // Files other programs wrote: a layered LAZ (point format 7, by the reference
-            // LASzip: `model::laz_layers`), and scans naming their coordinate system as PROJ
+            // A LAZ of several variable-sized chunks (`model::laz_chunks`), and files other
+            // programs wrote: a layered LAZ (point format 7, by the reference LASzip:
+            // `model::laz_layers`), and scans naming their coordinate system as PROJ
             // writes it: WKT2 of a compound system (in feet; LAZ) and GeoTIFF keys (in degrees;
             // LAS) (`model::las_crs`).
             for name in [
+                "chunked-60.laz",
                 "reference-sphere-200.laz",
                 "reference-sphere-200-feet.laz",
                 "reference-sphere-200-degrees.las",

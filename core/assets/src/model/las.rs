@@ -514,6 +514,59 @@ pub(crate) mod tests {
         }
     }
 
+    /// The plain LAS 1.4 point format 6 (layered when compressed) of [`chunked_60`]: 60 points
+    /// on a helix.
+    fn helix_60() -> Vec<u8> {
+        let mut builder = las::Builder::from((1, 4));
+        builder.point_format = las::point::Format::new(6).expect("format");
+        let header = builder.into_header().expect("header");
+        let mut writer = las::Writer::new(Cursor::new(Vec::new()), header).expect("writer");
+        for i in 0..60u32 {
+            let t = f64::from(i) * 0.3;
+            writer
+                .write_point(las::Point {
+                    x: t.cos(),
+                    y: t.sin(),
+                    z: t * 0.05,
+                    intensity: (i * 1000) as u16,
+                    gps_time: Some(t),
+                    ..las::Point::default()
+                })
+                .expect("point");
+        }
+        writer.into_inner().expect("written").into_inner()
+    }
+
+    /// Writes `tests/data/las/chunked-60.laz` (kept in the repository: a regression input and a
+    /// fuzz seed whose chunks are several and variable-sized).
+    #[test]
+    #[ignore = "writes a file kept in the repository; run by hand to make it again"]
+    fn write_chunked_60() {
+        let laz = recompressed(&helix_60(), Chunking::Variable(vec![20, 25]));
+        std::fs::write(
+            concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/las/chunked-60.laz"),
+            laz,
+        )
+        .unwrap();
+    }
+
+    /// `chunked-60.laz` (written once by `write_chunked_60`): three variable-sized chunks of 20,
+    /// 25 and 15 points, decoded in parallel and in order to the plain file's points.
+    #[test]
+    fn a_kept_file_of_variable_chunks_decodes_alike() {
+        let laz = std::fs::read(concat!(env!("CARGO_MANIFEST_DIR"), "/tests/data/las/chunked-60.laz")).unwrap();
+        let offset = u64::from(u32::from_le_bytes(laz[96..100].try_into().unwrap()));
+        let plan = laz_chunks::plan(&laz, offset, 60, 30).expect("a trusted chunk table");
+        assert_eq!(plan.chunks.iter().map(|c| c.points).collect::<Vec<_>>(), [20, 25, 15]);
+        let expected = all(helix_60()).unwrap();
+        for in_parallel in [true, false] {
+            let soup = decode(laz.clone(), RAW_POINTS_KEPT, |_| true, in_parallel)
+                .unwrap()
+                .unwrap();
+            assert_eq!(soup.positions, expected.positions, "parallel {in_parallel}");
+        }
+    }
+
     /// Decoding a LAZ's chunks on several threads gives exactly the points (and the progress
     /// and stopping) of decoding it in order: point-wise and layered, several chunks with the
     /// last one short, a stride (7) that does not divide the chunks, and the reference encoder's file.
