@@ -5,7 +5,8 @@
 //!
 //! * **Where the units are read**: the CRS record as OGC WKT (record 2112, which LAS 1.4 asks
 //!   for; WKT1, ESRI's variant or WKT2, parsed by `wkt`), else its GeoTIFF keys (records
-//!   34735–34737): the model type (projected, geographic, geocentric) and the linear, angular and
+//!   34735–34737): the model type (projected, geographic, geocentric; WKT also names local,
+//!   engineering systems: a scanner's or a site's own frame) and the linear, angular and
 //!   vertical unit keys. A unit is taken from the text's own factor (WKT) or from the EPSG unit
 //!   codes in [`linear_unit_m`] and [`angular_unit_rad`] (GeoTIFF); a projected or vertical
 //!   system named only by its EPSG code, with no unit key, has its unit from `epsg_units` (the
@@ -173,7 +174,16 @@ impl Parts {
             if let Some(source) = node.child(&["SOURCECRS"]).and_then(|s| s.children().next()) {
                 self.read(source, depth + 1);
             }
-        } else if node.is(&["PROJCS", "PROJCRS", "PROJECTEDCRS", "GEOCCS"]) {
+        } else if node.is(&[
+            "PROJCS",
+            "PROJCRS",
+            "PROJECTEDCRS",
+            "GEOCCS",
+            // A local (engineering) system: a scanner's or a site's own frame.
+            "LOCAL_CS",
+            "ENGCRS",
+            "ENGINEERINGCRS",
+        ]) {
             self.horizontal
                 .get_or_insert(Horizontal::Linear(unit_of(node, LINEAR).unwrap_or(1.0)));
         } else if node.is(&["GEOGCS", "GEOGCRS", "GEOGRAPHICCRS", "GEODCRS", "GEODETICCRS"]) {
@@ -404,7 +414,20 @@ mod tests {
     fn what_names_no_unit_is_none_or_metres() {
         assert_eq!(from_wkt("not WKT"), None);
         assert_eq!(from_wkt("VERT_CS[\"h\",UNIT[\"foot\",0.3048]]"), None);
-        assert_eq!(from_wkt("LOCAL_CS[\"x\"]"), None);
+        // A local (engineering) system: in its unit, heights too; metres without one.
+        assert!(close(linear(from_wkt("LOCAL_CS[\"x\"]")), (1.0, 1.0)));
+        assert!(close(
+            linear(from_wkt(
+                "LOCAL_CS[\"site grid\",LOCAL_DATUM[\"d\",0],UNIT[\"foot\",0.3048],AXIS[\"X\",EAST]]"
+            )),
+            (0.3048, 0.3048)
+        ));
+        assert!(close(
+            linear(from_wkt(
+                "ENGCRS[\"scanner\",EDATUM[\"s\"],CS[Cartesian,3],AXIS[\"x\",east],LENGTHUNIT[\"millimetre\",0.001]]"
+            )),
+            (0.001, 0.001)
+        ));
         // A projected system without a unit, or with one that cannot be, is in metres.
         assert!(close(linear(from_wkt("PROJCS[\"x\"]")), (1.0, 1.0)));
         assert!(close(
