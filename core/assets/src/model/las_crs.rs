@@ -202,7 +202,7 @@ impl Parts {
                     self.vertical_m.get_or_insert(height_m);
                 }
             }
-        } else if node.is(&["VERT_CS", "VERTCRS", "VERTICALCRS"]) {
+        } else if node.is(&["VERT_CS", "VERTCS", "VERTCRS", "VERTICALCRS"]) {
             self.vertical_m.get_or_insert(unit_of(node, LINEAR).unwrap_or(1.0));
         }
     }
@@ -372,6 +372,11 @@ mod tests {
     fn esri_wkt_in_us_feet() {
         let esri = "PROJCS[\"NAD_1983_StatePlane_California_VI_FIPS_0406_Feet\",GEOGCS[\"GCS_North_American_1983\",DATUM[\"D_North_American_1983\",SPHEROID[\"GRS_1980\",6378137.0,298.257222101]],PRIMEM[\"Greenwich\",0.0],UNIT[\"Degree\",0.0174532925199433]],PROJECTION[\"Lambert_Conformal_Conic\"],PARAMETER[\"False_Easting\",6561666.666666666],UNIT[\"Foot_US\",0.3048006096012192]]";
         assert!(close(linear(from_wkt(esri)), (0.3048006096012192, 0.3048006096012192)));
+        // ESRI names a vertical system VERTCS; in a compound system, its unit is the heights'.
+        let esri_vertical = format!(
+            "COMPD_CS[\"x\",{esri},VERTCS[\"NAVD_1988\",VDATUM[\"North_American_Vertical_Datum_1988\"],PARAMETER[\"Vertical_Shift\",0.0],PARAMETER[\"Direction\",1.0],UNIT[\"Meter\",1.0]]]"
+        );
+        assert!(close(linear(from_wkt(&esri_vertical)), (0.3048006096012192, 1.0)));
     }
 
     #[test]
