@@ -333,19 +333,29 @@ fn rgb_colours(colours: &[[u16; 3]]) -> Vec<[f32; 3]> {
 pub(crate) mod tests {
     use super::*;
 
-    /// `n` points of a LAZ written by the `las` crate's writer (fixed chunks of 50 000 points):
-    /// point format 3 (point-wise compression) or 7 (layered), a spiral with every 13th point
-    /// noise, colour and intensity varying along it.
-    pub(crate) fn laz_file(n: u32, format: u8) -> Vec<u8> {
+    /// `points` in a file written by the `las` crate's writer: point `format` (LAS 1.2, or 1.4
+    /// for formats 6–10), LAZ-compressed (fixed chunks of 50 000 points) or not.
+    pub(crate) fn written(format: u8, compressed: bool, points: impl IntoIterator<Item = las::Point>) -> Vec<u8> {
         let mut builder = las::Builder::from((1, if format >= 6 { 4 } else { 2 }));
         builder.point_format = las::point::Format::new(format).expect("format");
-        builder.point_format.is_compressed = true;
-        let mut writer =
-            las::Writer::new(Cursor::new(Vec::new()), builder.into_header().expect("header")).expect("writer");
-        for i in 0..n {
-            let t = f64::from(i) * 1e-3;
-            writer
-                .write_point(las::Point {
+        builder.point_format.is_compressed = compressed;
+        let header = builder.into_header().expect("header");
+        let mut writer = las::Writer::new(Cursor::new(Vec::new()), header).expect("writer");
+        for point in points {
+            writer.write_point(point).expect("point");
+        }
+        writer.into_inner().expect("written").into_inner()
+    }
+
+    /// `n` points of a LAZ by [`written`]: point format 3 (point-wise compression) or 7
+    /// (layered), a spiral with every 13th point noise, colour and intensity varying along it.
+    pub(crate) fn laz_file(n: u32, format: u8) -> Vec<u8> {
+        written(
+            format,
+            true,
+            (0..n).map(|i| {
+                let t = f64::from(i) * 1e-3;
+                las::Point {
                     x: t.cos() * (1.0 + t),
                     y: t.sin() * (1.0 + t),
                     z: t * 0.1,
@@ -358,10 +368,9 @@ pub(crate) mod tests {
                     color: Some(las::Color::new((i % 65536) as u16, 1000, (i / 7 % 65536) as u16)),
                     gps_time: Some(t),
                     ..las::Point::default()
-                })
-                .expect("point");
-        }
-        writer.into_inner().expect("written").into_inner()
+                }
+            }),
+        )
     }
 
     /// Withheld points (deleted) are left out whichever way the format stores the flag: the
@@ -369,23 +378,18 @@ pub(crate) mod tests {
     #[test]
     fn withheld_points_are_left_out_in_every_format() {
         for format in [3, 7] {
-            let mut builder = las::Builder::from((1, if format >= 6 { 4 } else { 2 }));
-            builder.point_format = las::point::Format::new(format).expect("format");
-            let mut writer =
-                las::Writer::new(Cursor::new(Vec::new()), builder.into_header().expect("header")).expect("writer");
-            for i in 0..10 {
-                writer
-                    .write_point(las::Point {
-                        x: f64::from(i),
-                        y: f64::from(i % 3),
-                        is_withheld: i % 4 == 1,
-                        color: Some(las::Color::new(100, 100, 100)),
-                        gps_time: Some(0.0),
-                        ..las::Point::default()
-                    })
-                    .expect("point");
-            }
-            let bytes = writer.into_inner().expect("written").into_inner();
+            let bytes = written(
+                format,
+                false,
+                (0..10).map(|i| las::Point {
+                    x: f64::from(i),
+                    y: f64::from(i % 3),
+                    is_withheld: i % 4 == 1,
+                    color: Some(las::Color::new(100, 100, 100)),
+                    gps_time: Some(0.0),
+                    ..las::Point::default()
+                }),
+            );
             let soup = all(bytes).unwrap();
             // Points 1, 5 and 9 withheld.
             assert_eq!(soup.positions.len(), 7, "format {format}");
@@ -456,15 +460,13 @@ pub(crate) mod tests {
     /// plain file, point-wise (format 3) and layered (format 6).
     #[test]
     fn chunks_of_every_size_decode_alike() {
-        for (format, version) in [(3u8, 2u8), (6, 4)] {
-            let mut builder = las::Builder::from((1, version));
-            builder.point_format = las::point::Format::new(format).expect("format");
-            let mut writer =
-                las::Writer::new(Cursor::new(Vec::new()), builder.into_header().expect("header")).expect("writer");
-            for i in 0..5_000u32 {
-                let t = f64::from(i) * 1e-2;
-                writer
-                    .write_point(las::Point {
+        for format in [3u8, 6] {
+            let plain = written(
+                format,
+                false,
+                (0..5_000u32).map(|i| {
+                    let t = f64::from(i) * 1e-2;
+                    las::Point {
                         x: t.cos(),
                         y: t.sin(),
                         z: t * 0.01,
@@ -472,10 +474,9 @@ pub(crate) mod tests {
                         color: (format == 3).then(|| las::Color::new((i * 13) as u16, 7, 9)),
                         gps_time: Some(t),
                         ..las::Point::default()
-                    })
-                    .expect("point");
-            }
-            let plain = writer.into_inner().expect("written").into_inner();
+                    }
+                }),
+            );
             let expected = all(plain.clone()).unwrap();
             assert_eq!(expected.positions.len(), 5_000);
             for (chunking, counts) in [
@@ -514,27 +515,24 @@ pub(crate) mod tests {
         }
     }
 
-    /// The plain LAS 1.4 point format 6 (layered when compressed) of [`chunked_60`]: 60 points
-    /// on a helix.
+    /// 60 points on a helix as a plain LAS 1.4 in point format 6 (layered when compressed): the
+    /// points of `chunked-60.laz`.
     fn helix_60() -> Vec<u8> {
-        let mut builder = las::Builder::from((1, 4));
-        builder.point_format = las::point::Format::new(6).expect("format");
-        let header = builder.into_header().expect("header");
-        let mut writer = las::Writer::new(Cursor::new(Vec::new()), header).expect("writer");
-        for i in 0..60u32 {
-            let t = f64::from(i) * 0.3;
-            writer
-                .write_point(las::Point {
+        written(
+            6,
+            false,
+            (0..60u32).map(|i| {
+                let t = f64::from(i) * 0.3;
+                las::Point {
                     x: t.cos(),
                     y: t.sin(),
                     z: t * 0.05,
                     intensity: (i * 1000) as u16,
                     gps_time: Some(t),
                     ..las::Point::default()
-                })
-                .expect("point");
-        }
-        writer.into_inner().expect("written").into_inner()
+                }
+            }),
+        )
     }
 
     /// Writes `tests/data/las/chunked-60.laz` (kept in the repository: a regression input and a
