@@ -25,6 +25,7 @@ use std::io::Cursor;
 
 use e57::{CartesianCoordinate, E57Reader};
 
+use super::le_fields;
 use super::mesh_file::Soup;
 use super::scan_points::{CUT_SHORT, RAW_POINTS_KEPT, ScanPoints};
 
@@ -48,11 +49,7 @@ pub fn parse(bytes: Vec<u8>, keep_going: impl FnMut(f64) -> bool) -> Result<Opti
 fn parse_keeping(bytes: Vec<u8>, most: u64, keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
     // The header's physical length (bytes 16–24): a file shorter than it was cut short, which
     // the reader reports only as pages it cannot check.
-    let stated = bytes
-        .get(16..24)
-        .and_then(|b| b.try_into().ok())
-        .map(u64::from_le_bytes);
-    if let Some(stated) = stated
+    if let Some(stated) = le_fields::u64_at(&bytes, 16)
         && stated > bytes.len() as u64
     {
         return Err(format!(

@@ -36,6 +36,7 @@ use las::{PointData, PointDataBuilder, Reader};
 
 use super::las_crs::Units;
 use super::laz_chunks;
+use super::le_fields;
 use super::mesh_file::Soup;
 use super::scan_points::{CUT_SHORT, RAW_POINTS_KEPT, ScanPoints};
 
@@ -78,10 +79,7 @@ fn decode(
     let total = header.number_of_points();
     let stride = total.div_ceil(most.max(1)).max(1);
     let record_len = usize::from(header.point_format().len()).max(1);
-    let offset_to_points = bytes
-        .get(96..100)
-        .and_then(|b| b.try_into().ok())
-        .map_or(0, |b: [u8; 4]| u64::from(u32::from_le_bytes(b)));
+    let offset_to_points = le_fields::u32_at(&bytes, 96).map_or(0, u64::from);
     let plan = (in_parallel && header.point_format().is_compressed)
         .then(|| laz_chunks::plan(&bytes, offset_to_points, total, record_len))
         .flatten();
@@ -210,11 +208,10 @@ impl Picked {
 /// `laz_layers`). Each LAZ chunk begins with one point stored whole, so a file holds at most its
 /// length over the record length of chunks. A plain LAS shorter than its points is cut short.
 fn check_header(bytes: &[u8]) -> Result<(), String> {
-    // Offsets come from the file: the end of a field is added checked.
-    let field = |at: usize, len: usize| bytes.get(at..at.checked_add(len)?);
-    let u16_at = |at: usize| field(at, 2).map(|b| u16::from_le_bytes([b[0], b[1]]));
-    let u32_at = |at: usize| field(at, 4).and_then(|b| b.try_into().ok()).map(u32::from_le_bytes);
-    let u64_at = |at: usize| field(at, 8).and_then(|b| b.try_into().ok()).map(u64::from_le_bytes);
+    // Offsets come from the file: every read is checked (`le_fields`).
+    let u16_at = |at: u64| le_fields::u16_at(bytes, at);
+    let u32_at = |at: u64| le_fields::u32_at(bytes, at);
+    let u64_at = |at: u64| le_fields::u64_at(bytes, at);
     let cut = || "the header is cut short".to_owned();
     let minor = *bytes.get(25).ok_or_else(cut)?;
     let header_size = u16_at(94).ok_or_else(cut)?;
@@ -243,16 +240,14 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
         // could not go back to set it, closes the file; the table holds a version and a count.
         // Read as `laz` reads it: signed, and taken from the file's end when not past the start.
         let start = i64::from(offset_to_points);
-        let signed_at = |at: usize| u64_at(at).map(|v| v as i64);
-        let table = match usize::try_from(start).ok().and_then(signed_at) {
+        let signed_at = |at: u64| u64_at(at).map(|v| v as i64);
+        let table = match signed_at(u64::from(offset_to_points)) {
             Some(at) if at > start => Some(at),
-            Some(_) => signed_at(bytes.len().saturating_sub(8)).filter(|&at| at > start),
+            Some(_) => signed_at((bytes.len() as u64).saturating_sub(8)).filter(|&at| at > start),
             None => None,
         };
-        let chunks = table
-            .and_then(|at| usize::try_from(at).ok())
-            .and_then(|at| at.checked_add(4))
-            .and_then(u32_at);
+        // Past the start, so not negative.
+        let chunks = table.and_then(|at| u32_at((at as u64).checked_add(4)?));
         let most = bytes.len() as u64 / u64::from(record_len.max(1));
         if let Some(chunks) = chunks
             && u64::from(chunks) > most
@@ -270,10 +265,7 @@ fn check_header(bytes: &[u8]) -> Result<(), String> {
         let start = u64_at(235).ok_or_else(cut)?;
         let records = u32_at(243).ok_or_else(cut)?;
         // The crate reads the first extended record where both are set; its length is 20 bytes in.
-        let length = usize::try_from(start)
-            .ok()
-            .and_then(|start| start.checked_add(20))
-            .and_then(u64_at);
+        let length = start.checked_add(20).and_then(u64_at);
         if start > 0
             && records > 0
             && let Some(length) = length

@@ -16,6 +16,8 @@
 use laz::laszip::ChunkTable;
 use laz::{LazItemType, LazVlr};
 
+use super::le_fields;
+
 /// The LASzip record's user and number.
 const LASZIP_USER: &[u8] = b"laszip encoded";
 const LASZIP_RECORD: u16 = 22204;
@@ -65,7 +67,7 @@ pub fn check(bytes: &[u8], offset_to_points: u64, points: u64) -> Result<(), Str
         let in_chunk = match &table {
             _ if !vlr.uses_variable_size_chunks() => u64::from(vlr.chunk_size()),
             Some(counts) => counts.get(chunk).copied().unwrap_or(0),
-            None => u32_at(bytes, at.saturating_add(layout.first_point)).unwrap_or(0),
+            None => le_fields::u32_at(bytes, at.saturating_add(layout.first_point)).map_or(0, u64::from),
         };
         at = end;
         chunk += 1;
@@ -103,7 +105,7 @@ pub fn chunk_end(bytes: &[u8], at: u64, layout: Layout, limit: u64) -> ChunkEnd 
         return ChunkEnd::SizesCut;
     }
     let claimed = (0..layout.layers)
-        .map(|k| u32_at(bytes, sizes_at + 4 * k).unwrap_or(0))
+        .map(|k| le_fields::u32_at(bytes, sizes_at + 4 * k).map_or(0, u64::from))
         .fold(0u64, u64::saturating_add);
     let room = limit - sizes_end;
     if claimed > room {
@@ -113,24 +115,16 @@ pub fn chunk_end(bytes: &[u8], at: u64, layout: Layout, limit: u64) -> ChunkEnd 
     }
 }
 
-fn u32_at(bytes: &[u8], at: u64) -> Option<u64> {
-    let at = usize::try_from(at).ok()?;
-    let b = bytes.get(at..at.checked_add(4)?)?;
-    Some(u64::from(u32::from_le_bytes(b.try_into().ok()?)))
-}
-
 /// The LASzip record among the header's records (not the extended ones, which LASzip does not
 /// use), parsed by `laz`.
 pub fn laszip_record(bytes: &[u8]) -> Option<LazVlr> {
-    let u16_at = |at: usize| Some(u16::from_le_bytes(bytes.get(at..at.checked_add(2)?)?.try_into().ok()?));
-    let u32_at = |at: usize| Some(u32::from_le_bytes(bytes.get(at..at.checked_add(4)?)?.try_into().ok()?));
-    let mut at = usize::from(u16_at(94)?);
-    let records = u32_at(100)?;
+    let mut at = usize::from(le_fields::u16_at(bytes, 94)?);
+    let records = le_fields::u32_at(bytes, 100)?;
     for _ in 0..records {
         // A record's header: reserved (2), user (16), number (2), length (2), description (32).
         let user = bytes.get(at.checked_add(2)?..at.checked_add(18)?)?;
-        let number = u16_at(at.checked_add(18)?)?;
-        let length = usize::from(u16_at(at.checked_add(20)?)?);
+        let number = le_fields::u16_at(bytes, at as u64 + 18)?;
+        let length = usize::from(le_fields::u16_at(bytes, at as u64 + 20)?);
         let data_at = at.checked_add(54)?;
         let data = bytes.get(data_at..data_at.checked_add(length)?)?;
         let user_end = user.iter().position(|&b| b == 0).unwrap_or(user.len());

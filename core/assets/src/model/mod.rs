@@ -807,6 +807,7 @@ pub mod layer_textures;
 pub mod layers;
 mod laz_chunks;
 mod laz_layers;
+mod le_fields;
 mod loader;
 mod mesh_file;
 mod meshopt_views;
