@@ -420,7 +420,8 @@ pub struct LogWriter {
 
 enum Sink {
     Plain(BufWriter<File>),
-    Gzip(GzEncoder<BufWriter<File>>),
+    /// Boxed: the encoder's state is eight times the plain writer's.
+    Gzip(Box<GzEncoder<BufWriter<File>>>),
 }
 
 impl LogWriter {
@@ -429,7 +430,7 @@ impl LogWriter {
         let mut atomic = AtomicFile::create(path).map_err(|e| LogError::io(path, e))?;
         let file = BufWriter::new(atomic.file().try_clone().map_err(|e| LogError::io(path, e))?);
         let sink = if path.extension().is_some_and(|e| e == "gz") {
-            Sink::Gzip(GzEncoder::new(file, Compression::default()))
+            Sink::Gzip(Box::new(GzEncoder::new(file, Compression::default())))
         } else {
             Sink::Plain(file)
         };
