@@ -1,7 +1,8 @@
 //! The model loader on any bytes, as a `.glb`, a `.gltf`, a `scene.svx.json`, a `.ply`, an
-//! `.stl`, an `.obj`, a point cloud as text, `.xyz`, or a LAS/LAZ or E57 scan (by the first
-//! bytes), beside a small valid buffer and PNG that URIs and material libraries may name. Within
-//! the phone budget: an input may fail, never panic, hang or take more than the budget.
+//! `.stl`, an `.obj`, a point cloud as text, `.xyz`, a LAS/LAZ or E57 scan, or USD (`.usdz`,
+//! `.usdc`, `.usda`) (by the first bytes), beside a small valid buffer and PNG that URIs and
+//! material libraries may name. Within the phone budget: an input may fail, never panic, hang or
+//! take more than the budget.
 #![no_main]
 
 #[path = "scratch.rs"]
@@ -84,6 +85,10 @@ fuzz_target!(|data: &[u8]| {
         scratch::write(dir, "tex.png", include_bytes!("seeds/tex.png"));
     }
     let name = match data.first() {
+        // USD: a package (a zip whose first file is a layer), the binary format, the text one.
+        Some(b'P') if data.starts_with(b"PK") => "model.usdz",
+        Some(b'P') => "model.usdc",
+        Some(b'#') if data.starts_with(b"#usda") => "model.usda",
         Some(b'{') if data.windows(8).any(|w| w == b"\"models\"") => "scene.svx.json",
         Some(b'{') => "model.gltf",
         Some(b'p') => "model.ply",

@@ -550,6 +550,18 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             let e57 = std::fs::read(workspace_root().join("core/assets/tests/data/e57/reference-sphere-200.e57"))
                 .context("reading the test scan reference-sphere-200.e57")?;
             put("reference-sphere-200.e57", &e57)?;
+            // USD by Pixar's own library (`core/assets/tests/data/usd`): a package (a referenced
+            // layer and a texture inside), its root layer alone in the binary format, and the
+            // referenced layer in the text format.
+            for (name, file) in [
+                ("reference-box.usdz", "reference-box.usdz"),
+                ("reference-box.usdc", "loose/reference-box.usdc"),
+                ("knob.usda", "loose/parts/knob.usda"),
+            ] {
+                let bytes = std::fs::read(workspace_root().join("core/assets/tests/data/usd").join(file))
+                    .with_context(|| format!("reading the test stage {file}"))?;
+                put(name, &bytes)?;
+            }
             // A tetrahedron as binary STL (its header begins "solid", as many do), as ASCII STL,
             // and as binary PLY with a colour per vertex.
             let corners = [[0.0f32, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];

@@ -15,8 +15,8 @@ use winit::event_loop::EventLoop;
 #[derive(clap::Args)]
 pub struct SceneArgs {
     /// A glTF 2.0 model (.gltf or .glb), a Smithsonian Voyager folder or its scene.svx.json
-    /// (its best scan present), an .stl, .ply or .obj scan, a point cloud as text (.xyz, .pts), or a laser scan
-    /// (.las, .laz, .e57);
+    /// (its best scan present), a USD package or layer (.usdz, .usd, .usda, .usdc), an .stl,
+    /// .ply or .obj scan, a point cloud as text (.xyz, .pts), or a laser scan (.las, .laz, .e57);
     /// the default artifact when omitted.
     model: Option<PathBuf>,
     /// One of the built-in artifacts instead: amphora (the default), medal or tablet; or the

@@ -103,7 +103,7 @@ impl Engine {
         self.diorama.as_deref()
     }
 
-    /// Imports a file the user opened (its display name and bytes: a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj`, `.xyz`, `.pts`, `.las`, `.laz`, `.e57` or `.zip`)
+    /// Imports a file the user opened (its display name and bytes: a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj`, `.xyz`, `.pts`, `.las`, `.laz`, `.e57`, `.usdz` or `.zip`)
     /// into the library and shows it when loaded, in the background as [`Self::select_artifact`].
     pub fn import_artifact(&mut self, name: &str, bytes: Vec<u8>) {
         self.import_artifact_from(name, crate::artifacts::FileSource::Bytes(bytes));

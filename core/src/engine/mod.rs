@@ -397,7 +397,7 @@ pub struct Engine {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ShellRequest {
     /// Show the system's document picker for a `.glb`, `.gltf`, `.stl`, `.ply`, `.obj`, `.xyz`, `.pts`,
-    /// `.las`, `.laz`, `.e57` or `.zip`.
+    /// `.las`, `.laz`, `.e57`, `.usdz` or `.zip`.
     OpenFile,
     /// Show the system's camera permission request (the user has read why, on the core's
     /// camera page, and wants it): see [`Engine::camera_permission_needed`].

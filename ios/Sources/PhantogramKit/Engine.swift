@@ -100,7 +100,7 @@ public final class Engine {
 
     /// What the core's screens ask of the app (`pg_take_shell_request`).
     enum ShellRequest {
-        /// The document picker for a .glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las, .laz, .e57 or .zip.
+        /// The document picker for a .glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las, .laz, .e57, .usdz or .zip.
         case openFile
         /// The system's camera permission request (the core's camera page said why).
         case cameraPermission

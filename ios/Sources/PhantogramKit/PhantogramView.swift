@@ -150,10 +150,11 @@ public final class PhantogramView: UIView, UIDocumentPickerDelegate {
     }
 
     /// The core's menu asked for a file: the system's document browser for glTF, STL, PLY, OBJ,
-    /// point clouds as text (.xyz, .pts), laser scans (.las, .laz, .e57) and zip files.
+    /// point clouds as text (.xyz, .pts), laser scans (.las, .laz, .e57), USD (.usdz, .usd, .usda,
+    /// .usdc) and zip files.
     private func presentDocumentPicker() {
         var types: [UTType] = [.zip]
-        for ext in ["glb", "gltf", "stl", "ply", "obj", "xyz", "pts", "las", "laz", "e57"] {
+        for ext in ["glb", "gltf", "usdz", "usd", "usda", "usdc", "stl", "ply", "obj", "xyz", "pts", "las", "laz", "e57"] {
             if let t = UTType(filenameExtension: ext) { types.append(t) }
         }
         let picker = UIDocumentPickerViewController(forOpeningContentTypes: types, asCopy: true)

@@ -1,5 +1,6 @@
 //! Turning bytes the user opened (a file picker's document, an "Open with" intent, a share) into a
-//! folder of the library: a `.glb`, a self-contained `.gltf`, an `.stl`, `.ply` or `.obj` scan,
+//! folder of the library: a `.glb`, a self-contained `.gltf`, a USD package (`.usdz`, kept whole:
+//! it is a zip, but one model) or layer, an `.stl`, `.ply` or `.obj` scan,
 //! a point cloud as text (`.xyz`, `.pts`) or a laser scan (`.las`, `.laz`, `.e57`),
 //! or a zip holding one of those (an OBJ with its materials and textures comes as one) or a
 //! Smithsonian Voyager download (`scene.svx.json` beside its scans).
@@ -24,7 +25,7 @@ pub enum Format {
     Glb,
     GltfJson,
     Zip,
-    /// STL, PLY, OBJ, a point cloud as text, or a LAS/LAZ or E57 scan.
+    /// USD, STL, PLY, OBJ, a point cloud as text, or a LAS/LAZ or E57 scan.
     Mesh(MeshFormat),
 }
 
@@ -32,6 +33,10 @@ pub enum Format {
 pub fn sniff(bytes: &[u8]) -> Option<Format> {
     if bytes.starts_with(b"glTF") {
         return Some(Format::Glb);
+    }
+    // A USD package is a zip whose first file is a USD layer: one model, kept whole.
+    if let Some(usd @ MeshFormat::Usdz) = MeshFormat::sniff(bytes) {
+        return Some(Format::Mesh(usd));
     }
     if bytes.starts_with(b"PK\x03\x04") || bytes.starts_with(b"PK\x05\x06") {
         return Some(Format::Zip);
@@ -123,7 +128,7 @@ fn copy(from: &mut impl Read, to: &mut std::fs::File) -> std::io::Result<u64> {
 }
 
 /// The model an unpacked folder holds: the shallowest Voyager scene's folder, else its only
-/// `.glb`/`.gltf`/`.stl`/`.ply`/`.obj`/`.xyz`/`.pts`/`.las`/`.laz`/`.e57` file, else one of the variants of one glTF
+/// `.glb`/`.gltf`/`.usdz`/`.usd(a|c)`/`.stl`/`.ply`/`.obj`/`.xyz`/`.pts`/`.las`/`.laz`/`.e57` file, else one of the variants of one glTF
 /// model laid out as the Khronos samples are ([`khronos_variant`]).
 pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> {
     let mut scenes = Vec::new();
@@ -152,6 +157,9 @@ pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> 
     if let Some(variant) = khronos_variant(&models) {
         return Ok(variant);
     }
+    if let Some(root) = usd_root(&models, folder) {
+        return Ok(root);
+    }
     match models.len() {
         1 => Ok(models.remove(0)),
         0 => Err(LibraryError::NoModel {
@@ -169,6 +177,22 @@ pub fn find_model(folder: &Path, source: &str) -> Result<PathBuf, LibraryError> 
                 models: names,
             })
         }
+    }
+}
+
+/// Where `models` are all loose USD layers (`.usd`, `.usda`, `.usdc`) and one of them lies higher
+/// in `folder` than the others: that one, the stage's root (an exporter puts the layers it
+/// references beside or below it). `None` otherwise.
+fn usd_root(models: &[PathBuf], folder: &Path) -> Option<PathBuf> {
+    let is_layer = |p: &Path| matches!(MeshFormat::of(p), Some(MeshFormat::Usd));
+    if models.len() < 2 || !models.iter().all(|p| is_layer(p)) {
+        return None;
+    }
+    let depth = |p: &Path| p.strip_prefix(folder).map_or(usize::MAX, |r| r.components().count());
+    let top = models.iter().map(|p| depth(p)).min()?;
+    match models.iter().filter(|p| depth(p) == top).collect::<Vec<_>>().as_slice() {
+        [root] => Some((*root).clone()),
+        _ => None,
     }
 }
 
@@ -252,10 +276,47 @@ mod tests {
         ));
     }
 
+    /// A loose USD stage with its parts below it gives its root; two roots side by side, or a
+    /// layer beside another kind of model, stay an error.
+    #[test]
+    fn a_usd_stages_root_is_its_model() {
+        let dir = phantogram_testkit::Scratch::new("usd-root");
+        let write = |rel: &str| {
+            let path = dir.join(rel);
+            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+            std::fs::write(&path, b"#usda 1.0\n").unwrap();
+        };
+        write("Stage/scene.usdc");
+        write("Stage/parts/knob.usda");
+        write("Stage/parts/base.usd");
+        let found = find_model(&dir.join("Stage"), "Stage").unwrap();
+        assert!(found.ends_with("Stage/scene.usdc"), "{}", found.display());
+        write("Stage/other.usda");
+        assert!(matches!(
+            find_model(&dir.join("Stage"), "Stage"),
+            Err(LibraryError::SeveralModels { .. })
+        ));
+        write("Mixed/scene.usda");
+        write("Mixed/parts/scan.ply");
+        assert!(matches!(
+            find_model(&dir.join("Mixed"), "Mixed"),
+            Err(LibraryError::SeveralModels { .. })
+        ));
+    }
+
     #[test]
     fn formats_are_told_by_their_first_bytes() {
         assert_eq!(sniff(b"glTF\x02\0\0\0"), Some(Format::Glb));
         assert_eq!(sniff(b"PK\x03\x04rest"), Some(Format::Zip));
+        // A zip whose first file is a USD layer is a USD package, one model.
+        let mut usdz = b"PK\x03\x04".to_vec();
+        usdz.resize(26, 0);
+        usdz.extend_from_slice(&10u16.to_le_bytes());
+        usdz.extend_from_slice(&[0, 0]);
+        usdz.extend_from_slice(b"scene.usdc");
+        assert_eq!(sniff(&usdz), Some(Format::Mesh(MeshFormat::Usdz)));
+        assert_eq!(sniff(b"PXR-USDC\x00\x08"), Some(Format::Mesh(MeshFormat::Usd)));
+        assert_eq!(sniff(b"#usda 1.0\n"), Some(Format::Mesh(MeshFormat::Usd)));
         assert_eq!(sniff(b"\xEF\xBB\xBF \n {\"asset\":{}}"), Some(Format::GltfJson));
         assert_eq!(sniff(b"\x89PNG\r\n"), None);
         assert_eq!(sniff(b""), None);

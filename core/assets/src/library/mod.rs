@@ -53,7 +53,7 @@ pub enum LibraryError {
     #[error("{message}")]
     Invalid { message: String, error: Box<ModelError> },
     #[error(
-        "{name}: not a model this app opens (a .glb, .gltf, .stl, .ply or .obj, a point cloud as .xyz, .pts, .las, .laz or .e57, or a .zip holding one)"
+        "{name}: not a model this app opens (a .glb, .gltf, .usdz, .stl, .ply or .obj, a point cloud as .xyz, .pts, .las, .laz or .e57, or a .zip holding one)"
     )]
     UnknownFormat { name: String },
     #[error("{name}: a damaged or unsupported zip archive: {message}")]
@@ -514,7 +514,8 @@ fn names_in(dir: &Path) -> Vec<String> {
 
 /// The kinds of model file the library opens, by extension, as messages to the user name them
 /// (each one `is_model_name` accepts; a zip holding one is opened too).
-pub const MODEL_FILE_TYPES: &str = ".glb, .gltf, .stl, .ply, .obj, .xyz, .pts, .las, .laz or .e57";
+pub const MODEL_FILE_TYPES: &str =
+    ".glb, .gltf, .usdz, .usd, .usda, .usdc, .stl, .ply, .obj, .xyz, .pts, .las, .laz or .e57";
 
 /// A file name the model loader opens: glTF, or a format of `model::MeshFormat`.
 pub(crate) fn is_model_name(name: &str) -> bool {

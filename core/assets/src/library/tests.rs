@@ -269,7 +269,7 @@ fn the_model_file_types_named_are_those_opened() {
         .split([',', ' '])
         .filter(|word| word.starts_with('.'))
         .collect();
-    assert_eq!(named.len(), 10, "{MODEL_FILE_TYPES}");
+    assert_eq!(named.len(), 14, "{MODEL_FILE_TYPES}");
     for extension in named {
         assert!(is_model_name(&format!("scan{extension}")), "{extension}");
         assert!(

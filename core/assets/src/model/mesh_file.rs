@@ -24,7 +24,7 @@ use std::path::Path;
 use glam::{Mat4, Vec3};
 
 use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file};
-use super::{Material, Mesh, Model, Primitive, Vertex, e57, las, ply, point_cloud, stl, xyz};
+use super::{Material, Mesh, Model, Primitive, Vertex, e57, las, ply, point_cloud, stl, usd_files, xyz};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
 
@@ -63,6 +63,10 @@ pub enum MeshFormat {
     Las,
     /// Laser scans in ASTM E57 (the `e57` module).
     E57,
+    /// A USD package (`.usdz`: the root layer and its files in one zip; the `usd` module).
+    Usdz,
+    /// A USD layer alone (`.usd`, `.usda`, `.usdc`), with the files beside it.
+    Usd,
 }
 
 impl MeshFormat {
@@ -76,6 +80,8 @@ impl MeshFormat {
             "xyz" | "pts" => Some(MeshFormat::Xyz),
             "las" | "laz" => Some(MeshFormat::Las),
             "e57" => Some(MeshFormat::E57),
+            "usdz" => Some(MeshFormat::Usdz),
+            "usd" | "usda" | "usdc" => Some(MeshFormat::Usd),
             _ => None,
         }
     }
@@ -84,6 +90,12 @@ impl MeshFormat {
     /// by its first line, STL by its first word or by a binary file's exact size, OBJ by its
     /// first statement that is not a comment (a vertex, a group, a material library…).
     pub fn sniff(bytes: &[u8]) -> Option<MeshFormat> {
+        if usd_files::is_package(bytes) {
+            return Some(MeshFormat::Usdz);
+        }
+        if usd_files::is_layer(bytes) {
+            return Some(MeshFormat::Usd);
+        }
         if bytes.starts_with(b"ply\n") || bytes.starts_with(b"ply\r\n") {
             return Some(MeshFormat::Ply);
         }
@@ -118,6 +130,7 @@ impl MeshFormat {
             MeshFormat::Xyz => "point cloud",
             MeshFormat::Las => "LAS",
             MeshFormat::E57 => "E57",
+            MeshFormat::Usdz | MeshFormat::Usd => "USD",
         }
     }
 
@@ -130,6 +143,9 @@ impl MeshFormat {
             // LAZ too: the header, not the name, says whether the points are compressed.
             MeshFormat::Las => "las",
             MeshFormat::E57 => "e57",
+            MeshFormat::Usdz => "usdz",
+            // The reader tells the text format from the binary one by its first bytes.
+            MeshFormat::Usd => "usd",
         }
     }
 }
@@ -137,8 +153,10 @@ impl MeshFormat {
 /// Loads an STL or PLY file (`format`) into a model of one primitive, or an OBJ with its
 /// materials, within `budget`.
 pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &Progress) -> Result<Model, ModelError> {
-    if format == MeshFormat::Obj {
-        return super::obj::load(path, budget, progress);
+    match format {
+        MeshFormat::Obj => return super::obj::load(path, budget, progress),
+        MeshFormat::Usdz | MeshFormat::Usd => return super::usd::load(path, budget, progress),
+        _ => {}
     }
     let cancelled = |_| ModelError::Cancelled {
         path: path.to_path_buf(),

@@ -18,7 +18,6 @@
 use std::cell::RefCell;
 use std::path::Path;
 
-use super::encoded_image::Encoded;
 use super::loader::{
     MAX_COORDINATE, ModelError, join_and_check_draws, model_name, over_budget, read_model_file, resolve_inside,
 };
@@ -244,32 +243,10 @@ fn texture(
             return Ok(None);
         }
     };
-    let what = || format!("texture {name:.80}");
-    let header = match Encoded::probe(&raw) {
-        Ok(header) => header,
-        Err(message) => {
-            warnings.push(format!("{}: {message}: left out", what()));
-            return Ok(None);
-        }
-    };
-    let fitted = spending
-        .charge_image(what, header.width, header.height)
-        .map_err(|e| over_budget(path, e))?;
-    match header.decode(&raw, fitted, memory) {
-        Ok(decoded) => {
-            warnings.extend(header.scaled_down_note(&what(), fitted));
-            images.push(Image {
-                name: name.to_owned(),
-                width: decoded.width(),
-                height: decoded.height(),
-                rgba8: decoded.into_raw(),
-                basis: None,
-            });
-            Ok(Some(images.len() - 1))
-        }
-        Err(message) => {
-            warnings.push(format!("{}: {message}: left out", what()));
-            Ok(None)
-        }
-    }
+    Ok(
+        super::file_texture::decode(name, &raw, path, spending, warnings)?.map(|image| {
+            images.push(image);
+            images.len() - 1
+        }),
+    )
 }

@@ -308,14 +308,16 @@ class MainActivity : ComponentActivity(), SurfaceHolder.Callback {
         /** What the document picker offers: glTF binary and JSON, STL, PLY and OBJ (under the types
          *  apps report them as), point clouds as text (.xyz and .pts: reported as plain text, or
          *  as the molecule format that shares the .xyz name), laser scans (.las, .laz; an .e57
-         *  comes as octet-stream), zip (Voyager downloads), and octet-stream, as which many
-         *  providers report a .glb or .stl. The core recognises each by its bytes. */
+         *  comes as octet-stream), USD (.usdz and loose layers, under their IANA types), zip
+         *  (Voyager downloads), and octet-stream, as which many providers report a .glb or .stl.
+         *  The core recognises each by its bytes. */
         val MODEL_TYPES = arrayOf(
             "model/gltf-binary", "model/gltf+json",
             "model/stl", "model/x.stl-binary", "model/x.stl-ascii", "application/sla", "application/vnd.ms-pki.stl",
             "application/ply", "model/ply", "model/obj",
             "text/plain", "chemical/x-xyz",
             "application/vnd.las", "application/vnd.laszip",
+            "model/vnd.usdz+zip", "model/vnd.pixar.usd",
             "application/zip", "application/octet-stream"
         )
     }

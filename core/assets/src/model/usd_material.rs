@@ -1,0 +1,272 @@
+//! The glTF material for a USD material's `UsdPreviewSurface` (`usd_preview_surface`), its
+//! textures found among the stage's files and decoded within the budget.
+//!
+//! * **Textures** are named relative to the layer that authored them, which the reader does not
+//!   say: each layer read is tried as the anchor, the root first; in a package, the one file of
+//!   that name is the last resort. Each file is decoded once; one that cannot be found or decoded
+//!   is left out with a warning.
+//! * **Metallic and roughness**: constants, or glTF's one texture (roughness in G, metallic in B):
+//!   the file itself where it already is that (the same file, read through its `g` and `b`), else
+//!   packed from the files and channels named (the second resampled to the first's size).
+//! * **Opacity**: a constant, or the diffuse texture's alpha; a cut-off where a threshold is set.
+//!
+//! **Panics**: none.
+
+use std::collections::HashMap;
+use std::path::Path;
+use std::sync::Arc;
+
+use super::loader::ModelError;
+use super::usd_files::{Files, anchored};
+use super::usd_preview_surface::{Channel, Input, Surface, TextureInput};
+use super::{AlphaMode, Image, Material, Sampler, TextureRef};
+use crate::budget::Spending;
+
+/// The textures of a stage, read and decoded once each.
+pub(super) struct Textures<'a> {
+    pub files: &'a Files,
+    /// The layers read (each tried as the anchor of a texture's path).
+    pub layers: &'a [String],
+    /// The model's file (for messages).
+    pub path: &'a Path,
+    pub decoded: HashMap<String, Option<Arc<Image>>>,
+}
+
+impl Textures<'_> {
+    /// The texture file `file` (as authored in some layer), decoded; `None` (with a warning)
+    /// where it cannot be found or decoded.
+    fn get(
+        &mut self,
+        file: &str,
+        spending: &mut Spending,
+        warnings: &mut Vec<String>,
+    ) -> Result<Option<Arc<Image>>, ModelError> {
+        if let Some(known) = self.decoded.get(file) {
+            return Ok(known.clone());
+        }
+        // The layer naming it is not known here: each layer read is tried as its anchor, the
+        // root first; in a package, the one file of that name is the last resort.
+        let mut candidates: Vec<String> = self.layers.iter().filter_map(|l| anchored(file, Some(l))).collect();
+        candidates.extend(anchored(file, None));
+        let base = file.rsplit('/').next().unwrap_or(file);
+        let by_name: Vec<&str> = self
+            .files
+            .names()
+            .into_iter()
+            .filter(|n| n.rsplit('/').next() == Some(base))
+            .collect();
+        if let [only] = by_name.as_slice() {
+            candidates.push((*only).to_owned());
+        }
+        let mut raw = Err("names a place outside the artifact's files".to_owned());
+        for candidate in &candidates {
+            raw = self.files.read(candidate);
+            if raw.is_ok() {
+                break;
+            }
+        }
+        let image = match raw {
+            Ok(raw) => super::file_texture::decode(file, &raw, self.path, spending, warnings)?.map(Arc::new),
+            Err(message) => {
+                warnings.push(format!("texture {file:.80} not read ({message}): left out"));
+                None
+            }
+        };
+        self.decoded.insert(file.to_owned(), image.clone());
+        Ok(image)
+    }
+}
+
+/// The glTF material for the surface of the USD material `name`.
+pub(super) fn material_of(
+    name: &str,
+    surface: &Surface,
+    textures: &mut Textures,
+    spending: &mut Spending,
+    images: &mut Vec<Image>,
+    warnings: &mut Vec<String>,
+) -> Result<Material, ModelError> {
+    let mut material = Material {
+        name: name.rsplit('/').next().unwrap_or(name).to_owned(),
+        base_color: [0.18, 0.18, 0.18, 1.0],
+        metallic: 0.0,
+        roughness: 0.5,
+        ..Material::default()
+    };
+    let add = |image: &Arc<Image>, images: &mut Vec<Image>| {
+        // The same texture for two inputs is one image.
+        images
+            .iter()
+            .position(|i| i.name == image.name && i.rgba8 == image.rgba8)
+            .unwrap_or_else(|| {
+                images.push(Image::clone(image));
+                images.len() - 1
+            })
+    };
+    let reference = |image: usize, input: &TextureInput| TextureRef {
+        image,
+        tex_coord: 0,
+        transform: Default::default(),
+        sampler: Sampler {
+            wrap_u: input.wrap[0],
+            wrap_v: input.wrap[1],
+            ..Sampler::default()
+        },
+    };
+    // Diffuse colour, and opacity where it is the same texture's alpha.
+    let mut base_image = None;
+    match &surface.diffuse {
+        Input::Value(c) => material.base_color[..3].copy_from_slice(c),
+        Input::Texture(t) => {
+            if let Some(image) = textures.get(&t.file, spending, warnings)? {
+                let rgb = if t.channel == Channel::Rgb {
+                    image
+                } else {
+                    Arc::new(packed(
+                        &[
+                            (Some((&image, t.channel)), 0),
+                            (Some((&image, t.channel)), 1),
+                            (Some((&image, t.channel)), 2),
+                        ],
+                        &image.name,
+                    ))
+                };
+                material.base_color = [t.scale[0], t.scale[1], t.scale[2], 1.0];
+                base_image = Some((rgb, t.clone()));
+            }
+        }
+        Input::Unset => {}
+    }
+    match &surface.opacity {
+        Input::Value(o) => material.base_color[3] = o.clamp(0.0, 1.0),
+        Input::Texture(t) => match &base_image {
+            Some((_, diffuse)) if diffuse.file == t.file && t.channel == Channel::A => {
+                material.base_color[3] = t.scale[3];
+            }
+            _ => warnings.push(format!(
+                "material {name:.80}: its opacity is a texture other than its colour's alpha: drawn opaque"
+            )),
+        },
+        Input::Unset => {}
+    }
+    let cut = surface.opacity_threshold;
+    let see_through = material.base_color[3] < 1.0 || surface.opacity.texture().is_some();
+    material.alpha = if cut > 0.0 && see_through {
+        AlphaMode::Mask(cut)
+    } else if see_through && base_image.is_some() || material.base_color[3] < 1.0 {
+        AlphaMode::Blend
+    } else {
+        AlphaMode::Opaque
+    };
+    if let Some((image, input)) = &base_image {
+        let index = add(image, images);
+        material.base_color_texture = Some(reference(index, input));
+    }
+    // Metallic and roughness: constants, or textures packed as glTF's (G roughness, B metallic).
+    let roughness_texture = match surface.roughness.texture() {
+        Some(t) => textures.get(&t.file, spending, warnings)?.map(|i| (i, t.clone())),
+        None => None,
+    };
+    let metallic_texture = match surface.metallic.texture() {
+        Some(t) => textures.get(&t.file, spending, warnings)?.map(|i| (i, t.clone())),
+        None => None,
+    };
+    material.roughness = surface.roughness.value_or(0.5).clamp(0.0, 1.0);
+    material.metallic = surface.metallic.value_or(0.0).clamp(0.0, 1.0);
+    if roughness_texture.is_some() || metallic_texture.is_some() {
+        let first = roughness_texture
+            .as_ref()
+            .or(metallic_texture.as_ref())
+            .map(|(_, t)| t.clone());
+        let same_as_gltf = matches!((&roughness_texture, &metallic_texture),
+            (Some((r, rt)), Some((m, mt))) if Arc::ptr_eq(r, m) && rt.channel == Channel::G && mt.channel == Channel::B);
+        let image = if same_as_gltf {
+            roughness_texture.as_ref().map(|(i, _)| Image::clone(i))
+        } else {
+            let r = roughness_texture.as_ref().map(|(i, t)| (i, t.channel));
+            let m = metallic_texture.as_ref().map(|(i, t)| (i, t.channel));
+            let label = format!("{} (roughness, metallic)", material.name);
+            Some(packed(&[(None, 0), (r, 1), (m, 2)], &label))
+        };
+        if let Some((_, t)) = &roughness_texture {
+            material.roughness = t.scale[0];
+        }
+        if let Some((_, t)) = &metallic_texture {
+            material.metallic = t.scale[0];
+        }
+        if let (Some(image), Some(first)) = (image, first) {
+            let index = add(&Arc::new(image), images);
+            material.metallic_roughness_texture = Some(reference(index, &first));
+        }
+    }
+    if let Some(t) = &surface.normal
+        && let Some(image) = textures.get(&t.file, spending, warnings)?
+    {
+        let index = add(&image, images);
+        material.normal_texture = Some((reference(index, t), 1.0));
+    }
+    if let Some(t) = &surface.occlusion
+        && let Some(image) = textures.get(&t.file, spending, warnings)?
+    {
+        let image = if t.channel.offset() == 0 {
+            image
+        } else {
+            Arc::new(packed(
+                &[(Some((&image, t.channel)), 0)],
+                &format!("{} (occlusion)", image.name),
+            ))
+        };
+        let index = add(&image, images);
+        material.occlusion_texture = Some((reference(index, t), t.scale[0]));
+    }
+    match &surface.emissive {
+        Input::Value(c) => material.emissive = *c,
+        Input::Texture(t) => {
+            if let Some(image) = textures.get(&t.file, spending, warnings)? {
+                let index = add(&image, images);
+                material.emissive = [t.scale[0], t.scale[1], t.scale[2]];
+                material.emissive_texture = Some(reference(index, t));
+            }
+        }
+        Input::Unset => {}
+    }
+    Ok(material)
+}
+
+/// A channel of an image, or none (white).
+type Source<'a> = Option<(&'a Arc<Image>, Channel)>;
+
+/// An image whose channels are channels of source images (each pair: the source and its channel,
+/// the channel written, 0–3) (resampled to the
+/// first source's size, nearest texel), white where no source is given, alpha opaque unless
+/// set.
+fn packed(sources: &[(Source, usize)], name: &str) -> Image {
+    let (width, height) = sources
+        .iter()
+        .find_map(|(s, _)| s.map(|(i, _)| (i.width.max(1), i.height.max(1))))
+        .unwrap_or((1, 1));
+    let mut rgba8 = vec![255u8; width as usize * height as usize * 4];
+    for (source, out) in sources {
+        let Some((image, channel)) = source else { continue };
+        let (w, h) = (image.width.max(1) as usize, image.height.max(1) as usize);
+        for y in 0..height as usize {
+            let sy = y * h / height as usize;
+            for x in 0..width as usize {
+                let sx = x * w / width as usize;
+                let texel = image
+                    .rgba8
+                    .get((sy * w + sx) * 4 + channel.offset())
+                    .copied()
+                    .unwrap_or(255);
+                rgba8[(y * width as usize + x) * 4 + out] = texel;
+            }
+        }
+    }
+    Image {
+        name: name.to_owned(),
+        width,
+        height,
+        rgba8,
+        basis: None,
+    }
+}

@@ -1,0 +1,364 @@
+//! Artifacts in USD (`.usdz` packages and loose layers) load as models in glTF's frame, with
+//! their UsdPreviewSurface materials and textures, reading nothing outside their own files.
+//! Before, neither was read. The reference files were written by Pixar's own library
+//! (`tests/data/usd/reference_usd.py`), not by the crate that reads them.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use phantogram_assets::budget::ResourceBudget;
+use phantogram_assets::library::Library;
+use phantogram_assets::model::{AlphaMode, Model, ModelError, load_model};
+use phantogram_assets::progress::Progress;
+use phantogram_testkit::Scratch;
+
+fn data(file: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/usd").join(file)
+}
+
+/// Within 10 µm.
+fn near(a: Vec3, b: Vec3) -> bool {
+    (a - b).abs().max_element() < 1e-5
+}
+
+/// The reference stage (`reference_usd.py`): a box 40 × 20 × 10 cm, scaled from a 10 cm cube on
+/// its own prim, turned 90° about +z and moved 100 cm along +x by its parent, with a pyramid 5 cm
+/// high referenced from another layer on its top; centimetres with +Z up in the file.
+fn assert_is_the_reference_box(what: &str, model: &Model) {
+    assert!(model.warnings.is_empty(), "{what}: {:?}", model.warnings);
+    // In metres, +Y up: x 0.90–1.10 (the box's 20 cm, turned), up −0.05–0.10 (its 10 cm and the
+    // pyramid's 5 cm), depth ±0.20 (its 40 cm; the file's +y is glTF's −z).
+    let bounds = model.bounds().expect("bounds");
+    assert!(near(bounds.min, Vec3::new(0.90, -0.05, -0.20)), "{what}: {bounds:?}");
+    assert!(near(bounds.max, Vec3::new(1.10, 0.10, 0.20)), "{what}: {bounds:?}");
+    assert_eq!(
+        model.triangle_count(),
+        12 + 6,
+        "{what}: the box's six quads, four sides and a base"
+    );
+    // Every face's front outward from its solid's centre (the winding kept through the turn and
+    // the axes' change).
+    for primitive in &model.primitives {
+        let mesh = &primitive.mesh;
+        let bounds = mesh.bounds().expect("bounds");
+        let centre = (bounds.min + bounds.max) / 2.0;
+        for tri in mesh.indices.chunks(3) {
+            let p = |k: usize| Vec3::from(mesh.vertices[tri[k] as usize].position);
+            let normal = (p(1) - p(0)).cross(p(2) - p(0));
+            let middle = (p(0) + p(1) + p(2)) / 3.0;
+            assert!(
+                normal.dot(middle - centre) > 0.0,
+                "{what}: a face turned inward at {middle}"
+            );
+        }
+    }
+    // The painted box: its texture (red, green / blue, white) and constants.
+    let painted = model
+        .materials
+        .iter()
+        .position(|m| m.name == "Painted")
+        .expect("the box's material");
+    let material = &model.materials[painted];
+    assert_eq!((material.roughness, material.metallic), (0.3, 0.0), "{what}");
+    assert_eq!(material.alpha, AlphaMode::Opaque);
+    let texture = material.base_color_texture.as_ref().expect("its texture");
+    let image = &model.images[texture.image];
+    assert_eq!((image.width, image.height), (2, 2));
+    assert_eq!(
+        &image.rgba8[..8],
+        &[255, 0, 0, 255, 0, 255, 0, 255],
+        "{what}: the top row red, green"
+    );
+    // The top face's corner at file point (−5, −5, 5) × (4, 2, 1), turned and moved: (110, −20, 5)
+    // cm, glTF (1.10, 0.05, 0.20); its st (0, 0) is the image's bottom left, glTF's uv (0, 1).
+    let box_mesh = &model
+        .primitives
+        .iter()
+        .find(|p| p.material == painted)
+        .expect("the box")
+        .mesh;
+    let corner = box_mesh
+        .vertices
+        .iter()
+        .filter(|v| near(Vec3::from(v.position), Vec3::new(1.10, 0.05, 0.20)))
+        .find(|v| v.normal[1] > 0.99)
+        .expect("the top face's corner");
+    assert_eq!(&corner.uv[..2], &[0.0, 1.0], "{what}");
+    // The referenced pyramid: its own material, from its own layer.
+    let metal = model
+        .materials
+        .iter()
+        .find(|m| m.name == "Metal")
+        .expect("the pyramid's material");
+    assert_eq!(&metal.base_color[..3], &[0.2, 0.4, 0.6], "{what}");
+    assert_eq!((metal.metallic, metal.roughness), (1.0, 0.25), "{what}");
+}
+
+#[test]
+fn usd_files_by_pixars_library_read_as_written() {
+    for file in ["reference-box.usdz", "loose/reference-box.usdc"] {
+        let model = load_model(&data(file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+        assert_is_the_reference_box(file, &model);
+    }
+}
+
+/// Writes `files` (name, text) into a scratch folder and loads its first file.
+fn load_stage(test: &str, files: &[(&str, &str)]) -> Result<Model, ModelError> {
+    let dir = Scratch::new(&format!("usd-files-{test}"));
+    for (name, text) in files {
+        let path = dir.join(name);
+        std::fs::create_dir_all(path.parent().expect("a folder")).expect("folder");
+        std::fs::write(&path, text).expect("write");
+    }
+    load_model(&dir.join(files[0].0))
+}
+
+/// A unit square (two triangles' worth, as one quad) in the plane z = 0, front +z, metres, Z up.
+const SQUARE: &str = r#"
+        int[] faceVertexCounts = [4]
+        int[] faceVertexIndices = [0, 1, 2, 3]
+        point3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]"#;
+
+#[test]
+fn a_stage_reads_nothing_outside_its_own_files() {
+    // The layer sits in `inner/`; beside the folder lie a layer and a texture it names by `..`
+    // and by an absolute path. Neither is read; the square itself is drawn, and the user is told.
+    let dir_layer = format!(
+        r#"#usda 1.0
+(
+    metersPerUnit = 1
+    upAxis = "Z"
+)
+def Mesh "Square" (
+    prepend references = @../secret.usda@
+)
+{{{SQUARE}
+    rel material:binding = </Look>
+}}
+def "Stolen" (
+    prepend references = @/etc/hostname@
+)
+{{
+}}
+def Material "Look"
+{{
+    token outputs:surface.connect = </Look/Surface.outputs:surface>
+    def Shader "Surface"
+    {{
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </Look/Tex.outputs:rgb>
+        token outputs:surface
+    }}
+    def Shader "Tex"
+    {{
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @../secret.png@
+        color3f outputs:rgb
+    }}
+}}
+"#
+    );
+    let secret = format!("#usda 1.0\ndef Mesh \"Secret\"\n{{{SQUARE}\n}}\n");
+    let model = load_stage(
+        "outside",
+        &[
+            ("inner/scene.usda", &dir_layer),
+            ("secret.usda", &secret),
+            ("secret.png", "not read"),
+        ],
+    )
+    .expect("the square loads");
+    assert_eq!(model.triangle_count(), 2, "only the square's own quad");
+    assert!(model.images.is_empty(), "no texture read from outside");
+    let said = model.warnings.join("\n");
+    assert!(said.contains("secret.png"), "the texture left out is named: {said}");
+    assert!(said.contains("secret.usda"), "the reference left out is named: {said}");
+}
+
+#[test]
+fn mirrored_and_left_handed_meshes_keep_their_fronts() {
+    // One square four ways, each facing +z (glTF's +y; Z up in the file): plain (wound
+    // counter-clockwise seen from +z); mirrored across x by its transform (a mirror across a
+    // vertical plane leaves a floor tile facing up, though it winds the square's corners the other
+    // way round); left-handed, wound clockwise (its front by the left-hand rule); and both.
+    let mesh = |name: &str, indices: &str, extra: &str| {
+        format!(
+            "def Mesh \"{name}\"\n{{\n    int[] faceVertexCounts = [4]\n    int[] faceVertexIndices = [{indices}]\n    point3f[] points = [(0, 0, 0), (1, 0, 0), (1, 1, 0), (0, 1, 0)]\n{extra}}}\n"
+        )
+    };
+    let mirror = "    float3 xformOp:scale = (-1, 1, 1)\n    uniform token[] xformOpOrder = [\"xformOp:scale\"]\n";
+    let left = "    uniform token orientation = \"leftHanded\"\n";
+    let stage = format!(
+        "#usda 1.0\n(\n    metersPerUnit = 1\n    upAxis = \"Z\"\n)\n{}{}{}{}",
+        mesh("Plain", "0, 1, 2, 3", ""),
+        mesh("Mirrored", "0, 1, 2, 3", mirror),
+        mesh("Left", "0, 3, 2, 1", left),
+        mesh("Both", "0, 3, 2, 1", &format!("{mirror}{left}")),
+    );
+    let model = load_stage("handedness", &[("scene.usda", &stage)]).expect("loads");
+    assert_eq!(model.triangle_count(), 8);
+    for primitive in &model.primitives {
+        let mesh = &primitive.mesh;
+        for tri in mesh.indices.chunks(3) {
+            let p = |k: usize| Vec3::from(mesh.vertices[tri[k] as usize].position);
+            let normal = (p(1) - p(0)).cross(p(2) - p(0));
+            assert!(normal.y > 0.0, "a square at {} faces {normal}", p(0));
+        }
+    }
+}
+
+#[test]
+fn face_subsets_display_colours_and_the_default_unit() {
+    // Centimetres by USD's fallback (no metersPerUnit), Y up by its fallback. Two quads: the first
+    // bound to a red material through a face subset, the second to the mesh's blue one; a second
+    // mesh with only a display colour (green); a third with neither (plaster).
+    let stage = r#"#usda 1.0
+def Mesh "Two" (
+    prepend apiSchemas = ["MaterialBindingAPI"]
+)
+{
+    int[] faceVertexCounts = [4, 4]
+    int[] faceVertexIndices = [0, 1, 2, 3, 1, 4, 5, 2]
+    point3f[] points = [(0, 0, 0), (100, 0, 0), (100, 100, 0), (0, 100, 0), (200, 0, 0), (200, 100, 0)]
+    rel material:binding = </Blue>
+    def GeomSubset "First" (
+        prepend apiSchemas = ["MaterialBindingAPI"]
+    )
+    {
+        uniform token elementType = "face"
+        uniform token familyName = "materialBind"
+        int[] indices = [0]
+        rel material:binding = </Red>
+    }
+}
+def Mesh "Green"
+{
+    int[] faceVertexCounts = [3]
+    int[] faceVertexIndices = [0, 1, 2]
+    point3f[] points = [(0, 0, 10), (100, 0, 10), (0, 100, 10)]
+    color3f[] primvars:displayColor = [(0, 1, 0)] (
+        interpolation = "constant"
+    )
+}
+def Mesh "Bare"
+{
+    int[] faceVertexCounts = [3]
+    int[] faceVertexIndices = [0, 1, 2]
+    point3f[] points = [(0, 0, 20), (100, 0, 20), (0, 100, 20)]
+}
+def Material "Red"
+{
+    token outputs:surface.connect = </Red/S.outputs:surface>
+    def Shader "S"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor = (1, 0, 0)
+        token outputs:surface
+    }
+}
+def Material "Blue"
+{
+    token outputs:surface.connect = </Blue/S.outputs:surface>
+    def Shader "S"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor = (0, 0, 1)
+        float inputs:opacity = 0.5
+        token outputs:surface
+    }
+}
+"#;
+    let model = load_stage("subsets", &[("scene.usda", stage)]).expect("loads");
+    let bounds = model.bounds().expect("bounds");
+    assert!(near(bounds.max, Vec3::new(2.0, 1.0, 0.2)), "centimetres: {bounds:?}");
+    let colour_of = |name: &str| {
+        let material = model
+            .materials
+            .iter()
+            .position(|m| m.name == name)
+            .unwrap_or_else(|| panic!("{name}"));
+        let triangles: usize = model
+            .primitives
+            .iter()
+            .filter(|p| p.material == material)
+            .map(|p| p.mesh.indices.len() / 3)
+            .sum();
+        (model.materials[material].base_color, triangles)
+    };
+    assert_eq!(colour_of("Red"), ([1.0, 0.0, 0.0, 1.0], 2), "the subset's face");
+    assert_eq!(
+        colour_of("Blue"),
+        ([0.0, 0.0, 1.0, 0.5], 2),
+        "the other face, half see-through"
+    );
+    let blue = model.materials.iter().find(|m| m.name == "Blue").expect("blue");
+    assert_eq!(blue.alpha, AlphaMode::Blend);
+    assert_eq!(colour_of("display colour"), ([0.0, 1.0, 0.0, 1.0], 1));
+    assert_eq!(colour_of("plaster").1, 1);
+}
+
+#[test]
+fn damaged_usd_files_are_named_errors() {
+    let package = std::fs::read(data("reference-box.usdz")).expect("the reference package");
+    let dir = Scratch::new("usd-files-damaged");
+    // Cut short, and with its layer's bytes overwritten.
+    let mut scrambled = package.clone();
+    for b in scrambled.iter_mut().skip(200).take(400) {
+        *b = 0x5a;
+    }
+    for (name, bytes) in [
+        ("cut.usdz", package[..package.len() / 2].to_vec()),
+        ("scrambled.usdz", scrambled),
+        ("empty.usda", b"#usda 1.0\n".to_vec()),
+        ("garbage.usdc", b"PXR-USDC\0\0\0\0 not a crate file".to_vec()),
+    ] {
+        let path = dir.join(name);
+        std::fs::write(&path, &bytes).expect("write");
+        match load_model(&path) {
+            Err(ModelError::Parse { format: "USD", .. } | ModelError::Empty { .. }) => {}
+            other => panic!("{name}: {other:?}"),
+        }
+    }
+}
+
+#[test]
+fn a_usdz_opened_from_bytes_is_kept_whole_and_loaded_whatever_its_name() {
+    let package = std::fs::read(data("reference-box.usdz")).expect("the reference package");
+    let dir = Scratch::new("usd-files-share");
+    let lib = Library::new(Some(dir.to_path_buf()), None);
+    // A zip, but one model: not unpacked into its layers (which would be two "models").
+    let imported = lib
+        .import("document.bin", &package, ResourceBudget::PHONE, &Progress::new())
+        .expect("imported");
+    assert_is_the_reference_box("imported", &imported.model);
+}
+
+/// Every kind of xformOp and op order (`reference_transforms.py`): each triangle's corners where
+/// Pixar's own library puts them (its `UsdGeom.XformCache`), within 1 µm.
+#[test]
+fn transforms_compose_as_pixars_library_composes_them() {
+    let model = load_model(&data("transforms.usda")).expect("loads");
+    let loaded: Vec<Vec3> = model
+        .primitives
+        .iter()
+        .flat_map(|p| p.mesh.vertices.iter().map(|v| Vec3::from(v.position)))
+        .collect();
+    let expected = std::fs::read_to_string(data("transforms-expected.txt")).expect("the expected corners");
+    let mut meshes = 0;
+    for line in expected.lines() {
+        let mut words = line.split_whitespace();
+        let name = words.next().expect("a prim");
+        let numbers: Vec<f32> = words.map(|w| w.parse().expect("a number")).collect();
+        for corner in numbers.chunks(3) {
+            let corner = Vec3::new(corner[0], corner[1], corner[2]);
+            let nearest = loaded.iter().map(|p| p.distance(corner)).fold(f32::MAX, f32::min);
+            assert!(
+                nearest < 1e-6,
+                "{name}: no corner within 1 µm of {corner} (nearest {nearest} m)"
+            );
+        }
+        meshes += 1;
+    }
+    assert_eq!(meshes, 12);
+    assert_eq!(model.triangle_count(), 12);
+}
