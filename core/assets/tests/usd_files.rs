@@ -84,6 +84,13 @@ fn assert_is_the_reference_box(what: &str, model: &Model) {
         .find(|v| v.normal[1] > 0.99)
         .expect("the top face's corner");
     assert_eq!(&corner.uv[..2], &[0.0, 1.0], "{what}");
+    // Its tangent (for normal maps: MikkTSpace, which USD does not store) along increasing s: the
+    // file's +x, turned to +y by the parent, glTF's −z.
+    assert!(
+        near(Vec3::from_slice(&corner.tangent[..3]), Vec3::NEG_Z),
+        "{what}: tangent {:?}",
+        corner.tangent
+    );
     // The referenced pyramid: its own material, from its own layer.
     let metal = model
         .materials

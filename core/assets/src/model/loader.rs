@@ -1092,13 +1092,17 @@ fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
     if a.normals.is_none() {
         mesh.smooth_normals();
     }
-    if a.tangents.is_none()
-        && a.uv0.is_some()
-        && bevy_mikktspace::generate_tangents(&mut MikkGeometry { mesh: &mut mesh }).is_err()
-    {
-        // Degenerate UVs: keep the placeholder tangents; normal maps then shade as flat.
+    if a.tangents.is_none() && a.uv0.is_some() {
+        generate_tangents(&mut mesh);
     }
     Ok(mesh)
+}
+
+/// Gives `mesh` the tangents normal maps are baked against (MikkTSpace, from its positions,
+/// normals and first texture coordinates). Where the coordinates are degenerate the placeholder
+/// tangents stay: normal maps then shade as flat.
+pub(super) fn generate_tangents(mesh: &mut Mesh) {
+    let _ = bevy_mikktspace::generate_tangents(&mut MikkGeometry { mesh });
 }
 
 /// The orientation a Smithsonian Voyager scene gives this model file: Voyager scenes

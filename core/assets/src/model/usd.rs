@@ -34,7 +34,9 @@ use std::sync::Arc;
 use glam::{DMat4, DQuat, DVec3};
 use openusd::{sdf, usd};
 
-use super::loader::{MAX_COORDINATE, ModelError, join_and_check_draws, model_name, over_budget, read_model_file};
+use super::loader::{
+    MAX_COORDINATE, ModelError, generate_tangents, join_and_check_draws, model_name, over_budget, read_model_file,
+};
 use super::usd_files::{Confined, Files, folded, folder_of, is_package};
 use super::usd_material::{Textures, material_of};
 use super::usd_mesh::{Look, ReadMesh, attribute_value, read_mesh};
@@ -467,6 +469,10 @@ fn build_model(
             }
             if mesh.normals.is_none() || built.vertices.iter().any(|v| v.normal == [0.0; 3]) {
                 built.smooth_normals();
+            }
+            // A normal map is baked against MikkTSpace tangents; USD stores none.
+            if mesh.uvs.is_some() {
+                generate_tangents(&mut built);
             }
             primitives.push(Primitive {
                 mesh: built,
