@@ -1905,6 +1905,31 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
     Ok(model)
 }
 
+/// Whether every vertex of `mesh` (the part `what` of the model at `path`) lies at a finite
+/// position within ±[`MAX_COORDINATE`]; else the error naming the first that does not.
+pub(super) fn check_positions(mesh: &Mesh, path: &Path, what: impl FnOnce() -> String) -> Result<(), ModelError> {
+    match mesh.out_of_range_vertex() {
+        Some((i, position)) => Err(ModelError::Data {
+            path: path.to_path_buf(),
+            what: what(),
+            message: format!("vertex {i} lies at {position:?}, not a finite position within ±{MAX_COORDINATE:e}"),
+        }),
+        None => Ok(()),
+    }
+}
+
+/// A model read from a mesh format, finished as glTF's are: refused when it has no triangle to
+/// draw, its parts joined and its draws checked ([`join_and_check_draws`]).
+pub(super) fn finish_mesh_model(mut model: Model, path: &Path, spending: &Spending) -> Result<Model, ModelError> {
+    if model.triangle_count() == 0 {
+        return Err(ModelError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    join_and_check_draws(&mut model, path, spending)?;
+    Ok(model)
+}
+
 /// Joins `model`'s small primitives that share a material ([`super::join`]) and checks what is
 /// then drawn against the budget's primitives.
 pub(super) fn join_and_check_draws(model: &mut Model, path: &Path, spending: &Spending) -> Result<(), ModelError> {

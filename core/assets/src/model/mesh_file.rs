@@ -23,7 +23,7 @@ use std::path::Path;
 
 use glam::{Mat4, Vec3};
 
-use super::loader::{MAX_COORDINATE, ModelError, model_name, over_budget, read_model_file};
+use super::loader::{ModelError, check_positions, model_name, over_budget, read_model_file};
 use super::{Material, Mesh, Model, Primitive, Vertex, e57, las, ply, point_cloud, stl, usd_files, xyz};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
@@ -235,13 +235,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
         _ => {}
     }
     // Checked in the model's frame, as glTF's vertices are after their node transforms.
-    if let Some((i, position)) = mesh.out_of_range_vertex() {
-        return Err(ModelError::Data {
-            path: path.to_path_buf(),
-            what: "the mesh".to_owned(),
-            message: format!("vertex {i} lies at {position:?}, not a finite position within ±{MAX_COORDINATE:e}"),
-        });
-    }
+    check_positions(&mesh, path, || "the mesh".to_owned())?;
     progress.step(0.9).map_err(cancelled)?;
     let coloured = mesh.vertices.iter().any(|v| v.color != [1.0; 4]);
     let mut material = if coloured {

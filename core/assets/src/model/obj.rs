@@ -19,7 +19,7 @@ use std::cell::RefCell;
 use std::path::Path;
 
 use super::loader::{
-    MAX_COORDINATE, ModelError, join_and_check_draws, model_name, over_budget, read_model_file, resolve_inside,
+    ModelError, check_positions, finish_mesh_model, model_name, over_budget, read_model_file, resolve_inside,
 };
 use super::mesh_file::{MeshFormat, scan_colour};
 use super::{AlphaMode, Image, Material, Mesh, Model, Primitive, TextureRef, Vertex};
@@ -128,13 +128,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
             vertices,
             indices: mesh.indices.clone(),
         };
-        if let Some((i, position)) = built.out_of_range_vertex() {
-            return Err(ModelError::Data {
-                path: path.to_path_buf(),
-                what: format!("object {:.60}", m.name),
-                message: format!("vertex {i} lies at {position:?}, not a finite position within ±{MAX_COORDINATE:e}"),
-            });
-        }
+        check_positions(&built, path, || format!("object {:.60}", m.name))?;
         if !has_normals || built.vertices.iter().any(|v| v.normal == [0.0; 3]) {
             built.smooth_normals();
         } else {
@@ -153,7 +147,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
         });
     }
     progress.step(0.9).map_err(cancelled)?;
-    let mut model = Model {
+    let model = Model {
         name: model_name(path),
         primitives,
         materials: model_materials,
@@ -161,13 +155,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
         warnings,
         ..Model::default()
     };
-    if model.triangle_count() == 0 {
-        return Err(ModelError::Empty {
-            path: path.to_path_buf(),
-        });
-    }
-    join_and_check_draws(&mut model, path, &spending)?;
-    Ok(model)
+    finish_mesh_model(model, path, &spending)
 }
 
 /// Row `i` of `n` values in `data`, if there.

@@ -35,7 +35,7 @@ use glam::{DMat4, DQuat, DVec3};
 use openusd::{sdf, usd};
 
 use super::loader::{
-    MAX_COORDINATE, ModelError, generate_tangents, join_and_check_draws, model_name, over_budget, read_model_file,
+    ModelError, check_positions, finish_mesh_model, generate_tangents, model_name, over_budget, read_model_file,
 };
 use super::usd_files::{Confined, Files, folded, folder_of, is_package};
 use super::usd_material::{Textures, material_of};
@@ -458,15 +458,7 @@ fn build_model(
                 })
                 .collect();
             let mut built = Mesh { vertices, indices };
-            if let Some((i, position)) = built.out_of_range_vertex() {
-                return Err(ModelError::Data {
-                    path: path.to_path_buf(),
-                    what: what(),
-                    message: format!(
-                        "vertex {i} lies at {position:?}, not a finite position within ±{MAX_COORDINATE:e}"
-                    ),
-                });
-            }
+            check_positions(&built, path, what)?;
             if mesh.normals.is_none() || built.vertices.iter().any(|v| v.normal == [0.0; 3]) {
                 built.smooth_normals();
             }
@@ -483,7 +475,7 @@ fn build_model(
         }
     }
     progress.step(0.9).map_err(cancelled)?;
-    let mut model = Model {
+    let model = Model {
         name: model_name(path),
         primitives,
         materials,
@@ -491,11 +483,5 @@ fn build_model(
         warnings,
         ..Model::default()
     };
-    if model.triangle_count() == 0 {
-        return Err(ModelError::Empty {
-            path: path.to_path_buf(),
-        });
-    }
-    join_and_check_draws(&mut model, path, spending)?;
-    Ok(model)
+    finish_mesh_model(model, path, spending)
 }
