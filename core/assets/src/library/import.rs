@@ -242,17 +242,19 @@ fn khronos_variant(models: &[PathBuf]) -> Option<PathBuf> {
 mod tests {
     use super::*;
 
+    /// Writes `bytes` at `path`, making its folders.
+    fn write_file(path: &Path, bytes: &[u8]) {
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, bytes).unwrap();
+    }
+
     /// A Khronos sample's folder (Box: glTF, glTF-Binary, glTF-Draco) gives its binary variant;
     /// without it, the plain one; two different models, or a variant beside an unrelated model,
     /// stay an error.
     #[test]
     fn a_khronos_samples_variants_give_one_model() {
         let dir = phantogram_testkit::Scratch::new("khronos-variants");
-        let write = |rel: &str| {
-            let path = dir.join(rel);
-            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-            std::fs::write(&path, b"{}").unwrap();
-        };
+        let write = |rel: &str| write_file(&dir.join(rel), b"{}");
         write("Box/glTF/Box.gltf");
         write("Box/glTF/Box0.bin");
         write("Box/glTF-Draco/Box.gltf");
@@ -281,11 +283,7 @@ mod tests {
     #[test]
     fn a_usd_stages_root_is_its_model() {
         let dir = phantogram_testkit::Scratch::new("usd-root");
-        let write = |rel: &str| {
-            let path = dir.join(rel);
-            std::fs::create_dir_all(path.parent().unwrap()).unwrap();
-            std::fs::write(&path, b"#usda 1.0\n").unwrap();
-        };
+        let write = |rel: &str| write_file(&dir.join(rel), b"#usda 1.0\n");
         write("Stage/scene.usdc");
         write("Stage/parts/knob.usda");
         write("Stage/parts/base.usd");
