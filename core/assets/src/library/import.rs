@@ -242,6 +242,11 @@ fn khronos_variant(models: &[PathBuf]) -> Option<PathBuf> {
 mod tests {
     use super::*;
 
+    /// Whether `folder` is refused as holding several models.
+    fn several_models(folder: &Path) -> bool {
+        matches!(find_model(folder, "folder"), Err(LibraryError::SeveralModels { .. }))
+    }
+
     /// Writes `bytes` at `path`, making its folders.
     fn write_file(path: &Path, bytes: &[u8]) {
         std::fs::create_dir_all(path.parent().unwrap()).unwrap();
@@ -266,16 +271,10 @@ mod tests {
         let found = find_model(&dir.join("Box"), "Box").unwrap();
         assert!(found.ends_with("glTF/Box.gltf"), "{}", found.display());
         write("Box/glTF/Other.gltf");
-        assert!(matches!(
-            find_model(&dir.join("Box"), "Box"),
-            Err(LibraryError::SeveralModels { .. })
-        ));
+        assert!(several_models(&dir.join("Box")));
         write("Two/a/Box.gltf");
         write("Two/b/Box.gltf");
-        assert!(matches!(
-            find_model(&dir.join("Two"), "Two"),
-            Err(LibraryError::SeveralModels { .. })
-        ));
+        assert!(several_models(&dir.join("Two")));
     }
 
     /// A loose USD stage with its parts below it gives its root; two roots side by side, or a
@@ -290,16 +289,10 @@ mod tests {
         let found = find_model(&dir.join("Stage"), "Stage").unwrap();
         assert!(found.ends_with("Stage/scene.usdc"), "{}", found.display());
         write("Stage/other.usda");
-        assert!(matches!(
-            find_model(&dir.join("Stage"), "Stage"),
-            Err(LibraryError::SeveralModels { .. })
-        ));
+        assert!(several_models(&dir.join("Stage")));
         write("Mixed/scene.usda");
         write("Mixed/parts/scan.ply");
-        assert!(matches!(
-            find_model(&dir.join("Mixed"), "Mixed"),
-            Err(LibraryError::SeveralModels { .. })
-        ));
+        assert!(several_models(&dir.join("Mixed")));
     }
 
     #[test]
