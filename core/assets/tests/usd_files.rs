@@ -218,7 +218,8 @@ fn mirrored_and_left_handed_meshes_keep_their_fronts() {
 fn face_subsets_display_colours_and_the_default_unit() {
     // Centimetres by USD's fallback (no metersPerUnit), Y up by its fallback. Two quads: the first
     // bound to a red material through a face subset, the second to the mesh's blue one; a second
-    // mesh with only a display colour (green); a third with neither (plaster).
+    // mesh with only a display colour (green); one coloured by its vertices; one with neither
+    // (plaster).
     let stage = r#"#usda 1.0
 def Mesh "Two" (
     prepend apiSchemas = ["MaterialBindingAPI"]
@@ -245,6 +246,15 @@ def Mesh "Green"
     point3f[] points = [(0, 0, 10), (100, 0, 10), (0, 100, 10)]
     color3f[] primvars:displayColor = [(0, 1, 0)] (
         interpolation = "constant"
+    )
+}
+def Mesh "Painted"
+{
+    int[] faceVertexCounts = [3]
+    int[] faceVertexIndices = [0, 1, 2]
+    point3f[] points = [(0, 0, 30), (100, 0, 30), (0, 100, 30)]
+    color3f[] primvars:displayColor = [(1, 0, 0), (0, 1, 0), (0, 0, 1)] (
+        interpolation = "vertex"
     )
 }
 def Mesh "Bare"
@@ -277,7 +287,7 @@ def Material "Blue"
 "#;
     let model = load_stage("subsets", &[("scene.usda", stage)]).expect("loads");
     let bounds = model.bounds().expect("bounds");
-    assert!(near(bounds.max, Vec3::new(2.0, 1.0, 0.2)), "centimetres: {bounds:?}");
+    assert!(near(bounds.max, Vec3::new(2.0, 1.0, 0.3)), "centimetres: {bounds:?}");
     let colour_of = |name: &str| {
         let material = model
             .materials
@@ -301,6 +311,25 @@ def Material "Blue"
     let blue = model.materials.iter().find(|m| m.name == "Blue").expect("blue");
     assert_eq!(blue.alpha, AlphaMode::Blend);
     assert_eq!(colour_of("display colour"), ([0.0, 1.0, 0.0, 1.0], 1));
+    // A display colour is the material's colour alone, not a vertex tint as well; one that
+    // varies over a mesh is its vertices' colours, over white.
+    let painted = model
+        .materials
+        .iter()
+        .position(|m| m.name == "vertex colours")
+        .expect("painted");
+    for primitive in &model.primitives {
+        let mut colours: Vec<[f32; 4]> = primitive.mesh.vertices.iter().map(|v| v.color).collect();
+        colours.dedup();
+        if primitive.material == painted {
+            assert_eq!(
+                colours,
+                [[1.0, 0.0, 0.0, 1.0], [0.0, 1.0, 0.0, 1.0], [0.0, 0.0, 1.0, 1.0]]
+            );
+        } else {
+            assert_eq!(colours, [[1.0; 4]], "tinted vertices");
+        }
+    }
     assert_eq!(colour_of("plaster").1, 1);
 }
 

@@ -11,21 +11,22 @@
 //!   mirroring transforms keep their faces' fronts. Normals and texture coordinates by their
 //!   interpolation (constant, uniform, vertex, varying, face-varying), indexed or not; corners
 //!   that share all their values share a vertex. Subdivision surfaces are drawn as their control
-//!   meshes. Other kinds of prims (points, curves, cubes, spheres) are not drawn (a warning
-//!   says so).
+//!   meshes (`usd_mesh`). Other kinds of prims (points, curves, cubes, spheres) are not drawn
+//!   (a warning says so).
 //! * **Units and axes**: the stage's `metersPerUnit` (USD's fallback: centimetres) and `upAxis`
 //!   (`Z` turned into glTF's +Y up).
 //! * **Materials**: the one bound to a mesh (or to a face subset of it, `GeomSubset` of family
 //!   `materialBind`), closest binding first, read as its `UsdPreviewSurface`
-//!   (`usd_material`): its textures decoded within the budget, a metallic and a roughness
-//!   texture packed into glTF's one (roughness in G, metallic in B). Texture coordinates are
-//!   the primvar `st` (or the one a texture's primvar reader names). A mesh without a
-//!   material shows its `displayColor`, or else plaster. Texture coordinates are flipped to
-//!   glTF's top-left origin.
+//!   (`usd_preview_surface`) and made a glTF material (`usd_material`): its textures decoded
+//!   within the budget, a metallic and a roughness texture packed into glTF's one (roughness in
+//!   G, metallic in B). Texture coordinates are the primvar `st` (or `st0`, `UVMap`, `uv`,
+//!   `map1`, as exporters name it; else the first of two components), flipped to glTF's top-left
+//!   origin; MikkTSpace tangents are made for normal maps. A mesh without a material shows its
+//!   `displayColor`, or else plaster.
 //!
 //! **Budget**: the package is unpacked within the budget; each mesh is charged before it is
-//! built, each texture before it is decoded. **Panics**: none escape (the reader's become the
-//! file's error).
+//! built, each texture before it is decoded. **Threading**: the caller's thread (the reader's
+//! stage is not shared). **Panics**: none escape (the reader's become the file's error).
 
 use std::collections::HashMap;
 use std::path::Path;
@@ -443,6 +444,9 @@ fn build_model(
                     )
                 })
                 .map_err(|e| over_budget(path, e))?;
+            // Display colours only where they are the look (USD shows them where no material
+            // is bound); a constant one is the look's material colour, not a vertex tint.
+            let colours = mesh.colours.as_ref().filter(|_| scene.looks[look].vertex_colours);
             let vertices = used
                 .iter()
                 .map(|&i| Vertex {
@@ -450,10 +454,7 @@ fn build_model(
                     normal: mesh.normals.as_ref().map_or([0.0; 3], |n| n[i]),
                     tangent: [1.0, 0.0, 0.0, 1.0],
                     uv: mesh.uvs.as_ref().map_or([0.0; 4], |t| [t[i][0], t[i][1], 0.0, 0.0]),
-                    color: mesh
-                        .colours
-                        .as_ref()
-                        .map_or([1.0; 4], |c| [c[i][0], c[i][1], c[i][2], 1.0]),
+                    color: colours.map_or([1.0; 4], |c| [c[i][0], c[i][1], c[i][2], 1.0]),
                     material: [1.0, 1.0],
                 })
                 .collect();
