@@ -398,3 +398,78 @@ fn transforms_compose_as_pixars_library_composes_them() {
     assert_eq!(meshes, 12);
     assert_eq!(model.triangle_count(), 12);
 }
+
+#[test]
+fn opacity_from_the_colour_textures_alpha_is_cut_or_blended() {
+    // A leaf: its colour texture's alpha is its opacity, cut at 0.5; a second material reads its
+    // opacity from another texture, which is not read (drawn opaque, said so).
+    let dir = Scratch::new("usd-files-opacity");
+    let mut png = Vec::new();
+    image::RgbaImage::from_raw(2, 1, vec![0, 200, 0, 255, 0, 200, 0, 0])
+        .expect("2 × 1")
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("png");
+    std::fs::write(dir.join("leaf.png"), &png).expect("write");
+    std::fs::write(dir.join("mask.png"), &png).expect("write");
+    let material = |name: &str, opacity_file: &str| {
+        format!(
+            r#"def Material "{name}"
+{{
+    token outputs:surface.connect = </{name}/S.outputs:surface>
+    def Shader "S"
+    {{
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </{name}/Colour.outputs:rgb>
+        float inputs:opacity.connect = </{name}/Opacity.outputs:a>
+        float inputs:opacityThreshold = 0.5
+        token outputs:surface
+    }}
+    def Shader "Colour"
+    {{
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @leaf.png@
+        color3f outputs:rgb
+    }}
+    def Shader "Opacity"
+    {{
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @{opacity_file}@
+        float outputs:a
+    }}
+}}
+"#
+        )
+    };
+    let mesh = |name: &str, z: u32| {
+        format!(
+            "def Mesh \"{name}Mesh\"\n{{\n    int[] faceVertexCounts = [3]\n    int[] faceVertexIndices = [0, 1, 2]\n    point3f[] points = [(0, 0, {z}), (1, 0, {z}), (0, 1, {z})]\n    rel material:binding = </{name}>\n}}\n"
+        )
+    };
+    let stage = format!(
+        "#usda 1.0\n(\n    metersPerUnit = 1\n)\n{}{}{}{}",
+        mesh("Leaf", 0),
+        mesh("Other", 1),
+        material("Leaf", "leaf.png"),
+        material("Other", "mask.png")
+    );
+    std::fs::write(dir.join("scene.usda"), stage).expect("write");
+    let model = load_model(&dir.join("scene.usda")).expect("loads");
+    let find = |name: &str| model.materials.iter().find(|m| m.name == name).expect(name);
+    let leaf = find("Leaf");
+    assert_eq!(leaf.alpha, AlphaMode::Mask(0.5));
+    let texture = leaf.base_color_texture.as_ref().expect("its texture");
+    assert_eq!(
+        &model.images[texture.image].rgba8[4..8],
+        &[0, 200, 0, 0],
+        "the alpha kept"
+    );
+    assert_eq!(find("Other").alpha, AlphaMode::Opaque);
+    assert!(
+        model
+            .warnings
+            .iter()
+            .any(|w| w.contains("Other") && w.contains("opaque")),
+        "{:?}",
+        model.warnings
+    );
+}

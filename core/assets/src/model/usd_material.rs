@@ -137,11 +137,16 @@ pub(super) fn material_of(
         }
         Input::Unset => {}
     }
+    // Whether the colour texture's alpha is the opacity.
+    let mut alpha_textured = false;
     match &surface.opacity {
         Input::Value(o) => material.base_color[3] = o.clamp(0.0, 1.0),
         Input::Texture(t) => match &base_image {
-            Some((_, diffuse)) if diffuse.file == t.file && t.channel == Channel::A => {
+            Some((_, diffuse))
+                if diffuse.file == t.file && t.channel == Channel::A && diffuse.channel == Channel::Rgb =>
+            {
                 material.base_color[3] = t.scale[3];
+                alpha_textured = true;
             }
             _ => warnings.push(format!(
                 "material {name:.80}: its opacity is a texture other than its colour's alpha: drawn opaque"
@@ -149,14 +154,11 @@ pub(super) fn material_of(
         },
         Input::Unset => {}
     }
-    let cut = surface.opacity_threshold;
-    let see_through = material.base_color[3] < 1.0 || surface.opacity.texture().is_some();
-    material.alpha = if cut > 0.0 && see_through {
-        AlphaMode::Mask(cut)
-    } else if see_through && base_image.is_some() || material.base_color[3] < 1.0 {
-        AlphaMode::Blend
-    } else {
-        AlphaMode::Opaque
+    let see_through = alpha_textured || material.base_color[3] < 1.0;
+    material.alpha = match (see_through, surface.opacity_threshold) {
+        (false, _) => AlphaMode::Opaque,
+        (true, cut) if cut > 0.0 => AlphaMode::Mask(cut),
+        (true, _) => AlphaMode::Blend,
     };
     if let Some((image, input)) = &base_image {
         let index = add(image, images);
