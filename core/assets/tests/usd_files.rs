@@ -473,3 +473,37 @@ fn opacity_from_the_colour_textures_alpha_is_cut_or_blended() {
         model.warnings
     );
 }
+
+#[test]
+fn the_specular_workflow_is_read_as_a_dielectric_and_said_so() {
+    let stage = r#"#usda 1.0
+def Mesh "Tile"
+{
+    int[] faceVertexCounts = [3]
+    int[] faceVertexIndices = [0, 1, 2]
+    point3f[] points = [(0, 0, 0), (100, 0, 0), (0, 100, 0)]
+    rel material:binding = </Glaze>
+}
+def Material "Glaze"
+{
+    token outputs:surface.connect = </Glaze/S.outputs:surface>
+    def Shader "S"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        int inputs:useSpecularWorkflow = 1
+        color3f inputs:specularColor = (1, 1, 1)
+        float inputs:metallic = 1
+        float inputs:roughness = 0.2
+        token outputs:surface
+    }
+}
+"#;
+    let model = load_stage("specular", &[("scene.usda", stage)]).expect("loads");
+    let glaze = model.materials.iter().find(|m| m.name == "Glaze").expect("glaze");
+    assert_eq!((glaze.metallic, glaze.roughness), (0.0, 0.2));
+    assert!(
+        model.warnings.iter().any(|w| w.contains("specular workflow")),
+        "{:?}",
+        model.warnings
+    );
+}

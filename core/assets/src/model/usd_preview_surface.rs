@@ -147,15 +147,21 @@ pub fn read(stage: &usd::Stage, material: &sdf::Path, warnings: &mut Vec<String>
         material: name,
         warnings,
     };
-    if reader.scalar("useSpecularWorkflow")?.value_or(0.0) != 0.0 {
+    // The specular workflow's colour has no place in glTF's model: a dielectric, whatever
+    // `metallic` (unused in that workflow) says.
+    let specular_workflow = reader.scalar("useSpecularWorkflow")?.value_or(0.0) != 0.0;
+    let metallic = if specular_workflow {
         reader.warnings.push(format!(
             "material {name:.80} uses the specular workflow: read as a dielectric (metallic 0)"
         ));
-    }
+        Input::Value(0.0)
+    } else {
+        reader.scalar("metallic")?
+    };
     Ok(Some(Surface {
         diffuse: reader.colour("diffuseColor")?,
         emissive: reader.colour("emissiveColor")?,
-        metallic: reader.scalar("metallic")?,
+        metallic,
         roughness: reader.scalar("roughness")?,
         opacity: reader.scalar("opacity")?,
         opacity_threshold: reader.scalar("opacityThreshold")?.value_or(0.0),
@@ -212,14 +218,12 @@ impl InputReader<'_> {
             if let Some(output) = property.strip_prefix("outputs:")
                 && let Some(id) = shader_id(self.stage, &node)?
             {
-                let id = Some(id);
-                if id.as_deref() == Some("UsdUVTexture") {
+                if id == "UsdUVTexture" {
                     return self.texture(&node, output, input);
                 }
                 self.warnings.push(format!(
-                    "material {:.80}: its {input} comes from a {:.40} node, which is not evaluated: left at its default",
-                    self.material,
-                    id.as_deref().unwrap_or("unnamed")
+                    "material {:.80}: its {input} comes from a {id:.40} node, which is not evaluated: left at its default",
+                    self.material
                 ));
                 return Ok(Source::Nothing);
             }
