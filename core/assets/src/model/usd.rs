@@ -42,7 +42,7 @@ use super::usd_files::{Confined, Files, folded, folder_of, is_package};
 use super::usd_material::{Textures, material_of};
 use super::usd_mesh::{Look, ReadMesh, attribute_value, read_mesh};
 use super::usd_preview_surface::{self, Surface, scalar, text, token, vec3};
-use super::{Material, Mesh, Model, Primitive, Vertex};
+use super::{Image, Material, Mesh, Model, Primitive, Vertex};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
 
@@ -394,7 +394,7 @@ fn build_model(
             None if look.vertex_colours => Material::vertex_coloured_scan(),
             None => match look.display_colour {
                 Some(c) => {
-                    let [r, g, b] = c.map(|v| v as f32 / 1e6);
+                    let [r, g, b] = c;
                     Material {
                         name: "display colour".into(),
                         base_color: [r, g, b, 1.0],
@@ -476,6 +476,12 @@ fn build_model(
         }
     }
     progress.step(0.9).map_err(cancelled)?;
+    // The cache let go, each image has one owner left: moved out, not copied.
+    drop(textures);
+    let images = images
+        .into_iter()
+        .map(|image| Arc::try_unwrap(image).unwrap_or_else(|shared| Image::clone(&shared)))
+        .collect();
     let model = Model {
         name: model_name(path),
         primitives,

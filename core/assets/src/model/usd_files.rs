@@ -18,6 +18,7 @@
 //! **Threading**: [`Files`] is shared (`Arc`) between the resolver, which the reader owns, and
 //! the loader, which reads the textures after the stage is read. **Panics**: none.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::io::{Cursor, Read};
 use std::path::{Path, PathBuf};
@@ -25,6 +26,7 @@ use std::sync::Arc;
 
 use openusd::ar;
 
+use super::le_fields;
 use super::loader::resolve_inside;
 
 /// Most entries read from one package (an artifact's package holds a layer or two and a few
@@ -54,10 +56,10 @@ pub enum Files {
 /// specification requires (a zip of other things is not one).
 pub fn is_package(bytes: &[u8]) -> bool {
     // The first local header: its name's length at bytes 26–28, the name from byte 30.
-    let Some(name_len) = bytes.get(26..28).map(|b| u16::from_le_bytes([b[0], b[1]]) as usize) else {
+    let Some(name_len) = le_fields::u16_at(bytes, 26) else {
         return false;
     };
-    bytes.starts_with(ZIP_SIGNATURE) && bytes.get(30..30 + name_len).is_some_and(is_layer_name)
+    bytes.starts_with(ZIP_SIGNATURE) && bytes.get(30..30 + usize::from(name_len)).is_some_and(is_layer_name)
 }
 
 /// Whether `bytes` are a USD layer alone: the binary format's magic or the text format's header.
@@ -117,12 +119,13 @@ impl Files {
         Ok((Files::Package(entries), root))
     }
 
-    /// The file `name` (a folded path, [`folded`]), or why it cannot be read.
-    pub fn read(&self, name: &str) -> Result<Vec<u8>, String> {
+    /// The file `name` (a folded path, [`folded`]), or why it cannot be read: a package's entry
+    /// lent, a file beside the layer read.
+    pub fn read(&self, name: &str) -> Result<Cow<'_, [u8]>, String> {
         match self {
             Files::Package(entries) => entries
                 .get(name)
-                .cloned()
+                .map(|bytes| Cow::Borrowed(bytes.as_slice()))
                 .ok_or_else(|| "is not in the package".to_owned()),
             Files::Folder {
                 folder,
@@ -130,10 +133,12 @@ impl Files {
                 memory_bytes,
             } => {
                 if name == root.0 {
-                    return Ok(root.1.clone());
+                    return Ok(Cow::Borrowed(&root.1));
                 }
                 let file = resolve_inside(folder, name)?;
-                phantogram_files::read_regular_file(&file, *memory_bytes).map_err(|e| e.to_string())
+                phantogram_files::read_regular_file(&file, *memory_bytes)
+                    .map(Cow::Owned)
+                    .map_err(|e| e.to_string())
             }
         }
     }
@@ -219,7 +224,8 @@ impl ar::Resolver for Confined {
         let name = resolved_path.to_string_lossy();
         self.0
             .read(&name)
-            .map(|bytes| Box::new(Cursor::new(bytes)) as Box<dyn ar::Asset>)
+            // The reader owns what it reads.
+            .map(|bytes| Box::new(Cursor::new(bytes.into_owned())) as Box<dyn ar::Asset>)
             .map_err(|message| std::io::Error::new(std::io::ErrorKind::NotFound, format!("{name:.80} {message}")))
     }
 
@@ -284,7 +290,7 @@ mod tests {
         assert!(!is_layer(b"#usd"));
         let (files, root) = Files::unpack(&zip("scene.usda"), 1 << 20).unwrap();
         assert_eq!(root, "scene.usda");
-        assert_eq!(files.read("scene.usda").unwrap(), b"#usda 1.0\n");
+        assert_eq!(files.read("scene.usda").unwrap().as_ref(), b"#usda 1.0\n");
         assert!(files.read("other.usda").is_err());
         // Over the budget as it inflates.
         assert!(Files::unpack(&zip("scene.usda"), 4).unwrap_err().contains("more than"));

@@ -83,7 +83,7 @@ pub(super) fn material_of(
     surface: &Surface,
     textures: &mut Textures,
     spending: &mut Spending,
-    images: &mut Vec<Image>,
+    images: &mut Vec<Arc<Image>>,
     warnings: &mut Vec<String>,
 ) -> Result<Material, ModelError> {
     let mut material = Material {
@@ -93,13 +93,14 @@ pub(super) fn material_of(
         roughness: 0.5,
         ..Material::default()
     };
-    let add = |image: &Arc<Image>, images: &mut Vec<Image>| {
-        // The same texture for two inputs is one image.
+    let add = |image: &Arc<Image>, images: &mut Vec<Arc<Image>>| {
+        // The same texture for two inputs is one image: the same decoded file (one `Arc` from
+        // `Textures`), else the same name and texels.
         images
             .iter()
-            .position(|i| i.name == image.name && i.rgba8 == image.rgba8)
+            .position(|i| Arc::ptr_eq(i, image) || (i.name == image.name && i.rgba8 == image.rgba8))
             .unwrap_or_else(|| {
-                images.push(Image::clone(image));
+                images.push(Arc::clone(image));
                 images.len() - 1
             })
     };
@@ -175,20 +176,20 @@ pub(super) fn material_of(
     };
     material.roughness = surface.roughness.value_or(0.5).clamp(0.0, 1.0);
     material.metallic = surface.metallic.value_or(0.0).clamp(0.0, 1.0);
-    if roughness_texture.is_some() || metallic_texture.is_some() {
-        let first = roughness_texture
-            .as_ref()
-            .or(metallic_texture.as_ref())
-            .map(|(_, t)| t.clone());
-        let same_as_gltf = matches!((&roughness_texture, &metallic_texture),
-            (Some((r, rt)), Some((m, mt))) if Arc::ptr_eq(r, m) && rt.channel == Channel::G && mt.channel == Channel::B);
-        let image = if same_as_gltf {
-            roughness_texture.as_ref().map(|(i, _)| Image::clone(i))
-        } else {
-            let r = roughness_texture.as_ref().map(|(i, t)| (i, t.channel));
-            let m = metallic_texture.as_ref().map(|(i, t)| (i, t.channel));
-            let label = format!("{} (roughness, metallic)", material.name);
-            Some(packed(&[(None, 0), (r, 1), (m, 2)], &label))
+    if let Some((_, first)) = roughness_texture.as_ref().or(metallic_texture.as_ref()) {
+        let image = match (&roughness_texture, &metallic_texture) {
+            // Already glTF's: one file read through its g and b.
+            (Some((r, rt)), Some((m, mt)))
+                if Arc::ptr_eq(r, m) && rt.channel == Channel::G && mt.channel == Channel::B =>
+            {
+                Arc::clone(r)
+            }
+            _ => {
+                let r = roughness_texture.as_ref().map(|(i, t)| (i, t.channel));
+                let m = metallic_texture.as_ref().map(|(i, t)| (i, t.channel));
+                let label = format!("{} (roughness, metallic)", material.name);
+                Arc::new(packed(&[(None, 0), (r, 1), (m, 2)], &label))
+            }
         };
         if let Some((_, t)) = &roughness_texture {
             material.roughness = t.scale[0];
@@ -196,10 +197,8 @@ pub(super) fn material_of(
         if let Some((_, t)) = &metallic_texture {
             material.metallic = t.scale[0];
         }
-        if let (Some(image), Some(first)) = (image, first) {
-            let index = add(&Arc::new(image), images);
-            material.metallic_roughness_texture = Some(reference(index, &first));
-        }
+        let index = add(&image, images);
+        material.metallic_roughness_texture = Some(reference(index, first));
     }
     if let Some(t) = &surface.normal
         && let Some(image) = textures.get(&t.file, spending, warnings)?

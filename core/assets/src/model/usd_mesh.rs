@@ -31,13 +31,12 @@ pub(super) struct ReadMesh {
 
 /// How a part of a mesh is drawn: its material's path (none: its display colour), and whether
 /// both sides show.
-#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+#[derive(Clone, Debug, PartialEq)]
 pub(super) struct Look {
     pub material: Option<String>,
     pub double_sided: bool,
-    /// The mesh's constant display colour (linear, in millionths: a key), where it has no
-    /// material.
-    pub display_colour: Option<[u32; 3]>,
+    /// The mesh's constant display colour (linear), where it has no material.
+    pub display_colour: Option<[f32; 3]>,
     /// Whether its display colour varies over it (then its vertices' colours).
     pub vertex_colours: bool,
 }
@@ -223,7 +222,7 @@ pub(super) fn read_mesh(
     let base_look = |material: Option<String>| Look {
         display_colour: match (&material, &display) {
             (None, Some(d)) if d.interpolation == Interpolation::Constant => {
-                d.values.first().map(|c| c.map(|v| (v.clamp(0.0, 1.0) * 1e6) as u32))
+                d.values.first().map(|c| c.map(|v| v.clamp(0.0, 1.0) as f32))
             }
             _ => None,
         },
