@@ -1,0 +1,83 @@
+# A glTF binary's meshes (one node level, node transforms applied) and its metallic-roughness
+# materials written as a .usdz by Pixar's own library (PyPI usd-core 26.11; pygltflib, numpy),
+# textures packaged, so that the USD loader can be compared with the glTF one on real models
+# (benchmarks/usd.md). Run in a throwaway environment, never a dependency of the project:
+#   python3 -m venv /tmp/v && /tmp/v/bin/pip install usd-core==26.11 pygltflib numpy
+#   /tmp/v/bin/python benchmarks/usd/glb_to_usdz.py IN.glb OUT.usdz
+import sys, os, io, numpy as np, pygltflib
+from pxr import Usd, UsdGeom, UsdShade, Sdf, Gf, UsdUtils
+src, out = sys.argv[1], sys.argv[2]
+g = pygltflib.GLTF2().load(src)
+blob = g.binary_blob()
+def acc(i):
+    a = g.accessors[i]; v = g.bufferViews[a.bufferView]
+    n = {"SCALAR":1,"VEC2":2,"VEC3":3,"VEC4":4}[a.type]
+    dt = {5126: np.float32, 5125: np.uint32, 5123: np.uint16, 5121: np.uint8}[a.componentType]
+    off = (v.byteOffset or 0) + (a.byteOffset or 0)
+    stride = v.byteStride or n * np.dtype(dt).itemsize
+    raw = np.frombuffer(blob, dtype=np.uint8, count=stride*(a.count-1)+n*np.dtype(dt).itemsize, offset=off)
+    return np.lib.stride_tricks.as_strided(raw.view(dt), shape=(a.count, n), strides=(stride, np.dtype(dt).itemsize)).copy()
+tmp = out + ".dir"; os.makedirs(tmp + "/tex", exist_ok=True)
+stage = Usd.Stage.CreateNew(f"{tmp}/scene.usdc")
+UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y); UsdGeom.SetStageMetersPerUnit(stage, 1.0)
+root = UsdGeom.Xform.Define(stage, "/Root"); stage.SetDefaultPrim(root.GetPrim())
+def image(i):
+    im = g.images[i]; v = g.bufferViews[im.bufferView]
+    ext = "png" if "png" in (im.mimeType or "") else "jpg"
+    name = f"tex/image{i}.{ext}"
+    open(f"{tmp}/{name}", "wb").write(blob[v.byteOffset or 0:(v.byteOffset or 0)+v.byteLength])
+    return name
+def texture(mat, shader, inp, tex, output, ctype, reader, extra=None):
+    t = UsdShade.Shader.Define(stage, f"{mat}/{inp}Tex"); t.CreateIdAttr("UsdUVTexture")
+    t.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(image(g.textures[tex.index].source))
+    t.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
+    for k, v in (extra or {}).items(): t.CreateInput(k, Sdf.ValueTypeNames.Float4).Set(v)
+    t.CreateOutput(output, ctype)
+    shader.CreateInput(inp, ctype).ConnectToSource(t.ConnectableAPI(), output)
+mats = []
+for mi, m in enumerate(g.materials):
+    path = f"/Root/Material{mi}"; mat = UsdShade.Material.Define(stage, path)
+    sh = UsdShade.Shader.Define(stage, f"{path}/Surface"); sh.CreateIdAttr("UsdPreviewSurface")
+    rd = UsdShade.Shader.Define(stage, f"{path}/St"); rd.CreateIdAttr("UsdPrimvarReader_float2")
+    rd.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st")
+    pbr = m.pbrMetallicRoughness
+    if pbr.baseColorTexture: texture(path, sh, "diffuseColor", pbr.baseColorTexture, "rgb", Sdf.ValueTypeNames.Color3f, rd)
+    else: sh.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*pbr.baseColorFactor[:3]))
+    if pbr.metallicRoughnessTexture:
+        texture(path, sh, "roughness", pbr.metallicRoughnessTexture, "g", Sdf.ValueTypeNames.Float, rd)
+        texture(path, sh, "metallic", pbr.metallicRoughnessTexture, "b", Sdf.ValueTypeNames.Float, rd)
+    else:
+        sh.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0)
+        sh.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(pbr.metallicFactor if pbr.metallicFactor is not None else 1.0)
+    if m.normalTexture: texture(path, sh, "normal", m.normalTexture, "rgb", Sdf.ValueTypeNames.Normal3f, rd, {"scale": Gf.Vec4f(2,2,2,1), "bias": Gf.Vec4f(-1,-1,-1,0)})
+    if m.occlusionTexture: texture(path, sh, "occlusion", m.occlusionTexture, "r", Sdf.ValueTypeNames.Float, rd)
+    if m.emissiveTexture: texture(path, sh, "emissiveColor", m.emissiveTexture, "rgb", Sdf.ValueTypeNames.Color3f, rd)
+    mat.CreateSurfaceOutput().ConnectToSource(sh.ConnectableAPI(), "surface")
+    mats.append(mat)
+k = 0
+for ni, node in enumerate(g.nodes):
+    if node.mesh is None: continue
+    x = UsdGeom.Xform.Define(stage, f"/Root/Node{ni}")
+    if node.matrix: x.AddTransformOp().Set(Gf.Matrix4d(*node.matrix))
+    else:
+        if node.translation: x.AddTranslateOp().Set(Gf.Vec3d(*node.translation))
+        if node.rotation: x.AddOrientOp().Set(Gf.Quatf(node.rotation[3], *node.rotation[:3]))
+        if node.scale: x.AddScaleOp().Set(Gf.Vec3f(*node.scale))
+    for pi, p in enumerate(g.meshes[node.mesh].primitives):
+        mesh = UsdGeom.Mesh.Define(stage, f"/Root/Node{ni}/Prim{pi}")
+        pts = acc(p.attributes.POSITION); idx = acc(p.indices).reshape(-1).astype(np.int32)
+        mesh.CreatePointsAttr([Gf.Vec3f(*map(float, q)) for q in pts])
+        # glTF winds counter-clockwise for the front, as USD's right-handed default does.
+        mesh.CreateFaceVertexCountsAttr([3] * (len(idx)//3)); mesh.CreateFaceVertexIndicesAttr(idx.tolist())
+        mesh.CreateSubdivisionSchemeAttr("none")
+        if p.attributes.NORMAL is not None:
+            n = acc(p.attributes.NORMAL); mesh.CreateNormalsAttr([Gf.Vec3f(*map(float, q)) for q in n]); mesh.SetNormalsInterpolation("vertex")
+        if p.attributes.TEXCOORD_0 is not None:
+            uv = acc(p.attributes.TEXCOORD_0)
+            st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
+            st.Set([Gf.Vec2f(float(q[0]), 1.0 - float(q[1])) for q in uv])
+        if p.material is not None: UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(mats[p.material])
+        k += 1
+stage.Save()
+UsdUtils.CreateNewUsdzPackage(f"{tmp}/scene.usdc", out)
+print("meshes", k)
