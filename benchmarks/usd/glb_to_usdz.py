@@ -1,13 +1,21 @@
-# A glTF binary's meshes (one node level, node transforms applied) and its metallic-roughness
+# A glTF binary's meshes (in its node hierarchy, each node's transform) and its metallic-roughness
 # materials written as a .usdz by Pixar's own library (PyPI usd-core 26.11; pygltflib, numpy),
-# textures packaged, so that the USD loader can be compared with the glTF one on real models
-# (benchmarks/usd.md). Run in a throwaway environment, never a dependency of the project:
+# textures packaged with their samplers' wrap modes and KHR_texture_transform as UsdTransform2d,
+# so that the USD loader can be compared with the glTF one on real models (benchmarks/usd.md).
+# Run in a throwaway environment, never a dependency of the project:
 #   python3 -m venv /tmp/v && /tmp/v/bin/pip install usd-core==26.11 pygltflib numpy
 #   /tmp/v/bin/python benchmarks/usd/glb_to_usdz.py IN.glb OUT.usdz
-import sys, os, io, numpy as np, pygltflib
+# A .gltf with its files beside it is read too (its buffers and images by their URIs).
+#
+# The texture transform: glTF's uv' = T·R·S·uv (v down) is USD's st' = R(θ)·S·st + t (t = 1 − v)
+# with θ the same angle, S the same scale and t = (ox + sy·sin θ, 1 − oy − sy·cos θ). The USD
+# working group's conversion of Khronos's TextureTransformTest holds exactly these values (its
+# material "All": 17.188734°, 1.5, (0.24328034, −0.33300462) for glTF's 0.3, 1.5, (−0.2, −0.1)).
+import sys, os, io, math, numpy as np, pygltflib
 from pxr import Usd, UsdGeom, UsdShade, Sdf, Gf, UsdUtils
 src, out = sys.argv[1], sys.argv[2]
 g = pygltflib.GLTF2().load(src)
+if src.endswith(".gltf"): g.convert_buffers(pygltflib.BufferFormat.BINARYBLOB)
 blob = g.binary_blob()
 def acc(i):
     a = g.accessors[i]; v = g.bufferViews[a.bufferView]
@@ -22,15 +30,38 @@ stage = Usd.Stage.CreateNew(f"{tmp}/scene.usdc")
 UsdGeom.SetStageUpAxis(stage, UsdGeom.Tokens.y); UsdGeom.SetStageMetersPerUnit(stage, 1.0)
 root = UsdGeom.Xform.Define(stage, "/Root"); stage.SetDefaultPrim(root.GetPrim())
 def image(i):
-    im = g.images[i]; v = g.bufferViews[im.bufferView]
-    ext = "png" if "png" in (im.mimeType or "") else "jpg"
+    im = g.images[i]
+    if im.uri:
+        data = open(os.path.join(os.path.dirname(src), im.uri), "rb").read()
+        ext = "png" if im.uri.lower().endswith(".png") else "jpg"
+    else:
+        v = g.bufferViews[im.bufferView]
+        data = blob[v.byteOffset or 0:(v.byteOffset or 0)+v.byteLength]
+        ext = "png" if "png" in (im.mimeType or "") else "jpg"
     name = f"tex/image{i}.{ext}"
-    open(f"{tmp}/{name}", "wb").write(blob[v.byteOffset or 0:(v.byteOffset or 0)+v.byteLength])
+    open(f"{tmp}/{name}", "wb").write(data)
     return name
+WRAP = {33071: "clamp", 33648: "mirror", 10497: "repeat"}
 def texture(mat, shader, inp, tex, output, ctype, reader, extra=None):
     t = UsdShade.Shader.Define(stage, f"{mat}/{inp}Tex"); t.CreateIdAttr("UsdUVTexture")
-    t.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(image(g.textures[tex.index].source))
-    t.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
+    gt = g.textures[tex.index]
+    t.CreateInput("file", Sdf.ValueTypeNames.Asset).Set(image(gt.source))
+    if gt.sampler is not None:
+        smp = g.samplers[gt.sampler]
+        t.CreateInput("wrapS", Sdf.ValueTypeNames.Token).Set(WRAP[smp.wrapS or 10497])
+        t.CreateInput("wrapT", Sdf.ValueTypeNames.Token).Set(WRAP[smp.wrapT or 10497])
+    source = reader
+    tt = (tex.extensions or {}).get("KHR_texture_transform")
+    if tt:
+        theta = tt.get("rotation", 0.0); sx, sy = tt.get("scale", [1.0, 1.0]); ox, oy = tt.get("offset", [0.0, 0.0])
+        place = UsdShade.Shader.Define(stage, f"{mat}/{inp}Place"); place.CreateIdAttr("UsdTransform2d")
+        place.CreateInput("in", Sdf.ValueTypeNames.Float2).ConnectToSource(reader.ConnectableAPI(), "result")
+        place.CreateInput("rotation", Sdf.ValueTypeNames.Float).Set(math.degrees(theta))
+        place.CreateInput("scale", Sdf.ValueTypeNames.Float2).Set(Gf.Vec2f(sx, sy))
+        place.CreateInput("translation", Sdf.ValueTypeNames.Float2).Set(
+            Gf.Vec2f(ox + sy * math.sin(theta), 1.0 - oy - sy * math.cos(theta)))
+        source = place
+    t.CreateInput("st", Sdf.ValueTypeNames.Float2).ConnectToSource(source.ConnectableAPI(), "result")
     for k, v in (extra or {}).items(): t.CreateInput(k, Sdf.ValueTypeNames.Float4).Set(v)
     t.CreateOutput(output, ctype)
     shader.CreateInput(inp, ctype).ConnectToSource(t.ConnectableAPI(), output)
@@ -54,17 +85,19 @@ for mi, m in enumerate(g.materials):
     if m.emissiveTexture: texture(path, sh, "emissiveColor", m.emissiveTexture, "rgb", Sdf.ValueTypeNames.Color3f, rd)
     mat.CreateSurfaceOutput().ConnectToSource(sh.ConnectableAPI(), "surface")
     mats.append(mat)
+parents = {c: ni for ni, n in enumerate(g.nodes) for c in (n.children or [])}
+def node_path(ni): return (node_path(parents[ni]) if ni in parents else "/Root") + f"/Node{ni}"
 k = 0
 for ni, node in enumerate(g.nodes):
-    if node.mesh is None: continue
-    x = UsdGeom.Xform.Define(stage, f"/Root/Node{ni}")
+    x = UsdGeom.Xform.Define(stage, node_path(ni))
     if node.matrix: x.AddTransformOp().Set(Gf.Matrix4d(*node.matrix))
     else:
         if node.translation: x.AddTranslateOp().Set(Gf.Vec3d(*node.translation))
         if node.rotation: x.AddOrientOp().Set(Gf.Quatf(node.rotation[3], *node.rotation[:3]))
         if node.scale: x.AddScaleOp().Set(Gf.Vec3f(*node.scale))
+    if node.mesh is None: continue
     for pi, p in enumerate(g.meshes[node.mesh].primitives):
-        mesh = UsdGeom.Mesh.Define(stage, f"/Root/Node{ni}/Prim{pi}")
+        mesh = UsdGeom.Mesh.Define(stage, f"{node_path(ni)}/Prim{pi}")
         pts = acc(p.attributes.POSITION); idx = acc(p.indices).reshape(-1).astype(np.int32)
         mesh.CreatePointsAttr([Gf.Vec3f(*map(float, q)) for q in pts])
         # glTF winds counter-clockwise for the front, as USD's right-handed default does.

@@ -507,3 +507,174 @@ def Material "Glaze"
         model.warnings
     );
 }
+
+#[test]
+fn texture_coordinates_follow_the_transform_and_the_primvar_named() {
+    // Pixar's library wrote the stage (`reference_texture_coordinates.py`): a unit quad whose
+    // colour is placed by a `UsdTransform2d`, read through a primvar named by the material's
+    // interface input, and whose occlusion reads a second primvar. Before, both were ignored: the
+    // colour drawn unplaced, the occlusion from the first set.
+    let model = load_model(&data("coords/texture-coordinates.usda")).expect("loads");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let material = model
+        .materials
+        .iter()
+        .find(|m| m.name == "Transformed")
+        .expect("the material");
+    let colour = material.base_color_texture.as_ref().expect("its colour texture");
+    assert_eq!(colour.tex_coord, 0);
+    // The same placement as glTF states it: Khronos's TextureTransformTest, material "All", whose
+    // USD conversion by the USD working group holds the transform written here.
+    let t = colour.transform;
+    let close = |a: f32, b: f32| (a - b).abs() < 1e-5;
+    assert!(
+        close(t.offset[0], -0.2) && close(t.offset[1], -0.1),
+        "offset {:?}",
+        t.offset
+    );
+    assert!(close(t.rotation_rad, 0.3), "rotation {}", t.rotation_rad);
+    assert!(close(t.scale[0], 1.5) && close(t.scale[1], 1.5), "scale {:?}", t.scale);
+    let (occlusion, _) = material.occlusion_texture.as_ref().expect("its occlusion");
+    assert_eq!(occlusion.tex_coord, 1, "the occlusion reads st1");
+    assert_eq!(occlusion.transform, Default::default());
+
+    // Corner by corner, where the specification puts the sample: st' = R(17.188734°)·1.5·st + t,
+    // with t running up from the image's bottom, against where the model's transform puts it (its
+    // v down from the top). The quad's st is its position's x and y; its st1 is that mirrored.
+    let mesh = &model.primitives[0].mesh;
+    assert_eq!(mesh.vertices.len(), 4);
+    let (sin, cos) = 17.188734f32.to_radians().sin_cos();
+    let rows = t.rows();
+    for vertex in &mesh.vertices {
+        let [x, y, _] = vertex.position;
+        let (s, tt) = (1.5 * x, 1.5 * y);
+        let expected = [cos * s - sin * tt + 0.24328034, sin * s + cos * tt - 0.33300462];
+        let [u, v, u1, v1] = vertex.uv;
+        let placed = [
+            rows[0][0] * u + rows[0][1] * v + rows[0][2],
+            rows[1][0] * u + rows[1][1] * v + rows[1][2],
+        ];
+        assert!(
+            close(placed[0], expected[0]) && close(placed[1], 1.0 - expected[1]),
+            "corner ({x}, {y}): sampled at {placed:?}, the specification's {expected:?} (t up)"
+        );
+        assert!(
+            close(u1, 1.0 - x) && close(v1, 1.0 - y),
+            "corner ({x}, {y}): second set ({u1}, {v1})"
+        );
+    }
+}
+
+#[test]
+fn texture_coordinates_that_cannot_be_followed_are_named() {
+    // A texture placed by a node that is not evaluated, and one by a turn then a stretch along s
+    // (a shear glTF's transform cannot hold): each drawn with what can be, and said so. A third
+    // placed by a shift then a turn, which glTF's transform holds: composed in that order.
+    let texture = |name: &str, st_source: &str| {
+        format!(
+            r#"    def Shader "{name}"
+    {{
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @grid.png@
+        float2 inputs:st.connect = </M/{st_source}.outputs:result>
+        color3f outputs:rgb
+    }}
+"#
+        )
+    };
+    let stage = format!(
+        r#"#usda 1.0
+(
+    metersPerUnit = 1
+)
+def Mesh "Tile"
+{{{SQUARE}
+    texCoord2f[] primvars:st = [(0, 0), (1, 0), (1, 1), (0, 1)] (interpolation = "vertex")
+    rel material:binding = </M>
+}}
+def Material "M"
+{{
+    token outputs:surface.connect = </M/S.outputs:surface>
+    def Shader "S"
+    {{
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </M/Colour.outputs:rgb>
+        color3f inputs:emissiveColor.connect = </M/Glow.outputs:rgb>
+        float inputs:occlusion.connect = </M/Shade.outputs:r>
+        token outputs:surface
+    }}
+    def Shader "Reader"
+    {{
+        uniform token info:id = "UsdPrimvarReader_float2"
+        string inputs:varname = "st"
+        float2 outputs:result
+    }}
+    def Shader "Noise"
+    {{
+        uniform token info:id = "ND_noise2d_vector2"
+        float2 outputs:result
+    }}
+    def Shader "Turn"
+    {{
+        uniform token info:id = "UsdTransform2d"
+        float2 inputs:in.connect = </M/Reader.outputs:result>
+        float inputs:rotation = 45
+        float2 outputs:result
+    }}
+    def Shader "Stretch"
+    {{
+        uniform token info:id = "UsdTransform2d"
+        float2 inputs:in.connect = </M/Turn.outputs:result>
+        float2 inputs:scale = (2, 1)
+        float2 outputs:result
+    }}
+    def Shader "Shift"
+    {{
+        uniform token info:id = "UsdTransform2d"
+        float2 inputs:in.connect = </M/Reader.outputs:result>
+        float2 inputs:translation = (0.5, 0)
+        float2 outputs:result
+    }}
+    def Shader "Quarter"
+    {{
+        uniform token info:id = "UsdTransform2d"
+        float2 inputs:in.connect = </M/Shift.outputs:result>
+        float inputs:rotation = 90
+        float2 outputs:result
+    }}
+{}{}{}}}
+"#,
+        texture("Colour", "Noise"),
+        texture("Glow", "Stretch"),
+        texture("Shade", "Quarter").replace("color3f outputs:rgb", "float outputs:r")
+    );
+    let mut png = Vec::new();
+    image::RgbaImage::from_raw(1, 1, vec![200, 100, 50, 255])
+        .expect("1 × 1")
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("png");
+    let dir = Scratch::new("usd-files-coordinates-named");
+    std::fs::write(dir.join("grid.png"), &png).expect("write");
+    std::fs::write(dir.join("scene.usda"), stage).expect("write");
+    let model = load_model(&dir.join("scene.usda")).expect("loads");
+    let said = |what: &str| model.warnings.iter().any(|w| w.contains(what));
+    assert!(said("ND_noise2d_vector2"), "{:?}", model.warnings);
+    assert!(said("sheared"), "{:?}", model.warnings);
+    let material = &model.materials[0];
+    assert_eq!(
+        material.base_color_texture.as_ref().expect("colour").transform,
+        Default::default(),
+        "the node not evaluated: the mesh's own coordinates"
+    );
+    let glow = material.emissive_texture.as_ref().expect("glow").transform;
+    assert!(glow.rows().iter().flatten().all(|v| v.is_finite()), "{glow:?}");
+    // st' = R(90°)·(st + (0.5, 0)) = R(90°)·st + (0, 0.5): glTF's offset (0 − 1, 1 − 0.5 − 0).
+    // Composed the other way round (the shift after the turn) it would be (−0.5, 1).
+    let (shade, _) = material.occlusion_texture.as_ref().expect("shade");
+    let t = shade.transform;
+    assert!(
+        (t.offset[0] + 1.0).abs() < 1e-5 && (t.offset[1] - 0.5).abs() < 1e-5,
+        "{t:?}"
+    );
+    assert!((t.rotation_rad - std::f32::consts::FRAC_PI_2).abs() < 1e-5, "{t:?}");
+}

@@ -19,10 +19,11 @@
 //!   `materialBind`), closest binding first, read as its `UsdPreviewSurface`
 //!   (`usd_preview_surface`) and made a glTF material (`usd_material`): its textures decoded
 //!   within the budget, a metallic and a roughness texture packed into glTF's one (roughness in
-//!   G, metallic in B). Texture coordinates are the primvar `st` (or `st0`, `UVMap`, `uv`,
-//!   `map1`, as exporters name it; else the first of two components), flipped to glTF's top-left
-//!   origin; MikkTSpace tangents are made for normal maps. A mesh without a material shows its
-//!   `displayColor`, or else plaster.
+//!   G, metallic in B). Texture coordinates are the primvars the material's primvar readers name
+//!   (a first and a second set), else `st` (or `st0`, `UVMap`, `uv`, `map1`, as exporters name
+//!   it; else the first of two components), flipped to glTF's top-left origin; a texture's
+//!   `UsdTransform2d`s become glTF's texture transform. MikkTSpace tangents are made for normal
+//!   maps. A mesh without a material shows its `displayColor`, or else plaster.
 //!
 //! **Budget**: the package is unpacked within the budget; each mesh is charged before it is
 //! built, each texture before it is decoded. **Threading**: the caller's thread (the reader's
@@ -185,25 +186,40 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
         warnings: Vec::new(),
     };
     let count = shown.len().max(1);
+    // Each material read once, when a mesh first names it (its textures say which primvars the
+    // mesh's texture coordinates are).
+    let mut read: HashMap<String, Option<Surface>> = HashMap::new();
+    let mut surface_warnings = Vec::new();
+    let mut failure = None;
+    let mut primvars_of = |material: &str| -> Vec<String> {
+        let surface = read.entry(material.to_owned()).or_insert_with(|| {
+            let path = sdf::Path::new(material).map_err(text);
+            match path.and_then(|path| usd_preview_surface::read(&stage, &path, &mut surface_warnings)) {
+                Ok(surface) => surface,
+                Err(message) => {
+                    failure.get_or_insert(message);
+                    None
+                }
+            }
+        });
+        surface
+            .as_ref()
+            .map_or_else(Vec::new, |s| s.primvars().into_iter().map(str::to_owned).collect())
+    };
     for (i, (p, _)) in shown.iter().enumerate() {
         if progress.step(0.1 + 0.5 * i as f32 / count as f32).is_err() {
             return Ok(None);
         }
         let world = to_model * world_transform(&stage, p)?;
-        if let Some(mesh) = read_mesh(&stage, p, world, &mut scene.looks, &mut warnings)? {
+        if let Some(mesh) = read_mesh(&stage, p, world, &mut scene.looks, &mut primvars_of, &mut warnings)? {
             scene.meshes.push(mesh);
         }
     }
-    for look in scene.looks.clone() {
-        if let Some(material) = &look.material
-            && !scene.surfaces.contains_key(material)
-        {
-            let path = sdf::Path::new(material).map_err(text)?;
-            if let Some(surface) = usd_preview_surface::read(&stage, &path, &mut warnings)? {
-                scene.surfaces.insert(material.clone(), surface);
-            }
-        }
+    if let Some(message) = failure {
+        return Err(message);
     }
+    warnings.append(&mut surface_warnings);
+    scene.surfaces = read.into_iter().filter_map(|(k, s)| Some((k, s?))).collect();
     // What composition could not read (a reference to a file outside, a missing layer), known
     // once the prims have been visited.
     let mut unread: Vec<String> = stage
@@ -453,7 +469,12 @@ fn build_model(
                     position: mesh.positions[i],
                     normal: mesh.normals.as_ref().map_or([0.0; 3], |n| n[i]),
                     tangent: [1.0, 0.0, 0.0, 1.0],
-                    uv: mesh.uvs.as_ref().map_or([0.0; 4], |t| [t[i][0], t[i][1], 0.0, 0.0]),
+                    uv: {
+                        // A second set where the material reads one, else the first again.
+                        let [u, v] = mesh.uvs[0].as_ref().map_or([0.0; 2], |t| t[i]);
+                        let [u1, v1] = mesh.uvs[1].as_ref().map_or([u, v], |t| t[i]);
+                        [u, v, u1, v1]
+                    },
                     color: colours.map_or([1.0; 4], |c| [c[i][0], c[i][1], c[i][2], 1.0]),
                     material: [1.0, 1.0],
                 })
@@ -464,7 +485,7 @@ fn build_model(
                 built.smooth_normals();
             }
             // A normal map is baked against MikkTSpace tangents; USD stores none.
-            if mesh.uvs.is_some() {
+            if mesh.uvs[0].is_some() {
                 generate_tangents(&mut built);
             }
             primitives.push(Primitive {

@@ -9,6 +9,10 @@
 //!   the file itself where it already is that (the same file, read through its `g` and `b`), else
 //!   packed from the files and channels named (the second resampled to the first's size).
 //! * **Opacity**: a constant, or the diffuse texture's alpha; a cut-off where a threshold is set.
+//! * **Coordinates**: each texture's `UsdTransform2d`s become glTF's texture transform
+//!   ([`uv_transform`]); the primvars the material's textures name are its first and second sets
+//!   of texture coordinates, in the order [`Surface::primvars`] gives (the mesh reader puts them
+//!   there).
 //!
 //! **Panics**: none.
 
@@ -18,8 +22,10 @@ use std::sync::Arc;
 
 use super::loader::ModelError;
 use super::usd_files::{Files, anchored};
-use super::usd_preview_surface::{Channel, Input, Surface, TextureInput};
-use super::{AlphaMode, Image, Material, Sampler, TextureRef};
+use glam::{Affine2, Mat2, Vec2};
+
+use super::usd_preview_surface::{Channel, Coords, Input, Surface, TextureInput};
+use super::{AlphaMode, Image, Material, Sampler, TextureRef, UvTransform};
 use crate::budget::Spending;
 
 /// The textures of a stage, read and decoded once each.
@@ -104,16 +110,23 @@ pub(super) fn material_of(
                 images.len() - 1
             })
     };
-    let reference = |image: usize, input: &TextureInput| TextureRef {
+    let primvars = surface.primvars();
+    let reference = |image: usize, input: &TextureInput, warnings: &mut Vec<String>| TextureRef {
         image,
-        tex_coord: 0,
-        transform: Default::default(),
+        tex_coord: coordinate_set(&input.coords, &primvars),
+        transform: uv_transform(input.coords.st_transform, name, warnings),
         sampler: Sampler {
             wrap_u: input.wrap[0],
             wrap_v: input.wrap[1],
             ..Sampler::default()
         },
     };
+    if let Some(third) = primvars.get(2) {
+        warnings.push(format!(
+            "material {name:.80}: its textures read more than two sets of texture coordinates: those reading {third:.40} and after read {:.40}",
+            primvars[0]
+        ));
+    }
     // Diffuse colour, and opacity where it is the same texture's alpha.
     let mut base_image = None;
     match &surface.diffuse {
@@ -144,7 +157,10 @@ pub(super) fn material_of(
         Input::Value(o) => material.base_color[3] = o.clamp(0.0, 1.0),
         Input::Texture(t) => match &base_image {
             Some((_, diffuse))
-                if diffuse.file == t.file && t.channel == Channel::A && diffuse.channel == Channel::Rgb =>
+                if diffuse.file == t.file
+                    && diffuse.coords == t.coords
+                    && t.channel == Channel::A
+                    && diffuse.channel == Channel::Rgb =>
             {
                 material.base_color[3] = t.scale[3];
                 alpha_textured = true;
@@ -163,7 +179,7 @@ pub(super) fn material_of(
     };
     if let Some((image, input)) = &base_image {
         let index = add(image, images);
-        material.base_color_texture = Some(reference(index, input));
+        material.base_color_texture = Some(reference(index, input, warnings));
     }
     // Metallic and roughness: constants, or textures packed as glTF's (G roughness, B metallic).
     let roughness_texture = match surface.roughness.texture() {
@@ -177,6 +193,13 @@ pub(super) fn material_of(
     material.roughness = surface.roughness.value_or(0.5).clamp(0.0, 1.0);
     material.metallic = surface.metallic.value_or(0.0).clamp(0.0, 1.0);
     if let Some((_, first)) = roughness_texture.as_ref().or(metallic_texture.as_ref()) {
+        if let (Some((_, r)), Some((_, m))) = (&roughness_texture, &metallic_texture)
+            && r.coords != m.coords
+        {
+            warnings.push(format!(
+                "material {name:.80}: its metallic and roughness textures are placed differently: both read where the roughness is"
+            ));
+        }
         let image = match (&roughness_texture, &metallic_texture) {
             // Already glTF's: one file read through its g and b.
             (Some((r, rt)), Some((m, mt)))
@@ -198,13 +221,13 @@ pub(super) fn material_of(
             material.metallic = t.scale[0];
         }
         let index = add(&image, images);
-        material.metallic_roughness_texture = Some(reference(index, first));
+        material.metallic_roughness_texture = Some(reference(index, first, warnings));
     }
     if let Some(t) = &surface.normal
         && let Some(image) = textures.get(&t.file, spending, warnings)?
     {
         let index = add(&image, images);
-        material.normal_texture = Some((reference(index, t), 1.0));
+        material.normal_texture = Some((reference(index, t, warnings), 1.0));
     }
     if let Some(t) = &surface.occlusion
         && let Some(image) = textures.get(&t.file, spending, warnings)?
@@ -218,7 +241,7 @@ pub(super) fn material_of(
             ))
         };
         let index = add(&image, images);
-        material.occlusion_texture = Some((reference(index, t), t.scale[0]));
+        material.occlusion_texture = Some((reference(index, t, warnings), t.scale[0]));
     }
     match &surface.emissive {
         Input::Value(c) => material.emissive = *c,
@@ -226,12 +249,61 @@ pub(super) fn material_of(
             if let Some(image) = textures.get(&t.file, spending, warnings)? {
                 let index = add(&image, images);
                 material.emissive = [t.scale[0], t.scale[1], t.scale[2]];
-                material.emissive_texture = Some(reference(index, t));
+                material.emissive_texture = Some(reference(index, t, warnings));
             }
         }
         Input::Unset => {}
     }
     Ok(material)
+}
+
+/// The set of texture coordinates (0 or 1) a texture reads: where its primvar is among the
+/// material's `primvars` ([`Surface::primvars`]); the first for one that names none, or a third.
+fn coordinate_set(coords: &Coords, primvars: &[&str]) -> u32 {
+    coords
+        .primvar
+        .as_deref()
+        .and_then(|name| primvars.iter().position(|p| *p == name))
+        .filter(|&i| i < 2)
+        .map_or(0, |i| i as u32)
+}
+
+/// A texture's `UsdTransform2d`s (`st_transform`, in USD's st frame, t up) as glTF's texture
+/// transform on the mesh's coordinates, whose v the reader stores as 1 − t (`usd_mesh`).
+///
+/// With `F(x, y) = (x, 1 − y)`: `uv' = F(A(F(uv))) = D·L·D·uv + D·(L·(0, 1) + t) + (0, 1)`,
+/// `D = diag(1, −1)`, `A = L·st + t`. For one transform (`L = R(θ)·S`) that is exactly glTF's
+/// `T·R·S` with the rotation θ, the scale S and the offset `(tx − sy·sin θ, 1 − ty − sy·cos θ)`:
+/// what the USD working group's conversion of Khronos's TextureTransformTest holds for each of
+/// its materials (e.g. "All": θ 17.188734°, S 1.5, t (0.24328034, −0.33300462) against glTF's
+/// rotation 0.3, scale 1.5, offset (−0.2, −0.1)). Composed transforms whose scales differ may
+/// shear, which glTF's cannot: the shear is left out, with a warning.
+pub(super) fn uv_transform(st_transform: Affine2, material: &str, warnings: &mut Vec<String>) -> UvTransform {
+    let d = Mat2::from_diagonal(Vec2::new(1.0, -1.0));
+    let m = d * st_transform.matrix2 * d;
+    let offset = d * (st_transform.matrix2 * Vec2::Y + st_transform.translation) + Vec2::Y;
+    // m = [[c·sx, s·sy], [−s·sx, c·sy]] (glTF's rows): its first column is sx·(c, −s).
+    let (first, second) = (m.x_axis, m.y_axis);
+    let scale_x = first.length();
+    let rotation_rad = if scale_x > 0.0 { (-first.y).atan2(first.x) } else { 0.0 };
+    let (s, c) = rotation_rad.sin_cos();
+    let scale_y = second.dot(Vec2::new(s, c));
+    let shear = second.dot(Vec2::new(c, -s));
+    if shear.abs() > 1e-4 * scale_x.abs().max(scale_y.abs()) {
+        warnings.push(format!(
+            "material {material:.80}: a texture's coordinates are sheared by its transforms: drawn without the shear"
+        ));
+    }
+    let transform = UvTransform {
+        offset: offset.to_array(),
+        rotation_rad,
+        scale: [scale_x, scale_y],
+    };
+    if transform.rows().iter().flatten().all(|v| v.is_finite()) {
+        transform
+    } else {
+        UvTransform::default()
+    }
 }
 
 /// A channel of an image, or none (white).

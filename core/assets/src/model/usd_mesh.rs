@@ -3,7 +3,9 @@
 //! Polygons are fanned into triangles, holes left out; `leftHanded` meshes and mirroring
 //! transforms keep their faces' fronts. Normals, texture coordinates and display colours by their
 //! interpolation (constant, uniform, vertex, varying, face-varying), indexed or not; corners that
-//! share all their values share a vertex. A face subset (`GeomSubset` of family `materialBind`)
+//! share all their values share a vertex. Texture coordinates: the primvars the mesh's material
+//! reads (`usd_preview_surface::Surface::primvars`: first and second set), else the first found
+//! of [`UV_NAMES`], else the first two-component primvar. A face subset (`GeomSubset` of family `materialBind`)
 //! draws its faces with its own material; a mesh's material is its own binding or its closest
 //! ancestor's. A mesh that is malformed (face sizes that do not add up, a corner naming a point
 //! it does not have) is left out with a warning, not the whole stage.
@@ -22,7 +24,8 @@ pub(super) struct ReadMesh {
     pub name: String,
     pub positions: Vec<[f32; 3]>,
     pub normals: Option<Vec<[f32; 3]>>,
-    pub uvs: Option<Vec<[f32; 2]>>,
+    /// The first and second sets of texture coordinates (v down: USD's t as 1 − t).
+    pub uvs: [Option<Vec<[f32; 2]>>; 2],
     pub colours: Option<Vec<[f32; 3]>>,
     /// Triangles, and the look each is drawn with (an index into the looks [`read_mesh`] was
     /// given).
@@ -161,12 +164,14 @@ const UV_NAMES: [&str; 5] = [
 ];
 
 /// Reads the mesh at `p` (transformed by `world` into the model's frame); `None` (with a
-/// warning) where it has no face to draw.
+/// warning) where it has no face to draw. `primvars_of` gives the primvars a material's
+/// textures read (by the material's path; first and second set).
 pub(super) fn read_mesh(
     stage: &usd::Stage,
     p: &sdf::Path,
     world: DMat4,
     looks: &mut Vec<Look>,
+    primvars_of: &mut dyn FnMut(&str) -> Vec<String>,
     warnings: &mut Vec<String>,
 ) -> Result<Option<ReadMesh>, String> {
     let name = p.as_str().to_owned();
@@ -196,25 +201,6 @@ pub(super) fn read_mesh(
         Some(n) => Some(n),
         None => primvar(stage, p, "normals", Interpolation::Vertex, vec3s)?,
     };
-    let mut uvs = None;
-    for uv_name in UV_NAMES {
-        uvs = primvar(stage, p, uv_name, Interpolation::FaceVarying, vec2s)?;
-        if uvs.is_some() {
-            break;
-        }
-    }
-    if uvs.is_none() {
-        let attributes = stage.prim(p.clone()).map_err(text)?.property_names().map_err(text)?;
-        for property in attributes {
-            let property = property.as_str();
-            if property.starts_with("primvars:") && !property.ends_with(":indices") {
-                uvs = primvar(stage, p, property, Interpolation::FaceVarying, vec2s)?;
-                if uvs.is_some() {
-                    break;
-                }
-            }
-        }
-    }
     let display = primvar(stage, p, "primvars:displayColor", Interpolation::Constant, vec3s)?;
 
     // The look of each face: the mesh's binding, or a face subset's.
@@ -234,6 +220,7 @@ pub(super) fn read_mesh(
         double_sided,
     };
     let mut face_look = vec![look_index(looks, base_look(mesh_material.clone())); counts.len()];
+    let mut materials: Vec<String> = mesh_material.into_iter().collect();
     for child in stage.prim(p.clone()).map_err(text)?.children().map_err(text)? {
         let child = child.path().clone();
         if stage
@@ -257,7 +244,8 @@ pub(super) fn read_mesh(
         let Some(material) = direct_binding(stage, &child)? else {
             continue;
         };
-        let look = look_index(looks, base_look(Some(material)));
+        let look = look_index(looks, base_look(Some(material.clone())));
+        materials.push(material);
         for face in ints(attribute_value(stage, &child, "indices")?) {
             if let Some(slot) = usize::try_from(face).ok().and_then(|f| face_look.get_mut(f)) {
                 *slot = look;
@@ -265,15 +253,62 @@ pub(super) fn read_mesh(
         }
     }
 
+    // Texture coordinates: where the first material whose textures name primvars says, and where
+    // the sets of the others' differ, with a warning (a model's sets are per mesh).
+    let mut wanted: Option<Vec<String>> = None;
+    for material in &materials {
+        let names = primvars_of(material);
+        if names.is_empty() {
+            continue;
+        }
+        match &wanted {
+            None => wanted = Some(names),
+            Some(first) if names.iter().zip(first).any(|(a, b)| a != b) => warnings.push(format!(
+                "mesh {name:.80}: its materials read different texture coordinates ({:.40} and {:.40}): {:.80} reads the first material's",
+                first.join(", "),
+                names.join(", "),
+                material
+            )),
+            Some(_) => {}
+        }
+    }
+    let wanted = wanted.unwrap_or_default();
+    let named = |n: &String| primvar(stage, p, &format!("primvars:{n}"), Interpolation::FaceVarying, vec2s);
+    let mut first_set = match wanted.first() {
+        Some(n) => named(n)?,
+        None => None,
+    };
+    if first_set.is_none() {
+        first_set = texture_coordinates(stage, p)?;
+        if let (Some(n), Some(_)) = (wanted.first(), &first_set) {
+            warnings.push(format!(
+                "mesh {name:.80}: its material reads texture coordinates {n:.40}, which it lacks: its first set read instead"
+            ));
+        }
+    }
+    let second_set = match wanted.get(1) {
+        Some(n) => {
+            let set = named(n)?;
+            if set.is_none() {
+                warnings.push(format!(
+                    "mesh {name:.80}: its material reads texture coordinates {n:.40}, which it lacks: its first set read instead"
+                ));
+            }
+            set
+        }
+        None => None,
+    };
+    let uvs = [first_set, second_set];
+
     // Corners to vertices: one per distinct (point, normal, uv, colour) value.
     let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
     let flip = left_handed != (DMat3::from_mat4(world).determinant() < 0.0);
-    let mut welded: HashMap<[u32; 4], u32> = HashMap::new();
+    let mut welded: HashMap<[u32; 5], u32> = HashMap::new();
     let mut mesh = ReadMesh {
         name: name.clone(),
         positions: Vec::new(),
         normals: normals.as_ref().map(|_| Vec::new()),
-        uvs: uvs.as_ref().map(|_| Vec::new()),
+        uvs: [0, 1].map(|k| uvs[k].as_ref().map(|_| Vec::new())),
         colours: display.as_ref().map(|_| Vec::new()),
         triangles: Vec::new(),
     };
@@ -292,8 +327,9 @@ pub(super) fn read_mesh(
             let key = [
                 point as u32,
                 normals.as_ref().and_then(|v| v.at(face, c, point)).unwrap_or(u32::MAX),
-                uvs.as_ref().and_then(|v| v.at(face, c, point)).unwrap_or(u32::MAX),
+                uvs[0].as_ref().and_then(|v| v.at(face, c, point)).unwrap_or(u32::MAX),
                 display.as_ref().and_then(|v| v.at(face, c, point)).unwrap_or(u32::MAX),
+                uvs[1].as_ref().and_then(|v| v.at(face, c, point)).unwrap_or(u32::MAX),
             ];
             let next = mesh.positions.len() as u32;
             let vertex = *welded.entry(key).or_insert_with(|| {
@@ -303,10 +339,12 @@ pub(super) fn read_mesh(
                     let normal = n.values.get(key[1] as usize).map_or(DVec3::ZERO, |v| DVec3::from(*v));
                     out.push((normal_matrix * normal).normalize_or_zero().as_vec3().to_array());
                 }
-                if let (Some(out), Some(t)) = (&mut mesh.uvs, &uvs) {
-                    // USD's t runs up from the image's bottom; glTF's v down from its top.
-                    let [s, t] = t.values.get(key[2] as usize).copied().unwrap_or([0.0, 0.0]);
-                    out.push([s, 1.0 - t]);
+                for (k, slot) in [(0, 2), (1, 4)] {
+                    if let (Some(out), Some(t)) = (&mut mesh.uvs[k], &uvs[k]) {
+                        // USD's t runs up from the image's bottom; glTF's v down from its top.
+                        let [s, t] = t.values.get(key[slot] as usize).copied().unwrap_or([0.0, 0.0]);
+                        out.push([s, 1.0 - t]);
+                    }
                 }
                 if let (Some(out), Some(d)) = (&mut mesh.colours, &display) {
                     out.push(d.values.get(key[3] as usize).map_or([1.0; 3], |c| c.map(|v| v as f32)));
@@ -326,6 +364,27 @@ pub(super) fn read_mesh(
         return Ok(None);
     }
     Ok(Some(mesh))
+}
+
+/// The mesh's texture coordinates where its material names none: the first primvar of
+/// [`UV_NAMES`] it has, else its first primvar of two-component values.
+fn texture_coordinates(stage: &usd::Stage, p: &sdf::Path) -> Result<Option<Primvar<[f32; 2]>>, String> {
+    for uv_name in UV_NAMES {
+        if let Some(set) = primvar(stage, p, uv_name, Interpolation::FaceVarying, vec2s)? {
+            return Ok(Some(set));
+        }
+    }
+    let attributes = stage.prim(p.clone()).map_err(text)?.property_names().map_err(text)?;
+    for property in attributes {
+        let property = property.as_str();
+        if property.starts_with("primvars:")
+            && !property.ends_with(":indices")
+            && let Some(set) = primvar(stage, p, property, Interpolation::FaceVarying, vec2s)?
+        {
+            return Ok(Some(set));
+        }
+    }
+    Ok(None)
 }
 
 /// The index of `look` among `looks`, added where new.

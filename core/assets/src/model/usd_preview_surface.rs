@@ -5,14 +5,21 @@
 //! Each input is a constant, a texture (a `UsdUVTexture` connected to it: its file, which of its
 //! outputs — `rgb`, `r`, `g`, `b`, `a` — and its wrap modes and scale) or unset (the schema's
 //! fallback). Connections through a material's or node graph's interface inputs are followed
-//! (at most [`MAX_HOPS`]); any other node between a texture and the surface (a multiply, a
-//! `UsdTransform2d` on the coordinates) is not evaluated: the input reads as unset, with a
-//! warning. Read: diffuse and emissive colour, metallic, roughness, opacity and its threshold,
-//! normal and occlusion maps. Not read: clear coat, index of refraction, displacement; the
-//! specular workflow (`useSpecularWorkflow`) is read as a dielectric, with a warning.
+//! (at most [`MAX_HOPS`]); any other node between a texture and the surface (a multiply, say)
+//! is not evaluated: the input reads as unset, with a warning. Read: diffuse and emissive colour,
+//! metallic, roughness, opacity and its threshold, normal and occlusion maps. Not read: clear
+//! coat, index of refraction, displacement; the specular workflow (`useSpecularWorkflow`) is read
+//! as a dielectric, with a warning.
+//!
+//! A texture's coordinates ([`Coords`]) are followed from its `st` input: through
+//! `UsdTransform2d` nodes (composed: scale, then counter-clockwise rotation in degrees, then
+//! translation, each in USD's st frame, t up) to a `UsdPrimvarReader_float2`, whose `varname`
+//! names the mesh's primvar. Unconnected, or reaching another kind of node (with a warning), the
+//! texture reads the mesh's texture coordinates untransformed.
 //!
 //! Colours are linear (USD's `color3f`). **Panics**: none.
 
+use glam::{Affine2, Vec2};
 use openusd::{sdf, usd};
 
 use super::Wrap;
@@ -52,6 +59,27 @@ pub struct TextureInput {
     /// `inputs:scale` (multiplies the texel).
     pub scale: [f32; 4],
     pub wrap: [Wrap; 2],
+    pub coords: Coords,
+}
+
+/// Where a texture reads its coordinates.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coords {
+    /// The primvar (its name without `primvars:`, as the reader's `varname` gives it); `None`
+    /// where no reader names one: the mesh's texture coordinates, found by name.
+    pub primvar: Option<String>,
+    /// The coordinates the texture is sampled at, from the primvar's: `UsdTransform2d`s composed,
+    /// in USD's st frame (s right, t up from the image's bottom).
+    pub st_transform: Affine2,
+}
+
+impl Default for Coords {
+    fn default() -> Self {
+        Self {
+            primvar: None,
+            st_transform: Affine2::IDENTITY,
+        }
+    }
 }
 
 /// One input of the surface.
@@ -90,6 +118,36 @@ pub struct Surface {
     pub opacity_threshold: f32,
     pub normal: Option<TextureInput>,
     pub occlusion: Option<TextureInput>,
+}
+
+impl Surface {
+    /// Its textures, in the order of the fields.
+    pub fn textures(&self) -> impl Iterator<Item = &TextureInput> {
+        [
+            self.diffuse.texture(),
+            self.emissive.texture(),
+            self.metallic.texture(),
+            self.roughness.texture(),
+            self.opacity.texture(),
+            self.normal.as_ref(),
+            self.occlusion.as_ref(),
+        ]
+        .into_iter()
+        .flatten()
+    }
+
+    /// The primvars its textures name, each once, in the order of [`Surface::textures`]:
+    /// the first is read as the model's first set of texture coordinates, the second as its
+    /// second (a third has no place: its textures read the first).
+    pub fn primvars(&self) -> Vec<&str> {
+        let mut names: Vec<&str> = Vec::new();
+        for name in self.textures().filter_map(|t| t.coords.primvar.as_deref()) {
+            if !names.contains(&name) {
+                names.push(name);
+            }
+        }
+        names
+    }
 }
 
 /// The surface of the material at `material`; `None` (with a warning) where it has none this
@@ -284,7 +342,73 @@ impl InputReader<'_> {
             channel,
             scale,
             wrap: [wrap("wrapS")?, wrap("wrapT")?],
+            coords: self.coords(node, input)?,
         }))
+    }
+
+    /// Where the texture at `node` (read for the surface's `input`) takes its coordinates:
+    /// its `st` input followed through interface inputs and `UsdTransform2d`s to a primvar
+    /// reader.
+    fn coords(&mut self, node: &sdf::Path, input: &str) -> Result<Coords, String> {
+        let mut coords = Coords::default();
+        let mut at = node.append_property("inputs:st").map_err(text)?;
+        for _ in 0..MAX_HOPS {
+            let attribute = self.stage.attribute(at.clone()).map_err(text)?;
+            let Some(next) = attribute.connections().map_err(text)?.into_iter().next() else {
+                // Unconnected (or a constant): the mesh's own coordinates.
+                return Ok(coords);
+            };
+            let node = next.prim_path();
+            let is_output = next
+                .as_str()
+                .rsplit_once('.')
+                .is_some_and(|(_, p)| p.starts_with("outputs:"));
+            if is_output && let Some(id) = shader_id(self.stage, &node)? {
+                let inputs = |name: &str| -> Result<Option<sdf::Value>, String> {
+                    value_through(
+                        self.stage,
+                        node.append_property(format!("inputs:{name}")).map_err(text)?,
+                    )
+                };
+                match id.as_str() {
+                    "UsdPrimvarReader_float2" => {
+                        coords.primvar = inputs("varname")?
+                            .as_ref()
+                            .and_then(token)
+                            .filter(|n| !n.is_empty())
+                            .map(|n| n.strip_prefix("primvars:").unwrap_or(n).to_owned());
+                        return Ok(coords);
+                    }
+                    "UsdTransform2d" => {
+                        let pair = |v: Option<sdf::Value>, fallback: f32| {
+                            v.as_ref().and_then(vec2).map_or(Vec2::splat(fallback), |p| p.as_vec2())
+                        };
+                        let scale = pair(inputs("scale")?, 1.0);
+                        let translation = pair(inputs("translation")?, 0.0);
+                        let rotation_deg = inputs("rotation")?.as_ref().and_then(scalar).unwrap_or(0.0) as f32;
+                        // Reached from the texture's side: this one applies after those found
+                        // before it are (outer ∘ inner).
+                        coords.st_transform *=
+                            Affine2::from_scale_angle_translation(scale, rotation_deg.to_radians(), translation);
+                        at = node.append_property("inputs:in").map_err(text)?;
+                        continue;
+                    }
+                    other => {
+                        self.warnings.push(format!(
+                            "material {:.80}: the texture for its {input} takes its coordinates from a {other:.40} node, which is not evaluated: the mesh's own are used",
+                            self.material
+                        ));
+                        return Ok(Coords::default());
+                    }
+                }
+            }
+            at = next;
+        }
+        self.warnings.push(format!(
+            "material {:.80}: the coordinates of the texture for its {input} go through more than {MAX_HOPS} connections: the mesh's own are used",
+            self.material
+        ));
+        Ok(Coords::default())
     }
 }
 
@@ -341,6 +465,17 @@ pub fn vec3(value: &sdf::Value) -> Option<[f64; 3]> {
         _ => return None,
     };
     v.iter().all(|c| c.is_finite()).then_some(v)
+}
+
+/// A 2-vector, of any precision.
+fn vec2(value: &sdf::Value) -> Option<glam::DVec2> {
+    let v = match value {
+        sdf::Value::Vec2f(v) => [v.x, v.y].map(f64::from),
+        sdf::Value::Vec2d(v) => [v.x, v.y],
+        sdf::Value::Vec2h(v) => [v.x, v.y].map(|c| f64::from(c.to_f32())),
+        _ => return None,
+    };
+    v.iter().all(|c| c.is_finite()).then(|| glam::DVec2::from(v))
 }
 
 /// A 4-vector, of any precision.
