@@ -1,6 +1,8 @@
 # A glTF binary's meshes (in its node hierarchy, each node's transform) and its metallic-roughness
 # materials written as a .usdz by Pixar's own library (PyPI usd-core 26.11; pygltflib, numpy),
 # textures packaged with their samplers' wrap modes and KHR_texture_transform as UsdTransform2d,
+# colour, metallic, roughness, emission and occlusion factors as textures' scales (and biases),
+# alpha modes as opacity (and its threshold), a second set of texture coordinates as primvar st1,
 # so that the USD loader can be compared with the glTF one on real models (benchmarks/usd.md).
 # Run in a throwaway environment, never a dependency of the project:
 #   python3 -m venv /tmp/v && /tmp/v/bin/pip install usd-core==26.11 pygltflib numpy
@@ -66,23 +68,47 @@ def texture(mat, shader, inp, tex, output, ctype, reader, extra=None):
     t.CreateOutput(output, ctype)
     shader.CreateInput(inp, ctype).ConnectToSource(t.ConnectableAPI(), output)
 mats = []
+readers = {}
+def reader(path, tex):
+    # One primvar reader per set of texture coordinates: st, st1.
+    n = getattr(tex, "texCoord", 0) or 0
+    if (path, n) not in readers:
+        rd = UsdShade.Shader.Define(stage, f"{path}/St{n or ''}"); rd.CreateIdAttr("UsdPrimvarReader_float2")
+        rd.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st" if n == 0 else f"st{n}")
+        readers[(path, n)] = rd
+    return readers[(path, n)]
 for mi, m in enumerate(g.materials):
     path = f"/Root/Material{mi}"; mat = UsdShade.Material.Define(stage, path)
     sh = UsdShade.Shader.Define(stage, f"{path}/Surface"); sh.CreateIdAttr("UsdPreviewSurface")
-    rd = UsdShade.Shader.Define(stage, f"{path}/St"); rd.CreateIdAttr("UsdPrimvarReader_float2")
-    rd.CreateInput("varname", Sdf.ValueTypeNames.Token).Set("st")
     pbr = m.pbrMetallicRoughness
-    if pbr.baseColorTexture: texture(path, sh, "diffuseColor", pbr.baseColorTexture, "rgb", Sdf.ValueTypeNames.Color3f, rd)
-    else: sh.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*pbr.baseColorFactor[:3]))
+    base = pbr.baseColorFactor or [1.0, 1.0, 1.0, 1.0]
+    if pbr.baseColorTexture:
+        texture(path, sh, "diffuseColor", pbr.baseColorTexture, "rgb", Sdf.ValueTypeNames.Color3f, reader(path, pbr.baseColorTexture), {"scale": Gf.Vec4f(*base)})
+    else: sh.CreateInput("diffuseColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*base[:3]))
+    # glTF's alpha: the colour texture's alpha times the factor's, blended or cut.
+    if m.alphaMode in ("BLEND", "MASK"):
+        if pbr.baseColorTexture:
+            texture(path, sh, "opacity", pbr.baseColorTexture, "a", Sdf.ValueTypeNames.Float, reader(path, pbr.baseColorTexture), {"scale": Gf.Vec4f(*base)})
+        else: sh.CreateInput("opacity", Sdf.ValueTypeNames.Float).Set(base[3])
+        if m.alphaMode == "MASK":
+            sh.CreateInput("opacityThreshold", Sdf.ValueTypeNames.Float).Set(m.alphaCutoff if m.alphaCutoff is not None else 0.5)
+    rough = pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0
+    metal = pbr.metallicFactor if pbr.metallicFactor is not None else 1.0
     if pbr.metallicRoughnessTexture:
-        texture(path, sh, "roughness", pbr.metallicRoughnessTexture, "g", Sdf.ValueTypeNames.Float, rd)
-        texture(path, sh, "metallic", pbr.metallicRoughnessTexture, "b", Sdf.ValueTypeNames.Float, rd)
+        rd = reader(path, pbr.metallicRoughnessTexture)
+        texture(path, sh, "roughness", pbr.metallicRoughnessTexture, "g", Sdf.ValueTypeNames.Float, rd, {"scale": Gf.Vec4f(rough, rough, rough, rough)})
+        texture(path, sh, "metallic", pbr.metallicRoughnessTexture, "b", Sdf.ValueTypeNames.Float, rd, {"scale": Gf.Vec4f(metal, metal, metal, metal)})
     else:
-        sh.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(pbr.roughnessFactor if pbr.roughnessFactor is not None else 1.0)
-        sh.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(pbr.metallicFactor if pbr.metallicFactor is not None else 1.0)
-    if m.normalTexture: texture(path, sh, "normal", m.normalTexture, "rgb", Sdf.ValueTypeNames.Normal3f, rd, {"scale": Gf.Vec4f(2,2,2,1), "bias": Gf.Vec4f(-1,-1,-1,0)})
-    if m.occlusionTexture: texture(path, sh, "occlusion", m.occlusionTexture, "r", Sdf.ValueTypeNames.Float, rd)
-    if m.emissiveTexture: texture(path, sh, "emissiveColor", m.emissiveTexture, "rgb", Sdf.ValueTypeNames.Color3f, rd)
+        sh.CreateInput("roughness", Sdf.ValueTypeNames.Float).Set(rough)
+        sh.CreateInput("metallic", Sdf.ValueTypeNames.Float).Set(metal)
+    if m.normalTexture: texture(path, sh, "normal", m.normalTexture, "rgb", Sdf.ValueTypeNames.Normal3f, reader(path, m.normalTexture), {"scale": Gf.Vec4f(2,2,2,1), "bias": Gf.Vec4f(-1,-1,-1,0)})
+    if m.occlusionTexture:
+        k = m.occlusionTexture.strength if m.occlusionTexture.strength is not None else 1.0
+        # glTF's 1 + k·(texel − 1) is USD's texel·scale + bias.
+        texture(path, sh, "occlusion", m.occlusionTexture, "r", Sdf.ValueTypeNames.Float, reader(path, m.occlusionTexture), {"scale": Gf.Vec4f(k, k, k, k), "bias": Gf.Vec4f(1 - k, 1 - k, 1 - k, 1 - k)})
+    glow = m.emissiveFactor or [0.0, 0.0, 0.0]
+    if m.emissiveTexture: texture(path, sh, "emissiveColor", m.emissiveTexture, "rgb", Sdf.ValueTypeNames.Color3f, reader(path, m.emissiveTexture), {"scale": Gf.Vec4f(*glow, 1.0)})
+    elif any(glow): sh.CreateInput("emissiveColor", Sdf.ValueTypeNames.Color3f).Set(Gf.Vec3f(*glow))
     mat.CreateSurfaceOutput().ConnectToSource(sh.ConnectableAPI(), "surface")
     mats.append(mat)
 parents = {c: ni for ni, n in enumerate(g.nodes) for c in (n.children or [])}
@@ -98,18 +124,22 @@ for ni, node in enumerate(g.nodes):
     if node.mesh is None: continue
     for pi, p in enumerate(g.meshes[node.mesh].primitives):
         mesh = UsdGeom.Mesh.Define(stage, f"{node_path(ni)}/Prim{pi}")
-        pts = acc(p.attributes.POSITION); idx = acc(p.indices).reshape(-1).astype(np.int32)
+        pts = acc(p.attributes.POSITION)
+        idx = (acc(p.indices).reshape(-1) if p.indices is not None else np.arange(len(pts))).astype(np.int32)
         mesh.CreatePointsAttr([Gf.Vec3f(*map(float, q)) for q in pts])
         # glTF winds counter-clockwise for the front, as USD's right-handed default does.
         mesh.CreateFaceVertexCountsAttr([3] * (len(idx)//3)); mesh.CreateFaceVertexIndicesAttr(idx.tolist())
         mesh.CreateSubdivisionSchemeAttr("none")
         if p.attributes.NORMAL is not None:
             n = acc(p.attributes.NORMAL); mesh.CreateNormalsAttr([Gf.Vec3f(*map(float, q)) for q in n]); mesh.SetNormalsInterpolation("vertex")
-        if p.attributes.TEXCOORD_0 is not None:
-            uv = acc(p.attributes.TEXCOORD_0)
-            st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar("st", Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
+        for name, a in (("st", p.attributes.TEXCOORD_0), ("st1", p.attributes.TEXCOORD_1)):
+            if a is None: continue
+            uv = acc(a)
+            st = UsdGeom.PrimvarsAPI(mesh).CreatePrimvar(name, Sdf.ValueTypeNames.TexCoord2fArray, UsdGeom.Tokens.vertex)
             st.Set([Gf.Vec2f(float(q[0]), 1.0 - float(q[1])) for q in uv])
-        if p.material is not None: UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(mats[p.material])
+        if p.material is not None:
+            UsdShade.MaterialBindingAPI.Apply(mesh.GetPrim()).Bind(mats[p.material])
+            if g.materials[p.material].doubleSided: mesh.CreateDoubleSidedAttr(True)
         k += 1
 stage.Save()
 UsdUtils.CreateNewUsdzPackage(f"{tmp}/scene.usdc", out)
