@@ -401,17 +401,24 @@ fn transforms_compose_as_pixars_library_composes_them() {
 
 #[test]
 fn opacity_from_the_colour_textures_alpha_is_cut_or_blended() {
-    // A leaf: its colour texture's alpha is its opacity, cut at 0.5; a second material reads its
-    // opacity from another texture, which is not read (drawn opaque, said so).
+    // A leaf: its colour texture's alpha is its opacity, cut at 0.5. A second material reads its
+    // opacity from another texture's red channel: written into the colour texture's alpha (it
+    // was drawn opaque before). A third places its opacity texture otherwise than its colour's,
+    // which glTF's one colour texture cannot hold: drawn opaque, and said so.
     let dir = Scratch::new("usd-files-opacity");
-    let mut png = Vec::new();
-    image::RgbaImage::from_raw(2, 1, vec![0, 200, 0, 255, 0, 200, 0, 0])
-        .expect("2 × 1")
-        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
-        .expect("png");
-    std::fs::write(dir.join("leaf.png"), &png).expect("write");
-    std::fs::write(dir.join("mask.png"), &png).expect("write");
-    let material = |name: &str, opacity_file: &str| {
+    let png = |rgba: Vec<u8>| {
+        let mut png = Vec::new();
+        image::RgbaImage::from_raw(2, 1, rgba)
+            .expect("2 × 1")
+            .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+            .expect("png");
+        png
+    };
+    std::fs::write(dir.join("leaf.png"), png(vec![0, 200, 0, 255, 0, 200, 0, 0])).expect("write");
+    // Red 0 then 255, both texels opaque: only a read of its red channel makes the leaf's left
+    // half clear.
+    std::fs::write(dir.join("mask.png"), png(vec![0, 9, 9, 255, 255, 9, 9, 255])).expect("write");
+    let material = |name: &str, opacity_file: &str, output: &str, placed: &str| {
         format!(
             r#"def Material "{name}"
 {{
@@ -420,7 +427,7 @@ fn opacity_from_the_colour_textures_alpha_is_cut_or_blended() {
     {{
         uniform token info:id = "UsdPreviewSurface"
         color3f inputs:diffuseColor.connect = </{name}/Colour.outputs:rgb>
-        float inputs:opacity.connect = </{name}/Opacity.outputs:a>
+        float inputs:opacity.connect = </{name}/Opacity.outputs:{output}>
         float inputs:opacityThreshold = 0.5
         token outputs:surface
     }}
@@ -430,11 +437,18 @@ fn opacity_from_the_colour_textures_alpha_is_cut_or_blended() {
         asset inputs:file = @leaf.png@
         color3f outputs:rgb
     }}
+    def Shader "Place"
+    {{
+        uniform token info:id = "UsdTransform2d"
+        float2 inputs:scale = (2, 2)
+        float2 outputs:result
+    }}
     def Shader "Opacity"
     {{
         uniform token info:id = "UsdUVTexture"
         asset inputs:file = @{opacity_file}@
-        float outputs:a
+        {placed}
+        float outputs:{output}
     }}
 }}
 "#
@@ -445,33 +459,55 @@ fn opacity_from_the_colour_textures_alpha_is_cut_or_blended() {
             "def Mesh \"{name}Mesh\"\n{{\n    int[] faceVertexCounts = [3]\n    int[] faceVertexIndices = [0, 1, 2]\n    point3f[] points = [(0, 0, {z}), (1, 0, {z}), (0, 1, {z})]\n    rel material:binding = </{name}>\n}}\n"
         )
     };
+    let tiled = format!("float2 inputs:st.connect = </{}/Place.outputs:result>", "Tiled");
+    // A fourth, "Veil", has a constant colour: its opacity texture becomes a white texture with
+    // that alpha.
+    let veil = material("Veil", "mask.png", "r", "").replace(
+        "color3f inputs:diffuseColor.connect = </Veil/Colour.outputs:rgb>",
+        "color3f inputs:diffuseColor = (0.5, 0.25, 0.125)",
+    );
     let stage = format!(
-        "#usda 1.0\n(\n    metersPerUnit = 1\n)\n{}{}{}{}",
+        "#usda 1.0\n(\n    metersPerUnit = 1\n)\n{}{}{}{}{}{}{}{}",
         mesh("Leaf", 0),
         mesh("Other", 1),
-        material("Leaf", "leaf.png"),
-        material("Other", "mask.png")
+        mesh("Tiled", 2),
+        mesh("Veil", 3),
+        material("Leaf", "leaf.png", "a", ""),
+        material("Other", "mask.png", "r", ""),
+        material("Tiled", "mask.png", "r", &tiled),
+        veil
     );
     std::fs::write(dir.join("scene.usda"), stage).expect("write");
     let model = load_model(&dir.join("scene.usda")).expect("loads");
     let find = |name: &str| model.materials.iter().find(|m| m.name == name).expect(name);
-    let leaf = find("Leaf");
-    assert_eq!(leaf.alpha, AlphaMode::Mask(0.5));
-    let texture = leaf.base_color_texture.as_ref().expect("its texture");
+    let texels = |name: &str| {
+        let texture = find(name).base_color_texture.as_ref().expect("its texture");
+        model.images[texture.image].rgba8.clone()
+    };
+    assert_eq!(find("Leaf").alpha, AlphaMode::Mask(0.5));
+    assert_eq!(&texels("Leaf")[4..8], &[0, 200, 0, 0], "the alpha kept");
+    assert_eq!(find("Other").alpha, AlphaMode::Mask(0.5));
     assert_eq!(
-        &model.images[texture.image].rgba8[4..8],
-        &[0, 200, 0, 0],
-        "the alpha kept"
+        texels("Other"),
+        vec![0, 200, 0, 0, 0, 200, 0, 255],
+        "the leaf's colour, the mask's red as alpha"
     );
-    assert_eq!(find("Other").alpha, AlphaMode::Opaque);
+    let veil = find("Veil");
+    assert_eq!(
+        (veil.alpha, veil.base_color),
+        (AlphaMode::Mask(0.5), [0.5, 0.25, 0.125, 1.0])
+    );
+    assert_eq!(texels("Veil"), vec![255, 255, 255, 0, 255, 255, 255, 255]);
+    assert_eq!(find("Tiled").alpha, AlphaMode::Opaque);
     assert!(
         model
             .warnings
             .iter()
-            .any(|w| w.contains("Other") && w.contains("opaque")),
+            .any(|w| w.contains("Tiled") && w.contains("opaque")),
         "{:?}",
         model.warnings
     );
+    assert_eq!(model.warnings.len(), 1, "{:?}", model.warnings);
 }
 
 #[test]

@@ -8,7 +8,11 @@
 //! * **Metallic and roughness**: constants, or glTF's one texture (roughness in G, metallic in B):
 //!   the file itself where it already is that (the same file, read through its `g` and `b`), else
 //!   packed from the files and channels named (the second resampled to the first's size).
-//! * **Opacity**: a constant, or the diffuse texture's alpha; a cut-off where a threshold is set.
+//! * **Opacity**: a constant, or a texture's channel: the diffuse texture's alpha as it is, any
+//!   other written into the colour texture's alpha (the second image resampled to the first's
+//!   size; white colour where there is no colour texture); a cut-off where a threshold is set.
+//!   An opacity texture placed otherwise than the colour's (its coordinates or wrap) cannot share
+//!   glTF's one colour texture: drawn opaque, with a warning.
 //! * **Coordinates**: each texture's `UsdTransform2d`s become glTF's texture transform
 //!   ([`uv_transform`]); the primvars the material's textures name are its first and second sets
 //!   of texture coordinates, in the order [`Surface::primvars`] gives (the mesh reader puts them
@@ -151,7 +155,8 @@ pub(super) fn material_of(
         }
         Input::Unset => {}
     }
-    // Whether the colour texture's alpha is the opacity.
+    // Whether the colour texture's alpha is the opacity: its own, or another texture's channel
+    // written into it (glTF's one place for a texture's opacity).
     let mut alpha_textured = false;
     match &surface.opacity {
         Input::Value(o) => material.base_color[3] = o.clamp(0.0, 1.0),
@@ -165,9 +170,41 @@ pub(super) fn material_of(
                 material.base_color[3] = t.scale[3];
                 alpha_textured = true;
             }
-            _ => warnings.push(format!(
-                "material {name:.80}: its opacity is a texture other than its colour's alpha: drawn opaque"
-            )),
+            Some((_, diffuse)) if diffuse.coords != t.coords || diffuse.wrap != t.wrap => {
+                warnings.push(format!(
+                    "material {name:.80}: its opacity texture is placed otherwise than its colour's: drawn opaque"
+                ));
+            }
+            _ => {
+                if let Some(opacity) = textures.get(&t.file, spending, warnings)? {
+                    let channel = t.channel;
+                    let (colour, input) = match base_image.take() {
+                        Some((colour, input)) => (Some(colour), input),
+                        None => (None, t.clone()),
+                    };
+                    let rgb = |c: Channel| colour.as_ref().map(|i| (i, c));
+                    let label = format!("{} (colour, opacity)", material.name);
+                    // Charged like any decoded texture: the combined image is a new one.
+                    let (w, h) = colour
+                        .as_ref()
+                        .map_or((opacity.width, opacity.height), |c| (c.width, c.height));
+                    spending
+                        .charge_bytes(|| label.clone(), u64::from(w) * u64::from(h) * 4)
+                        .map_err(|e| super::loader::over_budget(textures.path, e))?;
+                    let combined = packed(
+                        &[
+                            (rgb(Channel::R), 0),
+                            (rgb(Channel::G), 1),
+                            (rgb(Channel::B), 2),
+                            (Some((&opacity, channel)), 3),
+                        ],
+                        &label,
+                    );
+                    base_image = Some((Arc::new(combined), input));
+                    material.base_color[3] = t.scale[channel.offset()];
+                    alpha_textured = true;
+                }
+            }
         },
         Input::Unset => {}
     }
