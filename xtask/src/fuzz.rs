@@ -551,12 +551,15 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
                 .context("reading the test scan reference-sphere-200.e57")?;
             put("reference-sphere-200.e57", &e57)?;
             // USD by Pixar's own library (`core/assets/tests/data/usd`): a package (a referenced
-            // layer and a texture inside), its root layer alone in the binary format, and the
-            // referenced layer in the text format.
+            // layer and a texture inside), its root layer alone in the binary format, the
+            // referenced layer in the text format, a material placing its textures through
+            // transforms and named primvars, and a point cloud in the binary format.
             for (name, file) in [
                 ("reference-box.usdz", "reference-box.usdz"),
                 ("reference-box.usdc", "loose/reference-box.usdc"),
                 ("knob.usda", "loose/parts/knob.usda"),
+                ("texture-coordinates.usda", "coords/texture-coordinates.usda"),
+                ("points.usdc", "points.usdc"),
             ] {
                 let bytes = std::fs::read(workspace_root().join("core/assets/tests/data/usd").join(file))
                     .with_context(|| format!("reading the test stage {file}"))?;

@@ -714,3 +714,48 @@ def Material "M"
     );
     assert!((t.rotation_rad - std::f32::consts::FRAC_PI_2).abs() < 1e-5, "{t:?}");
 }
+
+#[test]
+fn a_points_prim_is_drawn_as_a_closed_cloud() {
+    // Pixar's library wrote it (`reference_points.py`): 2000 points on a sphere of 10 cm radius,
+    // 50 cm above the origin, centimetres with +Z up, red above its equator and blue below, and a
+    // guide cloud far away. Before, points were not drawn (the stage had nothing to show).
+    let model = load_model(&data("points.usdc")).expect("loads");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    assert_eq!(model.primitives.len(), 1, "the guide left out");
+    let primitive = &model.primitives[0];
+    let mesh = &primitive.mesh;
+    assert_eq!(mesh.indices.len() / 3, 2000 * 4, "a disc (four triangles) a point");
+    let material = &model.materials[primitive.material];
+    assert!(material.double_sided, "a disc turned the wrong way still draws");
+    // In metres, +Y up: the sphere's centre at (0, 0.5, 0), its discs within a centimetre of its
+    // 10 cm radius (they lie tangent to it, as wide as the gaps between points).
+    let centre = Vec3::new(0.0, 0.5, 0.0);
+    let bounds = mesh.bounds().expect("bounds");
+    assert!(
+        (bounds.min - (centre - Vec3::splat(0.1))).abs().max_element() < 0.01
+            && (bounds.max - (centre + Vec3::splat(0.1))).abs().max_element() < 0.01,
+        "{bounds:?}"
+    );
+    for v in &mesh.vertices {
+        let p = Vec3::from(v.position) - centre;
+        assert!(
+            (p.length() - 0.1).abs() < 0.01,
+            "a disc corner {} m from the centre",
+            p.length()
+        );
+        // The file's +z is up: red above the equator, blue below (linear, as USD stores them).
+        let expected = if p.y > 0.005 {
+            Some([1.0, 0.0, 0.0, 1.0])
+        } else if p.y < -0.005 {
+            Some([0.0, 0.0, 1.0, 1.0])
+        } else {
+            None
+        };
+        if let Some(colour) = expected {
+            assert_eq!(v.color, colour, "at {p}");
+        }
+        // Normals estimated from the neighbours, turned away from the cloud's centre.
+        assert!(Vec3::from(v.normal).dot(p) > 0.0, "a disc facing inward at {p}");
+    }
+}

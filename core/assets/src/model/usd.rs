@@ -11,8 +11,9 @@
 //!   mirroring transforms keep their faces' fronts. Normals and texture coordinates by their
 //!   interpolation (constant, uniform, vertex, varying, face-varying), indexed or not; corners
 //!   that share all their values share a vertex. Subdivision surfaces are drawn as their control
-//!   meshes (`usd_mesh`). Other kinds of prims (points, curves, cubes, spheres) are not drawn
-//!   (a warning says so).
+//!   meshes (`usd_mesh`). `Points` prims are clouds drawn as discs that close into their
+//!   surface (`point_cloud`), with their normals and display colours. Other kinds of prims
+//!   (curves, cubes, spheres) are not drawn (a warning says so).
 //! * **Units and axes**: the stage's `metersPerUnit` (USD's fallback: centimetres) and `upAxis`
 //!   (`Z` turned into glTF's +Y up).
 //! * **Materials**: the one bound to a mesh (or to a face subset of it, `GeomSubset` of family
@@ -41,9 +42,9 @@ use super::loader::{
 };
 use super::usd_files::{Confined, Files, folded, folder_of, is_package};
 use super::usd_material::{Textures, material_of};
-use super::usd_mesh::{Look, ReadMesh, attribute_value, read_mesh};
+use super::usd_mesh::{Look, ReadCloud, ReadMesh, attribute_value, read_mesh, read_points};
 use super::usd_preview_surface::{self, Surface, scalar, text, token, vec3};
-use super::{Image, Material, Mesh, Model, Primitive, Vertex};
+use super::{Image, Material, Mesh, Model, Primitive, Vertex, point_cloud};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
 
@@ -102,6 +103,7 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
 /// What the stage holds, read.
 struct Scene {
     meshes: Vec<ReadMesh>,
+    clouds: Vec<ReadCloud>,
     looks: Vec<Look>,
     surfaces: HashMap<String, Surface>,
     /// The layers read (to anchor texture paths at).
@@ -148,10 +150,11 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
     for p in &paths {
         let kind = stage.prim(p.clone()).map_err(text)?.type_name().map_err(text)?;
         match kind.as_ref().map(|t| t.as_str()) {
-            Some("Mesh") => mesh_paths.push(p.clone()),
+            Some("Mesh") => mesh_paths.push((p.clone(), false)),
+            Some("Points") => mesh_paths.push((p.clone(), true)),
             Some(
-                k @ ("Points" | "BasisCurves" | "NurbsCurves" | "NurbsPatch" | "Cube" | "Sphere" | "Cylinder" | "Cone"
-                | "Capsule" | "Plane" | "TetMesh"),
+                k @ ("BasisCurves" | "NurbsCurves" | "NurbsPatch" | "Cube" | "Sphere" | "Cylinder" | "Cone" | "Capsule"
+                | "Plane" | "TetMesh"),
             ) => {
                 *not_drawn.entry(k.to_owned()).or_default() += 1;
             }
@@ -161,25 +164,29 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
     let mut kinds: Vec<_> = not_drawn.into_iter().collect();
     kinds.sort();
     for (kind, n) in kinds {
-        warnings.push(format!("{n} prim(s) of kind {kind}: not drawn (only meshes are)"));
+        warnings.push(format!(
+            "{n} prim(s) of kind {kind}: not drawn (only meshes and points are)"
+        ));
     }
-    // Which meshes show: visible, not guides; proxies only where nothing else is drawn.
+    // Which meshes and clouds show: visible, not guides; proxies only where nothing else is
+    // drawn.
     let mut shown = Vec::new();
-    for p in mesh_paths {
+    for (p, cloud) in mesh_paths {
         if invisible(&stage, &p)? {
             continue;
         }
         let purpose = inherited_token(&stage, &p, "purpose")?;
         if purpose.as_deref() != Some("guide") {
-            shown.push((p, purpose.as_deref() == Some("proxy")));
+            shown.push((p, cloud, purpose.as_deref() == Some("proxy")));
         }
     }
-    if shown.iter().any(|(_, proxy)| !proxy) {
-        shown.retain(|(_, proxy)| !proxy);
+    if shown.iter().any(|(_, _, proxy)| !proxy) {
+        shown.retain(|(_, _, proxy)| !proxy);
     }
 
     let mut scene = Scene {
         meshes: Vec::new(),
+        clouds: Vec::new(),
         looks: Vec::new(),
         surfaces: HashMap::new(),
         layers: stage.layer_identifiers(),
@@ -206,12 +213,16 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
             .as_ref()
             .map_or_else(Vec::new, |s| s.primvars().into_iter().map(str::to_owned).collect())
     };
-    for (i, (p, _)) in shown.iter().enumerate() {
+    for (i, (p, cloud, _)) in shown.iter().enumerate() {
         if progress.step(0.1 + 0.5 * i as f32 / count as f32).is_err() {
             return Ok(None);
         }
         let world = to_model * world_transform(&stage, p)?;
-        if let Some(mesh) = read_mesh(&stage, p, world, &mut scene.looks, &mut primvars_of, &mut warnings)? {
+        if *cloud {
+            if let Some(cloud) = read_points(&stage, p, world, &mut scene.looks, &mut warnings)? {
+                scene.clouds.push(cloud);
+            }
+        } else if let Some(mesh) = read_mesh(&stage, p, world, &mut scene.looks, &mut primvars_of, &mut warnings)? {
             scene.meshes.push(mesh);
         }
     }
@@ -495,6 +506,43 @@ fn build_model(
                 lods: Vec::new(),
             });
         }
+    }
+    for cloud in scene.clouds {
+        let what = || format!("points {:.80}", cloud.name);
+        let discs = spending
+            .charge_primitive(what)
+            .and_then(|()| point_cloud::charge_discs(spending, cloud.positions.len(), what))
+            .map_err(|e| over_budget(path, e))?;
+        // Thinned before the points become vertices: only the kept ones are made.
+        let thinned = point_cloud::kept(&cloud.positions, discs);
+        let colours = cloud
+            .colours
+            .as_ref()
+            .filter(|_| scene.looks[cloud.look].vertex_colours);
+        let kept: Vec<Vertex> = thinned
+            .indices
+            .iter()
+            .map(|&i| Vertex {
+                position: cloud.positions[i],
+                normal: cloud.normals.as_ref().map_or([0.0; 3], |n| n[i]),
+                tangent: [1.0, 0.0, 0.0, 1.0],
+                uv: [0.0; 4],
+                color: colours.map_or([1.0; 4], |c| [c[i][0], c[i][1], c[i][2], 1.0]),
+                material: [1.0, 1.0],
+            })
+            .collect();
+        let built = point_cloud::discs(&kept, thinned.cell_m);
+        if built.indices.is_empty() {
+            warnings.push(format!("{}: all its points in one place: left out", what()));
+            continue;
+        }
+        check_positions(&built, path, what)?;
+        primitives.push(Primitive {
+            mesh: built,
+            material: cloud.look,
+            is_floor: false,
+            lods: Vec::new(),
+        });
     }
     progress.step(0.9).map_err(cancelled)?;
     // The cache let go, each image has one owner left: moved out, not copied.

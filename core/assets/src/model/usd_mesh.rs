@@ -32,6 +32,100 @@ pub(super) struct ReadMesh {
     pub triangles: Vec<([u32; 3], usize)>,
 }
 
+/// One `Points` prim read from the stage, in metres with +Y up: a cloud, drawn as discs
+/// (`point_cloud`). Its `widths` are not read: a disc's size comes from the gaps to its
+/// neighbours, which closes a scanned surface whatever size the writer gave its points.
+pub(super) struct ReadCloud {
+    pub name: String,
+    pub positions: Vec<[f32; 3]>,
+    /// One a point, where the prim has them (a zero one: none, estimated from the neighbours).
+    pub normals: Option<Vec<[f32; 3]>>,
+    /// Linear, one a point, where its display colour varies over it.
+    pub colours: Option<Vec<[f32; 3]>>,
+    /// An index into the looks [`read_points`] was given.
+    pub look: usize,
+}
+
+/// Reads the `Points` prim at `p` (transformed by `world` into the model's frame); `None` (with
+/// a warning) where it has no point.
+pub(super) fn read_points(
+    stage: &usd::Stage,
+    p: &sdf::Path,
+    world: DMat4,
+    looks: &mut Vec<Look>,
+    warnings: &mut Vec<String>,
+) -> Result<Option<ReadCloud>, String> {
+    let name = p.as_str().to_owned();
+    let points = attribute_value(stage, p, "points")?
+        .as_ref()
+        .and_then(vec3s)
+        .unwrap_or_default();
+    if points.is_empty() {
+        warnings.push(format!("points {name:.80}: no points: left out"));
+        return Ok(None);
+    }
+    let normals = match primvar(stage, p, "primvars:normals", Interpolation::Vertex, vec3s)? {
+        Some(n) => Some(n),
+        None => primvar(stage, p, "normals", Interpolation::Vertex, vec3s)?,
+    };
+    let display = primvar(stage, p, "primvars:displayColor", Interpolation::Constant, vec3s)?;
+    let material = bound_material(stage, p)?;
+    let varies = display
+        .as_ref()
+        .is_some_and(|d| d.interpolation != Interpolation::Constant);
+    let look = look_index(
+        looks,
+        Look {
+            display_colour: match (&material, &display) {
+                (None, Some(d)) if !varies => d.values.first().map(|c| c.map(|v| v.clamp(0.0, 1.0) as f32)),
+                _ => None,
+            },
+            vertex_colours: material.is_none() && varies,
+            material,
+            // A disc turned the wrong way by its estimated normal still draws.
+            double_sided: true,
+        },
+    );
+    let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
+    // A point's value: each point its own (vertex, varying, face-varying), else the one value.
+    let value_at = |interpolation: Interpolation, i: usize| match interpolation {
+        Interpolation::Constant | Interpolation::Uniform => 0,
+        Interpolation::Vertex | Interpolation::FaceVarying => i,
+    };
+    let cloud = ReadCloud {
+        name,
+        positions: points
+            .iter()
+            .map(|&q| world.transform_point3(DVec3::from(q)).as_vec3().to_array())
+            .collect(),
+        normals: normals.map(|n| {
+            (0..points.len())
+                .map(|i| {
+                    n.at(0, value_at(n.interpolation, i), value_at(n.interpolation, i))
+                        .and_then(|k| n.values.get(k as usize))
+                        .map_or([0.0; 3], |v| {
+                            (normal_matrix * DVec3::from(*v))
+                                .normalize_or_zero()
+                                .as_vec3()
+                                .to_array()
+                        })
+                })
+                .collect()
+        }),
+        colours: display.filter(|_| varies).map(|d| {
+            (0..points.len())
+                .map(|i| {
+                    d.at(0, value_at(d.interpolation, i), value_at(d.interpolation, i))
+                        .and_then(|k| d.values.get(k as usize))
+                        .map_or([1.0; 3], |c| c.map(|v| v as f32))
+                })
+                .collect()
+        }),
+        look,
+    };
+    Ok(Some(cloud))
+}
+
 /// How a part of a mesh is drawn: its material's path (none: its display colour), and whether
 /// both sides show.
 #[derive(Clone, Debug, PartialEq)]
