@@ -759,3 +759,39 @@ fn a_points_prim_is_drawn_as_a_closed_cloud() {
         assert!(Vec3::from(v.normal).dot(p) > 0.0, "a disc facing inward at {p}");
     }
 }
+
+#[test]
+fn a_cloud_shows_the_material_bound_to_it() {
+    // Only a cloud is bound to the material: it is read all the same (it had been read only
+    // when a mesh named it, so the cloud came out plaster).
+    let stage = r#"#usda 1.0
+(
+    metersPerUnit = 1
+)
+def Points "Cloud"
+{
+    point3f[] points = [(0, 0, 0), (1, 0, 0), (0, 1, 0), (1, 1, 0), (0.5, 0.5, 0.1)]
+    rel material:binding = </Glaze>
+}
+def Material "Glaze"
+{
+    token outputs:surface.connect = </Glaze/S.outputs:surface>
+    def Shader "S"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor = (0.1, 0.6, 0.2)
+        float inputs:roughness = 0.2
+        token outputs:surface
+    }
+}
+"#;
+    let model = load_stage("cloud-material", &[("cloud.usda", stage)]).expect("loads");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let material = &model.materials[model.primitives[0].material];
+    assert_eq!(material.name, "Glaze");
+    assert_eq!(
+        (&material.base_color[..3], material.roughness),
+        (&[0.1, 0.6, 0.2][..], 0.2)
+    );
+    assert!(material.double_sided);
+}

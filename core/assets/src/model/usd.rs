@@ -145,13 +145,13 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
     stage
         .traverse(usd::PrimPredicate::DEFAULT_PROXIES, |p| paths.push(p.clone()))
         .map_err(text)?;
-    let mut mesh_paths = Vec::new();
+    let mut drawn_paths = Vec::new();
     let mut not_drawn: HashMap<String, usize> = HashMap::new();
     for p in &paths {
         let kind = stage.prim(p.clone()).map_err(text)?.type_name().map_err(text)?;
         match kind.as_ref().map(|t| t.as_str()) {
-            Some("Mesh") => mesh_paths.push((p.clone(), false)),
-            Some("Points") => mesh_paths.push((p.clone(), true)),
+            Some("Mesh") => drawn_paths.push((p.clone(), false)),
+            Some("Points") => drawn_paths.push((p.clone(), true)),
             Some(
                 k @ ("BasisCurves" | "NurbsCurves" | "NurbsPatch" | "Cube" | "Sphere" | "Cylinder" | "Cone" | "Capsule"
                 | "Plane" | "TetMesh"),
@@ -171,7 +171,7 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
     // Which meshes and clouds show: visible, not guides; proxies only where nothing else is
     // drawn.
     let mut shown = Vec::new();
-    for (p, cloud) in mesh_paths {
+    for (p, cloud) in drawn_paths {
         if invisible(&stage, &p)? {
             continue;
         }
@@ -224,6 +224,12 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
             }
         } else if let Some(mesh) = read_mesh(&stage, p, world, &mut scene.looks, &mut primvars_of, &mut warnings)? {
             scene.meshes.push(mesh);
+        }
+    }
+    // The materials only clouds are bound to.
+    for look in &scene.looks {
+        if let Some(material) = &look.material {
+            primvars_of(material);
         }
     }
     if let Some(message) = failure {

@@ -315,7 +315,7 @@ fn coordinate_set(coords: &Coords, primvars: &[&str]) -> u32 {
 /// its materials (e.g. "All": θ 17.188734°, S 1.5, t (0.24328034, −0.33300462) against glTF's
 /// rotation 0.3, scale 1.5, offset (−0.2, −0.1)). Composed transforms whose scales differ may
 /// shear, which glTF's cannot: the shear is left out, with a warning.
-pub(super) fn uv_transform(st_transform: Affine2, material: &str, warnings: &mut Vec<String>) -> UvTransform {
+fn uv_transform(st_transform: Affine2, material: &str, warnings: &mut Vec<String>) -> UvTransform {
     let d = Mat2::from_diagonal(Vec2::new(1.0, -1.0));
     let m = d * st_transform.matrix2 * d;
     let offset = d * (st_transform.matrix2 * Vec2::Y + st_transform.translation) + Vec2::Y;

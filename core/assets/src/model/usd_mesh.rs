@@ -5,9 +5,9 @@
 //! interpolation (constant, uniform, vertex, varying, face-varying), indexed or not; corners that
 //! share all their values share a vertex. Texture coordinates: the primvars the mesh's material
 //! reads (`usd_preview_surface::Surface::primvars`: first and second set), else the first found
-//! of [`UV_NAMES`], else the first two-component primvar. A face subset (`GeomSubset` of family `materialBind`)
-//! draws its faces with its own material; a mesh's material is its own binding or its closest
-//! ancestor's. A mesh that is malformed (face sizes that do not add up, a corner naming a point
+//! of [`UV_NAMES`], else the first two-component primvar. A face subset (`GeomSubset` of family
+//! `materialBind`) draws its faces with its own material; a mesh's material is its own binding or
+//! its closest ancestor's. A `Points` prim is read as a cloud ([`read_points`]). A mesh that is malformed (face sizes that do not add up, a corner naming a point
 //! it does not have) is left out with a warning, not the whole stage.
 //!
 //! **Panics**: none (indices are checked before use).
@@ -87,11 +87,6 @@ pub(super) fn read_points(
         },
     );
     let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
-    // A point's value: each point its own (vertex, varying, face-varying), else the one value.
-    let value_at = |interpolation: Interpolation, i: usize| match interpolation {
-        Interpolation::Constant | Interpolation::Uniform => 0,
-        Interpolation::Vertex | Interpolation::FaceVarying => i,
-    };
     let cloud = ReadCloud {
         name,
         positions: points
@@ -101,7 +96,9 @@ pub(super) fn read_points(
         normals: normals.map(|n| {
             (0..points.len())
                 .map(|i| {
-                    n.at(0, value_at(n.interpolation, i), value_at(n.interpolation, i))
+                    // A cloud is one face whose corners are its points: each point its own value
+                    // (vertex, varying, face-varying), or the one (constant, uniform).
+                    n.at(0, i, i)
                         .and_then(|k| n.values.get(k as usize))
                         .map_or([0.0; 3], |v| {
                             (normal_matrix * DVec3::from(*v))
@@ -115,7 +112,7 @@ pub(super) fn read_points(
         colours: display.filter(|_| varies).map(|d| {
             (0..points.len())
                 .map(|i| {
-                    d.at(0, value_at(d.interpolation, i), value_at(d.interpolation, i))
+                    d.at(0, i, i)
                         .and_then(|k| d.values.get(k as usize))
                         .map_or([1.0; 3], |c| c.map(|v| v as f32))
                 })
