@@ -196,14 +196,7 @@ pub fn load(path: &Path, format: MeshFormat, budget: ResourceBudget, progress: &
             .map_err(|e| over_budget(path, e))?;
         // Thinned before the points become vertices (80 bytes each, against the file's 12 or
         // so): only the kept ones are made.
-        let thinned = point_cloud::kept(&soup.positions, discs);
-        let kept = Soup {
-            positions: pick(&soup.positions, &thinned.indices),
-            normals: soup.normals.as_deref().map(|n| pick(n, &thinned.indices)),
-            colors: soup.colors.as_deref().map(|c| pick(c, &thinned.indices)),
-            indices: Vec::new(),
-        };
-        point_cloud::discs(&vertices(&kept), thinned.cell_m)
+        point_cloud::surfels_of(&soup.positions, discs, |i| vertex(&soup, i))
     } else {
         spending
             .charge_primitive(|| "the mesh".to_owned())
@@ -296,7 +289,7 @@ fn weld(soup: Soup) -> Soup {
 /// The vertices and triangles of a soup; normals from the file when it has them, else smooth.
 fn build(soup: Soup) -> Mesh {
     let mut mesh = Mesh {
-        vertices: vertices(&soup),
+        vertices: (0..soup.positions.len()).map(|i| vertex(&soup, i)).collect(),
         indices: soup.indices,
     };
     // Degenerate triangles (repeated corners, common in scans) draw nothing and bend smooth
@@ -315,40 +308,31 @@ fn build(soup: Soup) -> Mesh {
     mesh
 }
 
-/// The entries of `values` at `indices`, in that order (indices past the end left out).
-fn pick<T: Copy>(values: &[T], indices: &[usize]) -> Vec<T> {
-    indices.iter().filter_map(|&i| values.get(i).copied()).collect()
-}
-
 /// A scan's vertex colour, sRGB-encoded as scanners write it (0–1, alpha linear), made linear.
 pub(super) fn scan_colour(c: [f32; 4]) -> [f32; 4] {
     let linear = phantogram_geometry::srgb::to_linear;
     [linear(c[0]), linear(c[1]), linear(c[2]), c[3]]
 }
 
-/// A soup's vertices: its normals where given (else zero), its sRGB colours linearised (else
+/// A soup's `i`-th vertex: its normal where given (else zero), its sRGB colour linearised (else
 /// white).
-fn vertices(soup: &Soup) -> Vec<Vertex> {
-    soup.positions
-        .iter()
-        .enumerate()
-        .map(|(i, p)| Vertex {
-            position: *p,
-            normal: soup
-                .normals
-                .as_ref()
-                .and_then(|n| n.get(i))
-                .map_or([0.0; 3], |n| Vec3::from(*n).normalize_or_zero().to_array()),
-            tangent: [1.0, 0.0, 0.0, 1.0],
-            uv: [0.0; 4],
-            color: soup
-                .colors
-                .as_ref()
-                .and_then(|c| c.get(i))
-                .map_or([1.0; 4], |&c| scan_colour(c)),
-            material: [1.0, 1.0],
-        })
-        .collect()
+fn vertex(soup: &Soup, i: usize) -> Vertex {
+    Vertex {
+        position: soup.positions[i],
+        normal: soup
+            .normals
+            .as_ref()
+            .and_then(|n| n.get(i))
+            .map_or([0.0; 3], |n| Vec3::from(*n).normalize_or_zero().to_array()),
+        tangent: [1.0, 0.0, 0.0, 1.0],
+        uv: [0.0; 4],
+        color: soup
+            .colors
+            .as_ref()
+            .and_then(|c| c.get(i))
+            .map_or([1.0; 4], |&c| scan_colour(c)),
+        material: [1.0, 1.0],
+    }
 }
 
 #[cfg(test)]

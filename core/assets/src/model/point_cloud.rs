@@ -143,8 +143,14 @@ pub struct Thinned {
 /// `max_points` discs. Empty for an empty cloud or one whose points all coincide.
 pub fn surfels(cloud: &[Vertex], max_points: usize) -> Mesh {
     let positions: Vec<[f32; 3]> = cloud.iter().map(|v| v.position).collect();
-    let thinned = kept(&positions, max_points.max(1));
-    let points: Vec<Vertex> = thinned.indices.iter().map(|&i| cloud[i]).collect();
+    surfels_of(&positions, max_points, |i| cloud[i])
+}
+
+/// The same for a cloud held as its `positions`, point `i`'s vertex made by `vertex(i)`: only
+/// for the points kept (a vertex is 80 bytes against a position's 12), after thinning.
+pub fn surfels_of(positions: &[[f32; 3]], max_points: usize, vertex: impl Fn(usize) -> Vertex) -> Mesh {
+    let thinned = kept(positions, max_points.max(1));
+    let points: Vec<Vertex> = thinned.indices.iter().map(|&i| vertex(i)).collect();
     discs(&points, thinned.cell_m)
 }
 

@@ -519,25 +519,18 @@ fn build_model(
             .charge_primitive(what)
             .and_then(|()| point_cloud::charge_discs(spending, cloud.positions.len(), what))
             .map_err(|e| over_budget(path, e))?;
-        // Thinned before the points become vertices: only the kept ones are made.
-        let thinned = point_cloud::kept(&cloud.positions, discs);
         let colours = cloud
             .colours
             .as_ref()
             .filter(|_| scene.looks[cloud.look].vertex_colours);
-        let kept: Vec<Vertex> = thinned
-            .indices
-            .iter()
-            .map(|&i| Vertex {
-                position: cloud.positions[i],
-                normal: cloud.normals.as_ref().map_or([0.0; 3], |n| n[i]),
-                tangent: [1.0, 0.0, 0.0, 1.0],
-                uv: [0.0; 4],
-                color: colours.map_or([1.0; 4], |c| [c[i][0], c[i][1], c[i][2], 1.0]),
-                material: [1.0, 1.0],
-            })
-            .collect();
-        let built = point_cloud::discs(&kept, thinned.cell_m);
+        let built = point_cloud::surfels_of(&cloud.positions, discs, |i| Vertex {
+            position: cloud.positions[i],
+            normal: cloud.normals.as_ref().map_or([0.0; 3], |n| n[i]),
+            tangent: [1.0, 0.0, 0.0, 1.0],
+            uv: [0.0; 4],
+            color: colours.map_or([1.0; 4], |c| [c[i][0], c[i][1], c[i][2], 1.0]),
+            material: [1.0, 1.0],
+        });
         if built.indices.is_empty() {
             warnings.push(format!("{}: all its points in one place: left out", what()));
             continue;
