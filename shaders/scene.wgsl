@@ -1144,7 +1144,6 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let light_in = light_seen * n_dot_l;
     let occlusion = s.occlusion;
     let reflected = to_world(reflect(-v, n));
-    let lut_size = vec2<f32>(textureDimensions(brdf_lut));
     var direct = vec3<f32>(0.0);
     var ambient_light = vec3<f32>(0.0);
     // The dielectric's reflectance (Schlick, glTF's `fresnel_mix`), the visitor's specular scale
@@ -1155,6 +1154,21 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let fresnel_d = s.specular_weight * (f0_d + (f90_d - f0_d) * pow(1.0 - v_dot_h, 5.0));
     let f90_ambient_d = select(f0_d, max(vec3<f32>(1.0 - roughness), f0_d), s.fresnel_rises);
     let fresnel_ambient_d = s.specular_weight * (f0_d + (f90_ambient_d - f0_d) * pow(1.0 - n_dot_v, 5.0));
+    // The split-sum table at this view and roughness (Karis 2013): a microfacet surface's
+    // albedo after one bounce is F0·x + F90·y; E_ms = 1 − x − y is what a perfect (F = 1) one
+    // loses to light that leaves only after further bounces, up to half at roughness 1.
+    let lut_size = vec2<f32>(textureDimensions(brdf_lut));
+    let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+    let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
+    let e_ms = clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0);
+    // Those further bounces (Fdez-Agüera, "A Multiple-Scattering Microfacet Model for Real-Time
+    // Image-based Lighting", JCGT 2019, as Khronos's glTF Sample Viewer has them): each reflects
+    // Schlick's hemispherical mean F_avg = F0 + (F90 − F0)/21, so the single bounce's albedo
+    // grows by 1 / (1 − F_avg·E_ms). Without them a white rough metal looks grey.
+    let f_avg_d = s.specular_weight * (f0_d + (f90_d - f0_d) / 21.0);
+    let f_avg_m = base + (vec3<f32>(1.0) - base) / 21.0;
+    let bounces_d = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_d * e_ms);
+    let bounces_m = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_m * e_ms);
     // What the base does not scatter back passes through (glTF's transmission: a thin wall,
     // tinted by the base colour; through a volume, absorbed along the refracted path).
     let transmission = s.transmission * (1.0 - metallic);
@@ -1232,6 +1246,9 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let lambert = (1.0 - metallic) * (1.0 - s.transmission) * base / PI;
         let through_sheet = s.diffuse_transmission;
         let diffuse = (vec3<f32>(1.0) - fresnel) * lambert * (1.0 - through_sheet);
+        // The lobe with its further bounces, by the factor the image light below uses (as
+        // Filament scales its lobe by 1 + F0·(1/E_ss − 1): the same at F0 = 1).
+        specular = specular * mix(bounces_d, bounces_m, metallic);
         direct = (diffuse + specular) * light_in;
         if (through_sheet > 0.0) {
             let back = -s.geometric_n;
@@ -1239,22 +1256,24 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             direct += lambert * through_sheet * s.diffuse_transmission_color * light_behind;
         }
 
-        // Image-based light, world-fixed: diffuse from the environment's irradiance (ρ/π·E),
-        // specular by the split sum: the prefiltered radiance around the reflection direction at
-        // this roughness, times F0·scale + bias from the BRDF table (Karis 2013). Explicit
-        // levels: no derivatives, so the azimuth seam of the equirectangular map leaves no line.
-        let fresnel_ambient_m = base + (max(vec3<f32>(1.0 - roughness), base) - base) * pow(1.0 - n_dot_v, 5.0);
-        let fresnel_ambient = mix(fresnel_ambient_d, fresnel_ambient_m, metallic);
-        var diffuse_ambient = irradiance(to_world(n)) * lambert * (1.0 - through_sheet) * (vec3<f32>(1.0) - fresnel_ambient);
+        // Image-based light, world-fixed. Specular by the split sum: the prefiltered radiance
+        // around the reflection direction at this roughness times the single bounce's albedo;
+        // the further bounces' light has lost its direction and comes from the irradiance
+        // (Fdez-Agüera). Diffuse from the irradiance (ρ/π·E), of what the specular layer,
+        // all bounces together, does not reflect: a white dielectric returns all the light.
+        // Explicit levels: no derivatives, so the azimuth seam of the equirectangular map
+        // leaves no line.
+        let albedo_d = s.specular_weight * (f0_ambient_d * scale_bias.x + f90_d * scale_bias.y);
+        let albedo_m = f0_ambient_m * scale_bias.x + vec3<f32>(scale_bias.y);
+        let reflected_d = min(albedo_d * bounces_d, vec3<f32>(1.0));
+        let irradiance_n = irradiance(to_world(n));
+        var diffuse_ambient = irradiance_n * lambert * (1.0 - through_sheet) * (vec3<f32>(1.0) - reflected_d);
         if (through_sheet > 0.0) {
             diffuse_ambient += irradiance(to_world(-n)) * lambert * through_sheet * s.diffuse_transmission_color;
         }
-        let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
-        let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected_base), roughness * PREFILTERED_MAX_LEVEL).rgb;
-        let albedo_d = s.specular_weight * (f0_ambient_d * scale_bias.x + f90_d * scale_bias.y);
-        let albedo_m = f0_ambient_m * scale_bias.x + vec3<f32>(scale_bias.y);
-        let specular_ambient = prefiltered * mix(albedo_d, albedo_m, metallic);
+        let further = mix(albedo_d * (bounces_d - 1.0), albedo_m * (bounces_m - 1.0), metallic);
+        let specular_ambient = prefiltered * mix(albedo_d, albedo_m, metallic) + irradiance_n / PI * further;
         ambient_light = diffuse_ambient + specular_ambient;
 
         // Sheen over it (cloth): the fibres' lobe added, the layer below dimmed by what they

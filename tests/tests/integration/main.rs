@@ -19,6 +19,7 @@ mod diorama;
 mod eyetrack;
 mod face;
 mod fade;
+mod furnace;
 mod fusion_real;
 mod fusion_vigorous;
 mod glasses;

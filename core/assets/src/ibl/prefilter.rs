@@ -160,15 +160,24 @@ pub fn prefiltered_levels(env: &Environment, base_width: usize) -> Vec<Environme
 /// The split-sum BRDF table: `size × size` entries of `(scale, bias)` with n·v along x (0 → 1)
 /// and roughness along y (0 → 1), so that the specular image-based light is
 /// `prefiltered(r, roughness) · (F0 · scale + bias)`.
+///
+/// It integrates the BRDF the renderer's lights use (glTF's: GGX with the height-correlated
+/// Smith visibility, `scene.wgsl`'s `smith_visibility`), so that a surface reflects the room's
+/// light and a lamp's alike. (Karis's separable Schlick–GGX, k = α/2, gave up to a fifth less
+/// at grazing angles on rough surfaces.)
 pub fn brdf_lut(size: usize) -> Vec<[f32; 2]> {
     let samples = 256u32;
     let mut out = Vec::with_capacity(size * size);
     for j in 0..size {
         let roughness = (j as f32 + 0.5) / size as f32;
         let alpha = roughness * roughness;
-        // Schlick–GGX geometry with k = α/2 for image-based light (Karis 2013).
-        let k = alpha / 2.0;
-        let g1 = |c: f32| c / (c * (1.0 - k) + k);
+        let a2 = alpha * alpha;
+        // V = G / (4 n·l n·v), height-correlated (Heitz 2014).
+        let visibility = |n_dot_l: f32, n_dot_v: f32| {
+            let gv = n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt();
+            let gl = n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt();
+            0.5 / (gv + gl).max(1e-7)
+        };
         for i in 0..size {
             let n_dot_v = ((i as f32 + 0.5) / size as f32).max(1e-3);
             let v = Vec3::new((1.0 - n_dot_v * n_dot_v).sqrt(), 0.0, n_dot_v);
@@ -179,7 +188,8 @@ pub fn brdf_lut(size: usize) -> Vec<[f32; 2]> {
                 let l = h * 2.0 * v.dot(h) - v;
                 let (n_dot_l, n_dot_h, v_dot_h) = (l.z, h.z.max(0.0), v.dot(h).max(0.0));
                 if n_dot_l > 0.0 {
-                    let g_vis = g1(n_dot_l) * g1(n_dot_v) * v_dot_h / (n_dot_h * n_dot_v).max(1e-6);
+                    // f · n·l / pdf with the half vector's pdf D · n·h / (4 v·h): D cancels.
+                    let g_vis = 4.0 * visibility(n_dot_l, n_dot_v) * n_dot_l * v_dot_h / n_dot_h.max(1e-6);
                     let fc = (1.0 - v_dot_h).powi(5);
                     a += (1.0 - fc) * g_vis;
                     b += fc * g_vis;
@@ -208,6 +218,60 @@ mod tests {
         assert!(rough[0] + rough[1] < 0.8 && rough[0] > 0.2, "{rough:?}");
         // Every entry is a reflectance in [0, 1].
         assert!(lut.iter().all(|[a, b]| *a >= 0.0 && *b >= 0.0 && a + b <= 1.05));
+    }
+
+    /// The table holds the albedo of the BRDF the lights use (GGX, height-correlated Smith,
+    /// Schlick's Fresnel): checked against that BRDF integrated over the hemisphere of light
+    /// directions on a plain grid (no importance sampling), for F0 = 1 (scale + bias) and F0 = 0
+    /// (bias), where the lobe is wide enough for the grid.
+    #[test]
+    fn split_sum_table_is_the_albedo_of_the_lights_brdf() {
+        let size = 16usize;
+        let lut = brdf_lut(size);
+        let albedo = |n_dot_v: f32, roughness: f32| {
+            let (a2, v) = (
+                (roughness * roughness).powi(2),
+                Vec3::new((1.0 - n_dot_v * n_dot_v).sqrt(), 0.0, n_dot_v),
+            );
+            let (rows, cols) = (400usize, 800usize);
+            let (d_theta, d_phi) = (
+                std::f64::consts::FRAC_PI_2 / rows as f64,
+                std::f64::consts::TAU / cols as f64,
+            );
+            let (mut white, mut black) = (0.0f64, 0.0f64);
+            for r in 0..rows {
+                let theta = (r as f64 + 0.5) * d_theta;
+                for c in 0..cols {
+                    let phi = (c as f64 + 0.5) * d_phi;
+                    let l = Vec3::new(
+                        (theta.sin() * phi.cos()) as f32,
+                        (theta.sin() * phi.sin()) as f32,
+                        theta.cos() as f32,
+                    );
+                    let h = (l + v).normalize();
+                    let (n_dot_l, n_dot_h, v_dot_h) = (l.z, h.z, v.dot(h).max(0.0));
+                    let d = a2 / (std::f32::consts::PI * (n_dot_h * n_dot_h * (a2 - 1.0) + 1.0).powi(2));
+                    let vis = 0.5
+                        / (n_dot_l * (n_dot_v * n_dot_v * (1.0 - a2) + a2).sqrt()
+                            + n_dot_v * (n_dot_l * n_dot_l * (1.0 - a2) + a2).sqrt());
+                    let f = f64::from(d * vis * n_dot_l) * theta.sin() * d_theta * d_phi;
+                    white += f;
+                    black += f * f64::from((1.0 - v_dot_h).powi(5));
+                }
+            }
+            (white as f32, black as f32)
+        };
+        for i in [4usize, 9, 15] {
+            for j in [7usize, 11, 15] {
+                let (n_dot_v, roughness) = ((i as f32 + 0.5) / size as f32, (j as f32 + 0.5) / size as f32);
+                let [scale, bias] = lut[j * size + i];
+                let (white, black) = albedo(n_dot_v, roughness);
+                assert!(
+                    (scale + bias - white).abs() < 0.02 && (bias - black).abs() < 0.01,
+                    "n·v {n_dot_v}, roughness {roughness}: table {scale} + {bias}, integrated {white} (F0 = 0: {black})"
+                );
+            }
+        }
     }
 
     #[test]
