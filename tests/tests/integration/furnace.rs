@@ -4,8 +4,8 @@
 //! into the room; one that absorbs a share must send back less, never more.
 //!
 //! A rough metal fails this when only light that leaves the microfacets after one bounce is
-//! counted (the split sum's table alone): at roughness 1 about half the light seems to vanish
-//! and a white metal looks grey. `scene.wgsl`'s image light adds the light that leaves after
+//! counted (the split sum's table alone): at roughness 1 half to two thirds of the light seems
+//! to vanish and a white metal looks grey. `scene.wgsl`'s image light adds the light that leaves after
 //! further bounces (Fdez-Agüera 2019, as Khronos's glTF Sample Viewer does), and its
 //! dielectric passes to the diffuse layer only what the specular layer does not reflect.
 
@@ -21,7 +21,7 @@ use phantogram::screen::Screen;
 /// The room's radiance in every direction: below the tone curve's shoulder (0.76), so that a
 /// pixel's linear value gives back the radiance that made it (`radiance_of`).
 const ROOM: f32 = 0.5;
-/// Sphere radius (m) and the heights of the two rows' centres (device y, m).
+/// The spheres' radius (m).
 const RADIUS_M: f32 = 0.007;
 const ROUGHNESS: [f32; 3] = [0.2, 0.6, 1.0];
 const EYE: Vec3 = Vec3::new(0.0, 0.0, 0.3);
@@ -142,8 +142,8 @@ fn white_spheres_vanish_into_a_uniform_room() {
             }
         }
     }
-    // 3 %: the 8-bit code's step here is 0.5 %, the split-sum table's and the prefiltered
-    // levels' filtering a little more; a metal that loses its second bounces is 30–50 % off.
+    // 3 %: one 8-bit step here is about 1 %, the split-sum table's and the prefiltered levels'
+    // filtering add a little; a metal that loses its further bounces is up to 68 % off.
     assert!(
         worst.0 < 0.03,
         "a white sphere stands out of the room by {:.1} % ({})",
