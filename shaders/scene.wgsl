@@ -1164,8 +1164,10 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     // Those further bounces (Fdez-Agüera, "A Multiple-Scattering Microfacet Model for Real-Time
     // Image-based Lighting", JCGT 2019, as Khronos's glTF Sample Viewer has them): each reflects
     // Schlick's hemispherical mean F_avg = F0 + (F90 − F0)/21, so the single bounce's albedo
-    // grows by 1 / (1 − F_avg·E_ms). Without them a white rough metal looks grey.
-    let f_avg_d = s.specular_weight * (f0_d + (f90_d - f0_d) / 21.0);
+    // grows by 1 / (1 − F_avg·E_ms). Without them a white rough metal looks grey. F_avg is a
+    // reflectance, at most 1 (the visitor's specular can double F0), so the factor stays below
+    // 1 / E_ss.
+    let f_avg_d = min(s.specular_weight * (f0_d + (f90_d - f0_d) / 21.0), vec3<f32>(1.0));
     let f_avg_m = base + (vec3<f32>(1.0) - base) / 21.0;
     let bounces_d = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_d * e_ms);
     let bounces_m = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_m * e_ms);
