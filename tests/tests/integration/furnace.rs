@@ -13,7 +13,7 @@ use crate::render::{H, W, add_part, push_floor_marker, still_input};
 use phantogram::anaglyph::Method;
 use phantogram::glam::Vec3;
 use phantogram::ibl::Environment;
-use phantogram::model::{Material, Mesh, Model, Vertex};
+use phantogram::model::{Material, Mesh, Model};
 use phantogram::projection::{DepthRange, OffAxisProjection};
 use phantogram::render::Renderer;
 use phantogram::screen::Screen;
@@ -25,36 +25,6 @@ const ROOM: f32 = 0.5;
 const RADIUS_M: f32 = 0.007;
 const ROUGHNESS: [f32; 3] = [0.2, 0.6, 1.0];
 const EYE: Vec3 = Vec3::new(0.0, 0.0, 0.3);
-
-/// A sphere of `radius` about `centre`, with its own normals and tangents.
-fn sphere(centre: Vec3, radius: f32) -> Mesh {
-    let (rings, segments) = (48u32, 96u32);
-    let mut mesh = Mesh::default();
-    for i in 0..=rings {
-        let theta = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..=segments {
-            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
-            let t = Vec3::new(-phi.sin(), phi.cos(), 0.0);
-            mesh.vertices.push(Vertex {
-                position: (centre + n * radius).to_array(),
-                normal: n.to_array(),
-                tangent: t.extend(1.0).to_array(),
-                uv: [j as f32 / segments as f32, i as f32 / rings as f32, 0.0, 0.0],
-                color: [1.0; 4],
-                material: [1.0, 1.0],
-            });
-        }
-    }
-    let row = segments + 1;
-    for i in 0..rings {
-        for j in 0..segments {
-            let (a, b) = (i * row + j, (i + 1) * row + j);
-            mesh.indices.extend_from_slice(&[a, b, b + 1, a, b + 1, a + 1]);
-        }
-    }
-    mesh
-}
 
 /// The radiance that made an 8-bit sRGB code after the renderer's tone curve (Khronos PBR
 /// Neutral, exposure 1): below its shoulder the curve subtracts 0.04 from a grey of 0.08 or more.
@@ -98,7 +68,9 @@ fn furnace(base: [f32; 4]) -> Option<(Vec<u8>, OffAxisProjection, [[Vec3; 3]; 2]
                 roughness,
                 ..Material::default()
             };
-            add_part(&mut model, sphere(centre, RADIUS_M), material);
+            let mut ball = Mesh::default();
+            ball.push_ball(centre, RADIUS_M, 96, 48);
+            add_part(&mut model, ball, material);
         }
     }
     let room = Environment {

@@ -184,6 +184,36 @@ impl Mesh {
                 .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
         }
     }
+
+    /// Appends a UV sphere of `radius` at `centre` (annotation pins, tests): `segments` round,
+    /// `rings` from pole to pole, white, with its normals and tangents (along φ).
+    pub fn push_ball(&mut self, centre: Vec3, radius: f32, segments: u32, rings: u32) {
+        let base = self.vertices.len() as u32;
+        for i in 0..=rings {
+            let theta = std::f32::consts::PI * i as f32 / rings as f32;
+            for j in 0..=segments {
+                let phi = std::f32::consts::TAU * j as f32 / segments as f32;
+                let n = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
+                self.vertices.push(Vertex {
+                    position: (centre + n * radius).to_array(),
+                    normal: n.to_array(),
+                    tangent: [-phi.sin(), phi.cos(), 0.0, 1.0],
+                    uv: [j as f32 / segments as f32, i as f32 / rings as f32, 0.0, 0.0],
+                    color: [1.0; 4],
+                    material: [1.0, 1.0],
+                });
+            }
+        }
+        let row = segments + 1;
+        for i in 0..rings {
+            for j in 0..segments {
+                let a = base + i * row + j;
+                let b = a + row;
+                // Counter-clockwise seen from outside (θ grows towards −z, φ anticlockwise about z).
+                self.indices.extend_from_slice(&[a, b, a + 1, a + 1, b, b + 1]);
+            }
+        }
+    }
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -693,7 +723,7 @@ impl Model {
         }
         let mut mesh = Mesh::default();
         for a in &self.annotations {
-            push_ball(&mut mesh, Self::pin_centre(a), Self::PIN_RADIUS_M, 12, 8);
+            mesh.push_ball(Self::pin_centre(a), Self::PIN_RADIUS_M, 12, 8);
         }
         self.materials.push(Material {
             name: "annotation markers".into(),
@@ -751,35 +781,6 @@ impl Model {
             * Mat4::from_translation(Vec3::new(-centre.x, -centre.y, -b.min.z));
         self.transform(m);
         scale
-    }
-}
-
-/// Appends a UV sphere of `radius` at `centre`: `segments` round, `rings` from pole to pole.
-fn push_ball(mesh: &mut Mesh, centre: Vec3, radius: f32, segments: u32, rings: u32) {
-    let base = mesh.vertices.len() as u32;
-    for i in 0..=rings {
-        let theta = std::f32::consts::PI * i as f32 / rings as f32;
-        for j in 0..=segments {
-            let phi = std::f32::consts::TAU * j as f32 / segments as f32;
-            let n = Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos());
-            mesh.vertices.push(Vertex {
-                position: (centre + n * radius).to_array(),
-                normal: n.to_array(),
-                tangent: [-phi.sin(), phi.cos(), 0.0, 1.0],
-                uv: [j as f32 / segments as f32, i as f32 / rings as f32, 0.0, 0.0],
-                color: [1.0; 4],
-                material: [1.0, 1.0],
-            });
-        }
-    }
-    let row = segments + 1;
-    for i in 0..rings {
-        for j in 0..segments {
-            let a = base + i * row + j;
-            let b = a + row;
-            // Counter-clockwise seen from outside (θ grows towards −z, φ anticlockwise about z).
-            mesh.indices.extend_from_slice(&[a, b, a + 1, a + 1, b, b + 1]);
-        }
     }
 }
 
