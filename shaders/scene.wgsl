@@ -1315,17 +1315,25 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let coat_n_dot_l = max(dot(cn, l), 0.0);
         let coat_n_dot_v = max(dot(cn, v), 1e-4);
         let coat_alpha = coat_rough * coat_rough;
-        let fc = (0.04 + 0.96 * pow(1.0 - v_dot_h, 5.0)) * coat;
-        let coat_direct = fc * ggx(max(dot(cn, h), 0.0), coat_alpha)
-            * smith_visibility(coat_n_dot_l, coat_n_dot_v, coat_alpha) * light_seen * coat_n_dot_l;
-        direct = direct * (1.0 - fc) + coat_direct;
-        let fc_ambient = (0.04 + 0.96 * pow(1.0 - coat_n_dot_v, 5.0)) * coat;
+        // The coat's albedo from the split-sum table (F0 0.04, F90 1), with its further bounces
+        // as the layer below has them.
         let lut_uv = clamp(vec2<f32>(coat_n_dot_v, coat_rough), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
+        let coat_single = 0.04 * scale_bias.x + scale_bias.y;
+        let coat_bounces = 1.0 / (1.0 - (0.04 + 0.96 / 21.0) * clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0));
+        let fc = (0.04 + 0.96 * pow(1.0 - v_dot_h, 5.0)) * coat;
+        let coat_direct = fc * coat_bounces * ggx(max(dot(cn, h), 0.0), coat_alpha)
+            * smith_visibility(coat_n_dot_l, coat_n_dot_v, coat_alpha) * light_seen * coat_n_dot_l;
+        direct = direct * (1.0 - fc) + coat_direct;
+        // In the image light the coat keeps from the layer below what it reflects of the room,
+        // all bounces together, so that a white sphere under it still returns all the light
+        // (before: Schlick's F at n·v, more than a rough coat reflects).
+        let coat_total = min(coat_single * coat_bounces, 1.0) * coat;
         let coat_reflected = to_world(reflect(-v, cn));
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(coat_reflected), coat_rough * PREFILTERED_MAX_LEVEL).rgb;
-        ambient_light = ambient_light * (1.0 - fc_ambient) + prefiltered * (0.04 * scale_bias.x + scale_bias.y) * coat;
-        coat_reflects = fc_ambient;
+        let coat_further = irradiance(to_world(cn)) / PI * coat_single * (coat_bounces - 1.0);
+        ambient_light = ambient_light * (1.0 - coat_total) + (prefiltered * coat_single + coat_further) * coat;
+        coat_reflects = coat_total;
     }
     let ambient = eye.light.w * occlusion * ambient_light;
     let sin2_t = (1.0 - n_dot_v * n_dot_v) * s.inv_ior * s.inv_ior;

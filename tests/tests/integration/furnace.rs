@@ -6,14 +6,15 @@
 //! A rough metal fails this when only light that leaves the microfacets after one bounce is
 //! counted (the split sum's table alone): at roughness 1 half to two thirds of the light seems
 //! to vanish and a white metal looks grey. `scene.wgsl`'s image light adds the light that leaves after
-//! further bounces (Fdez-Agüera 2019, as Khronos's glTF Sample Viewer does), and its
-//! dielectric passes to the diffuse layer only what the specular layer does not reflect.
+//! further bounces (Fdez-Agüera 2019, as Khronos's glTF Sample Viewer does), its dielectric
+//! passes to the diffuse layer only what the specular layer does not reflect, and a clear coat
+//! keeps from the layer below only what it reflects itself.
 
 use crate::render::{H, W, add_part, push_floor_marker, still_input};
 use phantogram::anaglyph::Method;
 use phantogram::glam::Vec3;
 use phantogram::ibl::Environment;
-use phantogram::model::{Material, Mesh, Model};
+use phantogram::model::{Layers, Material, Mesh, Model};
 use phantogram::projection::{DepthRange, OffAxisProjection};
 use phantogram::render::Renderer;
 use phantogram::screen::Screen;
@@ -50,10 +51,10 @@ fn pixel_seen_at(pixels: &[u8], proj: &OffAxisProjection, centre: Vec3, n_dot_v:
     [pixels[i], pixels[i + 1], pixels[i + 2]]
 }
 
-/// The two rows of spheres (white metal above, white dielectric below, roughness 0.2, 0.6, 1
-/// from left to right) in the furnace; the frame, the projection and the spheres' centres by
-/// row, or `None` without a GPU.
-fn furnace(base: [f32; 4]) -> Option<(Vec<u8>, OffAxisProjection, [[Vec3; 3]; 2])> {
+/// The two rows of spheres (metal above, dielectric below, of colour `base`, roughness 0.2, 0.6,
+/// 1 from left to right; `coated`: under a clear coat of the same roughness) in the furnace; the
+/// frame, the projection and the spheres' centres by row, or `None` without a GPU.
+fn furnace(base: [f32; 4], coated: bool) -> Option<(Vec<u8>, OffAxisProjection, [[Vec3; 3]; 2])> {
     let gpu = phantogram_integration::gpu_or_skip()?;
     let mut marker = Mesh::default();
     push_floor_marker(&mut marker);
@@ -66,6 +67,11 @@ fn furnace(base: [f32; 4]) -> Option<(Vec<u8>, OffAxisProjection, [[Vec3; 3]; 2]
                 base_color: base,
                 metallic,
                 roughness,
+                layers: Layers {
+                    clear_coat: if coated { 1.0 } else { 0.0 },
+                    clear_coat_roughness: roughness,
+                    ..Layers::default()
+                },
                 ..Material::default()
             };
             let mut ball = Mesh::default();
@@ -93,7 +99,18 @@ const SEEN_AT: [f32; 3] = [0.97, 0.6, 0.3];
 
 #[test]
 fn white_spheres_vanish_into_a_uniform_room() {
-    let Some((pixels, proj, centres)) = furnace([1.0; 4]) else {
+    white_spheres_vanish(false);
+}
+
+#[test]
+fn varnished_white_spheres_vanish_too() {
+    // A clear coat reflects a share and passes the rest to the white sphere below, which sends
+    // it all back: together all the light again.
+    white_spheres_vanish(true);
+}
+
+fn white_spheres_vanish(coated: bool) {
+    let Some((pixels, proj, centres)) = furnace([1.0; 4], coated) else {
         return;
     };
     if std::env::var_os("PHANTOGRAM_FURNACE_PNG").is_some() {
@@ -105,7 +122,9 @@ fn white_spheres_vanish_into_a_uniform_room() {
     for (what, row) in ["white metal", "white dielectric"].into_iter().zip(&centres) {
         for (roughness, &centre) in ROUGHNESS.iter().zip(row) {
             let seen = SEEN_AT.map(|n_dot_v| radiance_of(pixel_seen_at(&pixels, &proj, centre, n_dot_v)[1]));
-            println!("{what}, roughness {roughness}: sends back {seen:.3?} of the room's {ROOM} at n·v {SEEN_AT:?}");
+            println!(
+                "{what}, roughness {roughness}, coated {coated}: sends back {seen:.3?} of the room's {ROOM} at n·v {SEEN_AT:?}"
+            );
             for (s, n_dot_v) in seen.into_iter().zip(SEEN_AT) {
                 let off = (s / ROOM - 1.0).abs();
                 if off > worst.0 {
@@ -131,10 +150,10 @@ fn grey_spheres_send_back_no_more_than_white_ones() {
     // returns half of what its specular layer passes and that layer reflects a few per cent:
     // half the light or a little more. (A grey rough metal may send back less than its F0 of
     // one half: light that bounces between its microfacets loses half at each bounce.)
-    let Some((white, proj, centres)) = furnace([1.0; 4]) else {
+    let Some((white, proj, centres)) = furnace([1.0; 4], false) else {
         return;
     };
-    let (grey, _, _) = furnace([0.5, 0.5, 0.5, 1.0]).expect("a frame");
+    let (grey, _, _) = furnace([0.5, 0.5, 0.5, 1.0], false).expect("a frame");
     let seen = |pixels: &[u8], centre: Vec3| {
         SEEN_AT.map(|n_dot_v| radiance_of(pixel_seen_at(pixels, &proj, centre, n_dot_v)[1]) / ROOM)
     };
