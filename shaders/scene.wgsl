@@ -1156,7 +1156,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let fresnel_ambient_d = s.specular_weight * (f0_d + (f90_ambient_d - f0_d) * pow(1.0 - n_dot_v, 5.0));
     // The split-sum table at this view and roughness (Karis 2013): a microfacet surface's
     // albedo after one bounce is F0·x + F90·y; E_ms = 1 − x − y is what a perfect (F = 1) one
-    // loses to light that leaves only after further bounces, up to half at roughness 1.
+    // loses to light that leaves only after further bounces: two thirds face on at roughness 1.
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));
     let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
     let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
