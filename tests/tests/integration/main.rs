@@ -2,6 +2,9 @@
 //! its own. One binary links the engine's dependencies (wgpu, tract, egui, …) once instead of two
 //! dozen times, and its tests share the cores instead of waiting for each other binary by binary.
 //! `cargo test -p phantogram-integration --test integration render::` runs one module.
+//! Filters match anywhere in a test's name: `.ci/run`'s `--skip face::` (the CPU-only face tests)
+//! also skips any module whose name ends in `face` — hence `surface_mode`, not `surface`, whose
+//! golden frame those runs once left unchecked.
 //!
 //! A test that measures the process itself (resident memory) cannot share it: it has its own
 //! binary (`tests/tests/memory.rs`).
@@ -37,7 +40,7 @@ mod room_light;
 mod seen_through;
 mod shared_data;
 mod sheen;
-mod surface;
+mod surface_mode;
 mod thin_sheets;
 mod transmission;
 mod viewpoint_and_light;
