@@ -1154,23 +1154,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let fresnel_d = s.specular_weight * (f0_d + (f90_d - f0_d) * pow(1.0 - v_dot_h, 5.0));
     let f90_ambient_d = select(f0_d, max(vec3<f32>(1.0 - roughness), f0_d), s.fresnel_rises);
     let fresnel_ambient_d = s.specular_weight * (f0_d + (f90_ambient_d - f0_d) * pow(1.0 - n_dot_v, 5.0));
-    // The split-sum table at this view and roughness (Karis 2013): a microfacet surface's
-    // albedo after one bounce is F0·x + F90·y; E_ms = 1 − x − y is what a perfect (F = 1) one
-    // loses to light that leaves only after further bounces: two thirds face on at roughness 1.
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));
-    let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
-    let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
-    let e_ms = clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0);
-    // Those further bounces (Fdez-Agüera, "A Multiple-Scattering Microfacet Model for Real-Time
-    // Image-based Lighting", JCGT 2019, as Khronos's glTF Sample Viewer has them): each reflects
-    // Schlick's hemispherical mean F_avg = F0 + (F90 − F0)/21, so the single bounce's albedo
-    // grows by 1 / (1 − F_avg·E_ms). Without them a white rough metal looks grey. F_avg is a
-    // reflectance, at most 1 (the visitor's specular can double F0), so the factor stays below
-    // 1 / E_ss.
-    let f_avg_d = min(s.specular_weight * (f0_d + (f90_d - f0_d) / 21.0), vec3<f32>(1.0));
-    let f_avg_m = base + (vec3<f32>(1.0) - base) / 21.0;
-    let bounces_d = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_d * e_ms);
-    let bounces_m = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_m * e_ms);
     // What the base does not scatter back passes through (glTF's transmission: a thin wall,
     // tinted by the base colour; through a volume, absorbed along the refracted path).
     let transmission = s.transmission * (1.0 - metallic);
@@ -1214,6 +1198,23 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let prefiltered = ward_image_light(v, n, tw, bw, ward_alpha);
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * (scale_bias.x + scale_bias.y);
     } else {
+        // The split-sum table at this view and roughness (Karis 2013): a microfacet surface's
+        // albedo after one bounce is F0·x + F90·y; E_ms = 1 − x − y is what a perfect (F = 1)
+        // one loses to light that leaves only after further bounces: two thirds face on at
+        // roughness 1.
+        let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+        let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
+        let e_ms = clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0);
+        // Those further bounces (Fdez-Agüera, "A Multiple-Scattering Microfacet Model for
+        // Real-Time Image-based Lighting", JCGT 2019, as Khronos's glTF Sample Viewer has them):
+        // each reflects Schlick's hemispherical mean F_avg = F0 + (F90 − F0)/21, so the single
+        // bounce's albedo grows by 1 / (1 − F_avg·E_ms). Without them a white rough metal looks
+        // grey. F_avg is a reflectance, at most 1 (the visitor's specular can double F0), so the
+        // factor stays below 1 / E_ss.
+        let f_avg_d = min(s.specular_weight * (f0_d + (f90_d - f0_d) / 21.0), vec3<f32>(1.0));
+        let f_avg_m = base + (vec3<f32>(1.0) - base) / 21.0;
+        let bounces_d = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_d * e_ms);
+        let bounces_m = vec3<f32>(1.0) / (vec3<f32>(1.0) - f_avg_m * e_ms);
         let fresnel_m = base + (vec3<f32>(1.0) - base) * pow(1.0 - v_dot_h, 5.0);
         var fresnel = mix(fresnel_d, fresnel_m, metallic);
         // A thin film's colours (KHR_materials_iridescence): the Fresnel term mixed towards the
