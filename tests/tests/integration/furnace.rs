@@ -10,7 +10,7 @@
 //! passes to the diffuse layer only what the specular layer does not reflect, and a clear coat
 //! keeps from the layer below only what it reflects itself.
 
-use crate::render::{H, W, add_part, push_floor_marker, still_input};
+use crate::render::{H, W, add_part, pixel_at, push_floor_marker, still_input};
 use phantogram::anaglyph::Method;
 use phantogram::glam::Vec3;
 use phantogram::ibl::Environment;
@@ -30,25 +30,16 @@ const EYE: Vec3 = Vec3::new(0.0, 0.0, 0.3);
 /// The radiance that made an 8-bit sRGB code after the renderer's tone curve (Khronos PBR
 /// Neutral, exposure 1): below its shoulder the curve subtracts 0.04 from a grey of 0.08 or more.
 fn radiance_of(code: u8) -> f32 {
-    let c = f32::from(code) / 255.0;
-    let linear = if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    };
-    linear + 0.04
+    phantogram_geometry::srgb::code_to_linear(code) + 0.04
 }
 
-/// Where the sphere about `centre` is seen at `n_dot_v` (the side towards +x), and that point's
+/// Where the sphere about `centre` is seen at `n_dot_v` (the side towards +x): that point's
 /// pixel in a `W × H` frame of `proj`.
-fn pixel_seen_at(pixels: &[u8], proj: &OffAxisProjection, centre: Vec3, n_dot_v: f32) -> [u8; 3] {
+fn pixel_seen_at(pixels: &[u8], proj: &OffAxisProjection, centre: Vec3, n_dot_v: f32) -> [u8; 4] {
     let v = (EYE - centre).normalize();
     let side = Vec3::X.reject_from(v).normalize();
     let n = v * n_dot_v + side * (1.0 - n_dot_v * n_dot_v).sqrt();
-    let p = centre + n * RADIUS_M;
-    let px = proj.project(p).expect("in view").pixel * (W as f32 / Screen::default().width_px() as f32);
-    let i = (px.y as u32 * W + px.x as u32) as usize * 4;
-    [pixels[i], pixels[i + 1], pixels[i + 2]]
+    pixel_at(pixels, proj, centre + n * RADIUS_M)
 }
 
 /// The two rows of spheres (metal above, dielectric below, of colour `base`, roughness 0.2, 0.6,
