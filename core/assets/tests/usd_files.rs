@@ -795,3 +795,102 @@ def Material "Glaze"
     );
     assert!(material.double_sided);
 }
+
+#[test]
+fn tangents_come_from_the_primvar_the_normal_map_reads() {
+    // The square's st stands upright on it (s along +x); its st1 is turned a quarter (s along +y,
+    // t along +x). The colour reads st, so st1 is the material's second set. A normal map read
+    // through st1 needs tangents along st1's s (+y, the map's up then along +x: handedness −1);
+    // a stage whose normal map reads st, or that has none, the first set's (+x, +1). Made from
+    // the first set always, the st1 map shaded as if lit from the side.
+    let stage = |normal_varname: &str| {
+        let normal = if normal_varname.is_empty() {
+            ""
+        } else {
+            "\n        normal3f inputs:normal.connect = </M/Bumps.outputs:rgb>"
+        };
+        format!(
+            r#"#usda 1.0
+(
+    metersPerUnit = 1
+)
+def Mesh "Tile"
+{{{SQUARE}
+    normal3f[] normals = [(0, 0, 1), (0, 0, 1), (0, 0, 1), (0, 0, 1)] (interpolation = "vertex")
+    texCoord2f[] primvars:st = [(0, 0), (1, 0), (1, 1), (0, 1)] (interpolation = "vertex")
+    texCoord2f[] primvars:st1 = [(0, 0), (0, 1), (1, 1), (1, 0)] (interpolation = "vertex")
+    rel material:binding = </M>
+}}
+def Material "M"
+{{
+    token outputs:surface.connect = </M/S.outputs:surface>
+    def Shader "S"
+    {{
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor.connect = </M/Colour.outputs:rgb>{normal}
+        token outputs:surface
+    }}
+    def Shader "ColourReader"
+    {{
+        uniform token info:id = "UsdPrimvarReader_float2"
+        string inputs:varname = "st"
+        float2 outputs:result
+    }}
+    def Shader "Colour"
+    {{
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @flat.png@
+        float2 inputs:st.connect = </M/ColourReader.outputs:result>
+        color3f outputs:rgb
+    }}
+    def Shader "Reader"
+    {{
+        uniform token info:id = "UsdPrimvarReader_float2"
+        string inputs:varname = "{normal_varname}"
+        float2 outputs:result
+    }}
+    def Shader "Bumps"
+    {{
+        uniform token info:id = "UsdUVTexture"
+        asset inputs:file = @flat.png@
+        float2 inputs:st.connect = </M/Reader.outputs:result>
+        float4 inputs:scale = (2, 2, 2, 1)
+        float4 inputs:bias = (-1, -1, -1, 0)
+        color3f outputs:rgb
+    }}
+}}
+"#
+        )
+    };
+    let mut png = Vec::new();
+    image::RgbaImage::from_raw(1, 1, vec![128, 128, 255, 255])
+        .expect("1 × 1")
+        .write_to(&mut std::io::Cursor::new(&mut png), image::ImageFormat::Png)
+        .expect("png");
+    for (varname, expected_along_x, handedness) in [("st1", false, -1.0), ("st", true, 1.0), ("", true, 1.0)] {
+        let dir = Scratch::new(&format!("usd-files-tangents-{varname}"));
+        std::fs::write(dir.join("flat.png"), &png).expect("write");
+        std::fs::write(dir.join("scene.usda"), stage(varname)).expect("write");
+        let model = load_model(&dir.join("scene.usda")).expect("loads");
+        let material = &model.materials[model.primitives[0].material];
+        let wanted_set = u32::from(varname == "st1");
+        assert_eq!(
+            material.normal_texture.as_ref().map(|(t, _)| t.tex_coord),
+            (!varname.is_empty()).then_some(wanted_set),
+            "{varname}: {:?}",
+            model.warnings
+        );
+        // The square's own x and y as loaded (the stage's axes may be turned to the model's).
+        let mesh = &model.primitives[0].mesh;
+        let at = |i: usize| Vec3::from(mesh.vertices[i].position);
+        let (x, y) = ((at(1) - at(0)).normalize(), (at(3) - at(0)).normalize());
+        let along = if expected_along_x { x } else { y };
+        for v in &mesh.vertices {
+            let t = v.tangent;
+            assert!(
+                Vec3::new(t[0], t[1], t[2]).distance(along) < 1e-4 && t[3] == handedness,
+                "normal map reading {varname:?}: tangent {t:?}, expected {along} with handedness {handedness}"
+            );
+        }
+    }
+}

@@ -16,6 +16,7 @@ use super::meshopt_views::{self, DecodedViews};
 use super::point_cloud;
 use super::skin;
 use super::spec_gloss::{self, SpecGloss};
+use super::tangents::{TangentUv, generate_tangents};
 use super::texture_info::TextureInfo;
 use super::topology;
 use super::*;
@@ -1009,41 +1010,9 @@ fn read_draco(
     })
 }
 
-struct MikkGeometry<'a> {
-    mesh: &'a mut Mesh,
-}
-
-impl bevy_mikktspace::Geometry for MikkGeometry<'_> {
-    fn num_faces(&self) -> usize {
-        self.mesh.indices.len() / 3
-    }
-    fn num_vertices_of_face(&self, _face: usize) -> usize {
-        3
-    }
-    fn position(&self, face: usize, vert: usize) -> [f32; 3] {
-        self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].position
-    }
-    fn normal(&self, face: usize, vert: usize) -> [f32; 3] {
-        self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].normal
-    }
-    fn tex_coord(&self, face: usize, vert: usize) -> [f32; 2] {
-        let uv = self.mesh.vertices[self.mesh.indices[face * 3 + vert] as usize].uv;
-        // MikkTSpace's bitangent runs towards increasing v; a glTF normal map's +Y (green) is the
-        // image's up, towards v = 0 (glTF's v runs down). So v is given flipped, as in the tools
-        // that bake normal maps (Blender's v runs up): the tangent is the same, its handedness
-        // (w) the one the file's own tangents would carry.
-        [uv[0], 1.0 - uv[1]]
-    }
-    fn set_tangent(&mut self, tangent_space: Option<bevy_mikktspace::TangentSpace>, face: usize, vert: usize) {
-        if let Some(ts) = tangent_space {
-            let i = self.mesh.indices[face * 3 + vert] as usize;
-            self.mesh.vertices[i].tangent = ts.tangent_encoded();
-        }
-    }
-}
-
-/// Builds the vertices; computes smooth normals where the file has none.
-fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
+/// Builds the vertices; computes smooth normals where the file has none, and tangents from
+/// `tangent_uv` (the material's normal map's coordinates).
+fn assemble(ctx: &Ctx, a: Attributes, tangent_uv: TangentUv, what: &str) -> Result<Mesh, ModelError> {
     let n = a.positions.len() / 3;
     let check = |v: &Option<Vec<f32>>, comps: usize, name: &str| -> Result<(), ModelError> {
         match v {
@@ -1097,17 +1066,9 @@ fn assemble(ctx: &Ctx, a: Attributes, what: &str) -> Result<Mesh, ModelError> {
         mesh.smooth_normals();
     }
     if a.tangents.is_none() && a.uv0.is_some() {
-        generate_tangents(&mut mesh);
+        generate_tangents(&mut mesh, tangent_uv.on(a.uv1.is_some()));
     }
     Ok(mesh)
-}
-
-/// Gives `mesh` the tangents normal maps are baked against (MikkTSpace, from its positions,
-/// normals and first texture coordinates), as glTF defines them: bitangent
-/// `cross(normal, tangent.xyz) · w` along the normal map's +Y. Where the coordinates are
-/// degenerate the placeholder tangents stay: normal maps then shade as flat.
-pub(super) fn generate_tangents(mesh: &mut Mesh) {
-    let _ = bevy_mikktspace::generate_tangents(&mut MikkGeometry { mesh });
 }
 
 /// The orientation a Smithsonian Voyager scene gives this model file: Voyager scenes
@@ -1771,7 +1732,14 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     )
                     .map_err(|e| over_budget(path, e))?;
                 let skin_data = attributes.skin.take();
-                let mut m = assemble(&ctx, attributes, &what)?;
+                let tangent_uv = materials
+                    .get(prim.material().index().unwrap_or(default_material))
+                    .and_then(|m| m.normal_texture.as_ref())
+                    .map_or_else(TangentUv::default, |(t, _)| TangentUv {
+                        set: t.tex_coord,
+                        transform: t.transform,
+                    });
+                let mut m = assemble(&ctx, attributes, tangent_uv, &what)?;
                 built_primitives += 1;
                 meshes_share
                     .step(built_primitives as f32 / declared_primitives)
@@ -1943,38 +1911,4 @@ pub(super) fn join_and_check_draws(model: &mut Model, path: &Path, spending: &Sp
     spending
         .check_drawn_primitives(|| "the model".to_owned(), model.primitives.len() as u64)
         .map_err(|e| over_budget(path, e))
-}
-
-#[cfg(test)]
-mod tangent_tests {
-    use super::*;
-
-    #[test]
-    fn generated_tangents_point_the_normal_maps_y_at_the_images_up() {
-        // A square facing +z, its texture upright on it: u along +x, the image's top (v = 0) at
-        // +y. A normal map's +Y (green) must then lean the normal towards +y: bitangent
-        // cross(+z, +x)·w = +y, so w = +1. (Generated with glTF's v as MikkTSpace's, w was −1:
-        // every normal map without its own tangents shaded with its green channel upside down.)
-        let corner = |x: f32, y: f32| Vertex {
-            position: [x, y, 0.0],
-            normal: [0.0, 0.0, 1.0],
-            tangent: [0.0; 4],
-            uv: [x, 1.0 - y, 0.0, 0.0],
-            color: [1.0; 4],
-            material: [1.0, 1.0],
-        };
-        let mut mesh = Mesh {
-            vertices: vec![corner(0.0, 0.0), corner(1.0, 0.0), corner(1.0, 1.0), corner(0.0, 1.0)],
-            indices: vec![0, 1, 2, 0, 2, 3],
-        };
-        generate_tangents(&mut mesh);
-        for v in &mesh.vertices {
-            let t = v.tangent;
-            assert!(
-                (t[0] - 1.0).abs() < 1e-5 && t[1].abs() < 1e-5 && t[2].abs() < 1e-5,
-                "{t:?}"
-            );
-            assert_eq!(t[3], 1.0, "handedness at {:?}", v.position);
-        }
-    }
 }

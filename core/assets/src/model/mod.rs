@@ -822,6 +822,7 @@ mod skin;
 mod spec_gloss;
 mod split;
 mod stl;
+mod tangents;
 mod texture_info;
 mod topology;
 mod usd;

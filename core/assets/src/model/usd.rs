@@ -37,9 +37,8 @@ use std::sync::Arc;
 use glam::{DMat4, DQuat, DVec3};
 use openusd::{sdf, usd};
 
-use super::loader::{
-    ModelError, check_positions, finish_mesh_model, generate_tangents, model_name, over_budget, read_model_file,
-};
+use super::loader::{ModelError, check_positions, finish_mesh_model, model_name, over_budget, read_model_file};
+use super::tangents::{TangentUv, generate_tangents};
 use super::usd_files::{Confined, Files, folded, folder_of, is_package};
 use super::usd_material::{Textures, material_of};
 use super::usd_mesh::{Look, ReadCloud, ReadMesh, attribute_value, read_mesh, read_points};
@@ -501,9 +500,17 @@ fn build_model(
             if mesh.normals.is_none() || built.vertices.iter().any(|v| v.normal == [0.0; 3]) {
                 built.smooth_normals();
             }
-            // A normal map is baked against MikkTSpace tangents; USD stores none.
+            // A normal map is baked against MikkTSpace tangents, from the coordinates it is read
+            // with; USD stores none.
             if mesh.uvs[0].is_some() {
-                generate_tangents(&mut built);
+                let uv = materials
+                    .get(look)
+                    .and_then(|m: &Material| m.normal_texture.as_ref())
+                    .map_or_else(TangentUv::default, |(t, _)| TangentUv {
+                        set: t.tex_coord,
+                        transform: t.transform,
+                    });
+                generate_tangents(&mut built, uv.on(mesh.uvs[1].is_some()));
             }
             primitives.push(Primitive {
                 mesh: built,
