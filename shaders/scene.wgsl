@@ -602,6 +602,13 @@ fn ward_image_light(v: vec3<f32>, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, alph
     return sum / kept;
 }
 
+// Where the albedo tables (`brdf_lut`: split sum and sheen) hold (n·v, roughness) = `at`: their
+// first and last entries stand at 0 and 1 exactly (assets crate, `ibl::table_axis`), so the
+// texture coordinate runs from the first texel's centre to the last one's.
+fn table_uv(at: vec2<f32>, size: vec2<f32>) -> vec2<f32> {
+    return (clamp(at, vec2<f32>(0.0), vec2<f32>(1.0)) * (size - 1.0) + 0.5) / size;
+}
+
 fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     let d = n_dot_h * n_dot_h * (a2 - 1.0) + 1.0;
@@ -1193,7 +1200,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let lobe = ward_lobe(l, v, tw, bw, n, ward_alpha);
         direct = (rho_d / PI + rho_s * lobe) * light_in;
         let rough_eq = clamp(sqrt(sqrt(ward_alpha.x * ward_alpha.y)), 0.045, 1.0);
-        let lut_uv = clamp(vec2<f32>(n_dot_v, rough_eq), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+        let lut_uv = table_uv(vec2<f32>(n_dot_v, rough_eq), lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let prefiltered = ward_image_light(v, n, tw, bw, ward_alpha);
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * (scale_bias.x + scale_bias.y);
@@ -1202,7 +1209,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         // albedo after one bounce is F0·x + F90·y; E_ms = 1 − x − y is what a perfect (F = 1)
         // one loses to light that leaves only after further bounces: two thirds face on at
         // roughness 1.
-        let lut_uv = clamp(vec2<f32>(n_dot_v, roughness), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+        let lut_uv = table_uv(vec2<f32>(n_dot_v, roughness), lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let e_ms = clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0);
         // Those further bounces (Fdez-Agüera, "A Multiple-Scattering Microfacet Model for
@@ -1244,11 +1251,23 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
                 * smith_visibility_anisotropic(n_dot_l, n_dot_v, vec2<f32>(dot(ta, v), dot(ba, v)), vec2<f32>(dot(ta, l), dot(ba, l)), alpha_t, alpha);
             reflected_base = to_world(anisotropic_reflection(n, v, ta, roughness, s.anisotropy));
         }
+        // The specular layer's albedo towards the view, its single bounce from the split-sum
+        // table and all bounces together (the image light's below uses both).
+        let albedo_d = s.specular_weight * (f0_ambient_d * scale_bias.x + f90_d * scale_bias.y);
+        let albedo_m = f0_ambient_m * scale_bias.x + vec3<f32>(scale_bias.y);
+        let reflected_d = min(albedo_d * bounces_d, vec3<f32>(1.0));
         // Lambert's share of what is not reflected, less what a thin sheet passes to its other
         // side; and what it passes from its other side, lit from there (paper against a window).
+        // What is not reflected: what the specular layer, all bounces together, does not send
+        // towards the view (albedo scaling, as OpenPBR layers its lobes), for a lamp as for the
+        // room's light, so that a white dielectric under lamps from every side returns all their
+        // light (`furnace::white_spheres_under_lamps_from_every_side_send_back_what_they_receive`).
+        // glTF's own mix weighs the diffuse lobe by 1 − F(v·h) instead, which is not the
+        // specular lobe's albedo: a white dielectric of roughness 1 then returned 2.7 % too
+        // little, of roughness 0.6 near grazing 1.9 % too much.
         let lambert = (1.0 - metallic) * (1.0 - s.transmission) * base / PI;
         let through_sheet = s.diffuse_transmission;
-        let diffuse = (vec3<f32>(1.0) - fresnel) * lambert * (1.0 - through_sheet);
+        let diffuse = (vec3<f32>(1.0) - reflected_d) * lambert * (1.0 - through_sheet);
         // The lobe with its further bounces, by the factor the image light below uses (as
         // Filament scales its lobe by 1 + F0·(1/E_ss − 1): the same at F0 = 1).
         specular = specular * mix(bounces_d, bounces_m, metallic);
@@ -1266,9 +1285,6 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         // all bounces together, does not reflect: a white dielectric returns all the light.
         // Explicit levels: no derivatives, so the azimuth seam of the equirectangular map
         // leaves no line.
-        let albedo_d = s.specular_weight * (f0_ambient_d * scale_bias.x + f90_d * scale_bias.y);
-        let albedo_m = f0_ambient_m * scale_bias.x + vec3<f32>(scale_bias.y);
-        let reflected_d = min(albedo_d * bounces_d, vec3<f32>(1.0));
         let irradiance_n = irradiance(to_world(n));
         var diffuse_ambient = irradiance_n * lambert * (1.0 - through_sheet) * (vec3<f32>(1.0) - reflected_d);
         if (through_sheet > 0.0) {
@@ -1287,7 +1303,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         if (sheen_strength > 0.0) {
             let sheen_rough = clamp(s.sheen_roughness, 0.07, 1.0);
             let sheen_alpha = sheen_rough * sheen_rough;
-            let sheen_uv = clamp(vec2<f32>(n_dot_v, sheen_rough), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+            let sheen_uv = table_uv(vec2<f32>(n_dot_v, sheen_rough), lut_size);
             let sheen_albedo = textureSampleLevel(brdf_lut, env_sampler, sheen_uv, 0.0).b;
             let below = 1.0 - sheen_strength * sheen_albedo;
             let sheen_direct = s.sheen_color * charlie(n_dot_h, sheen_alpha) * sheen_visibility(max(n_dot_l, 1e-4), n_dot_v, sheen_alpha) * light_in;
@@ -1318,18 +1334,20 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let coat_alpha = coat_rough * coat_rough;
         // The coat's albedo from the split-sum table (F0 0.04, F90 1), with its further bounces
         // as the layer below has them.
-        let lut_uv = clamp(vec2<f32>(coat_n_dot_v, coat_rough), 0.5 / lut_size, vec2<f32>(1.0) - 0.5 / lut_size);
+        let lut_uv = table_uv(vec2<f32>(coat_n_dot_v, coat_rough), lut_size);
         let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
         let coat_single = 0.04 * scale_bias.x + scale_bias.y;
         let coat_bounces = 1.0 / (1.0 - (0.04 + 0.96 / 21.0) * clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0));
         let fc = (0.04 + 0.96 * pow(1.0 - v_dot_h, 5.0)) * coat;
         let coat_direct = fc * coat_bounces * ggx(max(dot(cn, h), 0.0), coat_alpha)
             * smith_visibility(coat_n_dot_l, coat_n_dot_v, coat_alpha) * light_seen * coat_n_dot_l;
-        direct = direct * (1.0 - fc) + coat_direct;
-        // In the image light the coat keeps from the layer below what it reflects of the room,
-        // all bounces together, so that a white sphere under it still returns all the light
-        // (before: Schlick's F at n·v, more than a rough coat reflects).
+        // The coat keeps from the layer below what it reflects towards the view, all bounces
+        // together, so that a white sphere under it still returns all the light, a lamp's as
+        // the room's (albedo scaling, as below the specular layer; before: F(v·h) for a lamp,
+        // 2.7 % too little at roughness 1, and Schlick's F at n·v for the room, more than a rough
+        // coat reflects).
         let coat_total = min(coat_single * coat_bounces, 1.0) * coat;
+        direct = direct * (1.0 - coat_total) + coat_direct;
         let coat_reflected = to_world(reflect(-v, cn));
         let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(coat_reflected), coat_rough * PREFILTERED_MAX_LEVEL).rgb;
         let coat_further = irradiance(to_world(cn)) / PI * coat_single * (coat_bounces - 1.0);

@@ -51,6 +51,6 @@ fn main() {
     let split_sum = median_ms(5, || brdf_lut(64));
     let sheen = median_ms(5, || sheen_albedo_table(64));
     println!(
-        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms (1 core), sheen albedo {sheen:.1} ms ({cores} cores)"
+        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms, sheen albedo {sheen:.1} ms ({cores} cores each)"
     );
 }

@@ -10,7 +10,8 @@ pub(super) const BRDF_LUT_SIZE: usize = 64;
 
 /// Computes, once per process, the tables a [`Renderer`] needs before its first frame: the
 /// split-sum BRDF table and, if `studio`, the generated studio's prefiltered levels (the lighting
-/// when no environment is given). About 100 ms of CPU work on this machine's two cores; an app
+/// when no environment is given). About 100 ms of CPU work on this machine's two cores, and 35 ms
+/// more since the split-sum table takes four times the samples per entry (2026-12-07); an app
 /// calls it on a background thread at start-up, overlapping it with loading the model and opening
 /// the device (the sea turtle's cold load-to-first-frame: see `benchmarks/render.md`). Calling it
 /// is never required: the renderer computes what is missing, or waits for a computation under way.

@@ -38,7 +38,7 @@ pub mod sheen;
 pub use anisotropic::{WARD_IMAGE_LIGHT_TAPS, WARD_TAP_NODES, WardImageLight, sample_levels};
 pub use prefilter::{
     PREFILTER_LEVELS, PREFILTER_SAMPLES, PrefilterSources, brdf_lut, prefilter_base, prefilter_base_width,
-    prefiltered_levels,
+    prefiltered_levels, table_axis,
 };
 pub use sh::IrradianceSh;
 pub use sheen::sheen_albedo_table;

@@ -95,12 +95,12 @@ pub fn sheen_albedo(n_dot_v: f32, roughness: f32, steps: usize) -> f32 {
 pub const TABLE_STEPS: usize = 32;
 
 /// The sheen albedo as a `size × size` table laid out as the split-sum table
-/// ([`super::brdf_lut`]): row j at roughness (j + ½)/size, column i at n·v (i + ½)/size. Kept
+/// ([`super::brdf_lut`]): row j at roughness, column i at n·v [`super::table_axis`]. Kept
 /// at most 1: the fitted Λ lets the albedo pass 1 where n·v is under 0.045 and the roughness
 /// under 0.2 (up to 1.58 at n·v 0.008; tested), within 3° of grazing, where no more light can
 /// leave than came in.
 pub fn sheen_albedo_table(size: usize) -> Vec<f32> {
-    let at = |k: usize| (k as f32 + 0.5) / size as f32;
+    let at = |k: usize| super::table_axis(k, size);
     let rows: Vec<usize> = (0..size).collect();
     crate::parallel::map(&rows, |&j| {
         (0..size)
