@@ -1169,8 +1169,10 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         // Ward: ρd (times the base colour) / π + ρs · lobe along the tangent frame (any frame
         // about n where the mesh has no tangents: the lobe is then isotropic in effect only if
         // αx = αy). Its image-based light: the lobe's shape from `ward_image_light`, its albedo
-        // from the split sum with F0 = 1 at the GGX roughness of the same RMS slope,
-        // sqrt(sqrt(αx αy)).
+        // the Ward lobe's own (the tables' fourth channel, assets crate `ibl::ward_albedo`), read
+        // for the round lobe of the same mean square slope, so that the room's light and a
+        // lamp's agree (before: GGX's single-bounce albedo at the roughness of the same area,
+        // up to 19 % below Ward's at α = 1).
         var tw = t - n * dot(n, t);
         if (dot(tw, tw) < 1e-8) {
             tw = cross(select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9), n);
@@ -1199,11 +1201,12 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         rho_d = rho_d * (1.0 - transmission);
         let lobe = ward_lobe(l, v, tw, bw, n, ward_alpha);
         direct = (rho_d / PI + rho_s * lobe) * light_in;
-        let rough_eq = clamp(sqrt(sqrt(ward_alpha.x * ward_alpha.y)), 0.045, 1.0);
-        let lut_uv = table_uv(vec2<f32>(n_dot_v, rough_eq), lut_size);
-        let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
+        // The table's roughness axis is √α.
+        let round_alpha = sqrt(0.5 * dot(ward_alpha, ward_alpha));
+        let ward_uv = table_uv(vec2<f32>(n_dot_v, sqrt(round_alpha)), lut_size);
+        let ward_albedo = textureSampleLevel(brdf_lut, env_sampler, ward_uv, 0.0).a;
         let prefiltered = ward_image_light(v, n, tw, bw, ward_alpha);
-        ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * (scale_bias.x + scale_bias.y);
+        ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * ward_albedo;
     } else {
         // The split-sum table at this view and roughness (Karis 2013): a microfacet surface's
         // albedo after one bounce is F0·x + F90·y; E_ms = 1 − x − y is what a perfect (F = 1)

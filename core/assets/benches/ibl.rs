@@ -11,7 +11,9 @@
 use std::time::Instant;
 
 use phantogram_assets::ibl::sh::reference_projection;
-use phantogram_assets::ibl::{Environment, IrradianceSh, brdf_lut, prefiltered_levels, sheen_albedo_table};
+use phantogram_assets::ibl::{
+    Environment, IrradianceSh, brdf_lut, prefiltered_levels, sheen_albedo_table, ward_albedo_table,
+};
 
 /// The renderer's prefiltered base width (`phantogram_render`'s `PREFILTERED_BASE_WIDTH`).
 const PREFILTERED_BASE_WIDTH: usize = 256;
@@ -50,7 +52,8 @@ fn main() {
     // The renderer's `BRDF_LUT_SIZE`.
     let split_sum = median_ms(5, || brdf_lut(64));
     let sheen = median_ms(5, || sheen_albedo_table(64));
+    let ward = median_ms(5, || ward_albedo_table(64));
     println!(
-        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms, sheen albedo {sheen:.1} ms ({cores} cores each)"
+        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms, sheen albedo {sheen:.1} ms, Ward albedo {ward:.1} ms ({cores} cores each)"
     );
 }

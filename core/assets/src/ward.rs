@@ -100,6 +100,23 @@ impl WardLobe {
         Some((l, pdf_l))
     }
 
+    /// The lobe's directional albedo towards `v` (unit, surface frame): `∫ f_s(l, v) cos θ_l dω_l`
+    /// over the light directions, by importance sampling ([`Self::sample`]) on a `grid × grid`
+    /// stratified set of uniforms. At most 1 (the normalisation's bound); less where the lobe
+    /// reaches below the horizon.
+    pub fn directional_albedo(&self, v: Vec3, grid: usize) -> f32 {
+        let mut sum = 0.0f64;
+        for i in 0..grid {
+            for j in 0..grid {
+                let (u1, u2) = ((i as f32 + 0.5) / grid as f32, (j as f32 + 0.5) / grid as f32);
+                if let Some((l, pdf)) = self.sample(v, u1, u2) {
+                    sum += f64::from(self.eval(l, v) * l.z / pdf);
+                }
+            }
+        }
+        (sum / (grid * grid).max(1) as f64) as f32
+    }
+
     /// Ward's half-vector density per steradian of `h` (unit): integrates to 1 over the
     /// hemisphere.
     pub fn half_vector_pdf(&self, h: Vec3) -> f32 {
@@ -222,17 +239,7 @@ mod tests {
     /// `∫ f_s(l, v) cos θ_l dω_l` by importance sampling (a 128 × 128 stratified grid of
     /// uniforms through [`WardLobe::sample`]).
     fn albedo_sampled(lobe: &WardLobe, v: Vec3) -> f64 {
-        let n = 128;
-        let mut sum = 0.0f64;
-        for i in 0..n {
-            for j in 0..n {
-                let (u1, u2) = ((i as f32 + 0.5) / n as f32, (j as f32 + 0.5) / n as f32);
-                if let Some((l, pdf)) = lobe.sample(v, u1, u2) {
-                    sum += f64::from(lobe.eval(l, v) * l.z / pdf);
-                }
-            }
-        }
-        sum / (n * n) as f64
+        f64::from(lobe.directional_albedo(v, 128))
     }
 
     /// `∫ f(d) dω` over the upper hemisphere by brute-force quadrature: midpoints of `steps`

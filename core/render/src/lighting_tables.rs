@@ -10,8 +10,9 @@ pub(super) const BRDF_LUT_SIZE: usize = 64;
 
 /// Computes, once per process, the tables a [`Renderer`] needs before its first frame: the
 /// split-sum BRDF table and, if `studio`, the generated studio's prefiltered levels (the lighting
-/// when no environment is given). About 100 ms of CPU work on this machine's two cores, and 35 ms
-/// more since the split-sum table takes four times the samples per entry (2026-12-07); an app
+/// when no environment is given). About 100 ms of CPU work on this machine's two cores, and 60 ms
+/// more since the split-sum table takes four times the samples per entry and the Ward lobe's
+/// albedo joined it (2026-12-07); an app
 /// calls it on a background thread at start-up, overlapping it with loading the model and opening
 /// the device (the sea turtle's cold load-to-first-frame: see `benchmarks/render.md`). Calling it
 /// is never required: the renderer computes what is missing, or waits for a computation under way.
@@ -42,17 +43,20 @@ pub(super) fn default_prefiltered_environment() -> &'static [phantogram_assets::
     })
 }
 
-/// The split-sum table (scale and bias on F0) and the sheen's directional albedo
-/// ([`phantogram_assets::ibl::sheen`]) as `Rgba16Float` texels, read at the same (n·v, roughness),
-/// computed once per process (they depend on nothing).
+/// The split-sum table (scale and bias on F0), the sheen's directional albedo
+/// ([`phantogram_assets::ibl::sheen`]) and the round Ward lobe's
+/// ([`phantogram_assets::ibl::ward_albedo`]) as `Rgba16Float` texels, read at the same (n·v,
+/// roughness), computed once per process (they depend on nothing).
 pub(super) fn brdf_lut_texels() -> &'static [u8] {
     static TEXELS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
     TEXELS.get_or_init(|| {
         let sheen = phantogram_assets::ibl::sheen_albedo_table(BRDF_LUT_SIZE);
+        let ward = phantogram_assets::ibl::ward_albedo_table(BRDF_LUT_SIZE);
         phantogram_assets::ibl::brdf_lut(BRDF_LUT_SIZE)
             .into_iter()
             .zip(sheen)
-            .flat_map(|([a, b], e)| [a, b, e, 0.0].map(half::f16::from_f32))
+            .zip(ward)
+            .flat_map(|(([a, b], e), w)| [a, b, e, w].map(half::f16::from_f32))
             .flat_map(|h| h.to_le_bytes())
             .collect()
     })

@@ -34,6 +34,7 @@ pub mod anisotropic;
 pub mod prefilter;
 pub mod sh;
 pub mod sheen;
+pub mod ward_albedo;
 
 pub use anisotropic::{WARD_IMAGE_LIGHT_TAPS, WARD_TAP_NODES, WardImageLight, sample_levels};
 pub use prefilter::{
@@ -42,6 +43,7 @@ pub use prefilter::{
 };
 pub use sh::IrradianceSh;
 pub use sheen::sheen_albedo_table;
+pub use ward_albedo::ward_albedo_table;
 
 /// Widest environment [`Environment::load`] reads: 4096 × 2048 (128 MiB as RGBA floats while
 /// decoding). The image-based light is prefiltered down to a few hundred texels a side.
