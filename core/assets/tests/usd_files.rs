@@ -894,3 +894,132 @@ def Material "M"
         }
     }
 }
+
+#[test]
+fn primitive_shapes_are_drawn_as_the_schema_defines_them() {
+    // A stage of primitive shapes as exporters write props: a cube of the schema's size (2),
+    // a sphere moved and coloured, a capsule along X bound to a material, a double-sided plane;
+    // and a curve, still not drawn. Z up, centimetres: the loader turns them into metres, +Y up.
+    // Before, every shape was left out with a warning and the stage had nothing to show.
+    let stage = r#"#usda 1.0
+(
+    upAxis = "Z"
+)
+def Cube "Crate"
+{
+}
+def Sphere "Ball"
+{
+    double radius = 0.5
+    double3 xformOp:translate = (10, 0, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+    color3f[] primvars:displayColor = [(0.8, 0.1, 0.1)]
+}
+def Capsule "Rod"
+{
+    double radius = 0.25
+    double height = 4
+    uniform token axis = "X"
+    double3 xformOp:translate = (0, 10, 0)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+    rel material:binding = </Brass>
+}
+def Plane "Card"
+{
+    double width = 6
+    double length = 2
+    double3 xformOp:translate = (0, 0, 10)
+    uniform token[] xformOpOrder = ["xformOp:translate"]
+}
+def BasisCurves "Wire"
+{
+    int[] curveVertexCounts = [2]
+    point3f[] points = [(0, 0, 0), (1, 1, 1)]
+}
+def Material "Brass"
+{
+    token outputs:surface.connect = </Brass/S.outputs:surface>
+    def Shader "S"
+    {
+        uniform token info:id = "UsdPreviewSurface"
+        color3f inputs:diffuseColor = (0.7, 0.5, 0.2)
+        float inputs:metallic = 1
+        float inputs:roughness = 0.3
+        token outputs:surface
+    }
+}
+"#;
+    let model = load_stage("shapes", &[("shapes.usda", stage)]).expect("loads");
+    assert_eq!(
+        model.warnings,
+        vec!["1 prim(s) of kind BasisCurves: not drawn (only meshes, points and primitive shapes are)".to_owned()]
+    );
+    // Each shape's bounds in the model's frame (metres, Y up: the stage's (x, y, z) is the
+    // model's (x, z, −y)).
+    let bounds_of = |colour: Option<[f32; 3]>, name: Option<&str>| {
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        let mut found = 0;
+        for primitive in &model.primitives {
+            let material = &model.materials[primitive.material];
+            let this = match (colour, name) {
+                (Some(c), _) => material.base_color[..3] == c,
+                (_, Some(n)) => material.name == n,
+                _ => false,
+            };
+            if !this {
+                continue;
+            }
+            found += 1;
+            for v in &primitive.mesh.vertices {
+                lo = lo.min(Vec3::from(v.position));
+                hi = hi.max(Vec3::from(v.position));
+            }
+        }
+        (found, lo, hi)
+    };
+    let close = |a: Vec3, b: Vec3| a.distance(b) < 1e-3;
+    // The sphere: radius 0.5 cm about (10, 0, 0) cm, in its display colour.
+    let (found, lo, hi) = bounds_of(Some([0.8, 0.1, 0.1]), None);
+    assert_eq!(found, 1);
+    assert!(
+        close(lo, Vec3::new(0.095, -0.005, -0.005)) && close(hi, Vec3::new(0.105, 0.005, 0.005)),
+        "{lo} {hi}"
+    );
+    // The capsule: along the stage's X, 4 cm of spine and 0.25 cm caps, about (0, 10, 0) cm.
+    let (found, lo, hi) = bounds_of(None, Some("Brass"));
+    assert_eq!(found, 1);
+    assert!(
+        close(lo, Vec3::new(-0.0225, -0.0025, -0.1025)) && close(hi, Vec3::new(0.0225, 0.0025, -0.0975)),
+        "{lo} {hi}"
+    );
+    let brass = model.materials.iter().find(|m| m.name == "Brass").expect("the brass");
+    assert_eq!((brass.metallic, brass.roughness), (1.0, 0.3));
+    // The cube (2 cm) and the plane (6 × 2 cm, facing the stage's +Z, both sides) take the
+    // stage's plaster: the model's whole bounds reach from the cube's corner to the plane.
+    let plane = model
+        .primitives
+        .iter()
+        .find(|p| p.mesh.vertices.len() == 4)
+        .expect("the plane's four corners");
+    let normal = Vec3::from(plane.mesh.vertices[0].normal);
+    assert!(normal.distance(Vec3::Y) < 1e-5, "the plane faces up: {normal}");
+    assert!(model.materials[plane.material].double_sided, "a plane shows both sides");
+    let ys: Vec<f32> = plane.mesh.vertices.iter().map(|v| v.position[1]).collect();
+    assert!(ys.iter().all(|y| (y - 0.1).abs() < 1e-5), "{ys:?}");
+    let xs = plane.mesh.vertices.iter().map(|v| v.position[0].abs());
+    assert!(xs.fold(0.0f32, f32::max) - 0.03 < 1e-5);
+    let crate_ = model
+        .primitives
+        .iter()
+        .find(|p| p.mesh.vertices.len() == 24)
+        .expect("the cube's 24 corners");
+    let (lo, hi) = crate_.mesh.vertices.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), v| (lo.min(Vec3::from(v.position)), hi.max(Vec3::from(v.position))),
+    );
+    assert!(
+        close(lo, Vec3::splat(-0.01)) && close(hi, Vec3::splat(0.01)),
+        "{lo} {hi}"
+    );
+}

@@ -830,6 +830,7 @@ mod usd_files;
 mod usd_material;
 mod usd_mesh;
 mod usd_preview_surface;
+mod usd_shapes;
 mod wkt;
 mod xyz;
 

@@ -12,8 +12,10 @@
 //!   interpolation (constant, uniform, vertex, varying, face-varying), indexed or not; corners
 //!   that share all their values share a vertex. Subdivision surfaces are drawn as their control
 //!   meshes (`usd_mesh`). `Points` prims are clouds drawn as discs that close into their
-//!   surface (`point_cloud`), with their normals and display colours. Other kinds of prims
-//!   (curves, cubes, spheres) are not drawn (a warning says so).
+//!   surface (`point_cloud`), with their normals and display colours. Primitive shapes (cubes,
+//!   spheres, cylinders, cones, capsules, planes) are made into meshes as the schema defines
+//!   them (`usd_shapes`). Curves, NURBS and tetrahedral meshes are not drawn (a warning says
+//!   so).
 //! * **Units and axes**: the stage's `metersPerUnit` (USD's fallback: centimetres) and `upAxis`
 //!   (`Z` turned into glTF's +Y up).
 //! * **Materials**: the one bound to a mesh (or to a face subset of it, `GeomSubset` of family
@@ -43,6 +45,7 @@ use super::usd_files::{Confined, Files, folded, folder_of, is_package};
 use super::usd_material::{Textures, material_of};
 use super::usd_mesh::{Look, ReadCloud, ReadMesh, attribute_value, read_mesh, read_points};
 use super::usd_preview_surface::{self, Surface, scalar, text, token, vec3};
+use super::usd_shapes::{SHAPE_KINDS, read_shape};
 use super::{Image, Material, Mesh, Model, Primitive, Vertex, point_cloud};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
@@ -99,6 +102,15 @@ pub fn load(path: &Path, budget: ResourceBudget, progress: &Progress) -> Result<
     build_model(path, scene, &files, &mut spending, progress)
 }
 
+/// How a prim the stage shows is drawn.
+enum Drawn {
+    Mesh,
+    /// A cloud of discs.
+    Points,
+    /// A primitive shape of this kind (`usd_shapes::SHAPE_KINDS`).
+    Shape(String),
+}
+
 /// What the stage holds, read.
 struct Scene {
     meshes: Vec<ReadMesh>,
@@ -149,12 +161,10 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
     for p in &paths {
         let kind = stage.prim(p.clone()).map_err(text)?.type_name().map_err(text)?;
         match kind.as_ref().map(|t| t.as_str()) {
-            Some("Mesh") => drawn_paths.push((p.clone(), false)),
-            Some("Points") => drawn_paths.push((p.clone(), true)),
-            Some(
-                k @ ("BasisCurves" | "NurbsCurves" | "NurbsPatch" | "Cube" | "Sphere" | "Cylinder" | "Cone" | "Capsule"
-                | "Plane" | "TetMesh"),
-            ) => {
+            Some("Mesh") => drawn_paths.push((p.clone(), Drawn::Mesh)),
+            Some("Points") => drawn_paths.push((p.clone(), Drawn::Points)),
+            Some(k) if SHAPE_KINDS.contains(&k) => drawn_paths.push((p.clone(), Drawn::Shape(k.to_owned()))),
+            Some(k @ ("BasisCurves" | "NurbsCurves" | "NurbsPatch" | "TetMesh")) => {
                 *not_drawn.entry(k.to_owned()).or_default() += 1;
             }
             _ => {}
@@ -164,19 +174,19 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
     kinds.sort();
     for (kind, n) in kinds {
         warnings.push(format!(
-            "{n} prim(s) of kind {kind}: not drawn (only meshes and points are)"
+            "{n} prim(s) of kind {kind}: not drawn (only meshes, points and primitive shapes are)"
         ));
     }
     // Which meshes and clouds show: visible, not guides; proxies only where nothing else is
     // drawn.
     let mut shown = Vec::new();
-    for (p, cloud) in drawn_paths {
+    for (p, drawn) in drawn_paths {
         if invisible(&stage, &p)? {
             continue;
         }
         let purpose = inherited_token(&stage, &p, "purpose")?;
         if purpose.as_deref() != Some("guide") {
-            shown.push((p, cloud, purpose.as_deref() == Some("proxy")));
+            shown.push((p, drawn, purpose.as_deref() == Some("proxy")));
         }
     }
     if shown.iter().any(|(_, _, proxy)| !proxy) {
@@ -212,17 +222,27 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
             .as_ref()
             .map_or_else(Vec::new, |s| s.primvars().into_iter().map(str::to_owned).collect())
     };
-    for (i, (p, cloud, _)) in shown.iter().enumerate() {
+    for (i, (p, drawn, _)) in shown.iter().enumerate() {
         if progress.step(0.1 + 0.5 * i as f32 / count as f32).is_err() {
             return Ok(None);
         }
         let world = to_model * world_transform(&stage, p)?;
-        if *cloud {
-            if let Some(cloud) = read_points(&stage, p, world, &mut scene.looks, &mut warnings)? {
-                scene.clouds.push(cloud);
+        match drawn {
+            Drawn::Points => {
+                if let Some(cloud) = read_points(&stage, p, world, &mut scene.looks, &mut warnings)? {
+                    scene.clouds.push(cloud);
+                }
             }
-        } else if let Some(mesh) = read_mesh(&stage, p, world, &mut scene.looks, &mut primvars_of, &mut warnings)? {
-            scene.meshes.push(mesh);
+            Drawn::Mesh => {
+                if let Some(mesh) = read_mesh(&stage, p, world, &mut scene.looks, &mut primvars_of, &mut warnings)? {
+                    scene.meshes.push(mesh);
+                }
+            }
+            Drawn::Shape(kind) => {
+                if let Some(mesh) = read_shape(&stage, p, kind, world, &mut scene.looks, &mut warnings)? {
+                    scene.meshes.push(mesh);
+                }
+            }
         }
     }
     // The materials only clouds are bound to.

@@ -478,6 +478,32 @@ fn texture_coordinates(stage: &usd::Stage, p: &sdf::Path) -> Result<Option<Primv
     Ok(None)
 }
 
+/// The look of a prim drawn in one piece without colours of its own per vertex (a primitive
+/// shape, `usd_shapes`): its bound material, else its constant display colour; its index among
+/// `looks`, added where new.
+pub(super) fn look_of(
+    stage: &usd::Stage,
+    p: &sdf::Path,
+    looks: &mut Vec<Look>,
+    double_sided: bool,
+) -> Result<usize, String> {
+    let material = bound_material(stage, p)?;
+    let display = primvar(stage, p, "primvars:displayColor", Interpolation::Constant, vec3s)?;
+    let display_colour = match (&material, &display) {
+        (None, Some(d)) => d.values.first().map(|c| c.map(|v| v.clamp(0.0, 1.0) as f32)),
+        _ => None,
+    };
+    Ok(look_index(
+        looks,
+        Look {
+            material,
+            double_sided,
+            display_colour,
+            vertex_colours: false,
+        },
+    ))
+}
+
 /// The index of `look` among `looks`, added where new.
 fn look_index(looks: &mut Vec<Look>, look: Look) -> usize {
     looks.iter().position(|l| *l == look).unwrap_or_else(|| {
