@@ -18,8 +18,11 @@
 //! **Budget**: the caller read the file within the budget; the reader holds a page and a packet
 //! at a time, and at most [`RAW_POINTS_KEPT`] points are kept (40 bytes each) whatever the
 //! file's size. **Progress**: `keep_going` is told the share read every 65 536 points and stops
-//! the work by returning `false`. **Panics**: none (the reader's, should one slip through a
-//! damaged file, are caught and reported as the file's error).
+//! the work by returning `false` (for a file of several scans, decoded a window of scans at a
+//! time, after each window). **Threading**: a file of several scans has them decoded on every
+//! core, each with its own reader of the same bytes, and put together in the file's order (the
+//! same points as read one after another; tested). **Panics**: none (the reader's, should one
+//! slip through a damaged file, are caught and reported as the file's error).
 
 use std::io::Cursor;
 
@@ -57,58 +60,123 @@ fn parse_keeping(bytes: Vec<u8>, most: u64, keep_going: impl FnMut(f64) -> bool)
             bytes.len()
         ));
     }
-    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(bytes, most, keep_going)))
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| decode(&bytes, most, keep_going, true)))
         .map_err(|_| "the E57 reader failed on damaged data".to_owned())?
 }
 
-/// The points of every scan in `bytes`, as [`parse_keeping`] returns them.
-fn decode(bytes: Vec<u8>, most: u64, mut keep_going: impl FnMut(f64) -> bool) -> Result<Option<Soup>, String> {
-    let mut reader = E57Reader::new(Cursor::new(bytes)).map_err(|e| e.to_string())?;
+/// The points of every scan in `bytes`, as [`parse_keeping`] returns them. With `in_parallel`,
+/// a file of several scans has them decoded on several threads, as many scans at a time as
+/// there are threads (each thread its own reader of the same bytes), and put together in the
+/// file's order: the same points as one after another. A single scan is decoded on the
+/// caller's thread, which then reports its progress within it.
+fn decode(
+    bytes: &[u8],
+    most: u64,
+    mut keep_going: impl FnMut(f64) -> bool,
+    in_parallel: bool,
+) -> Result<Option<Soup>, String> {
+    let open = || E57Reader::new(Cursor::new(bytes)).map_err(|e| e.to_string());
+    let mut reader = open()?;
     let scans = reader.pointclouds();
     let total: u64 = scans.iter().map(|pc| pc.records).fold(0, u64::saturating_add);
     let stride = total.div_ceil(most.max(1)).max(1);
     let coloured = scans.iter().all(|pc| pc.has_color());
+    // Each scan's first point's index among all the file's points: the stride counts across
+    // scans.
+    let firsts: Vec<u64> = scans
+        .iter()
+        .scan(0u64, |next, pc| {
+            let first = *next;
+            *next = next.saturating_add(pc.records);
+            Some(first)
+        })
+        .collect();
     let mut kept = ScanPoints::default();
-    let mut index = 0u64;
-    for pc in &scans {
-        let mut points = reader.pointcloud_simple(pc).map_err(|e| e.to_string())?;
-        // The intensity stays an intensity (`scan_points` makes it grey where there is no
-        // colour); the reader's default would make it a colour.
-        points.intensity_to_color(false);
-        for point in points {
-            let point = point.map_err(|e| e.to_string())?;
-            let at = index;
-            index += 1;
-            if at % POINTS_PER_STEP == POINTS_PER_STEP - 1 && !keep_going(index as f64 / total.max(1) as f64) {
+    let mut read = 0u64;
+    let share = |read: u64| read as f64 / total.max(1) as f64;
+    if in_parallel && scans.len() > 1 {
+        let order: Vec<usize> = (0..scans.len()).collect();
+        for window in order.chunks(rayon::current_num_threads().max(1)) {
+            let parts = crate::parallel::map(window, |&k| {
+                let mut reader = open()?;
+                read_scan(&mut reader, &scans[k], firsts[k], stride, coloured, &mut |_| true)
+            });
+            for part in parts {
+                let Some((points, count)) = part? else {
+                    return Ok(None);
+                };
+                kept.append(points);
+                read += count;
+            }
+            if !keep_going(share(read)) {
                 return Ok(None);
             }
-            let CartesianCoordinate::Valid { x, y, z } = point.cartesian else {
-                continue;
+        }
+    } else {
+        for (pc, &first) in scans.iter().zip(&firsts) {
+            let Some((points, count)) = read_scan(&mut reader, pc, first, stride, coloured, &mut |at| {
+                keep_going(share(at))
+            })?
+            else {
+                return Ok(None);
             };
-            if !at.is_multiple_of(stride) {
-                continue;
-            }
-            if !(x.is_finite() && y.is_finite() && z.is_finite()) {
-                return Err(format!("point {at} lies at ({x}, {y}, {z}): not a position"));
-            }
-            kept.positions.push([x, y, z]);
-            if coloured {
-                let c = point.color.map_or([0.0; 3], |c| [c.red, c.green, c.blue]);
-                kept.colours
-                    .push(c.map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 }));
-            }
-            kept.intensities
-                .push(point.intensity.filter(|i| i.is_finite()).unwrap_or(0.0).max(0.0));
+            kept.append(points);
+            read += count;
         }
     }
     if kept.positions.is_empty() {
-        return Err(if index == 0 {
+        return Err(if read == 0 {
             "no points".to_owned()
         } else {
             "no point has a valid position".to_owned()
         });
     }
     Ok(Some(kept.into_soup()))
+}
+
+/// The points of scan `pc` kept at `stride` (the scan's first point is the file's point `first`)
+/// and the number read; `keep_going` is told the index of the file's point reached every
+/// [`POINTS_PER_STEP`] points, and `None` is returned where it says stop.
+fn read_scan(
+    reader: &mut E57Reader<Cursor<&[u8]>>,
+    pc: &e57::PointCloud,
+    first: u64,
+    stride: u64,
+    coloured: bool,
+    keep_going: &mut dyn FnMut(u64) -> bool,
+) -> Result<Option<(ScanPoints, u64)>, String> {
+    let mut kept = ScanPoints::default();
+    let mut points = reader.pointcloud_simple(pc).map_err(|e| e.to_string())?;
+    // The intensity stays an intensity (`scan_points` makes it grey where there is no colour);
+    // the reader's default would make it a colour.
+    points.intensity_to_color(false);
+    let mut at = first;
+    for point in points {
+        let point = point.map_err(|e| e.to_string())?;
+        let this = at;
+        at += 1;
+        if this % POINTS_PER_STEP == POINTS_PER_STEP - 1 && !keep_going(at) {
+            return Ok(None);
+        }
+        let CartesianCoordinate::Valid { x, y, z } = point.cartesian else {
+            continue;
+        };
+        if !this.is_multiple_of(stride) {
+            continue;
+        }
+        if !(x.is_finite() && y.is_finite() && z.is_finite()) {
+            return Err(format!("point {this} lies at ({x}, {y}, {z}): not a position"));
+        }
+        kept.positions.push([x, y, z]);
+        if coloured {
+            let c = point.color.map_or([0.0; 3], |c| [c.red, c.green, c.blue]);
+            kept.colours
+                .push(c.map(|v| if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 }));
+        }
+        kept.intensities
+            .push(point.intensity.filter(|i| i.is_finite()).unwrap_or(0.0).max(0.0));
+    }
+    Ok(Some((kept, at - first)))
 }
 
 #[cfg(test)]
@@ -309,6 +377,76 @@ mod tests {
         for (p, e) in soup.positions.iter().zip(expected) {
             assert!((0..3).all(|k| (p[k] - e[k]).abs() < 1e-5), "{p:?} against {e:?}");
         }
+    }
+
+    #[test]
+    fn several_scans_decoded_together_are_the_same_points_in_order() {
+        // Five scans of different lengths (one of a single point), coloured, each posed apart;
+        // kept at a stride that runs across the scans' boundaries.
+        let scans: Vec<Scan> = [7usize, 1, 40, 13, 25]
+            .iter()
+            .enumerate()
+            .map(|(k, &n)| Scan {
+                at: [k as f64 * 3.0, 0.0, 0.0],
+                points: (0..n)
+                    .map(|i| {
+                        let c = ((k * 50 + i) % 256) as u8;
+                        ([i as f64 * 0.01, k as f64, 0.5], 0.5, Some([c, 255 - c, 7]))
+                    })
+                    .collect(),
+            })
+            .collect();
+        let bytes = e57_bytes(&scans);
+        for most in [u64::MAX, 20] {
+            let together = decode(&bytes, most, |_| true, true).unwrap().unwrap();
+            let in_turn = decode(&bytes, most, |_| true, false).unwrap().unwrap();
+            assert_eq!(together.positions, in_turn.positions, "at most {most}");
+            assert_eq!(together.colors, in_turn.colors, "at most {most}");
+            let expected = if most == 20 { 86usize.div_ceil(5) } else { 86 };
+            assert_eq!(together.positions.len(), expected, "at most {most}");
+        }
+        // Stopped after the first window of scans.
+        assert!(decode(&bytes, u64::MAX, |_| false, true).unwrap().is_none());
+    }
+
+    /// Milliseconds to decode a file of eight scans of 250 000 points each, on every core against
+    /// one scan after another, alternating five times (`benchmarks/scans.md`):
+    /// `cargo test --release -p phantogram-assets --lib e57::tests::time_several_scans -- --ignored --nocapture`.
+    #[test]
+    #[ignore = "a timing, run by hand"]
+    fn time_several_scans() {
+        let scans: Vec<Scan> = (0..8)
+            .map(|k| Scan {
+                at: [k as f64, 0.0, 0.0],
+                points: (0..250_000)
+                    .map(|i| {
+                        let t = i as f64 * 1e-5;
+                        ([t.sin(), t.cos(), t], 0.5, Some([(i % 256) as u8, 40, 90]))
+                    })
+                    .collect(),
+            })
+            .collect();
+        let bytes = e57_bytes(&scans);
+        let (mut together, mut in_turn) = (Vec::new(), Vec::new());
+        for _ in 0..5 {
+            for (parallel, times) in [(true, &mut together), (false, &mut in_turn)] {
+                let start = std::time::Instant::now();
+                let soup = decode(&bytes, RAW_POINTS_KEPT, |_| true, parallel).unwrap().unwrap();
+                times.push(start.elapsed().as_secs_f64() * 1e3);
+                assert!(!soup.positions.is_empty());
+            }
+        }
+        let median = |v: &mut Vec<f64>| {
+            v.sort_by(f64::total_cmp);
+            v[v.len() / 2]
+        };
+        let (t, s) = (median(&mut together), median(&mut in_turn));
+        println!(
+            "8 scans × 250 000 points, {} MiB, {} threads: together {t:.0} ms, one after another {s:.0} ms ({:.2}×)",
+            bytes.len() >> 20,
+            rayon::current_num_threads(),
+            s / t
+        );
     }
 
     #[test]

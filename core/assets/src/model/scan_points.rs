@@ -38,6 +38,13 @@ pub struct ScanPoints {
 }
 
 impl ScanPoints {
+    /// `other`'s points after these (a file's scans or chunks, read apart, put in order).
+    pub fn append(&mut self, mut other: ScanPoints) {
+        self.positions.append(&mut other.positions);
+        self.colours.append(&mut other.colours);
+        self.intensities.append(&mut other.intensities);
+    }
+
     /// The soup of these points (see the module docs): no normals, no triangles.
     pub fn into_soup(self) -> Soup {
         let (low, high) = self
