@@ -1023,3 +1023,32 @@ def Material "Brass"
         "{lo} {hi}"
     );
 }
+
+#[test]
+fn a_stage_of_more_shapes_than_the_budget_reads_is_refused() {
+    // A shape is a line of text and becomes two thousand vertices: each is charged as a part
+    // before it is made (`usd_shapes::ReadShape::into_mesh`), so a stage declaring more than the
+    // budget reads is refused (here 8 draws × 16 parts read per draw; the budget's own, 65 536,
+    // as for meshes).
+    let stage: String = std::iter::once("#usda 1.0\n".to_owned())
+        .chain((0..200).map(|i| format!("def Sphere \"S{i}\" {{ double radius = 0.01 }}\n")))
+        .collect();
+    let dir = Scratch::new("usd-files-many-shapes");
+    std::fs::write(dir.join("many.usda"), &stage).expect("write");
+    let small = ResourceBudget {
+        max_primitives: 8,
+        ..ResourceBudget::PHONE
+    };
+    match phantogram_assets::model::load_model_within(&dir.join("many.usda"), small) {
+        Err(ModelError::OverBudget { error, .. }) => {
+            assert_eq!(error.unit, "primitives read", "{error:?}");
+        }
+        other => panic!("{:?}", other.map(|m| m.primitives.len())),
+    }
+    // Within the budget they are drawn.
+    let few: String = stage.lines().take(41).map(|l| format!("{l}\n")).collect();
+    std::fs::write(dir.join("few.usda"), few).expect("write");
+    let model = phantogram_assets::model::load_model_within(&dir.join("few.usda"), small).expect("40 spheres load");
+    let vertices: usize = model.primitives.iter().map(|p| p.mesh.vertices.len()).sum();
+    assert_eq!(vertices, 40 * 33 * 64, "forty spheres of 33 rings of 64");
+}

@@ -45,7 +45,7 @@ use super::usd_files::{Confined, Files, folded, folder_of, is_package};
 use super::usd_material::{Textures, material_of};
 use super::usd_mesh::{Look, ReadCloud, ReadMesh, attribute_value, read_mesh, read_points};
 use super::usd_preview_surface::{self, Surface, scalar, text, token, vec3};
-use super::usd_shapes::{SHAPE_KINDS, read_shape};
+use super::usd_shapes::{ReadShape, SHAPE_KINDS, read_shape};
 use super::{Image, Material, Mesh, Model, Primitive, Vertex, point_cloud};
 use crate::budget::{ResourceBudget, Spending};
 use crate::progress::Progress;
@@ -114,6 +114,8 @@ enum Drawn {
 /// What the stage holds, read.
 struct Scene {
     meshes: Vec<ReadMesh>,
+    /// Primitive shapes, made into meshes as the model is built (`usd_shapes::ReadShape`).
+    shapes: Vec<ReadShape>,
     clouds: Vec<ReadCloud>,
     looks: Vec<Look>,
     surfaces: HashMap<String, Surface>,
@@ -195,6 +197,7 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
 
     let mut scene = Scene {
         meshes: Vec::new(),
+        shapes: Vec::new(),
         clouds: Vec::new(),
         looks: Vec::new(),
         surfaces: HashMap::new(),
@@ -239,8 +242,8 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
                 }
             }
             Drawn::Shape(kind) => {
-                if let Some(mesh) = read_shape(&stage, p, kind, world, &mut scene.looks, &mut warnings)? {
-                    scene.meshes.push(mesh);
+                if let Some(shape) = read_shape(&stage, p, kind, world, &mut scene.looks, &mut warnings)? {
+                    scene.shapes.push(shape);
                 }
             }
         }
@@ -464,7 +467,12 @@ fn build_model(
     progress.step(0.8).map_err(cancelled)?;
 
     let mut primitives = Vec::new();
-    for mesh in scene.meshes {
+    // Each shape made only when its turn comes, after the parts before it were charged.
+    for mesh in scene
+        .meshes
+        .into_iter()
+        .chain(scene.shapes.into_iter().map(ReadShape::into_mesh))
+    {
         let mut by_look: HashMap<usize, Vec<u32>> = HashMap::new();
         for (triangle, look) in &mesh.triangles {
             by_look.entry(*look).or_default().extend_from_slice(triangle);

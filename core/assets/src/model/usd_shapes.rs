@@ -72,6 +72,21 @@ enum Shape {
 /// Which coordinate the spine runs along: 0 X, 1 Y, 2 Z.
 type Axis = usize;
 
+/// A primitive shape read from the stage, not yet made: made ([`ReadShape::into_mesh`]) only when
+/// the model is built, one at a time after the one before was charged to the budget, so that a
+/// small file declaring a great many shapes is refused by the budget before their meshes exist
+/// (a shape of a few bytes becomes two thousand vertices).
+pub(super) struct ReadShape {
+    name: String,
+    shape: Shape,
+    axis: Axis,
+    /// Its placement in the model's frame.
+    world: DMat4,
+    left_handed: bool,
+    /// An index into the looks [`read_shape`] was given.
+    look: usize,
+}
+
 /// The shape of kind `kind` at `p`, placed by `world` into the model's frame; `None` (with a
 /// warning) where a dimension is not a positive finite number.
 pub(super) fn read_shape(
@@ -81,7 +96,7 @@ pub(super) fn read_shape(
     world: DMat4,
     looks: &mut Vec<super::usd_mesh::Look>,
     warnings: &mut Vec<String>,
-) -> Result<Option<ReadMesh>, String> {
+) -> Result<Option<ReadShape>, String> {
     let name = p.as_str().to_owned();
     let number = |attribute: &str, fallback: f64| -> Result<f64, String> {
         Ok(attribute_value(stage, p, attribute)?
@@ -150,34 +165,48 @@ pub(super) fn read_shape(
         .map_or(matches!(shape, Shape::Plane { .. }), |d| d != 0.0);
     let left_handed = attribute_value(stage, p, "orientation")?.as_ref().and_then(token) == Some("leftHanded");
     let look = look_of(stage, p, looks, double_sided)?;
-    let (positions, normals, triangles) = shape.tessellate(axis);
-    let normal_matrix = DMat3::from_mat4(world).inverse().transpose();
-    // A left-handed prim's faces are wound the other way round; so are those of a mirroring
-    // placement.
-    let flip = left_handed != (DMat3::from_mat4(world).determinant() < 0.0);
-    Ok(Some(ReadMesh {
+    Ok(Some(ReadShape {
         name,
-        positions: positions
-            .iter()
-            .map(|&q| world.transform_point3(q).as_vec3().to_array())
-            .collect(),
-        normals: Some(
-            normals
-                .iter()
-                .map(|&n| {
-                    let n = (normal_matrix * n).normalize_or_zero();
-                    // A left-handed prim's normals follow its winding: they point in.
-                    if left_handed { -n } else { n }.as_vec3().to_array()
-                })
-                .collect(),
-        ),
-        uvs: [None, None],
-        colours: None,
-        triangles: triangles
-            .into_iter()
-            .map(|[a, b, c]| (if flip { [a, c, b] } else { [a, b, c] }, look))
-            .collect(),
+        shape,
+        axis,
+        world,
+        left_handed,
+        look,
     }))
+}
+
+impl ReadShape {
+    /// The shape's triangles, in the model's frame, as a mesh prim's are read.
+    pub(super) fn into_mesh(self) -> ReadMesh {
+        let (positions, normals, triangles) = self.shape.tessellate(self.axis);
+        let normal_matrix = DMat3::from_mat4(self.world).inverse().transpose();
+        // A left-handed prim's faces are wound the other way round; so are those of a mirroring
+        // placement.
+        let flip = self.left_handed != (DMat3::from_mat4(self.world).determinant() < 0.0);
+        ReadMesh {
+            name: self.name,
+            positions: positions
+                .iter()
+                .map(|&q| self.world.transform_point3(q).as_vec3().to_array())
+                .collect(),
+            normals: Some(
+                normals
+                    .iter()
+                    .map(|&n| {
+                        let n = (normal_matrix * n).normalize_or_zero();
+                        // A left-handed prim's normals follow its winding: they point in.
+                        if self.left_handed { -n } else { n }.as_vec3().to_array()
+                    })
+                    .collect(),
+            ),
+            uvs: [None, None],
+            colours: None,
+            triangles: triangles
+                .into_iter()
+                .map(|[a, b, c]| (if flip { [a, c, b] } else { [a, b, c] }, self.look))
+                .collect(),
+        }
+    }
 }
 
 /// One ring of a revolved shape's profile: its distance from the spine and height along it,
