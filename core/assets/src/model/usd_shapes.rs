@@ -2,8 +2,8 @@
 //! Capsule_1, Plane) as meshes: each made from its attributes as the schema defines them (the
 //! schema's fallback where one is not authored, e.g. a Cube of size 2, a Capsule of height 1 and
 //! radius 0.5, a Plane double-sided), then placed, bound and coloured as a `Mesh` prim is
-//! ([`super::usd_mesh`]). Exporters write props and stands this way, and Reality Composer writes
-//! its primitive shapes so.
+//! ([`super::usd_mesh`]). Stages made by hand or by scene tools use them for plinths, stands,
+//! cards and props beside a scanned mesh.
 //!
 //! Frames: each shape centred on its own origin, its spine (`axis`) along X, Y or Z; the
 //! revolved shapes are made about Z and turned onto their axis by a cyclic permutation of the
