@@ -553,13 +553,15 @@ fn seed(target: &str, corpus: &Path, max_len: usize) -> Result<()> {
             // USD by Pixar's own library (`core/assets/tests/data/usd`): a package (a referenced
             // layer and a texture inside), its root layer alone in the binary format, the
             // referenced layer in the text format, a material placing its textures through
-            // transforms and named primvars, and a point cloud in the binary format.
+            // transforms and named primvars, a point cloud in the binary format, and one prim of
+            // each primitive shape.
             for (name, file) in [
                 ("reference-box.usdz", "reference-box.usdz"),
                 ("reference-box.usdc", "loose/reference-box.usdc"),
                 ("knob.usda", "loose/parts/knob.usda"),
                 ("texture-coordinates.usda", "coords/texture-coordinates.usda"),
                 ("points.usdc", "points.usdc"),
+                ("shapes.usda", "shapes.usda"),
             ] {
                 let bytes = std::fs::read(workspace_root().join("core/assets/tests/data/usd").join(file))
                     .with_context(|| format!("reading the test stage {file}"))?;

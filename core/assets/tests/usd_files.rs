@@ -1052,3 +1052,46 @@ fn a_stage_of_more_shapes_than_the_budget_reads_is_refused() {
     let vertices: usize = model.primitives.iter().map(|p| p.mesh.vertices.len()).sum();
     assert_eq!(vertices, 40 * 33 * 64, "forty spheres of 33 rings of 64");
 }
+
+#[test]
+fn primitive_shapes_written_by_pixars_library_fill_its_extents() {
+    // `reference_shapes.py`: one prim of each shape kind, written by Pixar's library, and the
+    // world-space extent that library computes for each (`shapes-expected.txt`). The shapes stand
+    // apart, so each vertex belongs to the one box it lies in; each box is filled to its faces.
+    let model = load_model(&data("shapes.usda")).expect("loads");
+    assert!(model.warnings.is_empty(), "{:?}", model.warnings);
+    let expected = std::fs::read_to_string(data("shapes-expected.txt")).expect("the extents");
+    let boxes: Vec<(String, Vec3, Vec3)> = expected
+        .lines()
+        .map(|line| {
+            let mut words = line.split_whitespace();
+            let path = words.next().expect("a path").to_owned();
+            let v: Vec<f32> = words.map(|w| w.parse().expect("a number")).collect();
+            (path, Vec3::new(v[0], v[1], v[2]), Vec3::new(v[3], v[4], v[5]))
+        })
+        .collect();
+    assert_eq!(boxes.len(), 8);
+    let mut filled: Vec<(Vec3, Vec3)> = vec![(Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)); 8];
+    for v in model.primitives.iter().flat_map(|p| &p.mesh.vertices) {
+        let p = Vec3::from(v.position);
+        let k = boxes
+            .iter()
+            .position(|(_, lo, hi)| p.cmpge(*lo - 1e-4).all() && p.cmple(*hi + 1e-4).all())
+            .unwrap_or_else(|| panic!("vertex {p} in no shape's extent"));
+        filled[k] = (filled[k].0.min(p), filled[k].1.max(p));
+    }
+    for ((path, lo, hi), (min, max)) in boxes.iter().zip(filled) {
+        // The round parts' outline is a polygon: within 0.2 % of the extent's size.
+        let tolerance = 2e-3 * (*hi - *lo).max_element();
+        assert!(
+            min.distance(*lo) < tolerance && max.distance(*hi) < tolerance,
+            "{path}: {min} – {max}, Pixar's {lo} – {hi}"
+        );
+    }
+    let brass = model
+        .materials
+        .iter()
+        .find(|m| m.name == "Brass")
+        .expect("the bound material");
+    assert_eq!((brass.metallic, brass.roughness), (1.0, 0.3));
+}
