@@ -19,10 +19,9 @@
 //! page and a packet at a time, and at most [`RAW_POINTS_KEPT`] points are kept (40 bytes each)
 //! whatever the file's size. **Progress**: `keep_going` is told the share read every 65 536 points and stops
 //! the work by returning `false` (for a file of several scans, decoded a window of scans at a
-//! time, after each window). **Threading**: a file of several scans (up to
-//! [`MOST_SCANS_IN_PARALLEL`]) has them decoded on every core, each with its own reader of the
-//! same bytes, and put together in the file's order (the same points as read one after another;
-//! tested). **Panics**: none (the reader's, should one
+//! time, after each window). **Threading**: a file of several scans has them decoded on every
+//! core, each with its own reader of the same bytes (within [`MOST_XML_PARSED_AGAIN`]), and put
+//! together in the file's order (the same points as read one after another; tested). **Panics**: none (the reader's, should one
 //! slip through a damaged file, are caught and reported as the file's error).
 
 use std::io::Cursor;
@@ -39,11 +38,13 @@ const SIGNATURE: &[u8] = b"ASTM-E57";
 /// Points between two calls of `keep_going`.
 const POINTS_PER_STEP: u64 = 1 << 16;
 
-/// The most scans a file may have for them to be decoded in parallel: each thread's reader of a
-/// scan parses the file's XML section again, which grows with the number of scans, so a file of
-/// very many (a hostile one: thousands of empty scans) would cost that many parses of a large
-/// section. Scanning teams hand over a scan per scanner position, a few to a few dozen.
-const MOST_SCANS_IN_PARALLEL: usize = 64;
+/// The most XML the readers of a file decoded in parallel may parse again, bytes: each scan's
+/// reader parses the file's XML section (up to 50 MiB, the `e57` crate's limit) before its
+/// points, so a file of many scans or a large section (a hostile one: thousands of empty scans,
+/// or a section padded out) is decoded one scan after another instead. A scan's share of the
+/// section is a few kilobytes: files of a few dozen scans, a scan per scanner position as
+/// scanning teams hand them over, stay well within it.
+const MOST_XML_PARSED_AGAIN: u64 = 16 << 20;
 
 /// Whether `bytes` begin as an E57 file does.
 pub fn recognises(bytes: &[u8]) -> bool {
@@ -72,8 +73,8 @@ fn parse_keeping(bytes: Vec<u8>, most: u64, keep_going: impl FnMut(f64) -> bool)
 }
 
 /// The points of every scan in `bytes`, as [`parse_keeping`] returns them. With `in_parallel`,
-/// a file of several scans (at most [`MOST_SCANS_IN_PARALLEL`]) has them decoded on several
-/// threads, as many scans at a time as
+/// a file of several scans (their readers' XML within [`MOST_XML_PARSED_AGAIN`]) has them
+/// decoded on several threads, as many scans at a time as
 /// there are threads (each thread its own reader of the same bytes), and put together in the
 /// file's order: the same points as one after another. A single scan is decoded on the
 /// caller's thread, which then reports its progress within it.
@@ -102,7 +103,10 @@ fn decode(
     let mut kept = ScanPoints::default();
     let mut read = 0u64;
     let share = |read: u64| read as f64 / total.max(1) as f64;
-    if in_parallel && (2..=MOST_SCANS_IN_PARALLEL).contains(&scans.len()) {
+    // The XML section's length (header bytes 32–40).
+    let xml_bytes = le_fields::u64_at(bytes, 32).unwrap_or(u64::MAX);
+    let xml_again = xml_bytes.saturating_mul(scans.len() as u64);
+    if in_parallel && scans.len() > 1 && xml_again <= MOST_XML_PARSED_AGAIN {
         let order: Vec<usize> = (0..scans.len()).collect();
         for window in order.chunks(rayon::current_num_threads().max(1)) {
             let parts = crate::parallel::map(window, |&k| {
@@ -405,6 +409,9 @@ mod tests {
             })
             .collect();
         let bytes = e57_bytes(&scans);
+        // Within the XML parsed again: the scans are decoded in parallel.
+        let xml = le_fields::u64_at(&bytes, 32).expect("a header");
+        assert!(xml * 5 <= MOST_XML_PARSED_AGAIN, "{xml} bytes of XML");
         for most in [u64::MAX, 20] {
             let together = decode(&bytes, most, |_| true, true).unwrap().unwrap();
             let in_turn = decode(&bytes, most, |_| true, false).unwrap().unwrap();
