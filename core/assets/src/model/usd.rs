@@ -179,7 +179,7 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
             "{n} prim(s) of kind {kind}: not drawn (only meshes, points and primitive shapes are)"
         ));
     }
-    // Which meshes and clouds show: visible, not guides; proxies only where nothing else is
+    // Which meshes, shapes and clouds show: visible, not guides; proxies only where nothing else is
     // drawn.
     let mut shown = Vec::new();
     for (p, drawn) in drawn_paths {
@@ -248,7 +248,7 @@ fn read_scene(files: &Arc<Files>, root: &str, progress: &Progress) -> Result<Opt
             }
         }
     }
-    // The materials only clouds are bound to.
+    // The materials only clouds and shapes are bound to.
     for look in &scene.looks {
         if let Some(material) = &look.material {
             primvars_of(material);
