@@ -602,7 +602,7 @@ fn ward_image_light(v: vec3<f32>, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, alph
     return sum / kept;
 }
 
-// Where the albedo tables (`brdf_lut`: split sum and sheen) hold (n·v, roughness) = `at`: their
+// Where the albedo tables (`brdf_lut`: split sum, sheen, Ward) hold (n·v, roughness) = `at`: their
 // first and last entries stand at 0 and 1 exactly (assets crate, `ibl::table_axis`), so the
 // texture coordinate runs from the first texel's centre to the last one's.
 fn table_uv(at: vec2<f32>, size: vec2<f32>) -> vec2<f32> {
