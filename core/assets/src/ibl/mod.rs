@@ -23,9 +23,9 @@
 //! and return when done.
 //!
 //! Files: [`sh`] (the irradiance's nine coefficients), [`prefilter`] (the specular levels and
-//! the split-sum table), [`anisotropic`] (a Ward lobe's light read from those levels),
-//! [`accuracy`] (that read against a Monte-Carlo integral); this one holds the environment map
-//! itself.
+//! the split-sum table), [`sheen`] and [`ward_albedo`] (those lobes' albedo tables, beside the
+//! split sum's), [`anisotropic`] (a Ward lobe's light read from those levels), [`accuracy`]
+//! (that read against a Monte-Carlo integral); this one holds the environment map itself.
 
 use glam::Vec3;
 
