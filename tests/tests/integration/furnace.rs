@@ -36,9 +36,11 @@ const ROUGHNESS: [f32; 3] = [0.2, 0.6, 1.0];
 const EYE: Vec3 = Vec3::new(0.0, 0.0, 0.3);
 
 /// The radiance that made an 8-bit sRGB code after the renderer's tone curve (Khronos PBR
-/// Neutral, exposure 1): below its shoulder the curve subtracts 0.04 from a grey of 0.08 or more.
+/// Neutral, exposure 1): below its shoulder the curve subtracts 0.04 from a grey of 0.08 or more,
+/// and below that grey it is 6.25·x² (its toe).
 fn radiance_of(code: u8) -> f32 {
-    phantogram_geometry::srgb::code_to_linear(code) + 0.04
+    let shown = phantogram_geometry::srgb::code_to_linear(code);
+    if shown < 0.04 { 0.4 * shown.sqrt() } else { shown + 0.04 }
 }
 
 /// Where the sphere about `centre` is seen at `n_dot_v` (the side towards +x): that point's
@@ -74,16 +76,27 @@ fn furnace_in(base: [f32; 4], over: Over, look: Appearance) -> Option<(Vec<u8>, 
         height: 32,
         texels: vec![[ROOM; 3]; 64 * 32],
     };
-    let screen = Screen::default();
-    let mono = OffAxisProjection::new(&screen, EYE, DepthRange::default()).ok()?;
-    let gpu = phantogram_integration::gpu_or_skip()?;
-    let mut renderer = Renderer::with_environment(gpu, &model, Some(&room)).expect("renderer");
-    renderer.appearance = look;
-    renderer.lighting.light_rgb = Vec3::ZERO;
-    renderer.lighting.shadows = false;
+    let (mut renderer, mono) = furnace_renderer(&model, &room, look, Vec3::ZERO)?;
     let input = still_input(&mono, &mono, &mono, Vec3::Z);
     let pixels = renderer.render(&input, Method::Mono, W, H).expect("frame");
     Some((pixels, mono, centres))
+}
+
+/// A renderer of `model` in `room` under the visitor's `look`, its lamp of radiance `lamp_rgb`
+/// casting no shadow, and the view from [`EYE`]; `None` without a GPU.
+fn furnace_renderer(
+    model: &Model,
+    room: &Environment,
+    look: Appearance,
+    lamp_rgb: Vec3,
+) -> Option<(Renderer, OffAxisProjection)> {
+    let mono = OffAxisProjection::new(&Screen::default(), EYE, DepthRange::default()).ok()?;
+    let gpu = phantogram_integration::gpu_or_skip()?;
+    let mut renderer = Renderer::with_environment(gpu, model, Some(room)).expect("renderer");
+    renderer.appearance = look;
+    renderer.lighting.light_rgb = lamp_rgb;
+    renderer.lighting.shadows = false;
+    Some((renderer, mono))
 }
 
 /// The two rows of spheres of [`furnace`] and their centres by row.
@@ -206,31 +219,10 @@ fn grey_spheres_send_back_no_more_than_white_ones() {
     }
 }
 
-/// The radiance that made an 8-bit sRGB code after the tone curve, in its toe as well (below a
-/// radiance of 0.08 the curve is 6.25·x²).
-fn radiance_of_dim(code: u8) -> f32 {
-    let shown = phantogram_geometry::srgb::code_to_linear(code);
-    if shown < 0.04 { 0.4 * shown.sqrt() } else { shown + 0.04 }
-}
-
 /// The brighter exposure's factor, and the 8-bit code of the tone curve's shoulder (its output
 /// 0.76, sRGB-encoded: 226.6) below which a code gives back its radiance.
 const BRACKET: f32 = 8.0;
 const SHOULDER: u8 = 226;
-
-/// `n` directions spread evenly over the sphere (a Fibonacci lattice: each stands for the same
-/// solid angle, 4π / n).
-fn every_side(n: usize) -> Vec<Vec3> {
-    let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-    (0..n)
-        .map(|i| {
-            let z = 1.0 - (2 * i + 1) as f32 / n as f32;
-            let r = (1.0 - z * z).max(0.0).sqrt();
-            let (s, c) = (golden * i as f32).sin_cos();
-            Vec3::new(r * c, r * s, z)
-        })
-        .collect()
-}
 
 /// The furnace again, its room replaced by lamps: one frame per lamp, from directions spread
 /// evenly over the sphere, the frames' light added. Each lamp stands for its share of the sphere
@@ -253,18 +245,13 @@ fn lamp_furnace_in(over: Over, look: Appearance, level: f32) -> Option<Vec<(Stri
     // 512 lamps: the sums move by 0.1 % from 512 to 2048 (256 are 2 % off at roughness 0.6).
     const LAMPS: usize = 512;
     let (model, centres) = spheres([1.0; 4], over);
-    let screen = Screen::default();
-    let mono = OffAxisProjection::new(&screen, EYE, DepthRange::default()).ok()?;
-    let gpu = phantogram_integration::gpu_or_skip()?;
     let dark = Environment {
         width: 8,
         height: 4,
         texels: vec![[0.0; 3]; 32],
     };
-    let mut renderer = Renderer::with_environment(gpu, &model, Some(&dark)).expect("renderer");
-    renderer.appearance = look;
-    renderer.lighting.light_rgb = Vec3::splat(level * 4.0 * std::f32::consts::PI / LAMPS as f32);
-    renderer.lighting.shadows = false;
+    let lamp = Vec3::splat(level * 4.0 * std::f32::consts::PI / LAMPS as f32);
+    let (mut renderer, mono) = furnace_renderer(&model, &dark, look, lamp)?;
     let measured: Vec<(String, Vec3)> = ["white metal", "white dielectric"]
         .into_iter()
         .zip(&centres)
@@ -277,7 +264,9 @@ fn lamp_furnace_in(over: Over, look: Appearance, level: f32) -> Option<Vec<(Stri
         })
         .collect();
     let mut sums = vec![[0.0f64; 3]; measured.len()];
-    for toward_light in every_side(LAMPS) {
+    // Directions spread evenly over the sphere (a Fibonacci lattice): each stands for the same
+    // solid angle, 4π / n.
+    for toward_light in phantogram_geometry::sphere::fibonacci(LAMPS) {
         let input = still_input(&mono, &mono, &mono, toward_light);
         // Two exposures, 8 × apart: each point read from the brighter one unless that is past the
         // tone curve's shoulder (the 8-bit codes of the curve's dark toe are too coarse to add
@@ -295,9 +284,9 @@ fn lamp_furnace_in(over: Over, look: Appearance, level: f32) -> Option<Vec<(Stri
                 );
                 let code_bright = pixel_seen_at(&bright, &mono, *centre, n_dot_v)[1];
                 *s += if code_bright < SHOULDER {
-                    f64::from(radiance_of_dim(code_bright)) / f64::from(BRACKET)
+                    f64::from(radiance_of(code_bright)) / f64::from(BRACKET)
                 } else {
-                    f64::from(radiance_of_dim(code))
+                    f64::from(radiance_of(code))
                 };
             }
         }
