@@ -105,8 +105,14 @@ impl WardLobe {
     /// stratified set of uniforms. At most 1 (the normalisation's bound); less where the lobe
     /// reaches below the horizon.
     pub fn directional_albedo(&self, v: Vec3, grid: usize) -> f32 {
+        (self.sampled_sum(v, grid, grid) / (grid * grid).max(1) as f64) as f32
+    }
+
+    /// The sum behind [`Self::directional_albedo`] over the grid's first `rows` rows of the
+    /// first uniform (its cells at `(i + ½) / grid`).
+    pub(crate) fn sampled_sum(&self, v: Vec3, grid: usize, rows: usize) -> f64 {
         let mut sum = 0.0f64;
-        for i in 0..grid {
+        for i in 0..rows.min(grid) {
             for j in 0..grid {
                 let (u1, u2) = ((i as f32 + 0.5) / grid as f32, (j as f32 + 0.5) / grid as f32);
                 if let Some((l, pdf)) = self.sample(v, u1, u2) {
@@ -114,7 +120,7 @@ impl WardLobe {
                 }
             }
         }
-        (sum / (grid * grid).max(1) as f64) as f32
+        sum
     }
 
     /// Ward's half-vector density per steradian of `h` (unit): integrates to 1 over the

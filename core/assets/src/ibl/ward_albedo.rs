@@ -46,16 +46,7 @@ pub fn ward_albedo_table(size: usize) -> Vec<f32> {
 /// (the first uniform's cells at `u` and `1 − u` draw half vectors mirrored across it), so the
 /// grid's first half of rows, counted twice, gives the same sum. `grid` even.
 fn round_albedo(lobe: &WardLobe, v: Vec3, grid: usize) -> f32 {
-    let mut sum = 0.0f64;
-    for i in 0..grid / 2 {
-        for j in 0..grid {
-            let (u1, u2) = ((i as f32 + 0.5) / grid as f32, (j as f32 + 0.5) / grid as f32);
-            if let Some((l, pdf)) = lobe.sample(v, u1, u2) {
-                sum += f64::from(lobe.eval(l, v) * l.z / pdf);
-            }
-        }
-    }
-    (2.0 * sum / (grid * grid).max(1) as f64) as f32
+    (2.0 * lobe.sampled_sum(v, grid, grid / 2) / (grid * grid).max(1) as f64) as f32
 }
 
 #[cfg(test)]

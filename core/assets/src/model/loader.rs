@@ -1732,13 +1732,7 @@ pub fn load_gltf_with(path: &Path, budget: ResourceBudget, progress: &Progress) 
                     )
                     .map_err(|e| over_budget(path, e))?;
                 let skin_data = attributes.skin.take();
-                let tangent_uv = materials
-                    .get(prim.material().index().unwrap_or(default_material))
-                    .and_then(|m| m.normal_texture.as_ref())
-                    .map_or_else(TangentUv::default, |(t, _)| TangentUv {
-                        set: t.tex_coord,
-                        transform: t.transform,
-                    });
+                let tangent_uv = TangentUv::of(materials.get(prim.material().index().unwrap_or(default_material)));
                 let mut m = assemble(&ctx, attributes, tangent_uv, &what)?;
                 built_primitives += 1;
                 meshes_share

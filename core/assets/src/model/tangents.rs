@@ -12,7 +12,7 @@
 //!
 //! Pure CPU, any thread; no panics (degenerate coordinates leave a vertex's tangent as it was).
 
-use super::{Mesh, UvTransform};
+use super::{Material, Mesh, UvTransform};
 
 /// The texture coordinates tangents are made from: a material's normal texture's set and
 /// transform, or the first set as it stands where the material has no normal map (anisotropic
@@ -26,6 +26,17 @@ pub struct TangentUv {
 }
 
 impl TangentUv {
+    /// The coordinates `material`'s normal texture is read with; the first set as it stands
+    /// where there is no material or it has no normal map.
+    pub fn of(material: Option<&Material>) -> Self {
+        material
+            .and_then(|m| m.normal_texture.as_ref())
+            .map_or_else(Self::default, |(t, _)| Self {
+                set: t.tex_coord,
+                transform: t.transform,
+            })
+    }
+
     /// `self` for a mesh that `has_second_set` or not: a normal map naming a second set the mesh
     /// lacks is read at one point (the loader's missing set is all zeros), so its tangents are
     /// meaningless; the first set's are used instead.

@@ -531,13 +531,7 @@ fn build_model(
             // A normal map is baked against MikkTSpace tangents, from the coordinates it is read
             // with; USD stores none.
             if mesh.uvs[0].is_some() {
-                let uv = materials
-                    .get(look)
-                    .and_then(|m: &Material| m.normal_texture.as_ref())
-                    .map_or_else(TangentUv::default, |(t, _)| TangentUv {
-                        set: t.tex_coord,
-                        transform: t.transform,
-                    });
+                let uv = TangentUv::of(materials.get(look));
                 generate_tangents(&mut built, uv.on(mesh.uvs[1].is_some()));
             }
             primitives.push(Primitive {
