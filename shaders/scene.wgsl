@@ -602,11 +602,45 @@ fn ward_image_light(v: vec3<f32>, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, alph
     return sum / kept;
 }
 
-// Where the albedo tables (`brdf_lut`: split sum, sheen, Ward) hold (n·v, roughness) = `at`: their
-// first and last entries stand at 0 and 1 exactly (assets crate, `ibl::table_axis`), so the
-// texture coordinate runs from the first texel's centre to the last one's.
+// Where the round lobes' albedo tables (`brdf_lut`'s top square, as wide as the texture: split
+// sum, sheen, Ward) hold (n·v, roughness) = `at`, for the texture of `size`: their first and
+// last entries stand at 0 and 1 exactly (assets crate, `ibl::table_axis`), so the texture
+// coordinate runs from the first texel's centre to the last one's.
 fn table_uv(at: vec2<f32>, size: vec2<f32>) -> vec2<f32> {
-    return (clamp(at, vec2<f32>(0.0), vec2<f32>(1.0)) * (size - 1.0) + 0.5) / size;
+    return (clamp(at, vec2<f32>(0.0), vec2<f32>(1.0)) * (size.x - 1.0) + 0.5) / size;
+}
+
+// The stretched lobes' albedo table below the round ones (assets crate
+// `ibl::anisotropic_albedo`, whose `read` is this function's twin): tiles of
+// ANISOTROPIC_TILE × ANISOTROPIC_TILE entries (n·v × √ of the long roughness), ANISOTROPIC_TILES
+// across (the view's azimuth from the long axis) and down (the short roughness over the long
+// one). For a lobe of roughness `alpha_long` along one axis and `alpha_short` across it, seen at
+// `n_dot_v` and `azimuth` (0 along the long axis, 1 across it): the stretched GGX lobe's split
+// sum (xy: scale on F0 and F90) and the Ward lobe's albedo (z). Four reads, mixed between tiles.
+override ANISOTROPIC_TILE: f32 = 16.0;
+override ANISOTROPIC_TILES: f32 = 4.0;
+fn anisotropic_albedo(n_dot_v: f32, alpha_long: f32, alpha_short: f32, azimuth: f32) -> vec3<f32> {
+    let size = vec2<f32>(textureDimensions(brdf_lut));
+    let last = ANISOTROPIC_TILES - 1.0;
+    let ratio = select(1.0, alpha_short / alpha_long, alpha_long > 0.0);
+    let scaled = clamp(vec2<f32>(azimuth, ratio), vec2<f32>(0.0), vec2<f32>(1.0)) * last;
+    let first = min(floor(scaled), vec2<f32>(last - 1.0));
+    let t = scaled - first;
+    let at = clamp(vec2<f32>(n_dot_v, sqrt(max(alpha_long, 0.0))), vec2<f32>(0.0), vec2<f32>(1.0)) * (ANISOTROPIC_TILE - 1.0) + 0.5;
+    // The round tables' square lies above.
+    let corner = vec2<f32>(0.0, size.x) + first * ANISOTROPIC_TILE + at;
+    let step = ANISOTROPIC_TILE;
+    let a00 = textureSampleLevel(brdf_lut, env_sampler, corner / size, 0.0).xyz;
+    let a10 = textureSampleLevel(brdf_lut, env_sampler, (corner + vec2<f32>(step, 0.0)) / size, 0.0).xyz;
+    let a01 = textureSampleLevel(brdf_lut, env_sampler, (corner + vec2<f32>(0.0, step)) / size, 0.0).xyz;
+    let a11 = textureSampleLevel(brdf_lut, env_sampler, (corner + vec2<f32>(step, step)) / size, 0.0).xyz;
+    return mix(mix(a00, a10, t.x), mix(a01, a11, t.x), t.y);
+}
+
+// Where `v` looks from the axis `along` (unit, in the shading plane; `across` the other one):
+// 0 along it, 1 across it, either way round (the lobes are symmetric about both axes).
+fn azimuth_from(v: vec3<f32>, along: vec3<f32>, across: vec3<f32>) -> f32 {
+    return atan2(abs(dot(across, v)), abs(dot(along, v)) + 1e-6) / (0.5 * PI);
 }
 
 fn ggx(n_dot_h: f32, alpha: f32) -> f32 {
@@ -1169,10 +1203,11 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         // Ward: ρd (times the base colour) / π + ρs · lobe along the tangent frame (any frame
         // about n where the mesh has no tangents: the lobe is then isotropic in effect only if
         // αx = αy). Its image-based light: the lobe's shape from `ward_image_light`, its albedo
-        // the Ward lobe's own (the tables' fourth channel, assets crate `ibl::ward_albedo`), read
-        // for the round lobe of the same mean square slope, so that the room's light and a
+        // the Ward lobe's own (round: the tables' fourth channel, assets crate
+        // `ibl::ward_albedo`; stretched: `anisotropic_albedo`), so that the room's light and a
         // lamp's agree (before: GGX's single-bounce albedo at the roughness of the same area,
-        // up to 19 % below Ward's at α = 1).
+        // up to 19 % below Ward's at α = 1; then the round lobe of the same mean square slope
+        // for a stretched one, up to 10 % off).
         var tw = t - n * dot(n, t);
         if (dot(tw, tw) < 1e-8) {
             tw = cross(select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9), n);
@@ -1201,10 +1236,17 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         rho_d = rho_d * (1.0 - transmission);
         let lobe = ward_lobe(l, v, tw, bw, n, ward_alpha);
         direct = (rho_d / PI + rho_s * lobe) * light_in;
-        // The table's roughness axis is √α.
-        let round_alpha = sqrt(0.5 * dot(ward_alpha, ward_alpha));
-        let ward_uv = table_uv(vec2<f32>(n_dot_v, sqrt(round_alpha)), lut_size);
-        let ward_albedo = textureSampleLevel(brdf_lut, env_sampler, ward_uv, 0.0).a;
+        // A round lobe's albedo from the round table (its roughness axis is √α), a stretched
+        // one's from the stretched lobes' (seen from its long axis).
+        var ward_albedo: f32;
+        if (ward_alpha.x == ward_alpha.y) {
+            let ward_uv = table_uv(vec2<f32>(n_dot_v, sqrt(ward_alpha.x)), lut_size);
+            ward_albedo = textureSampleLevel(brdf_lut, env_sampler, ward_uv, 0.0).a;
+        } else {
+            let x_long = ward_alpha.x > ward_alpha.y;
+            let azimuth = select(azimuth_from(v, bw, tw), azimuth_from(v, tw, bw), x_long);
+            ward_albedo = anisotropic_albedo(n_dot_v, max(ward_alpha.x, ward_alpha.y), min(ward_alpha.x, ward_alpha.y), azimuth).z;
+        }
         let prefiltered = ward_image_light(v, n, tw, bw, ward_alpha);
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * ward_albedo;
     } else {
@@ -1212,8 +1254,19 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         // albedo after one bounce is F0·x + F90·y; E_ms = 1 − x − y is what a perfect (F = 1)
         // one loses to light that leaves only after further bounces: two thirds face on at
         // roughness 1.
-        let lut_uv = table_uv(vec2<f32>(n_dot_v, roughness), lut_size);
-        let scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
+        // A stretched lobe (KHR_materials_anisotropy: α_t along `ta`, α across) reads its own
+        // table, seen from `ta`; it read the round one at α before, as Khronos's glTF Sample
+        // Viewer does, and sent back up to twice what its lobe does under lamps.
+        var scale_bias: vec2<f32>;
+        let ta = s.anisotropy_t;
+        let ba = cross(n, ta);
+        let alpha_t = mix(alpha, 1.0, s.anisotropy * s.anisotropy);
+        if (s.anisotropy > 0.0) {
+            scale_bias = anisotropic_albedo(n_dot_v, alpha_t, alpha, azimuth_from(v, ta, ba)).xy;
+        } else {
+            let lut_uv = table_uv(vec2<f32>(n_dot_v, roughness), lut_size);
+            scale_bias = textureSampleLevel(brdf_lut, env_sampler, lut_uv, 0.0).rg;
+        }
         let e_ms = clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0);
         // Those further bounces (Fdez-Agüera, "A Multiple-Scattering Microfacet Model for
         // Real-Time Image-based Lighting", JCGT 2019, as Khronos's glTF Sample Viewer has them):
@@ -1247,9 +1300,6 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         // about a normal bent towards the stretch (`anisotropic_reflection`).
         var reflected_base = reflected;
         if (s.anisotropy > 0.0) {
-            let ta = s.anisotropy_t;
-            let ba = cross(n, ta);
-            let alpha_t = mix(alpha, 1.0, s.anisotropy * s.anisotropy);
             specular = fresnel * ggx_anisotropic(n_dot_h, dot(ta, h), dot(ba, h), alpha_t, alpha)
                 * smith_visibility_anisotropic(n_dot_l, n_dot_v, vec2<f32>(dot(ta, v), dot(ba, v)), vec2<f32>(dot(ta, l), dot(ba, l)), alpha_t, alpha);
             reflected_base = to_world(anisotropic_reflection(n, v, ta, roughness, s.anisotropy));

@@ -53,7 +53,8 @@ fn main() {
     let split_sum = median_ms(5, || brdf_lut(64));
     let sheen = median_ms(5, || sheen_albedo_table(64));
     let ward = median_ms(5, || ward_albedo_table(64));
+    let stretched = median_ms(5, phantogram_assets::ibl::anisotropic_albedo::anisotropic_albedo_table);
     println!(
-        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms, sheen albedo {sheen:.1} ms, Ward albedo {ward:.1} ms ({cores} cores each)"
+        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms, sheen albedo {sheen:.1} ms, Ward albedo {ward:.1} ms, stretched lobes {stretched:.1} ms ({cores} cores each)"
     );
 }

@@ -941,6 +941,17 @@ mod tests {
     }
 
     #[test]
+    fn the_shaders_stretched_lobes_table_is_laid_out_as_the_assets_crate_makes_it() {
+        // The pipelines set these overrides; their defaults serve shader validation and must say
+        // the same.
+        use phantogram_assets::ibl::anisotropic_albedo::{TILE, TILES};
+        for (name, value) in [("ANISOTROPIC_TILE", TILE), ("ANISOTROPIC_TILES", TILES)] {
+            let line = format!("override {name}: f32 = {value}.0;");
+            assert!(SCENE_WGSL.contains(&line), "scene.wgsl lacks `{line}`");
+        }
+    }
+
+    #[test]
     fn mips_average_colour_in_linear_light() {
         // A 2×1 image, black and white: the 1×1 mip is 50 % linear grey (188 in sRGB), not 128.
         let levels = mip_chain(2, 1, &[0, 0, 0, 255, 255, 255, 255, 255], true);

@@ -5,14 +5,23 @@ use super::*;
 
 /// Width of the prefiltered environment's sharpest level (mirror-like reflections).
 pub const PREFILTERED_BASE_WIDTH: usize = 256;
-/// Size of the split-sum BRDF table (n·v × roughness).
+/// Size of the split-sum BRDF table (n·v × roughness), and the lighting tables' texture width.
 pub(super) const BRDF_LUT_SIZE: usize = 64;
+/// The lighting tables' texture height: the round lobes' tables above, the stretched lobes'
+/// ([`phantogram_assets::ibl::anisotropic_albedo`]) below, both as wide as the texture.
+pub(super) const LIGHTING_TABLES_HEIGHT: usize = BRDF_LUT_SIZE + anisotropic_albedo::SIDE;
+const _: () = assert!(
+    anisotropic_albedo::SIDE == BRDF_LUT_SIZE,
+    "the two tables share the texture's width"
+);
+
+use phantogram_assets::ibl::anisotropic_albedo;
 
 /// Computes, once per process, the tables a [`Renderer`] needs before its first frame: the
 /// split-sum BRDF table and, if `studio`, the generated studio's prefiltered levels (the lighting
 /// when no environment is given). About 100 ms of CPU work on this machine's two cores, and 60 ms
 /// more since the split-sum table takes four times the samples per entry and the Ward lobe's
-/// albedo joined it (2026-12-07); an app
+/// albedo joined it, and about 50 ms more for the stretched lobes' table (2026-12-07); an app
 /// calls it on a background thread at start-up, overlapping it with loading the model and opening
 /// the device (the sea turtle's cold load-to-first-frame: see `benchmarks/render.md`). Calling it
 /// is never required: the renderer computes what is missing, or waits for a computation under way.
@@ -43,20 +52,29 @@ pub(super) fn default_prefiltered_environment() -> &'static [phantogram_assets::
     })
 }
 
-/// The split-sum table (scale and bias on F0), the sheen's directional albedo
-/// ([`phantogram_assets::ibl::sheen`]) and the round Ward lobe's
-/// ([`phantogram_assets::ibl::ward_albedo`]) as `Rgba16Float` texels, read at the same (n·v,
-/// roughness), computed once per process (they depend on nothing).
+/// The lighting tables as `Rgba16Float` texels, `BRDF_LUT_SIZE` wide and
+/// `LIGHTING_TABLES_HEIGHT` high, computed once per process (they depend on nothing). Above, the
+/// round lobes' tables read at the same (n·v, roughness): the split sum (scale and bias on F0),
+/// the sheen's directional albedo ([`phantogram_assets::ibl::sheen`]) and the round Ward lobe's
+/// ([`phantogram_assets::ibl::ward_albedo`]). Below, the stretched lobes' tiles
+/// ([`anisotropic_albedo`]): the stretched GGX lobe's split sum and the Ward lobe's albedo (the
+/// fourth channel unused, 1).
 pub(super) fn brdf_lut_texels() -> &'static [u8] {
     static TEXELS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
     TEXELS.get_or_init(|| {
         let sheen = phantogram_assets::ibl::sheen_albedo_table(BRDF_LUT_SIZE);
         let ward = phantogram_assets::ibl::ward_albedo_table(BRDF_LUT_SIZE);
-        phantogram_assets::ibl::brdf_lut(BRDF_LUT_SIZE)
+        let round = phantogram_assets::ibl::brdf_lut(BRDF_LUT_SIZE)
             .into_iter()
             .zip(sheen)
             .zip(ward)
-            .flat_map(|(([a, b], e), w)| [a, b, e, w].map(half::f16::from_f32))
+            .map(|(([a, b], e), w)| [a, b, e, w]);
+        let stretched = anisotropic_albedo::anisotropic_albedo_table()
+            .into_iter()
+            .map(|[a, b, w]| [a, b, w, 1.0]);
+        round
+            .chain(stretched)
+            .flat_map(|texel| texel.map(half::f16::from_f32))
             .flat_map(|h| h.to_le_bytes())
             .collect()
     })
@@ -92,10 +110,10 @@ impl IblTextures {
     pub(super) fn with_texture(gpu: &Gpu, texture: &wgpu::Texture) -> Self {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let lut = device.create_texture(&wgpu::TextureDescriptor {
-            label: Some("split-sum BRDF table"),
+            label: Some("lighting tables"),
             size: wgpu::Extent3d {
                 width: BRDF_LUT_SIZE as u32,
-                height: BRDF_LUT_SIZE as u32,
+                height: LIGHTING_TABLES_HEIGHT as u32,
                 depth_or_array_layers: 1,
             },
             mip_level_count: 1,
@@ -116,11 +134,11 @@ impl IblTextures {
             wgpu::TexelCopyBufferLayout {
                 offset: 0,
                 bytes_per_row: Some(8 * BRDF_LUT_SIZE as u32),
-                rows_per_image: Some(BRDF_LUT_SIZE as u32),
+                rows_per_image: Some(LIGHTING_TABLES_HEIGHT as u32),
             },
             wgpu::Extent3d {
                 width: BRDF_LUT_SIZE as u32,
-                height: BRDF_LUT_SIZE as u32,
+                height: LIGHTING_TABLES_HEIGHT as u32,
                 depth_or_array_layers: 1,
             },
         );

@@ -5,6 +5,7 @@ use crate::{
     DEPTH_FORMAT, HDR_FORMAT,
     gpu_model::{GpuModel, MaterialVariant, TEXTURE_OVERRIDES},
 };
+use phantogram_assets::ibl::anisotropic_albedo;
 use phantogram_assets::model::Vertex;
 
 /// Scene pipelines, one per [`MaterialVariant`] in use, created when a model is set (never while
@@ -94,6 +95,9 @@ impl ScenePipelines {
         constants.push(("HAS_LAYERS", flag(v.layers)));
         constants.push(("HAS_LAYER_TEXTURES", flag(v.layer_textures)));
         constants.push(("GLASS_SHADOWS", flag(v.glass_shadows)));
+        // The stretched lobes' table's layout, as the assets crate makes it.
+        constants.push(("ANISOTROPIC_TILE", anisotropic_albedo::TILE as f64));
+        constants.push(("ANISOTROPIC_TILES", anisotropic_albedo::TILES as f64));
         let fade_attributes = FADE_ATTRIBUTES;
         let plain = [Some(vertex_buffer(&vertex_attributes))];
         let fading = [

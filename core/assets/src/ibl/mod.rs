@@ -15,8 +15,9 @@
 //!   roughnesses (one equirectangular mip level each, assuming n = v = r), and [`brdf_lut`]
 //!   tabulates the scale and bias applied to F0 as a function of n·v and roughness.
 //!
-//!   The renderer uploads the levels as an `Rgba16Float` mip chain and the table as an `Rg16Float`
-//!   texture and samples them with the roughness as the level of detail.
+//!   The renderer uploads the levels as an `Rgba16Float` mip chain, sampled with the roughness as
+//!   the level of detail, and the albedo tables as one `Rgba16Float` texture: the round lobes'
+//!   (split sum, sheen, Ward) above, the stretched lobes' ([`anisotropic_albedo`]) below.
 //!
 //! **Threading**: everything here is plain data and pure functions; [`prefiltered_levels`] and
 //! [`IrradianceSh::from_environment`] spread their rows over the cores ([`crate::parallel::map`])
@@ -24,13 +25,15 @@
 //!
 //! Files: [`sh`] (the irradiance's nine coefficients), [`prefilter`] (the specular levels and
 //! the split-sum table), [`sheen`] and [`ward_albedo`] (those lobes' albedo tables, beside the
-//! split sum's), [`anisotropic`] (a Ward lobe's light read from those levels), [`accuracy`]
+//! split sum's), [`anisotropic_albedo`] (the stretched GGX and Ward lobes' albedo, by view
+//! azimuth and stretch), [`anisotropic`] (a Ward lobe's light read from those levels), [`accuracy`]
 //! (that read against a Monte-Carlo integral); this one holds the environment map itself.
 
 use glam::Vec3;
 
 pub mod accuracy;
 pub mod anisotropic;
+pub mod anisotropic_albedo;
 pub mod prefilter;
 pub mod sh;
 pub mod sheen;
