@@ -573,13 +573,15 @@ fn ward_lobe(l: vec3<f32>, v: vec3<f32>, t: vec3<f32>, b: vec3<f32>, n: vec3<f32
     return dot(h, h) / (PI * alpha.x * alpha.y * hn * hn * hn * hn) * exp(-(hx * hx + hy * hy) / (hn * hn));
 }
 
-// The image light of the Ward lobe (unit albedo) towards v, with v and the frame (t, b, n) in the
-// mesh's space: eight reads of the prefiltered level of the shorter roughness, about the mirror
-// directions of half vectors tilted along the longer axis by the nodes of a one-dimensional
-// Gaussian of the remaining slope (ibl/anisotropic.rs, its reference and measurements). Taps
-// below the surface are left out; a round lobe reads the mirror direction eight times.
-fn ward_image_light(v: vec3<f32>, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, alpha: vec2<f32>) -> vec3<f32> {
-    // WARD_TAP_NODES: Φ⁻¹((k + ½)/8) scaled to unit variance.
+// The image light of a stretched lobe (unit albedo; Ward's, or GGX's under
+// KHR_materials_anisotropy) of roughnesses `alpha` along t and b, towards v, with v and the
+// frame (t, b, n) in the mesh's space: eight reads of the prefiltered level of the shorter
+// roughness, about the mirror directions of half vectors tilted along the longer axis by the
+// nodes of a one-dimensional Gaussian of the remaining slope (ibl/anisotropic.rs, its reference
+// and measurements). Taps below the surface are left out; a round lobe reads the mirror
+// direction eight times.
+fn stretched_image_light(v: vec3<f32>, n: vec3<f32>, t: vec3<f32>, b: vec3<f32>, alpha: vec2<f32>) -> vec3<f32> {
+    // STRETCH_TAP_NODES: Φ⁻¹((k + ½)/8) scaled to unit variance.
     var nodes = array<f32, 8>(-1.66312, -0.96171, -0.52991, -0.17053, 0.17053, 0.52991, 0.96171, 1.66312);
     let short = min(alpha.x, alpha.y);
     let long = max(alpha.x, alpha.y);
@@ -664,22 +666,6 @@ fn smith_visibility_anisotropic(n_dot_l: f32, n_dot_v: f32, tb_v: vec2<f32>, tb_
     let gv = n_dot_l * length(vec3<f32>(alpha_t * tb_v.x, alpha_b * tb_v.y, n_dot_v));
     let g_l = n_dot_v * length(vec3<f32>(alpha_t * tb_l.x, alpha_b * tb_l.y, n_dot_l));
     return 0.5 / max(gv + g_l, 1e-5);
-}
-
-// Where an anisotropic lobe's image light is looked up (the glTF sample viewer's bent normal,
-// after Filament): the normal turned towards the one that faces the eye across the stretch
-// direction `ta`, the more the stronger the stretch and the smoother the surface, so that the
-// prefiltered environment's reflection is drawn out along `ta`.
-fn anisotropic_reflection(n: vec3<f32>, v: vec3<f32>, ta: vec3<f32>, roughness: f32, anisotropy: f32) -> vec3<f32> {
-    let across = cross(ta, v);
-    let facing = cross(across, ta);
-    let bend = 1.0 - anisotropy * (1.0 - roughness);
-    let bend4 = bend * bend * bend * bend;
-    var bent = mix(facing, n, bend4);
-    if (dot(bent, bent) < 1e-8) {
-        bent = n;
-    }
-    return reflect(-v, normalize(bent));
 }
 
 // CIE XYZ to linear Rec. 709 (sRGB primaries, D65), columns.
@@ -1202,7 +1188,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     if (look.ward_rho_d.w > 0.5) {
         // Ward: ρd (times the base colour) / π + ρs · lobe along the tangent frame (any frame
         // about n where the mesh has no tangents: the lobe is then isotropic in effect only if
-        // αx = αy). Its image-based light: the lobe's shape from `ward_image_light`, its albedo
+        // αx = αy). Its image-based light: the lobe's shape from `stretched_image_light`, its albedo
         // the Ward lobe's own (round: the tables' fourth channel, assets crate
         // `ibl::ward_albedo`; stretched: `anisotropic_albedo`), so that the room's light and a
         // lamp's agree (before: GGX's single-bounce albedo at the roughness of the same area,
@@ -1247,7 +1233,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             let azimuth = select(azimuth_from(v, bw, tw), azimuth_from(v, tw, bw), x_long);
             ward_albedo = anisotropic_albedo(n_dot_v, max(ward_alpha.x, ward_alpha.y), min(ward_alpha.x, ward_alpha.y), azimuth).z;
         }
-        let prefiltered = ward_image_light(v, n, tw, bw, ward_alpha);
+        let prefiltered = stretched_image_light(v, n, tw, bw, ward_alpha);
         ambient_light = irradiance(to_world(n)) / PI * rho_d + prefiltered * rho_s * ward_albedo;
     } else {
         // The split-sum table at this view and roughness (Karis 2013): a microfacet surface's
@@ -1298,13 +1284,9 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             f0_ambient_m = mix(base, film_f0(at_view_m, base, vec3<f32>(1.0), n_dot_v), s.iridescence);
         }
         var specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
-        // Where the light's reflection is looked up: about the normal, or for an anisotropic lobe
-        // about a normal bent towards the stretch (`anisotropic_reflection`).
-        var reflected_base = reflected;
         if (s.anisotropy > 0.0) {
             specular = fresnel * ggx_anisotropic(n_dot_h, dot(ta, h), dot(ba, h), alpha_t, alpha)
                 * smith_visibility_anisotropic(n_dot_l, n_dot_v, vec2<f32>(dot(ta, v), dot(ba, v)), vec2<f32>(dot(ta, l), dot(ba, l)), alpha_t, alpha);
-            reflected_base = to_world(anisotropic_reflection(n, v, ta, roughness, s.anisotropy));
         }
         // The specular layer's albedo towards the view, its single bounce from the split-sum
         // table and all bounces together (the image light's below uses both).
@@ -1345,7 +1327,17 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         if (through_sheet > 0.0) {
             diffuse_ambient += irradiance(to_world(-n)) * lambert * through_sheet * s.diffuse_transmission_color;
         }
-        let prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected_base), roughness * PREFILTERED_MAX_LEVEL).rgb;
+        // The room's light reflected: the level of this roughness about the mirror direction,
+        // or for a stretched lobe the taps along its stretch (`stretched_image_light`). Before,
+        // one read about a normal bent across the stretch (Khronos's glTF Sample Viewer's,
+        // after Filament), 0.75–1.8 of the light off (relative RMS against the lobe's integral;
+        // the taps 0.10–0.51: assets crate `ibl::accuracy::stretched_ggx_read_errors`).
+        var prefiltered: vec3<f32>;
+        if (s.anisotropy > 0.0) {
+            prefiltered = stretched_image_light(v, n, ta, ba, vec2<f32>(alpha_t, alpha));
+        } else {
+            prefiltered = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), roughness * PREFILTERED_MAX_LEVEL).rgb;
+        }
         let further = mix(albedo_d * (bounces_d - 1.0), albedo_m * (bounces_m - 1.0), metallic);
         let specular_ambient = prefiltered * mix(albedo_d, albedo_m, metallic) + irradiance_n / PI * further;
         ambient_light = diffuse_ambient + specular_ambient;

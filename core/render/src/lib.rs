@@ -925,7 +925,7 @@ mod tests {
 
     #[test]
     fn the_shader_taps_a_ward_lobe_where_its_reference_does() {
-        // `ward_image_light` in scene.wgsl holds its own copy of the nodes (WGSL has no shared
+        // `stretched_image_light` in scene.wgsl holds its own copy of the nodes (WGSL has no shared
         // constants with Rust); they must be the reference's.
         let start = SCENE_WGSL
             .find("var nodes = array<f32, 8>(")
@@ -933,7 +933,7 @@ mod tests {
         let list = &SCENE_WGSL[start..];
         let list = &list[list.find('(').expect("open") + 1..list.find(')').expect("close")];
         let nodes: Vec<f32> = list.split(',').map(|x| x.trim().parse().expect("a number")).collect();
-        let reference = phantogram_assets::ibl::WARD_TAP_NODES;
+        let reference = phantogram_assets::ibl::STRETCH_TAP_NODES;
         assert_eq!(nodes.len(), reference.len());
         for (a, b) in nodes.iter().zip(reference) {
             assert!((a - b).abs() < 1e-4, "{nodes:?} vs {reference:?}");

@@ -1,5 +1,5 @@
 //! Brushed metal (`KHR_materials_anisotropy`; `scene.wgsl`'s `ggx_anisotropic` and
-//! `anisotropic_reflection`): the light's highlight on a metal plate is drawn out along the
+//! `stretched_image_light`): the light's highlight on a metal plate is drawn out along the
 //! direction the extension names (the mesh's tangent turned by its rotation, or its texture's
 //! direction), and not at all without it.
 

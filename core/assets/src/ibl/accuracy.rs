@@ -1,14 +1,17 @@
-//! How close the renderer's image light of a Ward lobe ([`super::anisotropic`]) comes to the
-//! truth: a Monte-Carlo integral of the lobe over the environment, compared with the tapped read
-//! and with the single round read the renderer made before, over a spread of surface frames and
-//! views. Used by the tests here and by the integration tests over the shared rooms.
+//! How close the renderer's image light of a stretched lobe ([`super::anisotropic`]) comes to
+//! the truth: a Monte-Carlo integral of the lobe over the environment, compared with the tapped
+//! read and with the single read the renderer made before, over a spread of surface frames and
+//! views; for a Ward lobe ([`read_errors`]) and for GGX stretched by `KHR_materials_anisotropy`
+//! ([`stretched_ggx_read_errors`]). Used by the tests here and by the integration tests over the
+//! shared rooms.
 //!
 //! Pure functions; slow (thousands of samples per case), no panics.
 
 use glam::Vec3;
 use phantogram_geometry::srgb::luminance;
 
-use super::anisotropic::{WardImageLight, sample_levels};
+use super::anisotropic::{StretchedImageLight, sample_levels};
+use super::anisotropic_albedo::{smith_lambda, visible_normal};
 use super::{Environment, prefiltered_levels};
 use crate::ward::WardLobe;
 
@@ -19,7 +22,7 @@ use crate::ward::WardLobe;
 pub struct ReadErrors {
     /// One read of the level at the lobe's geometric-mean roughness about the mirror direction.
     pub round: f32,
-    /// [`WardImageLight`]'s taps.
+    /// [`StretchedImageLight`]'s taps.
     pub tapped: f32,
 }
 
@@ -96,7 +99,7 @@ fn reference(env: &Environment, lobe: WardLobe, frame: Frame, v: Vec3, samples: 
 /// for the truth; levels prefiltered at the renderer's 256-texel base width).
 pub fn read_errors(env: &Environment, lobe: WardLobe, count: usize) -> ReadErrors {
     let levels = prefiltered_levels(env, 256);
-    let light = WardImageLight::for_lobe(lobe);
+    let light = StretchedImageLight::for_lobe(lobe);
     let (mut round, mut tapped, mut norm) = (0.0f64, 0.0f64, 0.0f64);
     for (frame, v) in cases(count) {
         let (truth, albedo) = reference(env, lobe, frame, v, 2048);
@@ -147,4 +150,89 @@ pub fn sun_and_band() -> Environment {
         }
     }
     env
+}
+
+/// The two reads' errors for GGX stretched by `KHR_materials_anisotropy` (roughness `roughness`,
+/// strength `strength`: α along the tangent `mix(α, 1, strength²)`, α = roughness² across),
+/// relative RMS (luminance) over `count` frames and views, each scaled by the lobe's true albedo
+/// as in [`read_errors`]: `round` the read `scene.wgsl` made before, the level of the short
+/// roughness about the mirror direction of a normal bent across the stretch (Khronos's glTF
+/// Sample Viewer's, after Filament), `tapped` [`StretchedImageLight`]'s taps. The truth: 4096
+/// visible normals (Heitz 2018) per case.
+pub fn stretched_ggx_read_errors(env: &Environment, roughness: f32, strength: f32, count: usize) -> ReadErrors {
+    let levels = prefiltered_levels(env, 256);
+    let alpha = roughness * roughness;
+    let alpha_t = alpha + (1.0 - alpha) * strength * strength;
+    let light = StretchedImageLight::for_alphas(alpha_t, alpha);
+    let (mut bent, mut tapped, mut norm) = (0.0f64, 0.0f64, 0.0f64);
+    for (frame, v) in cases(count) {
+        let (truth, albedo) = ggx_reference(env, alpha_t, alpha, frame, v, 4096);
+        let truth = luminance(truth) as f64;
+        let bent_read = luminance(sample_levels(
+            &levels,
+            frame.world(bent_reflection(v, roughness, strength)),
+            roughness,
+        ));
+        let mut tapped_read = 0.0f32;
+        for (l, w) in light.taps(v) {
+            tapped_read += luminance(sample_levels(&levels, frame.world(l), light.level_roughness)) * w;
+        }
+        bent += ((bent_read * albedo) as f64 - truth).powi(2);
+        tapped += ((tapped_read * albedo) as f64 - truth).powi(2);
+        norm += truth * truth;
+    }
+    let norm = norm.max(1e-30);
+    ReadErrors {
+        round: (bent / norm).sqrt() as f32,
+        tapped: (tapped / norm).sqrt() as f32,
+    }
+}
+
+/// Monte-Carlo radiance reflected by the stretched GGX lobe (αx along the tangent, αy along the
+/// bitangent; F = 1, single bounce) towards `v`, and its albedo: visible normals, each weighted
+/// by G2 / G1(v) (height-correlated Smith).
+fn ggx_reference(
+    env: &Environment,
+    alpha_x: f32,
+    alpha_y: f32,
+    frame: Frame,
+    v: Vec3,
+    samples: u32,
+) -> ([f32; 3], f32) {
+    let lambda_v = smith_lambda(v, alpha_x, alpha_y);
+    let mut sum = [0.0f64; 3];
+    let mut albedo = 0.0f64;
+    for i in 0..samples {
+        let (u1, u2) = hammersley(i, samples);
+        let h = visible_normal(v, alpha_x, alpha_y, u1, u2);
+        let l = h * 2.0 * v.dot(h) - v;
+        if l.z <= 0.0 {
+            continue;
+        }
+        let w = f64::from((1.0 + lambda_v) / (1.0 + lambda_v + smith_lambda(l, alpha_x, alpha_y)));
+        let c = env.sample(frame.world(l));
+        for ch in 0..3 {
+            sum[ch] += c[ch] as f64 * w;
+        }
+        albedo += w;
+    }
+    let n = samples as f64;
+    (sum.map(|s| (s / n) as f32), (albedo / n) as f32)
+}
+
+/// The reflection about the bent normal that the renderer read for a stretched GGX lobe before
+/// (surface frame, the stretch along +x; Khronos's glTF Sample Viewer's
+/// `getIBLRadianceAnisotropy`): the normal turned towards the one that faces the view across the
+/// stretch, the more the stronger the stretch and the smoother the surface.
+fn bent_reflection(v: Vec3, roughness: f32, strength: f32) -> Vec3 {
+    let across = Vec3::X.cross(v);
+    let facing = across.cross(Vec3::X);
+    let bend = (1.0 - strength * (1.0 - roughness)).powi(4);
+    let bent = facing.lerp(Vec3::Z, bend);
+    let bent = if bent.length_squared() < 1e-8 {
+        Vec3::Z
+    } else {
+        bent.normalize()
+    };
+    bent * 2.0 * v.dot(bent) - v
 }

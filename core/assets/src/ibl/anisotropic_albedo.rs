@@ -103,7 +103,7 @@ pub fn view_at(n_dot_v: f32, azimuth_rad: f32) -> Vec3 {
 }
 
 /// Smith's Λ of the GGX lobe (αx, αy) for the direction `w` (unit, surface frame, above it).
-fn smith_lambda(w: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
+pub(crate) fn smith_lambda(w: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
     let (x, y) = (alpha_x * w.x, alpha_y * w.y);
     let z2 = (w.z * w.z).max(1e-12);
     0.5 * ((1.0 + (x * x + y * y) / z2).sqrt() - 1.0)
@@ -111,7 +111,7 @@ fn smith_lambda(w: Vec3, alpha_x: f32, alpha_y: f32) -> f32 {
 
 /// A visible normal of the GGX lobe (αx, αy) seen from `v` for the uniforms (u1, u2) (Heitz,
 /// "Sampling the GGX Distribution of Visible Normals", JCGT 2018).
-fn visible_normal(v: Vec3, alpha_x: f32, alpha_y: f32, u1: f32, u2: f32) -> Vec3 {
+pub(crate) fn visible_normal(v: Vec3, alpha_x: f32, alpha_y: f32, u1: f32, u2: f32) -> Vec3 {
     let vh = Vec3::new(alpha_x * v.x, alpha_y * v.y, v.z).normalize();
     let len2 = vh.x * vh.x + vh.y * vh.y;
     let t1 = if len2 > 0.0 {

@@ -39,7 +39,7 @@ pub mod sh;
 pub mod sheen;
 pub mod ward_albedo;
 
-pub use anisotropic::{WARD_IMAGE_LIGHT_TAPS, WARD_TAP_NODES, WardImageLight, sample_levels};
+pub use anisotropic::{STRETCH_TAP_NODES, STRETCHED_IMAGE_LIGHT_TAPS, StretchedImageLight, sample_levels};
 pub use prefilter::{
     PREFILTER_LEVELS, PREFILTER_SAMPLES, PrefilterSources, brdf_lut, prefilter_base, prefilter_base_width,
     prefiltered_levels, table_axis,
