@@ -78,12 +78,26 @@ fn cases(count: usize) -> Vec<(Frame, Vec3)> {
 /// Monte-Carlo radiance reflected by the unit-albedo lobe towards `v`, and the lobe's
 /// directional albedo (the same samples under a white environment).
 fn reference(env: &Environment, lobe: WardLobe, frame: Frame, v: Vec3, samples: u32) -> ([f32; 3], f32) {
+    weighted_sum(env, frame, samples, |u1, u2| {
+        let (l, pdf) = lobe.sample(v, u1, u2)?;
+        Some((l, f64::from(lobe.eval(l, v) * l.z / pdf.max(1e-12))))
+    })
+}
+
+/// The mean over `samples` Hammersley points of the environment's radiance in the direction each
+/// draws (surface frame) times its weight, and the mean weight: `draw` gives both, or `None` for a
+/// sample that counts as zero.
+fn weighted_sum(
+    env: &Environment,
+    frame: Frame,
+    samples: u32,
+    draw: impl Fn(f32, f32) -> Option<(Vec3, f64)>,
+) -> ([f32; 3], f32) {
     let mut sum = [0.0f64; 3];
     let mut albedo = 0.0f64;
     for i in 0..samples {
         let (u1, u2) = hammersley(i, samples);
-        if let Some((l, pdf)) = lobe.sample(v, u1, u2) {
-            let w = (lobe.eval(l, v) * l.z / pdf.max(1e-12)) as f64;
+        if let Some((l, w)) = draw(u1, u2) {
             let c = env.sample(frame.world(l));
             for ch in 0..3 {
                 sum[ch] += c[ch] as f64 * w;
@@ -91,7 +105,7 @@ fn reference(env: &Environment, lobe: WardLobe, frame: Frame, v: Vec3, samples: 
             albedo += w;
         }
     }
-    let n = samples as f64;
+    let n = f64::from(samples.max(1));
     (sum.map(|s| (s / n) as f32), (albedo / n) as f32)
 }
 
@@ -200,24 +214,14 @@ fn ggx_reference(
     samples: u32,
 ) -> ([f32; 3], f32) {
     let lambda_v = smith_lambda(v, alpha_x, alpha_y);
-    let mut sum = [0.0f64; 3];
-    let mut albedo = 0.0f64;
-    for i in 0..samples {
-        let (u1, u2) = hammersley(i, samples);
+    weighted_sum(env, frame, samples, |u1, u2| {
         let h = visible_normal(v, alpha_x, alpha_y, u1, u2);
         let l = h * 2.0 * v.dot(h) - v;
-        if l.z <= 0.0 {
-            continue;
-        }
-        let w = f64::from((1.0 + lambda_v) / (1.0 + lambda_v + smith_lambda(l, alpha_x, alpha_y)));
-        let c = env.sample(frame.world(l));
-        for ch in 0..3 {
-            sum[ch] += c[ch] as f64 * w;
-        }
-        albedo += w;
-    }
-    let n = samples as f64;
-    (sum.map(|s| (s / n) as f32), (albedo / n) as f32)
+        (l.z > 0.0).then(|| {
+            let w = (1.0 + lambda_v) / (1.0 + lambda_v + smith_lambda(l, alpha_x, alpha_y));
+            (l, f64::from(w))
+        })
+    })
 }
 
 /// The reflection about the bent normal that the renderer read for a stretched GGX lobe before
