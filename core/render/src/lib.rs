@@ -924,7 +924,7 @@ mod tests {
     }
 
     #[test]
-    fn the_shader_taps_a_ward_lobe_where_its_reference_does() {
+    fn the_shader_taps_a_stretched_lobe_where_its_reference_does() {
         // `stretched_image_light` in scene.wgsl holds its own copy of the nodes (WGSL has no shared
         // constants with Rust); they must be the reference's.
         let start = SCENE_WGSL

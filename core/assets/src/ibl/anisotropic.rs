@@ -22,8 +22,14 @@
 //! levels assume n = v = r and a GGX shape), is 0.07–0.12 (studio) and 0.18–0.24 (sun). The
 //! shared rooms: `ward_image_light_on_the_shared_rooms` in the integration tests.
 //!
-//! The renderer's scene shader (`shaders/scene.wgsl`, `stretched_image_light`) does the same with the
-//! same nodes; this module is its reference, used by the tests.
+//! GGX stretched by `KHR_materials_anisotropy` takes the same taps, spread from its α's as if
+//! they were Ward's ([`StretchedImageLight::for_alphas`]): 0.10–0.51 against GGX's own integral
+//! where the normal bent across the stretch, which the renderer read before (Khronos's glTF
+//! Sample Viewer's), was 0.75–1.8 ([`super::accuracy::stretched_ggx_read_errors`]; the shared
+//! rooms: `stretched_ggx_image_light_on_the_shared_rooms`).
+//!
+//! The renderer's scene shader (`shaders/scene.wgsl`, `stretched_image_light`) does the same
+//! with the same nodes; this module is its reference, used by the tests.
 //!
 //! Pure functions, no panics.
 
@@ -35,7 +41,8 @@ use crate::ward::WardLobe;
 /// Reads per pixel for a Ward lobe's image light. Chosen by the Monte-Carlo comparison: 4 → 8 →
 /// 16 taps, brushed metal under the sun and band 0.368 → 0.266 → 0.221, under the studio
 /// 0.120 → 0.103 → 0.104; a 20:1 lobe (0.02 / 0.4) under the sun 0.510 → 0.470 → 0.422. A
-/// phone's fragment shader affords eight reads where the visitor picked a Ward material.
+/// phone's fragment shader affords eight reads where the visitor picked a Ward material or a
+/// model's material is brushed.
 pub const STRETCHED_IMAGE_LIGHT_TAPS: usize = 8;
 
 /// The taps' positions along the long axis in units of the one-dimensional Gaussian's standard

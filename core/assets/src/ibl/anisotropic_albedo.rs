@@ -38,10 +38,12 @@ pub const TILES: usize = 4;
 pub const SIDE: usize = TILE * TILES;
 /// GGX's sharpest lobe the table holds (the renderer's least roughness, 0.045, squared).
 pub const GGX_LEAST_ALPHA: f32 = 0.045 * 0.045;
-/// Stratified samples per entry as a side of their grid, for GGX (its visible normals, whose
-/// weights are at most 1) and Ward (its own sampling): the table read between its nodes is as
-/// close to fine integrals with Ward's 12 × 12 as with 16 × 16 (tested), at half the cost.
+/// Stratified samples per entry for GGX, as a side of their grid (its visible normals, whose
+/// weights are at most 1).
 pub const GGX_GRID: usize = 16;
+/// The same for Ward (its own sampling): the table read between its nodes comes as close to fine
+/// integrals with 12 × 12 as with 16 × 16 (2.5 % and 2.7 % at worst above n·v 0.15, 1000 lobes),
+/// at half the cost.
 pub const WARD_GRID: usize = 12;
 
 /// One entry: the stretched GGX lobe's split sum (F0 scale, F90 scale) and the Ward lobe's
