@@ -1344,8 +1344,8 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
 
         // Sheen over it (cloth): the fibres' lobe added, the layer below dimmed by what they
         // reflect of a white light (the table's albedo), so the two reflect no more than comes
-        // in. Its image light: the environment prefiltered at the sheen's roughness (the GGX
-        // levels, as Filament takes them) times that albedo.
+        // in. Its image light: the environment's roughest prefiltered level about the normal
+        // times that albedo.
         let sheen_strength = max(s.sheen_color.r, max(s.sheen_color.g, s.sheen_color.b));
         if (sheen_strength > 0.0) {
             let sheen_rough = clamp(s.sheen_roughness, 0.07, 1.0);
@@ -1355,7 +1355,12 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             let below = 1.0 - sheen_strength * sheen_albedo;
             let sheen_direct = s.sheen_color * charlie(n_dot_h, sheen_alpha) * sheen_visibility(max(n_dot_l, 1e-4), n_dot_v, sheen_alpha) * light_in;
             direct = direct * below + sheen_direct;
-            let sheen_env = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(reflected), sheen_rough * PREFILTERED_MAX_LEVEL).rgb;
+            // The fibres send light that grazes the surface, from a ring near the horizon, not a
+            // mirror image: the roughest level about the normal (assets crate
+            // `ibl::accuracy::sheen_read_errors`: 0.09–0.80 relative RMS against the lobe's
+            // integral over the shared rooms and two made ones, where the level of the sheen's
+            // roughness about the mirror direction, Filament's read, was 0.25–2.3).
+            let sheen_env = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(to_world(n)), PREFILTERED_MAX_LEVEL).rgb;
             ambient_light = ambient_light * below + sheen_env * s.sheen_color * sheen_albedo;
         }
     }

@@ -87,3 +87,27 @@ fn velvet_shines_where_it_turns_away_from_the_eye() {
         "the sheen's colour: {velvet_grazing:?}"
     );
 }
+
+#[test]
+fn the_sheens_room_light_on_the_shared_rooms() {
+    // The sheen's image light read about the normal (assets crate `ibl::accuracy`) checked where
+    // the read was not chosen: every shared room, a fine and a coarse sheen, against an integral
+    // of the lobe over the room. It must beat the mirror-direction read it replaced (Filament's
+    // and Khronos's glTF Sample Viewer's) in each.
+    use phantogram::ibl::{Environment, accuracy::sheen_read_errors};
+    let Some(files) = phantogram_integration::shared_environments() else {
+        return;
+    };
+    for path in &files {
+        let env = Environment::load(path).expect("environment");
+        for roughness in [0.3f32, 0.7] {
+            let e = sheen_read_errors(&env, roughness, 40);
+            let file = path.file_name().unwrap_or_default().to_string_lossy();
+            println!(
+                "{file:28} sheen roughness {roughness}: mirror {:.3} normal {:.3}",
+                e.before, e.now
+            );
+            assert!(e.now < e.before, "{file} {roughness}: {e:?}");
+        }
+    }
+}

@@ -1,9 +1,9 @@
 //! How close the renderer's image light of a stretched lobe ([`super::anisotropic`]) comes to
 //! the truth: a Monte-Carlo integral of the lobe over the environment, compared with the tapped
 //! read and with the single read the renderer made before, over a spread of surface frames and
-//! views; for a Ward lobe ([`read_errors`]) and for GGX stretched by `KHR_materials_anisotropy`
-//! ([`stretched_ggx_read_errors`]). Used by the tests here and by the integration tests over the
-//! shared rooms.
+//! views; for a Ward lobe ([`read_errors`]), for GGX stretched by `KHR_materials_anisotropy`
+//! ([`stretched_ggx_read_errors`]) and for the sheen of cloth ([`sheen_read_errors`]). Used by
+//! the tests here and by the integration tests over the shared rooms.
 //!
 //! Pure functions; slow (thousands of samples per case), no panics.
 
@@ -15,15 +15,15 @@ use super::anisotropic_albedo::{smith_lambda, visible_normal};
 use super::{Environment, prefiltered_levels};
 use crate::ward::WardLobe;
 
-/// Relative RMS error (luminance) of the two reads, each scaled by the lobe's true directional
-/// albedo so that only the direction-dependent part (what the split sum's table does not hold)
-/// is compared.
+/// Relative RMS error (luminance) of two reads of a lobe's image light, each scaled by the
+/// lobe's true directional albedo so that only the direction-dependent part (what the albedo
+/// tables do not hold) is compared.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ReadErrors {
-    /// One read of the level at the lobe's geometric-mean roughness about the mirror direction.
-    pub round: f32,
-    /// [`StretchedImageLight`]'s taps.
-    pub tapped: f32,
+    /// The read the renderer made before (each function says which).
+    pub before: f32,
+    /// The renderer's read now.
+    pub now: f32,
 }
 
 /// The `i`-th of `n` points of a 2-D low-discrepancy set (Hammersley, centred).
@@ -110,7 +110,9 @@ fn weighted_sum(
 }
 
 /// Both reads' errors for `lobe` under `env` over `count` frames and views (2048 samples each
-/// for the truth; levels prefiltered at the renderer's 256-texel base width).
+/// for the truth; levels prefiltered at the renderer's 256-texel base width): `before` one read of
+/// the level at the lobe's geometric-mean roughness about the mirror direction, `now`
+/// [`StretchedImageLight`]'s taps.
 pub fn read_errors(env: &Environment, lobe: WardLobe, count: usize) -> ReadErrors {
     let levels = prefiltered_levels(env, 256);
     let light = StretchedImageLight::for_lobe(lobe);
@@ -134,8 +136,8 @@ pub fn read_errors(env: &Environment, lobe: WardLobe, count: usize) -> ReadError
     }
     let norm = norm.max(1e-30);
     ReadErrors {
-        round: (round / norm).sqrt() as f32,
-        tapped: (tapped / norm).sqrt() as f32,
+        before: (round / norm).sqrt() as f32,
+        now: (tapped / norm).sqrt() as f32,
     }
 }
 
@@ -169,9 +171,9 @@ pub fn sun_and_band() -> Environment {
 /// The two reads' errors for GGX stretched by `KHR_materials_anisotropy` (roughness `roughness`,
 /// strength `strength`: α along the tangent `mix(α, 1, strength²)`, α = roughness² across),
 /// relative RMS (luminance) over `count` frames and views, each scaled by the lobe's true albedo
-/// as in [`read_errors`]: `round` the read `scene.wgsl` made before, the level of the short
+/// as in [`read_errors`]: `before` the read `scene.wgsl` made before, the level of the short
 /// roughness about the mirror direction of a normal bent across the stretch (Khronos's glTF
-/// Sample Viewer's, after Filament), `tapped` [`StretchedImageLight`]'s taps. The truth: 4096
+/// Sample Viewer's, after Filament), `now` [`StretchedImageLight`]'s taps. The truth: 4096
 /// visible normals (Heitz 2018) per case.
 pub fn stretched_ggx_read_errors(env: &Environment, roughness: f32, strength: f32, count: usize) -> ReadErrors {
     let levels = prefiltered_levels(env, 256);
@@ -197,8 +199,8 @@ pub fn stretched_ggx_read_errors(env: &Environment, roughness: f32, strength: f3
     }
     let norm = norm.max(1e-30);
     ReadErrors {
-        round: (bent / norm).sqrt() as f32,
-        tapped: (tapped / norm).sqrt() as f32,
+        before: (bent / norm).sqrt() as f32,
+        now: (tapped / norm).sqrt() as f32,
     }
 }
 
@@ -239,4 +241,50 @@ fn bent_reflection(v: Vec3, roughness: f32, strength: f32) -> Vec3 {
         bent.normalize()
     };
     bent * 2.0 * v.dot(bent) - v
+}
+
+/// The two reads' errors for the sheen of cloth (`KHR_materials_sheen`'s Charlie lobe, colour 1,
+/// at sheen roughness `roughness`) under `env` over `count` frames and views, relative RMS
+/// (luminance), each scaled by the lobe's albedo as in [`read_errors`]: `before` the level of the
+/// sheen's roughness about the mirror direction (Filament's and Khronos's glTF Sample Viewer's
+/// read), `now` the roughest level about the normal. The sheen's fibres send light that grazes
+/// the surface towards the eye, not a mirror image; its lobe gathers from a ring near the horizon.
+/// The truth: a midpoint rule over the hemisphere of light directions (64 × 256 cells).
+pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> ReadErrors {
+    use super::sheen::{charlie_distribution, sheen_albedo, sheen_visibility};
+    const STEPS: usize = 64;
+    let levels = prefiltered_levels(env, 256);
+    let (d_theta, d_phi) = (
+        std::f32::consts::FRAC_PI_2 / STEPS as f32,
+        std::f32::consts::TAU / (4 * STEPS) as f32,
+    );
+    let (mut mirror, mut normal, mut norm) = (0.0f64, 0.0f64, 0.0f64);
+    for (frame, v) in cases(count) {
+        let mut truth = 0.0f64;
+        for i in 0..STEPS {
+            let (sin_t, cos_t) = ((i as f32 + 0.5) * d_theta).sin_cos();
+            for j in 0..4 * STEPS {
+                let (sin_p, cos_p) = ((j as f32 + 0.5) * d_phi).sin_cos();
+                let l = Vec3::new(sin_t * cos_p, sin_t * sin_p, cos_t);
+                let h = (l + v).normalize();
+                let f = charlie_distribution(roughness, h.z) * sheen_visibility(roughness, l.z, v.z);
+                truth += f64::from(luminance(env.sample(frame.world(l))) * f * cos_t * sin_t * d_theta * d_phi);
+            }
+        }
+        let albedo = f64::from(sheen_albedo(v.z, roughness, STEPS));
+        let at_mirror = luminance(sample_levels(
+            &levels,
+            frame.world(Vec3::new(-v.x, -v.y, v.z)),
+            roughness,
+        ));
+        let at_normal = luminance(sample_levels(&levels, frame.world(Vec3::Z), 1.0));
+        mirror += (f64::from(at_mirror) * albedo - truth).powi(2);
+        normal += (f64::from(at_normal) * albedo - truth).powi(2);
+        norm += truth * truth;
+    }
+    let norm = norm.max(1e-30);
+    ReadErrors {
+        before: (mirror / norm).sqrt() as f32,
+        now: (normal / norm).sqrt() as f32,
+    }
 }
