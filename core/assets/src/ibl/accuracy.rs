@@ -116,29 +116,47 @@ fn weighted_sum(
 pub fn read_errors(env: &Environment, lobe: WardLobe, count: usize) -> ReadErrors {
     let levels = prefiltered_levels(env, 256);
     let light = StretchedImageLight::for_lobe(lobe);
-    let (mut round, mut tapped, mut norm) = (0.0f64, 0.0f64, 0.0f64);
-    for (frame, v) in cases(count) {
+    compare_reads(count, |frame, v| {
         let (truth, albedo) = reference(env, lobe, frame, v, 2048);
-        let truth = luminance(truth) as f64;
         let mirror = Vec3::new(-v.x, -v.y, v.z);
         let round_read = sample_levels(
             &levels,
             frame.world(mirror),
             (lobe.alpha_x * lobe.alpha_y).sqrt().sqrt(),
         );
-        let mut tapped_read = 0.0f32;
-        for (l, w) in light.taps(v) {
-            tapped_read += luminance(sample_levels(&levels, frame.world(l), light.level_roughness)) * w;
-        }
-        round += ((luminance(round_read) * albedo) as f64 - truth).powi(2);
-        tapped += ((tapped_read * albedo) as f64 - truth).powi(2);
+        let albedo = f64::from(albedo);
+        [
+            f64::from(luminance(truth)),
+            f64::from(luminance(round_read)) * albedo,
+            f64::from(tapped_read(&levels, &light, frame, v)) * albedo,
+        ]
+    })
+}
+
+/// The relative RMS errors of two reads over [`cases`]`(count)`: `case` gives, for each surface
+/// frame and view, the truth and the two reads (luminance, each scaled by the lobe's albedo).
+fn compare_reads(count: usize, mut case: impl FnMut(Frame, Vec3) -> [f64; 3]) -> ReadErrors {
+    let (mut before, mut now, mut norm) = (0.0f64, 0.0f64, 0.0f64);
+    for (frame, v) in cases(count) {
+        let [truth, before_read, now_read] = case(frame, v);
+        before += (before_read - truth).powi(2);
+        now += (now_read - truth).powi(2);
         norm += truth * truth;
     }
     let norm = norm.max(1e-30);
     ReadErrors {
-        before: (round / norm).sqrt() as f32,
-        now: (tapped / norm).sqrt() as f32,
+        before: (before / norm).sqrt() as f32,
+        now: (now / norm).sqrt() as f32,
     }
+}
+
+/// [`StretchedImageLight`]'s taps for the view `v` in `frame`, read from `levels` (luminance).
+fn tapped_read(levels: &[Environment], light: &StretchedImageLight, frame: Frame, v: Vec3) -> f32 {
+    light
+        .taps(v)
+        .into_iter()
+        .map(|(l, w)| luminance(sample_levels(levels, frame.world(l), light.level_roughness)) * w)
+        .sum()
 }
 
 /// A dim sky with a small bright sun (2° across) and a thin bright band along half the horizon:
@@ -180,28 +198,20 @@ pub fn stretched_ggx_read_errors(env: &Environment, roughness: f32, strength: f3
     let alpha = roughness * roughness;
     let alpha_t = alpha + (1.0 - alpha) * strength * strength;
     let light = StretchedImageLight::for_alphas(alpha_t, alpha);
-    let (mut bent, mut tapped, mut norm) = (0.0f64, 0.0f64, 0.0f64);
-    for (frame, v) in cases(count) {
+    compare_reads(count, |frame, v| {
         let (truth, albedo) = ggx_reference(env, alpha_t, alpha, frame, v, 4096);
-        let truth = luminance(truth) as f64;
         let bent_read = luminance(sample_levels(
             &levels,
             frame.world(bent_reflection(v, roughness, strength)),
             roughness,
         ));
-        let mut tapped_read = 0.0f32;
-        for (l, w) in light.taps(v) {
-            tapped_read += luminance(sample_levels(&levels, frame.world(l), light.level_roughness)) * w;
-        }
-        bent += ((bent_read * albedo) as f64 - truth).powi(2);
-        tapped += ((tapped_read * albedo) as f64 - truth).powi(2);
-        norm += truth * truth;
-    }
-    let norm = norm.max(1e-30);
-    ReadErrors {
-        before: (bent / norm).sqrt() as f32,
-        now: (tapped / norm).sqrt() as f32,
-    }
+        let albedo = f64::from(albedo);
+        [
+            f64::from(luminance(truth)),
+            f64::from(bent_read) * albedo,
+            f64::from(tapped_read(&levels, &light, frame, v)) * albedo,
+        ]
+    })
 }
 
 /// Monte-Carlo radiance reflected by the stretched GGX lobe (αx along the tangent, αy along the
@@ -258,8 +268,7 @@ pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> Rea
         std::f32::consts::FRAC_PI_2 / STEPS as f32,
         std::f32::consts::TAU / (4 * STEPS) as f32,
     );
-    let (mut mirror, mut normal, mut norm) = (0.0f64, 0.0f64, 0.0f64);
-    for (frame, v) in cases(count) {
+    compare_reads(count, |frame, v| {
         let mut truth = 0.0f64;
         for i in 0..STEPS {
             let (sin_t, cos_t) = ((i as f32 + 0.5) * d_theta).sin_cos();
@@ -278,13 +287,6 @@ pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> Rea
             roughness,
         ));
         let at_normal = luminance(sample_levels(&levels, frame.world(Vec3::Z), 1.0));
-        mirror += (f64::from(at_mirror) * albedo - truth).powi(2);
-        normal += (f64::from(at_normal) * albedo - truth).powi(2);
-        norm += truth * truth;
-    }
-    let norm = norm.max(1e-30);
-    ReadErrors {
-        before: (mirror / norm).sqrt() as f32,
-        now: (normal / norm).sqrt() as f32,
-    }
+        [truth, f64::from(at_mirror) * albedo, f64::from(at_normal) * albedo]
+    })
 }
