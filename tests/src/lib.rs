@@ -43,6 +43,27 @@ pub fn shared_environments() -> Option<Vec<PathBuf>> {
     Some(files)
 }
 
+/// Checks a read of a lobe's room light against the read it replaced, in every shared
+/// environment ([`shared_environments`]): `errors` gives, for one loaded environment, each case's
+/// name and both reads' errors against the truth (`phantogram::ibl::accuracy`); each is printed
+/// and the test fails where the new read is not the nearer. Checks nothing, after
+/// [`shared_environments`]' notice, where the data is not configured.
+pub fn nearer_in_every_shared_room(
+    errors: impl Fn(&phantogram::ibl::Environment) -> Vec<(String, phantogram::ibl::accuracy::ReadErrors)>,
+) {
+    let Some(files) = shared_environments() else {
+        return;
+    };
+    for path in &files {
+        let env = phantogram::ibl::Environment::load(path).expect("environment");
+        let file = path.file_name().unwrap_or_default().to_string_lossy();
+        for (case, e) in errors(&env) {
+            println!("{file:28} {case}: before {:.3}, now {:.3}", e.before, e.now);
+            assert!(e.now < e.before, "{file}, {case}: {e:?}");
+        }
+    }
+}
+
 pub use phantogram_testkit::Scratch;
 
 /// An engine on `config`; `None` (the test skips, saying so) where no GPU adapter is found,
