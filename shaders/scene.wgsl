@@ -1230,7 +1230,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             ward_albedo = textureSampleLevel(brdf_lut, env_sampler, ward_uv, 0.0).a;
         } else {
             let x_long = ward_alpha.x > ward_alpha.y;
-            let azimuth = select(azimuth_from(v, bw, tw), azimuth_from(v, tw, bw), x_long);
+            let azimuth = azimuth_from(v, select(bw, tw, x_long), select(tw, bw, x_long));
             ward_albedo = anisotropic_albedo(n_dot_v, max(ward_alpha.x, ward_alpha.y), min(ward_alpha.x, ward_alpha.y), azimuth).z;
         }
         let prefiltered = stretched_image_light(v, n, tw, bw, ward_alpha);

@@ -17,12 +17,13 @@
 //!
 //! **Budget**: the caller read the file within the budget; each reader (one a thread) holds a
 //! page and a packet at a time, and at most [`RAW_POINTS_KEPT`] points are kept (40 bytes each)
-//! whatever the file's size. **Progress**: `keep_going` is told the share read every 65 536 points and stops
-//! the work by returning `false` (for a file of several scans, decoded a window of scans at a
-//! time, after each window). **Threading**: a file of several scans has them decoded on every
-//! core, each with its own reader of the same bytes (within [`MOST_XML_PARSED_AGAIN`]), and put
-//! together in the file's order (the same points as read one after another; tested). **Panics**: none (the reader's, should one
-//! slip through a damaged file, are caught and reported as the file's error).
+//! whatever the file's size. **Progress**: `keep_going` is told the share read every 65 536
+//! points and stops the work by returning `false` (for a file of several scans, decoded a window
+//! of scans at a time, after each window). **Threading**: a file of several scans has them
+//! decoded on every core, each with its own reader of the same bytes (within
+//! [`MOST_XML_PARSED_AGAIN`]), and put together in the file's order (the same points as read one
+//! after another; tested). **Panics**: none (the reader's, should one slip through a damaged
+//! file, are caught and reported as the file's error).
 
 use std::io::Cursor;
 
