@@ -639,6 +639,29 @@ fn anisotropic_albedo(n_dot_v: f32, alpha_long: f32, alpha_short: f32, azimuth: 
     return mix(mix(a00, a10, t.x), mix(a01, a11, t.x), t.y);
 }
 
+// Where the sheen's image light is read from (assets crate `ibl::sheen_direction`, whose `read`
+// this mirrors; measured by `ibl::accuracy::sheen_read_errors`): the mean direction of the light
+// the Charlie lobe gathers, leaning from the normal `n` towards the view's azimuth, from a table
+// along the lighting tables' bottom SHEEN_DIRECTION_SIDE rows (its first SHEEN_DIRECTION_SIDE
+// columns: n·v × sheen roughness, the sine and cosine of the lean). v and n in the mesh's space.
+override SHEEN_DIRECTION_SIDE: f32 = 16.0;
+fn sheen_direction(v: vec3<f32>, n: vec3<f32>, n_dot_v: f32, roughness: f32) -> vec3<f32> {
+    let size = vec2<f32>(textureDimensions(brdf_lut));
+    let at = clamp(vec2<f32>(n_dot_v, roughness), vec2<f32>(0.0), vec2<f32>(1.0)) * (SHEEN_DIRECTION_SIDE - 1.0) + 0.5;
+    let lean = textureSampleLevel(brdf_lut, env_sampler, (vec2<f32>(0.0, size.y - SHEEN_DIRECTION_SIDE) + at) / size, 0.0).xy;
+    // The view's azimuth about the normal; any where it looks along the normal (no lean there).
+    var facing = v - n * dot(n, v);
+    if (dot(facing, facing) < 1e-8) {
+        let helper = select(vec3<f32>(1.0, 0.0, 0.0), vec3<f32>(0.0, 1.0, 0.0), abs(n.x) > 0.9);
+        facing = helper - n * dot(n, helper);
+    }
+    let d = normalize(facing) * lean.x + n * lean.y;
+    if (dot(d, d) < 1e-8) {
+        return n;
+    }
+    return normalize(d);
+}
+
 // Where `v` looks from the axis `along` (unit, in the shading plane; `across` the other one):
 // 0 along it, 1 across it, either way round (the lobes are symmetric about both axes).
 fn azimuth_from(v: vec3<f32>, along: vec3<f32>, across: vec3<f32>) -> f32 {
@@ -1356,11 +1379,9 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             let sheen_direct = s.sheen_color * charlie(n_dot_h, sheen_alpha) * sheen_visibility(max(n_dot_l, 1e-4), n_dot_v, sheen_alpha) * light_in;
             direct = direct * below + sheen_direct;
             // The fibres send light that grazes the surface, from a ring near the horizon, not a
-            // mirror image: the roughest level about the normal (assets crate
-            // `ibl::accuracy::sheen_read_errors`: 0.09–0.80 relative RMS against the lobe's
-            // integral over the shared rooms and two made ones, where the level of the sheen's
-            // roughness about the mirror direction, Filament's read, was 0.25–2.3).
-            let sheen_env = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(to_world(n)), PREFILTERED_MAX_LEVEL).rgb;
+            // mirror image: the roughest level about the direction the lobe gathers from on
+            // average (`sheen_direction`).
+            let sheen_env = textureSampleLevel(prefiltered_env, env_sampler, equirect_uv(to_world(sheen_direction(v, n, n_dot_v, sheen_rough))), PREFILTERED_MAX_LEVEL).rgb;
             ambient_light = ambient_light * below + sheen_env * s.sheen_color * sheen_albedo;
         }
     }

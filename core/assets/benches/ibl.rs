@@ -54,7 +54,8 @@ fn main() {
     let sheen = median_ms(5, || sheen_albedo_table(64));
     let ward = median_ms(5, || ward_albedo_table(64));
     let stretched = median_ms(5, phantogram_assets::ibl::anisotropic_albedo::anisotropic_albedo_table);
+    let sheen_direction = median_ms(5, phantogram_assets::ibl::sheen_direction::sheen_direction_table);
     println!(
-        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms, sheen albedo {sheen:.1} ms, Ward albedo {ward:.1} ms, stretched lobes {stretched:.1} ms ({cores} cores each)"
+        "\nstart-up tables, 64 × 64: split-sum {split_sum:.1} ms, sheen albedo {sheen:.1} ms, Ward albedo {ward:.1} ms, stretched lobes {stretched:.1} ms, sheen's mean directions (16 × 16) {sheen_direction:.1} ms ({cores} cores each)"
     );
 }

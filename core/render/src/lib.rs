@@ -941,11 +941,16 @@ mod tests {
     }
 
     #[test]
-    fn the_shaders_stretched_lobes_table_is_laid_out_as_the_assets_crate_makes_it() {
+    fn the_shaders_stretched_lobes_and_sheen_tables_are_laid_out_as_the_assets_crate_makes_them() {
         // The pipelines set these overrides; their defaults serve shader validation and must say
         // the same.
         use phantogram_assets::ibl::anisotropic_albedo::{TILE, TILES};
-        for (name, value) in [("ANISOTROPIC_TILE", TILE), ("ANISOTROPIC_TILES", TILES)] {
+        use phantogram_assets::ibl::sheen_direction::SIDE;
+        for (name, value) in [
+            ("ANISOTROPIC_TILE", TILE),
+            ("ANISOTROPIC_TILES", TILES),
+            ("SHEEN_DIRECTION_SIDE", SIDE),
+        ] {
             let line = format!("override {name}: f32 = {value}.0;");
             assert!(SCENE_WGSL.contains(&line), "scene.wgsl lacks `{line}`");
         }

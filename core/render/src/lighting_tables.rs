@@ -8,23 +8,25 @@ pub const PREFILTERED_BASE_WIDTH: usize = 256;
 /// Size of the split-sum BRDF table (n·v × roughness), and the lighting tables' texture width.
 pub(super) const BRDF_LUT_SIZE: usize = 64;
 /// The lighting tables' texture height: the round lobes' tables above, the stretched lobes'
-/// ([`phantogram_assets::ibl::anisotropic_albedo`]) below, both as wide as the texture.
-pub(super) const LIGHTING_TABLES_HEIGHT: usize = BRDF_LUT_SIZE + anisotropic_albedo::SIDE;
+/// ([`phantogram_assets::ibl::anisotropic_albedo`]) below them and the sheen's mean directions
+/// ([`phantogram_assets::ibl::sheen_direction`]) at the bottom, all as wide as the texture.
+pub(super) const LIGHTING_TABLES_HEIGHT: usize = BRDF_LUT_SIZE + anisotropic_albedo::SIDE + sheen_direction::SIDE;
 const _: () = assert!(
-    anisotropic_albedo::SIDE == BRDF_LUT_SIZE,
-    "the two tables share the texture's width"
+    anisotropic_albedo::SIDE == BRDF_LUT_SIZE && sheen_direction::TABLE_WIDTH == BRDF_LUT_SIZE,
+    "the tables share the texture's width"
 );
 
-use phantogram_assets::ibl::anisotropic_albedo;
+use phantogram_assets::ibl::{anisotropic_albedo, sheen_direction};
 
 /// Computes, once per process, the tables a [`Renderer`] needs before its first frame: the
 /// split-sum BRDF table and, if `studio`, the generated studio's prefiltered levels (the lighting
 /// when no environment is given). About 100 ms of CPU work on this machine's two cores, and 60 ms
 /// more since the split-sum table takes four times the samples per entry and the Ward lobe's
-/// albedo joined it, and about 50 ms more for the stretched lobes' table (2026-12-07); an app
-/// calls it on a background thread at start-up, overlapping it with loading the model and opening
-/// the device (the sea turtle's cold load-to-first-frame: see `benchmarks/render.md`). Calling it
-/// is never required: the renderer computes what is missing, or waits for a computation under way.
+/// albedo joined it, about 50 ms more for the stretched lobes' table and 10 ms for the sheen's
+/// mean directions (2026-12-07); an app calls it on a background thread at start-up, overlapping
+/// it with loading the model and opening the device (the sea turtle's cold load-to-first-frame:
+/// see `benchmarks/render.md`). Calling it is never required: the renderer computes what is
+/// missing, or waits for a computation under way.
 pub fn prepare_lighting_tables(studio: bool) {
     brdf_lut_texels();
     if studio {
@@ -58,7 +60,8 @@ pub(super) fn default_prefiltered_environment() -> &'static [phantogram_assets::
 /// the sheen's directional albedo ([`phantogram_assets::ibl::sheen`]) and the round Ward lobe's
 /// ([`phantogram_assets::ibl::ward_albedo`]). Below, the stretched lobes' tiles
 /// ([`anisotropic_albedo`]): the stretched GGX lobe's split sum and the Ward lobe's albedo (the
-/// fourth channel unused, 1).
+/// fourth channel unused, 1). At the bottom, where the sheen's image light is read from
+/// ([`sheen_direction`]).
 pub(super) fn brdf_lut_texels() -> &'static [u8] {
     static TEXELS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
     TEXELS.get_or_init(|| {
@@ -74,6 +77,7 @@ pub(super) fn brdf_lut_texels() -> &'static [u8] {
             .map(|[a, b, w]| [a, b, w, 1.0]);
         round
             .chain(stretched)
+            .chain(sheen_direction::sheen_direction_table())
             .flat_map(|texel| texel.map(half::f16::from_f32))
             .flat_map(|h| h.to_le_bytes())
             .collect()

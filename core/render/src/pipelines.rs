@@ -98,6 +98,11 @@ impl ScenePipelines {
         // The stretched lobes' table's layout, as the assets crate makes it.
         constants.push(("ANISOTROPIC_TILE", anisotropic_albedo::TILE as f64));
         constants.push(("ANISOTROPIC_TILES", anisotropic_albedo::TILES as f64));
+        // The sheen's mean directions' table's side, likewise.
+        constants.push((
+            "SHEEN_DIRECTION_SIDE",
+            phantogram_assets::ibl::sheen_direction::SIDE as f64,
+        ));
         let fade_attributes = FADE_ATTRIBUTES;
         let plain = [Some(vertex_buffer(&vertex_attributes))];
         let fading = [

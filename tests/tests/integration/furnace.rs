@@ -31,14 +31,14 @@ use phantogram::ward::{WardLobe, WardMap, WardMaterial};
 /// pixel's linear value gives back the radiance that made it (`radiance_of`).
 const ROOM: f32 = 0.5;
 /// The spheres' radius (m).
-const RADIUS_M: f32 = 0.007;
+pub(crate) const RADIUS_M: f32 = 0.007;
 const ROUGHNESS: [f32; 3] = [0.2, 0.6, 1.0];
-const EYE: Vec3 = Vec3::new(0.0, 0.0, 0.3);
+pub(crate) const EYE: Vec3 = Vec3::new(0.0, 0.0, 0.3);
 
 /// The radiance that made an 8-bit sRGB code after the renderer's tone curve (Khronos PBR
 /// Neutral, exposure 1): below its shoulder the curve subtracts 0.04 from a grey of 0.08 or more,
 /// and below that grey it is 6.25·x² (its toe).
-fn radiance_of(code: u8) -> f32 {
+pub(crate) fn radiance_of(code: u8) -> f32 {
     let shown = phantogram_geometry::srgb::code_to_linear(code);
     if shown < 0.04 { 0.4 * shown.sqrt() } else { shown + 0.04 }
 }
@@ -90,7 +90,7 @@ fn furnace_in(base: [f32; 4], over: Over, look: Appearance) -> Option<(Vec<u8>, 
 
 /// A renderer of `model` in `room` under the visitor's `look`, its lamp of radiance `lamp_rgb`
 /// casting no shadow, and the view from [`EYE`]; `None` without a GPU.
-fn furnace_renderer(
+pub(crate) fn furnace_renderer(
     model: &Model,
     room: &Environment,
     look: Appearance,

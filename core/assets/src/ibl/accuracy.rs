@@ -255,15 +255,18 @@ fn bent_reflection(v: Vec3, roughness: f32, strength: f32) -> Vec3 {
 
 /// The two reads' errors for the sheen of cloth (`KHR_materials_sheen`'s Charlie lobe, colour 1,
 /// at sheen roughness `roughness`) under `env` over `count` frames and views, relative RMS
-/// (luminance), each scaled by the lobe's albedo as in [`read_errors`]: `before` the level of the
-/// sheen's roughness about the mirror direction (Filament's and Khronos's glTF Sample Viewer's
-/// read), `now` the roughest level about the normal. The sheen's fibres send light that grazes
-/// the surface towards the eye, not a mirror image; its lobe gathers from a ring near the horizon.
-/// The truth: a midpoint rule over the hemisphere of light directions (64 × 256 cells).
+/// (luminance), each scaled by the lobe's albedo as in [`read_errors`]: `before` the roughest
+/// level about the normal (the renderer's read until 2026-12-07; before that it read the level of
+/// the sheen's roughness about the mirror direction, Filament's and Khronos's glTF Sample
+/// Viewer's), `now` the roughest level about the lobe's mean direction
+/// ([`super::sheen_direction`], read from its table as the shader reads it). The truth: a
+/// midpoint rule over the hemisphere of light directions (64 × 256 cells).
 pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> ReadErrors {
     use super::sheen::{charlie_distribution, sheen_albedo, sheen_visibility};
+    use super::sheen_direction::{read, sheen_direction_table};
     const STEPS: usize = 64;
     let levels = prefiltered_levels(env, 256);
+    let table = sheen_direction_table();
     let (d_theta, d_phi) = (
         std::f32::consts::FRAC_PI_2 / STEPS as f32,
         std::f32::consts::TAU / (4 * STEPS) as f32,
@@ -281,12 +284,8 @@ pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> Rea
             }
         }
         let albedo = f64::from(sheen_albedo(v.z, roughness, STEPS));
-        let at_mirror = luminance(sample_levels(
-            &levels,
-            frame.world(Vec3::new(-v.x, -v.y, v.z)),
-            roughness,
-        ));
         let at_normal = luminance(sample_levels(&levels, frame.world(Vec3::Z), 1.0));
-        [truth, f64::from(at_mirror) * albedo, f64::from(at_normal) * albedo]
+        let at_mean = luminance(sample_levels(&levels, frame.world(read(&table, v, roughness)), 1.0));
+        [truth, f64::from(at_normal) * albedo, f64::from(at_mean) * albedo]
     })
 }

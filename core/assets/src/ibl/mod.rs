@@ -17,7 +17,8 @@
 //!
 //!   The renderer uploads the levels as an `Rgba16Float` mip chain, sampled with the roughness as
 //!   the level of detail, and the albedo tables as one `Rgba16Float` texture: the round lobes'
-//!   (split sum, sheen, Ward) above, the stretched lobes' ([`anisotropic_albedo`]) below.
+//!   (split sum, sheen, Ward) above, the stretched lobes' ([`anisotropic_albedo`]) below them and
+//!   where to read the sheen's light from ([`sheen_direction`]) at the bottom.
 //!
 //! **Threading**: everything here is plain data and pure functions; [`prefiltered_levels`] and
 //! [`IrradianceSh::from_environment`] spread their rows over the cores ([`crate::parallel::map`])
@@ -26,8 +27,9 @@
 //! Files: [`sh`] (the irradiance's nine coefficients), [`prefilter`] (the specular levels and
 //! the split-sum table), [`sheen`] and [`ward_albedo`] (those lobes' albedo tables, beside the
 //! split sum's), [`anisotropic_albedo`] (the stretched GGX and Ward lobes' albedo, by view
-//! azimuth and stretch), [`anisotropic`] (a Ward lobe's light read from those levels), [`accuracy`]
-//! (that read against a Monte-Carlo integral); this one holds the environment map itself.
+//! azimuth and stretch), [`anisotropic`] (a stretched lobe's light read from those levels),
+//! [`sheen_direction`] (where the sheen's light is read from), [`accuracy`] (those reads against
+//! integrals of their lobes over the room); this one holds the environment map itself.
 
 use glam::Vec3;
 
@@ -37,6 +39,7 @@ pub mod anisotropic_albedo;
 pub mod prefilter;
 pub mod sh;
 pub mod sheen;
+pub mod sheen_direction;
 pub mod ward_albedo;
 
 pub use anisotropic::{STRETCH_TAP_NODES, STRETCHED_IMAGE_LIGHT_TAPS, StretchedImageLight, sample_levels};

@@ -7,9 +7,10 @@
 //! its albedo reaches 2.7 at grazing angles and low roughness, more light than came in.) The renderer keeps it beside the split-sum table (its third channel) and uses it
 //! twice, as glTF's extension and Filament do: the layer under the sheen is scaled by
 //! 1 − max(sheen colour) × albedo, so the two together reflect no more than came in, and the
-//! sheen's image light is the albedo times the environment: its roughest level about the normal,
-//! not the mirror direction (the fibres send light that grazes the surface, from a ring near the
-//! horizon; `ibl::accuracy::sheen_read_errors`).
+//! sheen's image light is the albedo times the environment read as the lobe gathers it: not about
+//! the mirror direction (the fibres send light that grazes the surface, from a ring near the
+//! horizon), but as the roughest level about the direction the lobe gathers from on average
+//! ([`super::sheen_direction`]; `ibl::accuracy::sheen_read_errors`).
 //!
 //! Roughness is the extension's, 0–1 (α = roughness²), kept at least [`MIN_SHEEN_ROUGHNESS`]: the
 //! distribution narrows to a line at grazing angles below it, which neither a table nor a pixel
@@ -213,22 +214,22 @@ mod tests {
     }
 
     #[test]
-    fn the_sheens_room_light_is_read_about_the_normal_not_the_mirror_direction() {
+    fn the_sheens_room_light_is_read_about_the_lobes_mean_direction() {
         // Against a midpoint-rule integral of the lobe over the room (`ibl::accuracy`): the
-        // roughest level about the normal must come well nearer the truth than the level of the
-        // sheen's roughness about the mirror direction, which the renderer read before (as
-        // Filament and Khronos's glTF Sample Viewer do). Measured (40 frames and views): studio
-        // 1.42 → 0.54 at roughness 0.3, 0.60 → 0.16 at 1; sun and band 0.58 → 0.28, 0.25 → 0.09.
+        // roughest level about the lobe's mean direction (`ibl::sheen_direction`) must come nearer
+        // the truth than the same level about the normal, which the renderer read before.
+        // Measured (40 frames and views): studio 0.54 → 0.29 at roughness 0.3, 0.16 → 0.11 at 1;
+        // sun and band 0.28 → 0.19, 0.09 → 0.06.
         use crate::ibl::Environment;
         use crate::ibl::accuracy::{sheen_read_errors, sun_and_band};
         for (name, env) in [("studio", Environment::studio()), ("sun and band", sun_and_band())] {
             for roughness in [0.3f32, 1.0] {
                 let e = sheen_read_errors(&env, roughness, 40);
                 println!(
-                    "{name}, sheen roughness {roughness}: mirror {:.3}, normal {:.3}",
+                    "{name}, sheen roughness {roughness}: about the normal {:.3}, about the mean {:.3}",
                     e.before, e.now
                 );
-                assert!(e.now < 0.6 * e.before, "{name}, sheen roughness {roughness}: {e:?}");
+                assert!(e.now < 0.8 * e.before, "{name}, sheen roughness {roughness}: {e:?}");
             }
         }
     }
