@@ -124,21 +124,7 @@ fn the_sheens_room_light_on_the_gpu_is_read_where_the_assets_crate_says() {
     use phantogram::anaglyph::Method;
     use phantogram::ibl::{Environment, prefiltered_levels, sample_levels, sheen::sheen_albedo, sheen_direction};
     use phantogram::screen::Screen;
-    let room = {
-        let (width, height) = (128, 64);
-        let mut env = Environment {
-            width,
-            height,
-            texels: vec![[0.0; 3]; width * height],
-        };
-        for y in 0..height {
-            for x in 0..width {
-                let d = env.direction(x, y);
-                env.texels[y * width + x] = [0.15 + 3.0 * d.x.max(0.0).powi(4); 3];
-            }
-        }
-        env
-    };
+    let room = Environment::from_directions(128, 64, |d| [0.15 + 3.0 * d.x.max(0.0).powi(4); 3]);
     let roughness = [0.3f32, 0.6, 1.0];
     let centres = roughness.map(|r| Vec3::new(-0.02 + 0.02 * (r - 0.3) / 0.35, 0.0, -0.012));
     let mut marker = Mesh::default();

@@ -162,28 +162,17 @@ fn tapped_read(levels: &[Environment], light: &StretchedImageLight, frame: Frame
 /// A dim sky with a small bright sun (2° across) and a thin bright band along half the horizon:
 /// the light whose reflection a brushed surface stretches into a streak.
 pub fn sun_and_band() -> Environment {
-    let (width, height) = (512, 256);
-    let mut env = Environment {
-        width,
-        height,
-        texels: vec![[0.0; 3]; width * height],
-    };
     let sun = Vec3::new(0.5, 0.3, 0.81).normalize();
     let sun_cos = 1f32.to_radians().cos();
-    for y in 0..height {
-        for x in 0..width {
-            let d = env.direction(x, y);
-            let mut c = [0.2 + 0.1 * d.z.max(0.0); 3];
-            if d.dot(sun) > sun_cos {
-                c = [200.0; 3];
-            }
-            if d.z.abs() < 0.03 && d.x > 0.0 {
-                c = [8.0; 3];
-            }
-            env.texels[y * width + x] = c;
+    Environment::from_directions(512, 256, |d| {
+        if d.z.abs() < 0.03 && d.x > 0.0 {
+            [8.0; 3]
+        } else if d.dot(sun) > sun_cos {
+            [200.0; 3]
+        } else {
+            [0.2 + 0.1 * d.z.max(0.0); 3]
         }
-    }
-    env
+    })
 }
 
 /// The two reads' errors for GGX stretched by `KHR_materials_anisotropy` (roughness `roughness`,

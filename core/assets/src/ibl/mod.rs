@@ -88,27 +88,34 @@ impl Environment {
     /// that a white surface facing up receives about the same irradiance as from the directional
     /// light's ambient share.
     pub fn studio() -> Self {
-        let (width, height) = (64usize, 32usize);
         let key = Vec3::new(-0.4, 0.4, 0.82).normalize();
         let fill = Vec3::new(0.5, -0.6, 0.62).normalize();
+        Self::from_directions(64, 32, |d| {
+            // Horizon band and floor: neutral grey, slightly warm above, darker below.
+            let base = if d.z >= 0.0 { 0.10 + 0.06 * d.z } else { 0.045 };
+            let soft = |centre: Vec3, width: f32, power: f32| power * ((d.dot(centre) - 1.0) / width).exp();
+            let k = soft(key, 0.08, 1.6);
+            let f = soft(fill, 0.15, 0.35);
+            [
+                base + k + f * 0.95,
+                base + k * 0.98 + f * 0.97,
+                base * 1.04 + k * 0.95 + f,
+            ]
+        })
+    }
+
+    /// A `width` × `height` map whose texel in each direction ([`Environment::direction`]) has
+    /// the radiance `radiance` gives it: rooms made from a formula.
+    pub fn from_directions(width: usize, height: usize, radiance: impl Fn(Vec3) -> [f32; 3]) -> Self {
         let mut env = Self {
             width,
             height,
-            texels: vec![[0.0; 3]; width * height],
+            texels: Vec::with_capacity(width * height),
         };
         for y in 0..height {
             for x in 0..width {
-                let d = env.direction(x, y);
-                // Horizon band and floor: neutral grey, slightly warm above, darker below.
-                let base = if d.z >= 0.0 { 0.10 + 0.06 * d.z } else { 0.045 };
-                let soft = |centre: Vec3, width: f32, power: f32| power * ((d.dot(centre) - 1.0) / width).exp();
-                let k = soft(key, 0.08, 1.6);
-                let f = soft(fill, 0.15, 0.35);
-                env.texels[y * width + x] = [
-                    base + k + f * 0.95,
-                    base + k * 0.98 + f * 0.97,
-                    base * 1.04 + k * 0.95 + f,
-                ];
+                let texel = radiance(env.direction(x, y));
+                env.texels.push(texel);
             }
         }
         env
