@@ -126,7 +126,7 @@ fn the_sheens_room_light_on_the_gpu_is_read_where_the_assets_crate_says() {
     use phantogram::screen::Screen;
     let room = Environment::from_directions(128, 64, |d| [0.15 + 3.0 * d.x.max(0.0).powi(4); 3]);
     let roughness = [0.3f32, 0.6, 1.0];
-    let centres = roughness.map(|r| Vec3::new(-0.02 + 0.02 * (r - 0.3) / 0.35, 0.0, -0.012));
+    let centres = [-0.02f32, 0.0, 0.02].map(|x| Vec3::new(x, 0.0, -0.012));
     let mut marker = Mesh::default();
     push_floor_marker(&mut marker);
     let mut model = Model::from_painted_mesh("sheen spheres", marker);
@@ -162,7 +162,8 @@ fn the_sheens_room_light_on_the_gpu_is_read_where_the_assets_crate_says() {
     };
     let levels = prefiltered_levels(&room, 256);
     let table = sheen_direction::sheen_direction_table();
-    let luminance = |c: [f32; 3]| c[1];
+    // The room is grey: its green channel stands for its luminance, as the pixel's does.
+    let green = |c: [f32; 3]| c[1];
     let (mut worst, mut apart) = (0.0f32, Vec::new());
     for (&r, &centre) in roughness.iter().zip(&centres) {
         for n_dot_v in [0.9f32, 0.6, 0.4] {
@@ -177,8 +178,8 @@ fn the_sheens_room_light_on_the_gpu_is_read_where_the_assets_crate_says() {
             let b = n.cross(t);
             let local = Vec3::new(v.dot(t), v.dot(b), v.dot(n));
             let mean = sheen_direction::read(&table, local, r);
-            let at_mean = luminance(sample_levels(&levels, t * mean.x + b * mean.y + n * mean.z, 1.0));
-            let about_normal = luminance(sample_levels(&levels, n, 1.0));
+            let at_mean = green(sample_levels(&levels, t * mean.x + b * mean.y + n * mean.z, 1.0));
+            let about_normal = green(sample_levels(&levels, n, 1.0));
             let albedo = sheen_albedo(local.z, r, 32);
             let expected = albedo * at_mean;
             let before = albedo * about_normal;
@@ -193,7 +194,7 @@ fn the_sheens_room_light_on_the_gpu_is_read_where_the_assets_crate_says() {
             apart.push((before - expected).abs() / expected.max(0.05));
         }
     }
-    // 5 % (measured: 2.3 % at worst): an 8-bit step is 1–4 % of these radiances, the tables are
+    // 5 % (measured: 3.8 % at worst): an 8-bit step is 1–4 % of these radiances, the tables are
     // half floats and the GPU filters its own levels.
     assert!(
         worst < 0.05,
