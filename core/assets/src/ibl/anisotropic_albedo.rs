@@ -178,26 +178,8 @@ pub fn read(table: &[Entry], n_dot_v: f32, alpha_long: f32, alpha_short: f32, az
     // The azimuth folded into the first quadrant: the lobes are symmetric about both axes.
     let folded = azimuth_rad.sin().abs().atan2(azimuth_rad.cos().abs());
     let ((c0, tc), (r0, tr)) = (across(folded / std::f32::consts::FRAC_PI_2), across(ratio));
-    let at = [n_dot_v, alpha_long.max(0.0).sqrt()].map(|a| a.clamp(0.0, 1.0) * (TILE - 1) as f32);
-    let in_tile = |col: usize, row: usize| -> Entry {
-        let (x0, y0) = (
-            (at[0].floor() as usize).min(TILE - 2),
-            (at[1].floor() as usize).min(TILE - 2),
-        );
-        let (fx, fy) = (at[0] - x0 as f32, at[1] - y0 as f32);
-        let entry = |x: usize, y: usize| {
-            table
-                .get((row * TILE + y) * SIDE + col * TILE + x)
-                .copied()
-                .unwrap_or_default()
-        };
-        let mix = |a: Entry, b: Entry, t: f32| [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * t);
-        mix(
-            mix(entry(x0, y0), entry(x0 + 1, y0), fx),
-            mix(entry(x0, y0 + 1), entry(x0 + 1, y0 + 1), fx),
-            fy,
-        )
-    };
+    let at = [n_dot_v, alpha_long.max(0.0).sqrt()];
+    let in_tile = |col: usize, row: usize| super::table_bilinear(table, SIDE, (col * TILE, row * TILE), TILE, at);
     let mix = |a: Entry, b: Entry, t: f32| [0, 1, 2].map(|k| a[k] + (b[k] - a[k]) * t);
     mix(
         mix(in_tile(c0, r0), in_tile(c0 + 1, r0), tc),

@@ -45,7 +45,7 @@ pub mod ward_albedo;
 pub use anisotropic::{STRETCH_TAP_NODES, STRETCHED_IMAGE_LIGHT_TAPS, StretchedImageLight, sample_levels};
 pub use prefilter::{
     PREFILTER_LEVELS, PREFILTER_SAMPLES, PrefilterSources, brdf_lut, prefilter_base, prefilter_base_width,
-    prefiltered_levels, table_axis,
+    prefiltered_levels, table_axis, table_bilinear,
 };
 pub use sh::IrradianceSh;
 pub use sheen::sheen_albedo_table;

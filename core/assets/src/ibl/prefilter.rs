@@ -170,6 +170,35 @@ pub fn table_axis(k: usize, size: usize) -> f32 {
     if size < 2 { 0.0 } else { k as f32 / (size - 1) as f32 }
 }
 
+/// A block of `side × side` entries laid out at [`table_axis`] (its first entry at column
+/// `corner.0`, row `corner.1` of a table `width` entries wide, row by row) read at `at` (each in
+/// [0, 1], clamped) as the GPU's bilinear filter reads it: the CPU twin of the shader's table
+/// reads. An entry the table lacks reads as zero.
+pub fn table_bilinear<const N: usize>(
+    table: &[[f32; N]],
+    width: usize,
+    corner: (usize, usize),
+    side: usize,
+    at: [f32; 2],
+) -> [f32; N] {
+    let side = side.max(2);
+    let [x, y] = at.map(|a| a.clamp(0.0, 1.0) * (side - 1) as f32);
+    let (x0, y0) = ((x.floor() as usize).min(side - 2), (y.floor() as usize).min(side - 2));
+    let (tx, ty) = (x - x0 as f32, y - y0 as f32);
+    let entry = |i: usize, j: usize| {
+        table
+            .get((corner.1 + j) * width + corner.0 + i)
+            .copied()
+            .unwrap_or([0.0; N])
+    };
+    let mix = |a: [f32; N], b: [f32; N], t: f32| std::array::from_fn(|k| a[k] + (b[k] - a[k]) * t);
+    mix(
+        mix(entry(x0, y0), entry(x0 + 1, y0), tx),
+        mix(entry(x0, y0 + 1), entry(x0 + 1, y0 + 1), tx),
+        ty,
+    )
+}
+
 /// The split-sum BRDF table: `size × size` entries of `(scale, bias)` with n·v along x and
 /// roughness along y, both from 0 to 1 ([`table_axis`]), so that the specular image-based light
 /// is `prefiltered(r, roughness) · (F0 · scale + bias)`.

@@ -81,24 +81,9 @@ pub fn sheen_direction_table() -> Vec<[f32; 4]> {
 /// The mean direction for the view `v` (unit, surface frame: the normal +z) at sheen
 /// `roughness`, read from `table` ([`sheen_direction_table`]) bilinearly as the shader reads it.
 pub fn read(table: &[[f32; 4]], v: Vec3, roughness: f32) -> Vec3 {
-    let at = |x: f32| x.clamp(0.0, 1.0) * (SIDE - 1) as f32;
-    let (x, y) = (at(v.z), at(roughness));
-    let (x0, y0) = ((x.floor() as usize).min(SIDE - 2), (y.floor() as usize).min(SIDE - 2));
-    let (tx, ty) = (x - x0 as f32, y - y0 as f32);
-    let texel = |i: usize, j: usize| table.get(j * TABLE_WIDTH + i).copied().unwrap_or([0.0, 1.0, 0.0, 1.0]);
-    let (a, b, c, d) = (
-        texel(x0, y0),
-        texel(x0 + 1, y0),
-        texel(x0, y0 + 1),
-        texel(x0 + 1, y0 + 1),
-    );
-    let mix = |k: usize| {
-        let top = a[k] + (b[k] - a[k]) * tx;
-        let bottom = c[k] + (d[k] - c[k]) * tx;
-        top + (bottom - top) * ty
-    };
+    let [sin, cos, _, _] = super::table_bilinear(table, TABLE_WIDTH, (0, 0), SIDE, [v.z, roughness]);
     let facing = Vec3::new(v.x, v.y, 0.0).try_normalize().unwrap_or(Vec3::X);
-    (facing * mix(0) + Vec3::Z * mix(1)).try_normalize().unwrap_or(Vec3::Z)
+    (facing * sin + Vec3::Z * cos).try_normalize().unwrap_or(Vec3::Z)
 }
 
 #[cfg(test)]
