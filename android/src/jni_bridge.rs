@@ -244,6 +244,8 @@ pub extern "system" fn Java_org_phantogram_NativeBridge_nativeCreate<'local>(
                 .unwrap_or_default(),
             model_path: optional_string(env, &model_path)?.map(Into::into),
             environment_path: None,
+            // A room with a sun lights with it (`EngineConfig::sun_from_environment`).
+            sun_from_environment: true,
             face_models_dir: optional_string(env, &face_models_dir)?.map(Into::into),
             camera_position_m: None,
             fit: Default::default(),

@@ -339,6 +339,8 @@ pub unsafe extern "C" fn pg_engine_create(config: *const PgConfig, out: *mut *mu
             method: anaglyph.as_deref().map(method).transpose()?.unwrap_or_default(),
             model_path: model.map(PathBuf::from),
             environment_path: environment.map(PathBuf::from),
+            // A room with a sun lights with it (`EngineConfig::sun_from_environment`).
+            sun_from_environment: true,
             face_models_dir: face.map(PathBuf::from),
             camera_position_m: None,
             fit: Default::default(),

@@ -38,6 +38,10 @@ pub struct SceneArgs {
     /// a generated neutral studio when omitted.
     #[arg(long)]
     environment: Option<PathBuf>,
+    /// Keep --environment's sun in its image (and the default key light over the viewer's
+    /// shoulder) instead of lighting with it as the directional light, with its shadow.
+    #[arg(long, requires = "environment")]
+    sun_in_image: bool,
     /// Light the artifact with the room as a phone's front camera would see it along this
     /// sensor log, looking into --environment (which then is the room, not the light): the live
     /// room light replayed on the desktop, captured before the first frame.
@@ -132,6 +136,7 @@ impl SceneArgs {
             } else {
                 self.environment.clone()
             },
+            sun_from_environment: !self.sun_in_image,
             room_light: self.environment_from_camera.is_some(),
             fit: DioramaFit {
                 placement: match self.placement {

@@ -85,6 +85,26 @@ impl Engine {
         input
     }
 
+    /// What the renderer draws for `view` with the mesh moved by `offset`: each eye's image to
+    /// its filter ([`Self::oriented`]), and the directional light from the room's sun where the
+    /// configured environment has one ([`EngineConfig::sun_from_environment`](super::EngineConfig::sun_from_environment))
+    /// and the room's own live light is not shown instead: towards the sun, in its colour and
+    /// strength (the session's world light, anchored over the viewer's shoulder, otherwise).
+    pub(super) fn scene_input<'a>(&mut self, view: &'a crate::session::FrameView, offset: Vec3) -> FrameInput<'a> {
+        let mut input = self.oriented(frame_input(view, offset));
+        if let Some(sun) = self.static_sun {
+            let live_room = self.room_light_on() && self.room_light_shown.is_some();
+            self.renderer.lighting.light_rgb = if live_room {
+                crate::render::Lighting::default().light_rgb
+            } else {
+                // The sun is fixed in the room: into the device frame as the device turns.
+                input.toward_light = input.device_to_world.inverse() * sun.toward;
+                Vec3::from(sun.irradiance_rgb) * self.renderer.lighting.environment_intensity
+            };
+        }
+        input
+    }
+
     /// Draws one frame that will be on screen at `display_t_ns` (sensor clock; `None`: for the
     /// newest sensor state, no prediction). A GPU device that was lost is replaced first, with
     /// the scene made again on the new one (`device_loss`; counted in
@@ -131,7 +151,7 @@ impl Engine {
         self.last_device_to_world = view.device_to_world;
         let centre = (self.bounds.min + self.bounds.max) * 0.5 + Vec3::Z * -push;
         self.renderer.lamp = self.lamp.as_mut().map(|l| l.lamp(view.device_to_world, centre));
-        let input = self.oriented(frame_input(&view, Vec3::Z * -push));
+        let input = self.scene_input(&view, Vec3::Z * -push);
         self.follow_seen_sides(&view, centre, display_t_ns);
         let levels = self.choose_levels(&input);
         let fades = match self.detail.as_mut() {
@@ -488,7 +508,7 @@ impl Engine {
             .filter(|&(w, h)| w > 0 && h > 0)
             .unwrap_or((screen.width_px(), screen.height_px()));
         let view = self.session.frame_at(self.last_display_t_ns)?;
-        let input = self.oriented(frame_input(&view, Vec3::Z * -self.last_push_m));
+        let input = self.scene_input(&view, Vec3::Z * -self.last_push_m);
         Ok(match kind {
             Snapshot::Composed => (w, h, self.renderer.render(&input, self.method, w, h)?),
             Snapshot::SideBySide => (w * 2, h, self.renderer.render_side_by_side(&input, w, h)?),

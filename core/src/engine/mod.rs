@@ -114,6 +114,12 @@ pub struct EngineConfig {
     pub bundled_dir: Option<PathBuf>,
     /// An equirectangular HDR/EXR environment; `None`: the generated studio.
     pub environment_path: Option<PathBuf>,
+    /// Where [`Self::environment_path`]'s room has a sun (a small source with a good share of
+    /// its light, [`crate::ibl::sun`]), light with it: the directional light comes from the sun,
+    /// with its colour and strength, and casts its shadow, and the image light is the room
+    /// without it. On by default; off: the room's light as it is, and the default key light over
+    /// the viewer's shoulder besides (the light a room without a sun always gets).
+    pub sun_from_environment: bool,
     /// The folder with the face-tracking models; `None`: tilt only (no camera, or permission
     /// refused).
     pub face_models_dir: Option<PathBuf>,
@@ -160,6 +166,7 @@ impl Default for EngineConfig {
             library_dir: None,
             bundled_dir: None,
             environment_path: None,
+            sun_from_environment: true,
             face_models_dir: None,
             camera_position_m: None,
             fit: crate::model::DioramaFit::default(),
@@ -384,6 +391,9 @@ pub struct Engine {
     room_light_shown: Option<crate::room_light::RoomLightUpdate>,
     /// The light when the room's is off: [`EngineConfig::environment_path`]'s, or the studio's.
     static_environment: Option<crate::ibl::Environment>,
+    /// That environment's sun, taken out of it ([`EngineConfig::sun_from_environment`]): the
+    /// directional light while the room's own light is not shown.
+    static_sun: Option<crate::ibl::sun::Sun>,
     /// A lamp the visitor placed (in place of the room's light), and the finger moving it.
     lamp: Option<crate::lamp::PlacedLamp>,
     lamp_finger: Option<i32>,
@@ -518,6 +528,16 @@ impl Engine {
             Some(path) => Some(crate::ibl::Environment::load(path)?),
             None => None,
         };
+        // The room's light level with its sun (what a live room light replaces), then the sun
+        // taken out of it where it has one.
+        let environment_level = environment.as_ref().map(|e| e.mean_luminance());
+        let (environment, sun) = match environment {
+            Some(env) if config.sun_from_environment => match crate::ibl::sun::Sun::find(&env) {
+                Some((sun, rest)) => (Some(rest), Some(sun)),
+                None => (Some(env), None),
+            },
+            other => (other, None),
+        };
         let gpu = gpu()?;
         let budget = crate::budget::ResourceBudget {
             max_image_side_px: crate::budget::ResourceBudget::PHONE
@@ -599,10 +619,7 @@ impl Engine {
         }
         // The worker waits, idle, while the room light is off, so the setting can switch it on.
         // The room's light keeps the level of the light it replaces (`room_light`'s **Level**).
-        let level = environment.as_ref().map_or_else(
-            || crate::ibl::Environment::studio().mean_luminance(),
-            |e| e.mean_luminance(),
-        );
+        let level = environment_level.unwrap_or_else(|| crate::ibl::Environment::studio().mean_luminance());
         // Where on the back the rear camera sits does not matter to a map of the room's light at
         // infinity; only which way it looks.
         let cameras = crate::camera::DeviceCameras {
@@ -684,6 +701,7 @@ impl Engine {
             room_light,
             room_light_shown: None,
             static_environment: environment,
+            static_sun: sun,
             lamp: None,
             lamp_finger: None,
             last_device_to_world: None,

@@ -40,6 +40,7 @@ mod room_light;
 mod seen_through;
 mod shared_data;
 mod sheen;
+mod sun;
 mod surface_mode;
 mod thin_sheets;
 mod transmission;

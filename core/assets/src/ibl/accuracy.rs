@@ -278,3 +278,58 @@ pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> Rea
         [truth, f64::from(at_normal) * albedo, f64::from(at_mean) * albedo]
     })
 }
+
+/// [`sheen_read_errors`] with `env`'s sun ([`super::sun::Sun::find`]) apart: `before` the
+/// renderer's read of the whole room about the lobe's mean direction, `now` the same read of the
+/// room without its sun plus the sun's light through the lobe exactly (as the renderer's
+/// directional light gives it). The truth is the lobe's integral over the room without its sun
+/// plus the sun's exact term, for both (a grid of directions would hit or miss a sun a fraction
+/// of a degree across). `None` when the room has no sun.
+pub fn sheen_read_errors_sun_apart(env: &Environment, roughness: f32, count: usize) -> Option<ReadErrors> {
+    use super::sheen::{charlie_distribution, sheen_albedo, sheen_visibility};
+    use super::sheen_direction::{read, sheen_direction_table};
+    const STEPS: usize = 64;
+    let (sun, rest) = super::sun::Sun::find(env)?;
+    let sun_lum = luminance(sun.irradiance_rgb);
+    let whole = prefiltered_levels(env, 256);
+    let levels = prefiltered_levels(&rest, 256);
+    let table = sheen_direction_table();
+    let (d_theta, d_phi) = (
+        std::f32::consts::FRAC_PI_2 / STEPS as f32,
+        std::f32::consts::TAU / (4 * STEPS) as f32,
+    );
+    let lobe = |l: Vec3, v: Vec3| {
+        let h = (l + v).normalize();
+        charlie_distribution(roughness, h.z) * sheen_visibility(roughness, l.z, v.z) * l.z
+    };
+    Some(compare_reads(count, |frame, v| {
+        let mut truth = 0.0f64;
+        for i in 0..STEPS {
+            let (sin_t, cos_t) = ((i as f32 + 0.5) * d_theta).sin_cos();
+            for j in 0..4 * STEPS {
+                let (sin_p, cos_p) = ((j as f32 + 0.5) * d_phi).sin_cos();
+                let l = Vec3::new(sin_t * cos_p, sin_t * sin_p, cos_t);
+                truth += f64::from(luminance(rest.sample(frame.world(l))) * lobe(l, v) * sin_t * d_theta * d_phi);
+            }
+        }
+        let to_sun = Vec3::new(
+            frame.t.dot(sun.toward),
+            frame.b.dot(sun.toward),
+            frame.n.dot(sun.toward),
+        );
+        let sun_term = if to_sun.z > 0.0 {
+            f64::from(sun_lum * lobe(to_sun, v))
+        } else {
+            0.0
+        };
+        let albedo = f64::from(sheen_albedo(v.z, roughness, STEPS));
+        let toward = frame.world(read(&table, v, roughness));
+        let whole_read = luminance(sample_levels(&whole, toward, 1.0));
+        let rest_read = luminance(sample_levels(&levels, toward, 1.0));
+        [
+            truth + sun_term,
+            f64::from(whole_read) * albedo,
+            f64::from(rest_read) * albedo + sun_term,
+        ]
+    }))
+}

@@ -29,7 +29,8 @@
 //! split sum's), [`anisotropic_albedo`] (the stretched GGX and Ward lobes' albedo, by view
 //! azimuth and stretch), [`anisotropic`] (a stretched lobe's light read from those levels),
 //! [`sheen_direction`] (where the sheen's light is read from), [`accuracy`] (those reads against
-//! integrals of their lobes over the room); this one holds the environment map itself.
+//! integrals of their lobes over the room), [`sun`] (a room's small bright source, taken out to
+//! light as the directional light); this one holds the environment map itself.
 
 use glam::Vec3;
 
@@ -40,6 +41,7 @@ pub mod prefilter;
 pub mod sh;
 pub mod sheen;
 pub mod sheen_direction;
+pub mod sun;
 pub mod ward_albedo;
 
 pub use anisotropic::{STRETCH_TAP_NODES, STRETCHED_IMAGE_LIGHT_TAPS, StretchedImageLight, sample_levels};
