@@ -12,7 +12,8 @@ struct Eye {
     view_proj: mat4x4<f32>,
     // Eye position in mesh coordinates (w unused).
     eye_pos: vec4<f32>,
-    // Unit vector towards the light (w unused).
+    // Unit vector towards the light; w: the light's angular radius, radians (a room's sun; 0 for
+    // the key light).
     toward_light: vec4<f32>,
     // Light radiance (rgb, linear) and, in w, the environment's intensity.
     light: vec4<f32>,
@@ -1184,6 +1185,10 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         roughness = clamp(look.params.x, 0.045, 1.0);
     }
     let alpha = roughness * roughness;
+    // The directional light's own width (a room's sun, render crate `Lighting`) widens its
+    // highlights: each lobe's α grows by half the sine of the source's angular radius (Karis
+    // 2013's sphere lights), the lobe's normalisation keeping its light. A lamp is a point.
+    let widening = select(0.5 * sin(eye.toward_light.w), 0.0, eye.lamp_position.w > 0.5);
 
     let n_dot_l = max(dot(n, l), 0.0);
     let n_dot_v = max(dot(n, v), 1e-4);
@@ -1243,7 +1248,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             ward_alpha = clamp(ward_alpha, vec2<f32>(0.01), vec2<f32>(1.0));
         }
         rho_d = rho_d * (1.0 - transmission);
-        let lobe = ward_lobe(l, v, tw, bw, n, ward_alpha);
+        let lobe = ward_lobe(l, v, tw, bw, n, min(ward_alpha + widening, vec2<f32>(1.0)));
         direct = (rho_d / PI + rho_s * lobe) * light_in;
         // A round lobe's albedo from the round table (its roughness axis is √α), a stretched
         // one's from the stretched lobes' (seen from its long axis).
@@ -1306,9 +1311,9 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
             f0_ambient_d = mix(f0_d, film_f0(at_view_d, f0_d, f90_d, n_dot_v), s.iridescence);
             f0_ambient_m = mix(base, film_f0(at_view_m, base, vec3<f32>(1.0), n_dot_v), s.iridescence);
         }
-        var specular = fresnel * ggx(n_dot_h, alpha) * smith_visibility(n_dot_l, n_dot_v, alpha);
+        var specular = fresnel * ggx(n_dot_h, min(alpha + widening, 1.0)) * smith_visibility(n_dot_l, n_dot_v, alpha);
         if (s.anisotropy > 0.0) {
-            specular = fresnel * ggx_anisotropic(n_dot_h, dot(ta, h), dot(ba, h), alpha_t, alpha)
+            specular = fresnel * ggx_anisotropic(n_dot_h, dot(ta, h), dot(ba, h), min(alpha_t + widening, 1.0), min(alpha + widening, 1.0))
                 * smith_visibility_anisotropic(n_dot_l, n_dot_v, vec2<f32>(dot(ta, v), dot(ba, v)), vec2<f32>(dot(ta, l), dot(ba, l)), alpha_t, alpha);
         }
         // The specular layer's albedo towards the view, its single bounce from the split-sum
@@ -1412,7 +1417,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let coat_single = 0.04 * scale_bias.x + scale_bias.y;
         let coat_bounces = 1.0 / (1.0 - (0.04 + 0.96 / 21.0) * clamp(1.0 - scale_bias.x - scale_bias.y, 0.0, 1.0));
         let fc = (0.04 + 0.96 * pow(1.0 - v_dot_h, 5.0)) * coat;
-        let coat_direct = fc * coat_bounces * ggx(max(dot(cn, h), 0.0), coat_alpha)
+        let coat_direct = fc * coat_bounces * ggx(max(dot(cn, h), 0.0), min(coat_alpha + widening, 1.0))
             * smith_visibility(coat_n_dot_l, coat_n_dot_v, coat_alpha) * light_seen * coat_n_dot_l;
         // The coat keeps from the layer below what it reflects towards the view, all bounces
         // together, so that a white sphere under it still returns all the light, a lamp's as

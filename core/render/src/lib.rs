@@ -779,7 +779,11 @@ impl Renderer {
             view_proj: view_proj.to_cols_array_2d(),
             // Shading happens in mesh coordinates, so the eye moves the other way.
             eye_pos: (proj.eye_m - input.offset).extend(1.0).to_array(),
-            toward_light: input.toward_light.normalize_or(Vec3::Z).extend(0.0).to_array(),
+            toward_light: input
+                .toward_light
+                .normalize_or(Vec3::Z)
+                .extend(l.light_angular_radius_rad.clamp(0.0, 1.5))
+                .to_array(),
             light: l.light_rgb.extend(l.environment_intensity).to_array(),
             world_from_device: {
                 let m = glam::Mat3::from_quat(input.device_to_world.normalize());

@@ -85,6 +85,10 @@ pub fn lamp_view_proj(bounds: &phantogram_geometry::containment::Aabb, lamp: &La
 pub struct Lighting {
     /// Radiance of the directional light, linear RGB.
     pub light_rgb: Vec3,
+    /// Angular radius of the directional light's source, radians: 0 for a point at infinity
+    /// (the default key light), a room's sun's ([`phantogram_assets::ibl::sun`]) otherwise. Its
+    /// highlights widen by it (`scene.wgsl`); a lamp is a point whatever this says.
+    pub light_angular_radius_rad: f32,
     /// Scale of the environment's light ([`phantogram_assets::ibl`]).
     pub environment_intensity: f32,
     /// Linear exposure multiplier before tone mapping.
@@ -97,6 +101,7 @@ impl Default for Lighting {
     fn default() -> Self {
         Self {
             light_rgb: Vec3::new(3.2, 3.05, 2.85),
+            light_angular_radius_rad: 0.0,
             environment_intensity: 1.0,
             exposure: 1.0,
             shadows: true,

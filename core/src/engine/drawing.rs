@@ -88,19 +88,24 @@ impl Engine {
     /// What the renderer draws for `view` with the mesh moved by `offset`: each eye's image to
     /// its filter ([`Self::oriented`]), and the directional light from the room's sun where the
     /// configured environment has one ([`EngineConfig::sun_from_environment`](super::EngineConfig::sun_from_environment))
-    /// and the room's own live light is not shown instead: towards the sun, in its colour and
-    /// strength (the session's world light, anchored over the viewer's shoulder, otherwise).
+    /// and the room's own live light is not shown instead: towards the sun, in its colour,
+    /// strength and width (the session's world light, anchored over the viewer's shoulder,
+    /// otherwise).
     pub(super) fn scene_input<'a>(&mut self, view: &'a crate::session::FrameView, offset: Vec3) -> FrameInput<'a> {
         let mut input = self.oriented(frame_input(view, offset));
         if let Some(sun) = self.static_sun {
             let live_room = self.room_light_on() && self.room_light_shown.is_some();
-            self.renderer.lighting.light_rgb = if live_room {
-                crate::render::Lighting::default().light_rgb
+            let lighting = &mut self.renderer.lighting;
+            if live_room {
+                let key = crate::render::Lighting::default();
+                lighting.light_rgb = key.light_rgb;
+                lighting.light_angular_radius_rad = key.light_angular_radius_rad;
             } else {
                 // The sun is fixed in the room: into the device frame as the device turns.
                 input.toward_light = input.device_to_world.inverse() * sun.toward;
-                Vec3::from(sun.irradiance_rgb) * self.renderer.lighting.environment_intensity
-            };
+                lighting.light_rgb = Vec3::from(sun.irradiance_rgb) * lighting.environment_intensity;
+                lighting.light_angular_radius_rad = sun.half_angle_rad();
+            }
         }
         input
     }

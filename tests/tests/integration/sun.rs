@@ -212,3 +212,102 @@ fn with_a_shared_rooms_sun_apart_its_light_is_read_nearer_the_truth() {
         assert!(suns.get() > 0, "no shared room has a sun: nothing was checked");
     }
 }
+
+#[test]
+fn a_wide_suns_highlight_on_polished_metal_is_as_wide_as_the_sun() {
+    // A white polished metal sphere (roughness at the shader's floor, α 0.002) seen from the
+    // front, the light behind the eye: the highlight is the mirror image of the source, a disc of
+    // the source's radiance whose normals lie within half its angular radius of the view. The
+    // shader widens the lobe by half the source's angular radius (Karis 2013), which gives at the
+    // peak the radiance of the disc and a half-maximum at 0.64 α' from it (GGX). A source of
+    // radiance 0.5 (below the tone curve's shoulder, so that a code gives back the radiance), 4°
+    // and 8° in radius: its irradiance π sin²β · 0.5. Without the widening the same light is a
+    // point: a highlight a pixel or two across and far too bright.
+    use crate::furnace::{EYE, furnace_renderer, radiance_of};
+    use crate::render::{H, W, add_part, push_floor_marker, still_input};
+    use phantogram::appearance::Appearance;
+    use phantogram::model::{Material, Mesh, Model};
+    use phantogram::screen::Screen;
+    const RADIUS_M: f32 = 0.02;
+    const DISC: f32 = 0.5;
+    let centre = Vec3::new(0.0, 0.0, -0.025);
+    let mut marker = Mesh::default();
+    push_floor_marker(&mut marker);
+    let mut model = Model::from_painted_mesh("polished sphere", marker);
+    let mut ball = Mesh::default();
+    ball.push_ball(centre, RADIUS_M, 192, 96);
+    let material = Material {
+        name: "polished white metal".into(),
+        base_color: [1.0; 4],
+        metallic: 1.0,
+        roughness: 0.0,
+        ..Material::default()
+    };
+    add_part(&mut model, ball, material);
+    let room = Environment::from_directions(64, 32, |_| [0.01; 3]);
+    let Some((mut renderer, mono)) = furnace_renderer(&model, &room, Appearance::default(), Vec3::ZERO) else {
+        return;
+    };
+    let (w, h) = (4 * W, 4 * H);
+    let scale = w as f32 / Screen::default().width_px() as f32;
+    let pixel_of = |p: Vec3| mono.project(p).expect("in view").pixel * scale;
+    // The sphere's point facing the eye, where the highlight's peak is.
+    let top = centre + (EYE - centre).normalize() * RADIUS_M;
+    let toward = (EYE - top).normalize();
+    let mut measured = Vec::new();
+    for radius_deg in [4.0f32, 8.0, 0.0] {
+        let beta = radius_deg.to_radians();
+        // The same light for the point source as for the widest.
+        let lit_by = if radius_deg > 0.0 { beta } else { 8f32.to_radians() };
+        let irradiance = std::f32::consts::PI * lit_by.sin().powi(2) * DISC;
+        renderer.lighting.light_rgb = Vec3::splat(irradiance);
+        renderer.lighting.light_angular_radius_rad = beta;
+        let input = still_input(&mono, &mono, &mono, toward);
+        let pixels = renderer.render(&input, Method::Mono, w, h).expect("frame");
+        let peak_px = pixel_of(top);
+        let code_at = |x: i64, y: i64| pixels[((y as u32) * w + x as u32) as usize * 4 + 1];
+        // The brightest code within a few pixels of where the peak should be.
+        let (cx, cy) = (peak_px.x as i64, peak_px.y as i64);
+        let peak = (-3..=3)
+            .flat_map(|dy| (-3..=3).map(move |dx| (dx, dy)))
+            .map(|(dx, dy)| code_at(cx + dx, cy + dy))
+            .max()
+            .unwrap_or(0);
+        // Pixels over half the disc's radiance near the sphere's front.
+        let over_half = (-80i64..=80)
+            .flat_map(|dy| (-80i64..=80).map(move |dx| (dx, dy)))
+            .filter(|&(dx, dy)| radiance_of(code_at(cx + dx, cy + dy)) > 0.5 * DISC)
+            .count();
+        // Where GGX of α' = α + sin β / 2 falls to half: 0.64 α' from the peak in the normal's
+        // angle; on the sphere, seen from the eye.
+        let alpha = 0.045f32 * 0.045 + 0.5 * beta.sin();
+        let side = Vec3::X.reject_from(toward).normalize();
+        let half_angle = 0.64 * alpha;
+        let at_half = centre + (toward * half_angle.cos() + side * half_angle.sin()) * RADIUS_M;
+        let expected_radius_px = (pixel_of(at_half) - peak_px).length();
+        let radius_px = (over_half as f32 / std::f32::consts::PI).sqrt();
+        println!(
+            "source {radius_deg}°: peak code {peak} ({:.3}, the disc's {DISC}), {over_half} pixels over half of it: radius {radius_px:.1} px, expected {expected_radius_px:.1} px",
+            radiance_of(peak)
+        );
+        measured.push((radiance_of(peak), radius_px, expected_radius_px, peak));
+    }
+    for &(peak, radius_px, expected_px, _) in &measured[..2] {
+        assert!(
+            (peak / DISC - 1.0).abs() < 0.15,
+            "the peak {peak} against the disc's {DISC}"
+        );
+        assert!(
+            (radius_px / expected_px - 1.0).abs() < 0.2,
+            "a highlight {radius_px:.1} px across against {expected_px:.1}"
+        );
+    }
+    // The point source: the same light in a small, clipped spot (over half the disc's radiance
+    // a few pixels out, in GGX's long tail at this brightness: 3.2 px measured).
+    let (_, point_radius_px, _, point_code) = measured[2];
+    assert!(
+        point_code == 255 && point_radius_px < measured[1].1 / 2.0,
+        "a point source's highlight: {:?}",
+        measured[2]
+    );
+}
