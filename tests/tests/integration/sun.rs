@@ -144,16 +144,15 @@ fn with_a_shared_rooms_sun_apart_its_light_is_read_nearer_the_truth() {
     // Checked where nothing was chosen: in every shared room with a sun (`Sun::find`), the
     // diffuse light (nine harmonics of the room, against nine of the room without its sun plus
     // the sun's exact cosine term) and the sheen's (the read about the lobe's mean direction,
-    // against the same read of the room without its sun plus the sun through the lobe) must be
-    // nearer an integral over the room. Rooms without one are named and left as they are.
+    // against the same read of the room without its sun plus the sun through the lobe), and the
+    // stretched GGX lobe's taps likewise, must be nearer an integral over the room. Rooms without one are named and left as they are.
     use phantogram::ibl::IrradianceSh;
-    use phantogram::ibl::accuracy::sheen_read_errors_sun_apart;
+    use phantogram::ibl::accuracy::{sheen_read_errors_sun_apart, stretched_ggx_read_errors_sun_apart};
     use phantogram::ibl::sun::Sun;
     use phantogram_geometry::srgb::luminance;
     let suns = std::cell::Cell::new(0);
     phantogram_integration::nearer_in_every_shared_room(|env| {
         let Some((sun, rest)) = Sun::find(env) else {
-            println!("no sun");
             return Vec::new();
         };
         suns.set(suns.get() + 1);
@@ -204,6 +203,12 @@ fn with_a_shared_rooms_sun_apart_its_light_is_read_nearer_the_truth() {
             cases.push((
                 format!("sheen roughness {roughness} (the room → its sun apart)"),
                 sheen_read_errors_sun_apart(env, roughness, 200).expect("the sun found above"),
+            ));
+        }
+        for (roughness, strength) in [(0.3f32, 0.8f32), (0.6, 0.5)] {
+            cases.push((
+                format!("stretched GGX roughness {roughness} strength {strength} (the room → its sun apart)"),
+                stretched_ggx_read_errors_sun_apart(env, roughness, strength, 60).expect("the sun found above"),
             ));
         }
         cases

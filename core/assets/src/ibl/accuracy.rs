@@ -333,3 +333,47 @@ pub fn sheen_read_errors_sun_apart(env: &Environment, roughness: f32, count: usi
         ]
     }))
 }
+
+/// [`stretched_ggx_read_errors`] with `env`'s sun ([`super::sun::Sun::find`]) apart: `before`
+/// the renderer's taps over the whole room, `now` its taps over the room without its sun plus the
+/// sun through the lobe exactly (the directional light). The truth: the visible-normal integral
+/// over the room without its sun plus the same exact term, for both (4096 samples would hit or
+/// miss a sun a fraction of a degree across). The sun is taken as a point: the lobes measured
+/// (roughness 0.3 and more) are far wider than it. `None` when the room has no sun.
+pub fn stretched_ggx_read_errors_sun_apart(
+    env: &Environment,
+    roughness: f32,
+    strength: f32,
+    count: usize,
+) -> Option<ReadErrors> {
+    let (sun, rest) = super::sun::Sun::find(env)?;
+    let sun_lum = luminance(sun.irradiance_rgb);
+    let (whole, levels) = (prefiltered_levels(env, 256), prefiltered_levels(&rest, 256));
+    let alpha = roughness * roughness;
+    let alpha_t = alpha + (1.0 - alpha) * strength * strength;
+    let light = StretchedImageLight::for_alphas(alpha_t, alpha);
+    Some(compare_reads(count, |frame, v| {
+        let (sky, albedo) = ggx_reference(&rest, alpha_t, alpha, frame, v, 4096);
+        let l = Vec3::new(
+            frame.t.dot(sun.toward),
+            frame.b.dot(sun.toward),
+            frame.n.dot(sun.toward),
+        );
+        let sun_term = if l.z > 0.0 {
+            // D · G2 / (4 n·l n·v) · n·l · E (F = 1).
+            let h = (l + v).normalize();
+            let s = Vec3::new(h.x / alpha_t, h.y / alpha, h.z);
+            let d = 1.0 / (std::f32::consts::PI * alpha_t * alpha * s.length_squared().powi(2));
+            let g2 = 1.0 / (1.0 + smith_lambda(v, alpha_t, alpha) + smith_lambda(l, alpha_t, alpha));
+            f64::from(d * g2 / (4.0 * v.z.max(1e-4)) * sun_lum)
+        } else {
+            0.0
+        };
+        let albedo = f64::from(albedo);
+        [
+            f64::from(luminance(sky)) + sun_term,
+            f64::from(tapped_read(&whole, &light, frame, v)) * albedo,
+            f64::from(tapped_read(&levels, &light, frame, v)) * albedo + sun_term,
+        ]
+    }))
+}
