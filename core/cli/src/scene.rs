@@ -40,7 +40,7 @@ pub struct SceneArgs {
     environment: Option<PathBuf>,
     /// Keep --environment's sun in its image (and the default key light over the viewer's
     /// shoulder) instead of lighting with it as the directional light, with its shadow.
-    #[arg(long, requires = "environment")]
+    #[arg(long, requires = "environment", conflicts_with = "environment_from_camera")]
     sun_in_image: bool,
     /// Light the artifact with the room as a phone's front camera would see it along this
     /// sensor log, looking into --environment (which then is the room, not the light): the live
