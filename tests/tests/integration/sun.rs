@@ -145,14 +145,15 @@ fn with_a_shared_rooms_sun_apart_its_light_is_read_nearer_the_truth() {
     // diffuse light (nine harmonics of the room, against nine of the room without its sun plus
     // the sun's exact cosine term) and the sheen's (the read about the lobe's mean direction,
     // against the same read of the room without its sun plus the sun through the lobe), and the
-    // stretched GGX lobe's taps likewise, must be nearer an integral over the room. Rooms without one are named and left as they are.
-    use phantogram::ibl::IrradianceSh;
-    use phantogram::ibl::accuracy::{sheen_read_errors_sun_apart, stretched_ggx_read_errors_sun_apart};
+    // stretched GGX lobe's taps likewise, must be nearer an integral over the room. Rooms
+    // without one are named and left as they are.
+    use phantogram::ibl::accuracy::{
+        irradiance_errors_sun_apart, sheen_read_errors_sun_apart, stretched_ggx_read_errors_sun_apart,
+    };
     use phantogram::ibl::sun::Sun;
-    use phantogram_geometry::srgb::luminance;
     let suns = std::cell::Cell::new(0);
     phantogram_integration::nearer_in_every_shared_room(|env| {
-        let Some((sun, rest)) = Sun::find(env) else {
+        let Some((sun, _)) = Sun::find(env) else {
             return Vec::new();
         };
         suns.set(suns.get() + 1);
@@ -162,42 +163,9 @@ fn with_a_shared_rooms_sun_apart_its_light_is_read_nearer_the_truth() {
             100.0 * sun.share,
             sun.toward
         );
-        let (whole_sh, rest_sh) = (
-            IrradianceSh::from_environment(env),
-            IrradianceSh::from_environment(&rest),
-        );
-        // The truth on a quarter-size copy of the room without its sun, plus the sun: the
-        // texels summed exactly.
-        let small = rest.box_filtered(4);
-        let (mut before, mut now, mut norm) = (0.0f64, 0.0f64, 0.0f64);
-        let count = 400;
-        for k in 0..count {
-            let z = 1.0 - 2.0 * (k as f32 + 0.5) / count as f32;
-            let phi = 2.399_963 * k as f32;
-            let r = (1.0 - z * z).sqrt();
-            let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            let sun_term = luminance(sun.irradiance_rgb) * n.dot(sun.toward).max(0.0);
-            let sky: f64 = (0..small.texels.len())
-                .map(|i| {
-                    let d = small.direction(i % small.width, i / small.width);
-                    f64::from(
-                        luminance(small.texels[i]) * n.dot(d).max(0.0) * small.texel_solid_angle_sr(i / small.width),
-                    )
-                })
-                .sum();
-            let truth = sky + f64::from(sun_term);
-            let whole = f64::from(luminance(whole_sh.irradiance(n)));
-            let apart = f64::from(luminance(rest_sh.irradiance(n)) + sun_term);
-            before += (whole - truth).powi(2);
-            now += (apart - truth).powi(2);
-            norm += truth * truth;
-        }
         let mut cases = vec![(
             "irradiance (the room in nine harmonics → its sun apart)".to_owned(),
-            phantogram::ibl::accuracy::ReadErrors {
-                before: (before / norm).sqrt() as f32,
-                now: (now / norm).sqrt() as f32,
-            },
+            irradiance_errors_sun_apart(env, 400).expect("the sun found above"),
         )];
         for roughness in [0.3f32, 0.7] {
             cases.push((

@@ -251,28 +251,13 @@ fn bent_reflection(v: Vec3, roughness: f32, strength: f32) -> Vec3 {
 /// ([`super::sheen_direction`], read from its table as the shader reads it). The truth: a
 /// midpoint rule over the hemisphere of light directions (64 × 256 cells).
 pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> ReadErrors {
-    use super::sheen::{charlie_distribution, sheen_albedo, sheen_visibility};
+    use super::sheen::sheen_albedo;
     use super::sheen_direction::{read, sheen_direction_table};
-    const STEPS: usize = 64;
     let levels = prefiltered_levels(env, 256);
     let table = sheen_direction_table();
-    let (d_theta, d_phi) = (
-        std::f32::consts::FRAC_PI_2 / STEPS as f32,
-        std::f32::consts::TAU / (4 * STEPS) as f32,
-    );
     compare_reads(count, |frame, v| {
-        let mut truth = 0.0f64;
-        for i in 0..STEPS {
-            let (sin_t, cos_t) = ((i as f32 + 0.5) * d_theta).sin_cos();
-            for j in 0..4 * STEPS {
-                let (sin_p, cos_p) = ((j as f32 + 0.5) * d_phi).sin_cos();
-                let l = Vec3::new(sin_t * cos_p, sin_t * sin_p, cos_t);
-                let h = (l + v).normalize();
-                let f = charlie_distribution(roughness, h.z) * sheen_visibility(roughness, l.z, v.z);
-                truth += f64::from(luminance(env.sample(frame.world(l))) * f * cos_t * sin_t * d_theta * d_phi);
-            }
-        }
-        let albedo = f64::from(sheen_albedo(v.z, roughness, STEPS));
+        let truth = sheen_integral(env, roughness, frame, v);
+        let albedo = f64::from(sheen_albedo(v.z, roughness, SHEEN_STEPS));
         let at_normal = luminance(sample_levels(&levels, frame.world(Vec3::Z), 1.0));
         let at_mean = luminance(sample_levels(&levels, frame.world(read(&table, v, roughness)), 1.0));
         [truth, f64::from(at_normal) * albedo, f64::from(at_mean) * albedo]
@@ -288,41 +273,26 @@ pub fn sheen_read_errors(env: &Environment, roughness: f32, count: usize) -> Rea
 pub fn sheen_read_errors_sun_apart(env: &Environment, roughness: f32, count: usize) -> Option<ReadErrors> {
     use super::sheen::{charlie_distribution, sheen_albedo, sheen_visibility};
     use super::sheen_direction::{read, sheen_direction_table};
-    const STEPS: usize = 64;
     let (sun, rest) = super::sun::Sun::find(env)?;
     let sun_lum = luminance(sun.irradiance_rgb);
     let whole = prefiltered_levels(env, 256);
     let levels = prefiltered_levels(&rest, 256);
     let table = sheen_direction_table();
-    let (d_theta, d_phi) = (
-        std::f32::consts::FRAC_PI_2 / STEPS as f32,
-        std::f32::consts::TAU / (4 * STEPS) as f32,
-    );
-    let lobe = |l: Vec3, v: Vec3| {
-        let h = (l + v).normalize();
-        charlie_distribution(roughness, h.z) * sheen_visibility(roughness, l.z, v.z) * l.z
-    };
     Some(compare_reads(count, |frame, v| {
-        let mut truth = 0.0f64;
-        for i in 0..STEPS {
-            let (sin_t, cos_t) = ((i as f32 + 0.5) * d_theta).sin_cos();
-            for j in 0..4 * STEPS {
-                let (sin_p, cos_p) = ((j as f32 + 0.5) * d_phi).sin_cos();
-                let l = Vec3::new(sin_t * cos_p, sin_t * sin_p, cos_t);
-                truth += f64::from(luminance(rest.sample(frame.world(l))) * lobe(l, v) * sin_t * d_theta * d_phi);
-            }
-        }
+        let truth = sheen_integral(&rest, roughness, frame, v);
         let to_sun = Vec3::new(
             frame.t.dot(sun.toward),
             frame.b.dot(sun.toward),
             frame.n.dot(sun.toward),
         );
         let sun_term = if to_sun.z > 0.0 {
-            f64::from(sun_lum * lobe(to_sun, v))
+            let h = (to_sun + v).normalize();
+            let lobe = charlie_distribution(roughness, h.z) * sheen_visibility(roughness, to_sun.z, v.z) * to_sun.z;
+            f64::from(sun_lum * lobe)
         } else {
             0.0
         };
-        let albedo = f64::from(sheen_albedo(v.z, roughness, STEPS));
+        let albedo = f64::from(sheen_albedo(v.z, roughness, SHEEN_STEPS));
         let toward = frame.world(read(&table, v, roughness));
         let whole_read = luminance(sample_levels(&whole, toward, 1.0));
         let rest_read = luminance(sample_levels(&levels, toward, 1.0));
@@ -376,4 +346,73 @@ pub fn stretched_ggx_read_errors_sun_apart(
             f64::from(tapped_read(&levels, &light, frame, v)) * albedo + sun_term,
         ]
     }))
+}
+
+/// Cells of the sheen's truth along the polar angle (four times as many in azimuth).
+const SHEEN_STEPS: usize = 64;
+
+/// The sheen lobe's light from `env` towards `v` in `frame` (luminance): a midpoint rule over
+/// the hemisphere of light directions.
+fn sheen_integral(env: &Environment, roughness: f32, frame: Frame, v: Vec3) -> f64 {
+    use super::sheen::{charlie_distribution, sheen_visibility};
+    let (d_theta, d_phi) = (
+        std::f32::consts::FRAC_PI_2 / SHEEN_STEPS as f32,
+        std::f32::consts::TAU / (4 * SHEEN_STEPS) as f32,
+    );
+    let mut sum = 0.0f64;
+    for i in 0..SHEEN_STEPS {
+        let (sin_t, cos_t) = ((i as f32 + 0.5) * d_theta).sin_cos();
+        for j in 0..4 * SHEEN_STEPS {
+            let (sin_p, cos_p) = ((j as f32 + 0.5) * d_phi).sin_cos();
+            let l = Vec3::new(sin_t * cos_p, sin_t * sin_p, cos_t);
+            let h = (l + v).normalize();
+            let f = charlie_distribution(roughness, h.z) * sheen_visibility(roughness, l.z, v.z);
+            sum += f64::from(luminance(env.sample(frame.world(l))) * f * cos_t * sin_t * d_theta * d_phi);
+        }
+    }
+    sum
+}
+
+/// The irradiance's error (relative RMS of luminance over `count` normals spread evenly) of the
+/// room's nine harmonics (`before`) and of its sun apart ([`super::sun::Sun::find`]: nine
+/// harmonics of the room without it plus its exact cosine term, `now`). The truth: the room
+/// without its sun summed texel by texel (on a copy at most 256 texels wide) plus the same
+/// exact term. `None` when the room has no sun.
+pub fn irradiance_errors_sun_apart(env: &Environment, count: usize) -> Option<ReadErrors> {
+    use super::IrradianceSh;
+    let (sun, rest) = super::sun::Sun::find(env)?;
+    let (whole_sh, rest_sh) = (
+        IrradianceSh::from_environment(env),
+        IrradianceSh::from_environment(&rest),
+    );
+    let mut factor = 1;
+    while rest.width / factor > 256 && rest.width % (2 * factor) == 0 && rest.height % (2 * factor) == 0 {
+        factor *= 2;
+    }
+    let small = rest.box_filtered(factor);
+    let sun_lum = luminance(sun.irradiance_rgb);
+    let (mut before, mut now, mut norm) = (0.0f64, 0.0f64, 0.0f64);
+    for k in 0..count {
+        // A Fibonacci sphere.
+        let z = 1.0 - 2.0 * (k as f32 + 0.5) / count as f32;
+        let phi = 2.399_963 * k as f32;
+        let r = (1.0 - z * z).max(0.0).sqrt();
+        let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+        let sun_term = f64::from(sun_lum * n.dot(sun.toward).max(0.0));
+        let sky: f64 = (0..small.texels.len())
+            .map(|i| {
+                let d = small.direction(i % small.width, i / small.width);
+                f64::from(luminance(small.texels[i]) * n.dot(d).max(0.0) * small.texel_solid_angle_sr(i / small.width))
+            })
+            .sum();
+        let truth = sky + sun_term;
+        before += (f64::from(luminance(whole_sh.irradiance(n))) - truth).powi(2);
+        now += (f64::from(luminance(rest_sh.irradiance(n))) + sun_term - truth).powi(2);
+        norm += truth * truth;
+    }
+    let norm = norm.max(1e-30);
+    Some(ReadErrors {
+        before: (before / norm).sqrt() as f32,
+        now: (now / norm).sqrt() as f32,
+    })
 }

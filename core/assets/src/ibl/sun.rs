@@ -193,7 +193,6 @@ impl Sun {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::ibl::IrradianceSh;
 
     /// A sky of `sky` radiance with a disc of `half_angle_rad` around `toward` at `disc` radiance.
     fn sky_with_disc(width: usize, toward: Vec3, half_angle_rad: f32, disc: [f32; 3], sky: [f32; 3]) -> Environment {
@@ -300,34 +299,8 @@ mod tests {
         // exact and the harmonics hold only the sky.
         let toward = Vec3::new(0.3, -0.8, 0.45).normalize();
         let env = sky_with_disc(256, toward, 1f32.to_radians(), [5000.0; 3], [0.3; 3]);
-        let (sun, rest) = Sun::find(&env).expect("a sun");
-        let (whole_sh, rest_sh) = (
-            IrradianceSh::from_environment(&env),
-            IrradianceSh::from_environment(&rest),
-        );
-        let (mut whole_err, mut apart_err, mut norm) = (0.0f64, 0.0f64, 0.0f64);
-        let count = 400;
-        for k in 0..count {
-            // Normals spread evenly (a Fibonacci sphere).
-            let z = 1.0 - 2.0 * (k as f32 + 0.5) / count as f32;
-            let phi = 2.399_963 * k as f32;
-            let r = (1.0 - z * z).sqrt();
-            let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
-            let truth: f64 = (0..env.texels.len())
-                .map(|i| {
-                    let d = env.direction(i % env.width, i / env.width);
-                    f64::from(luminance(env.texels[i]) * n.dot(d).max(0.0) * env.texel_solid_angle_sr(i / env.width))
-                })
-                .sum();
-            let whole = f64::from(luminance(whole_sh.irradiance(n)));
-            let apart = f64::from(
-                luminance(rest_sh.irradiance(n)) + luminance(sun.irradiance_rgb) * n.dot(sun.toward).max(0.0),
-            );
-            whole_err += (whole - truth).powi(2);
-            apart_err += (apart - truth).powi(2);
-            norm += truth * truth;
-        }
-        let (whole_err, apart_err) = ((whole_err / norm).sqrt(), (apart_err / norm).sqrt());
+        let errors = crate::ibl::accuracy::irradiance_errors_sun_apart(&env, 400).expect("a sun");
+        let (whole_err, apart_err) = (errors.before, errors.now);
         println!(
             "irradiance relative RMS: the whole room in nine harmonics {whole_err:.4}, the sun apart {apart_err:.4}"
         );
