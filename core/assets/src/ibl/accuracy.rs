@@ -46,6 +46,11 @@ impl Frame {
     fn world(&self, d: Vec3) -> Vec3 {
         self.t * d.x + self.b * d.y + self.n * d.z
     }
+
+    /// The world direction `d` in the surface frame.
+    fn local(&self, d: Vec3) -> Vec3 {
+        Vec3::new(self.t.dot(d), self.b.dot(d), self.n.dot(d))
+    }
 }
 
 /// A deterministic spread of frames and views: normals over the sphere, tangents turned about
@@ -280,11 +285,7 @@ pub fn sheen_read_errors_sun_apart(env: &Environment, roughness: f32, count: usi
     let table = sheen_direction_table();
     Some(compare_reads(count, |frame, v| {
         let truth = sheen_integral(&rest, roughness, frame, v);
-        let to_sun = Vec3::new(
-            frame.t.dot(sun.toward),
-            frame.b.dot(sun.toward),
-            frame.n.dot(sun.toward),
-        );
+        let to_sun = frame.local(sun.toward);
         let sun_term = if to_sun.z > 0.0 {
             let h = (to_sun + v).normalize();
             let lobe = charlie_distribution(roughness, h.z) * sheen_visibility(roughness, to_sun.z, v.z) * to_sun.z;
@@ -324,11 +325,7 @@ pub fn stretched_ggx_read_errors_sun_apart(
     let light = StretchedImageLight::for_alphas(alpha_t, alpha);
     Some(compare_reads(count, |frame, v| {
         let (sky, albedo) = ggx_reference(&rest, alpha_t, alpha, frame, v, 4096);
-        let l = Vec3::new(
-            frame.t.dot(sun.toward),
-            frame.b.dot(sun.toward),
-            frame.n.dot(sun.toward),
-        );
+        let l = frame.local(sun.toward);
         let sun_term = if l.z > 0.0 {
             // D · G2 / (4 n·l n·v) · n·l · E (F = 1).
             let h = (l + v).normalize();
