@@ -4,7 +4,8 @@
 //! plain texel-by-texel loop on one thread, and the specular levels ([`prefiltered_levels`] at the
 //! renderer's 256-texel base) — for 1024-, 2048- and 4096-wide maps, as in the tabletop paper's
 //! table; and the renderer's start-up tables (the split-sum table and the sheen's albedo table,
-//! 64 × 64 each, made once per process on a background thread). Each figure is the median of
+//! 64 × 64 each, made once per process on a background thread); and finding a room's sun
+//! ([`phantogram_assets::ibl::sun::Sun::find`], once when a room is loaded). Each figure is the median of
 //! several runs; the machine is shared and noisy, so compare
 //! figures of one run only. Prints a Markdown table.
 
@@ -32,19 +33,39 @@ fn median_ms<R>(runs: usize, mut f: impl FnMut() -> R) -> f64 {
     t[runs / 2]
 }
 
+/// Median milliseconds of `runs` calls of `f`, each on a fresh `input` made outside the timing
+/// (and its result dropped outside it).
+fn median_ms_of_each<I, R>(runs: usize, mut input: impl FnMut() -> I, mut f: impl FnMut(I) -> R) -> f64 {
+    let mut t: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            let given = input();
+            let start = Instant::now();
+            let out = std::hint::black_box(f(given));
+            let ms = start.elapsed().as_secs_f64() * 1e3;
+            drop(out);
+            ms
+        })
+        .collect();
+    t.sort_by(f64::total_cmp);
+    t[t.len() / 2]
+}
+
 fn main() {
     let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
     println!("CPU: {cores} cores; median of several runs, ms\n");
-    println!("| map | SH9 (ours, {cores} cores) | SH9 texel by texel (1 core) | ratio | specular levels (256 base) |");
-    println!("|---|---|---|---|---|");
+    println!(
+        "| map | SH9 (ours, {cores} cores) | SH9 texel by texel (1 core) | ratio | specular levels (256 base) | its sun found and taken out (1 core, the map not copied) |"
+    );
+    println!("|---|---|---|---|---|---|");
     for width in [1024, 2048, 4096] {
         let env = Environment::benchmark_sky(width);
         let runs = (4096 / width) * 10 + 5;
         let fast = median_ms(runs * 4, || IrradianceSh::from_environment(&env));
         let naive = median_ms(runs.min(9), || reference_projection(&env));
         let prefilter = median_ms(5, || prefiltered_levels(&env, PREFILTERED_BASE_WIDTH));
+        let sun = median_ms_of_each(runs.min(9), || env.clone(), phantogram_assets::ibl::sun::Sun::take_out);
         println!(
-            "| {width}×{} | {fast:.3} | {naive:.2} | {:.1}× | {prefilter:.1} |",
+            "| {width}×{} | {fast:.3} | {naive:.2} | {:.1}× | {prefilter:.1} | {sun:.1} |",
             width / 2,
             naive / fast
         );

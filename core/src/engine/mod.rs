@@ -535,10 +535,10 @@ impl Engine {
         // taken out of it where it has one.
         let environment_level = environment.as_ref().map(|e| e.mean_luminance());
         let (environment, sun) = match environment {
-            Some(env) if config.sun_from_environment => match crate::ibl::sun::Sun::find(&env) {
-                Some((sun, rest)) => (Some(rest), Some(sun)),
-                None => (Some(env), None),
-            },
+            Some(env) if config.sun_from_environment => {
+                let (sun, rest) = crate::ibl::sun::Sun::take_out(env);
+                (Some(rest), sun)
+            }
             other => (other, None),
         };
         let gpu = gpu()?;

@@ -176,17 +176,38 @@ impl Sun {
 
     /// The sun in `env`, if it has one (see the module docs), and the map without it.
     pub fn find(env: &Environment) -> Option<(Sun, Environment)> {
+        let candidate = Self::candidate(env)?;
+        let mut rest = env.clone();
+        candidate.take_out_of(&mut rest);
+        Some((candidate.sun, rest))
+    }
+
+    /// [`Self::find`] on a map the caller gives up: the sun, if there is one, is taken out of it
+    /// in place (no copy of a map that may be a hundred megabytes).
+    pub fn take_out(mut env: Environment) -> (Option<Sun>, Environment) {
+        let candidate = Self::candidate(&env);
+        if let Some(c) = &candidate {
+            c.take_out_of(&mut env);
+        }
+        (candidate.map(|c| c.sun), env)
+    }
+
+    /// What [`Self::measure`] finds around the brightest texel, if it counts as a sun.
+    fn candidate(env: &Environment) -> Option<Candidate> {
         let candidate = Self::measure(env, EDGE_OF_PEAK)?;
         let widest_sr = std::f32::consts::TAU * (1.0 - MAX_HALF_ANGLE_RAD.cos());
-        if candidate.sun.solid_angle_sr > widest_sr || candidate.sun.share < MIN_SHARE {
-            return None;
+        (candidate.sun.solid_angle_sr <= widest_sr && candidate.sun.share >= MIN_SHARE).then_some(candidate)
+    }
+}
+
+impl Candidate {
+    /// Leaves in `env`'s texels under it the lesser of their radiance and the sky's.
+    fn take_out_of(&self, env: &mut Environment) {
+        for &i in &self.texels {
+            if let Some(t) = env.texels.get_mut(i) {
+                *t = std::array::from_fn(|c| t[c].min(self.fill_rgb[c]));
+            }
         }
-        let mut rest = env.clone();
-        for &i in &candidate.texels {
-            let t = &mut rest.texels[i];
-            *t = std::array::from_fn(|c| t[c].min(candidate.fill_rgb[c]));
-        }
-        Some((candidate.sun, rest))
     }
 }
 
@@ -261,6 +282,9 @@ mod tests {
                     before[c]
                 );
             }
+            // The same when the map is given up rather than copied.
+            let (taken, taken_rest) = Sun::take_out(env.clone());
+            assert_eq!((taken, &taken_rest), (Some(sun), &rest));
             // And the map without it is sky: nothing left near the sun's radiance.
             let brightest = rest.texels.iter().map(|&t| luminance(t)).fold(0.0f32, f32::max);
             assert!(brightest < 1.5, "towards {toward}: {brightest} left");
