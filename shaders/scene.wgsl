@@ -1209,6 +1209,11 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let fresnel_d = s.specular_weight * (f0_d + (f90_d - f0_d) * pow(1.0 - v_dot_h, 5.0));
     let f90_ambient_d = select(f0_d, max(vec3<f32>(1.0 - roughness), f0_d), s.fresnel_rises);
     let fresnel_ambient_d = s.specular_weight * (f0_d + (f90_ambient_d - f0_d) * pow(1.0 - n_dot_v, 5.0));
+    // What the dielectric reflects of the light towards the view, all bounces together, and so
+    // does not pass through: the split sum's below (the same share the diffuse lobe keeps out,
+    // so that clear glass in a uniform room passes what it does not reflect; before, 1 − this
+    // Schlick term, which left rough glass 3 % dark in the furnace); Ward's keeps this one.
+    var reflected_view = fresnel_ambient_d;
     let lut_size = vec2<f32>(textureDimensions(brdf_lut));
     // What the base does not scatter back passes through (glTF's transmission: a thin wall,
     // tinted by the base colour; through a volume, absorbed along the refracted path).
@@ -1321,6 +1326,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
         let albedo_d = s.specular_weight * (f0_ambient_d * scale_bias.x + f90_d * scale_bias.y);
         let albedo_m = f0_ambient_m * scale_bias.x + vec3<f32>(scale_bias.y);
         let reflected_d = min(albedo_d * bounces_d, vec3<f32>(1.0));
+        reflected_view = reflected_d;
         // Lambert's share of what is not reflected, less what a thin sheet passes to its other
         // side; and what it passes from its other side, lit from there (paper against a window).
         // What is not reflected: what the specular layer, all bounces together, does not send
@@ -1435,7 +1441,7 @@ fn shade_surface(world: vec3<f32>, s: Surface) -> Shaded {
     let ambient = eye.light.w * occlusion * ambient_light;
     let sin2_t = (1.0 - n_dot_v * n_dot_v) * s.inv_ior * s.inv_ior;
     let cos_t = sqrt(max(1.0 - sin2_t, 1e-4));
-    let through = transmittance(transmission, fresnel_ambient_d, coat_reflects, base, s.optical_depth / cos_t);
+    let through = transmittance(transmission, reflected_view, coat_reflects, base, s.optical_depth / cos_t);
     return Shaded(direct + ambient + s.emissive, through);
 }
 
