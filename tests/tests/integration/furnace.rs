@@ -61,9 +61,11 @@ enum Over {
     Bare,
     Varnish,
     Sheen,
-    Brushed { rotation_rad: f32 },
-    /// Clear glass: all of what the base does not reflect passes through (`KHR_materials_transmission`,
-    /// a thin wall: no volume).
+    Brushed {
+        rotation_rad: f32,
+    },
+    /// Clear glass: all of what the base does not reflect passes through
+    /// (`KHR_materials_transmission`, a thin wall: no volume).
     Glass,
 }
 
