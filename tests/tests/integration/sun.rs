@@ -37,15 +37,22 @@ fn write_hdr(env: &Environment, path: &std::path::Path) {
         .expect("write the room");
 }
 
-/// Row of the frame's darkness centre: pixels darker than the bright floor, weighted by how much.
-fn darkness_row(rgba: &[u8], width: usize) -> f32 {
-    let lum: Vec<f32> = rgba
+/// Each pixel's brightness (the sum of its three codes) and the bright floor's: the 90th
+/// percentile.
+fn brightness(rgba: &[u8]) -> (Vec<f32>, f32) {
+    let sums: Vec<f32> = rgba
         .chunks_exact(4)
-        .map(|p| (f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2])) / 3.0)
+        .map(|p| f32::from(p[0]) + f32::from(p[1]) + f32::from(p[2]))
         .collect();
-    let mut sorted = lum.clone();
+    let mut sorted = sums.clone();
     sorted.sort_by(f32::total_cmp);
     let bright = sorted[sorted.len() * 9 / 10];
+    (sums, bright)
+}
+
+/// Row of the frame's darkness centre: pixels darker than the bright floor, weighted by how much.
+fn darkness_row(rgba: &[u8], width: usize) -> f32 {
+    let (lum, bright) = brightness(rgba);
     let (mut sum, mut weight) = (0.0f64, 0.0f64);
     for (i, l) in lum.iter().enumerate() {
         let w = f64::from((bright - l).max(0.0));
@@ -129,14 +136,8 @@ fn a_rooms_sun_is_the_light_and_the_shadow_falls_away_from_it() {
 
 /// Which pixels are in shadow: darker than 3/4 of the bright floor.
 fn shadowed(rgba: &[u8]) -> Vec<bool> {
-    let lum: Vec<u16> = rgba
-        .chunks_exact(4)
-        .map(|p| u16::from(p[0]) + u16::from(p[1]) + u16::from(p[2]))
-        .collect();
-    let mut sorted = lum.clone();
-    sorted.sort_unstable();
-    let bright = sorted[sorted.len() * 9 / 10];
-    lum.iter().map(|&l| l * 4 < bright * 3).collect()
+    let (lum, bright) = brightness(rgba);
+    lum.iter().map(|&l| l * 4.0 < bright * 3.0).collect()
 }
 
 #[test]

@@ -389,12 +389,7 @@ pub fn irradiance_errors_sun_apart(env: &Environment, count: usize) -> Option<Re
     let small = rest.box_filtered(factor);
     let sun_lum = luminance(sun.irradiance_rgb);
     let (mut before, mut now, mut norm) = (0.0f64, 0.0f64, 0.0f64);
-    for k in 0..count {
-        // A Fibonacci sphere.
-        let z = 1.0 - 2.0 * (k as f32 + 0.5) / count as f32;
-        let phi = 2.399_963 * k as f32;
-        let r = (1.0 - z * z).max(0.0).sqrt();
-        let n = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+    for n in phantogram_geometry::sphere::fibonacci(count) {
         let sun_term = f64::from(sun_lum * n.dot(sun.toward).max(0.0));
         let sky: f64 = (0..small.texels.len())
             .map(|i| {

@@ -85,6 +85,12 @@ impl Environment {
         Vec3::new(theta.sin() * phi.cos(), theta.sin() * phi.sin(), theta.cos())
     }
 
+    /// Solid angle of a texel in row `y`, steradians.
+    pub fn texel_solid_angle_sr(&self, y: usize) -> f32 {
+        let theta = std::f32::consts::PI * (y as f32 + 0.5) / self.height as f32;
+        (std::f32::consts::TAU / self.width as f32) * (std::f32::consts::PI / self.height as f32) * theta.sin()
+    }
+
     /// A neutral studio, made here: a soft overhead key panel towards the north-west, a dimmer fill
     /// from the south-east, a grey horizon and a darker floor. Values are linear radiance, tuned so
     /// that a white surface facing up receives about the same irradiance as from the directional

@@ -58,12 +58,6 @@ pub struct Candidate {
 }
 
 impl Environment {
-    /// Solid angle of a texel in row `y`, steradians.
-    pub fn texel_solid_angle_sr(&self, y: usize) -> f32 {
-        let theta = std::f32::consts::PI * (y as f32 + 0.5) / self.height as f32;
-        (std::f32::consts::TAU / self.width as f32) * (std::f32::consts::PI / self.height as f32) * theta.sin()
-    }
-
     /// The map's four neighbours of texel `i`, wrapping in azimuth (none past the poles).
     fn neighbours(&self, i: usize) -> impl Iterator<Item = usize> {
         let (w, h) = (self.width, self.height);
@@ -148,16 +142,9 @@ impl Sun {
             direction += env.direction(i % w, i / w).as_dvec3() * (l * dw);
             solid_angle += dw;
         }
-        let total: f64 = (0..h)
-            .map(|y| {
-                let dw = f64::from(env.texel_solid_angle_sr(y));
-                env.texels[y * w..(y + 1) * w]
-                    .iter()
-                    .map(|&c| f64::from(luminance(c)))
-                    .sum::<f64>()
-                    * dw
-            })
-            .sum();
+        // The room's ∫L dΩ: its mean luminance over the sphere times the sphere the texels cover.
+        let sphere_sr: f64 = (0..h).map(|y| w as f64 * f64::from(env.texel_solid_angle_sr(y))).sum();
+        let total = f64::from(env.mean_luminance()) * sphere_sr;
         let power_lum = f64::from(luminance(power.map(|p| p as f32)));
         let toward = direction
             .try_normalize()
