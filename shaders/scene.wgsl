@@ -157,6 +157,10 @@ override TRANSMIT_LAYER: u32 = 0u;
 // 3). A 1×1 placeholder while the model has no such glass.
 @group(0) @binding(10) var backdrop: texture_2d<f32>;
 @group(0) @binding(11) var backdrop_sampler: sampler;
+// The shadow map again, as plain floats: its depths as stored, which the soft shadow's blocker
+// search reads (`soft_shadow`). Naga's GLSL can neither `textureLoad` a depth texture nor
+// sample one without comparison.
+@group(0) @binding(12) var shadow_depths: texture_2d<f32>;
 
 @group(1) @binding(0) var<uniform> material: Material;
 @group(1) @binding(1) var base_texture: texture_2d<f32>;
@@ -428,7 +432,105 @@ fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
     if (p.w < 0.5) {
         return 1.0;
     }
+    // A light with a width (a room's sun; a lamp is a point) shadows softly.
+    if (eye.toward_light.w > 0.0 && eye.lamp_position.w < 0.5) {
+        return soft_shadow(p.xyz, n, tan(eye.toward_light.w));
+    }
     return shadow_pcf(p.xy, min(p.z, 1.0));
+}
+
+// Taps of the soft shadow's blocker search and of its filter, and the widest either reaches, in
+// shadow-map texels (`soft_shadow`).
+const SOFT_SEARCH_TAPS: u32 = 16u;
+const SOFT_FILTER_TAPS: u32 = 32u;
+const SOFT_MAX_RADIUS_TEXELS: f32 = 64.0;
+
+// The i-th of n points spread evenly over the unit disc (Vogel's spiral: radius √((i + ½)/n),
+// turning by the golden angle), so that equal weights average over the disc.
+fn vogel_disc(i: u32, n: u32) -> vec2<f32> {
+    let r = sqrt((f32(i) + 0.5) / f32(n));
+    let a = f32(i) * 2.39996323;
+    return r * vec2<f32>(cos(a), sin(a));
+}
+
+// The orthographic light view's scales: uv per metre across the map (xy; the map's two sides
+// may span different lengths) and depth per metre along the light (z), from `light_view_proj`'s
+// rows (uv = (x + 1) / 2, (1 − y) / 2 of the clip position; depth its z).
+fn light_view_scale() -> vec3<f32> {
+    let m = eye.light_view_proj;
+    return vec3<f32>(
+        0.5 * length(vec3<f32>(m[0].x, m[1].x, m[2].x)),
+        0.5 * length(vec3<f32>(m[0].y, m[1].y, m[2].y)),
+        length(vec3<f32>(m[0].z, m[1].z, m[2].z)),
+    );
+}
+
+// How the depth of the receiver's plane (normal `n`, mesh coordinates) changes with the shadow
+// map's uv: depth(uv + d) ≈ depth(uv) + dot(slope, d). The soft shadow's taps reach many texels
+// out, where a plane tilted to the light lies nearer it or farther than at the centre; comparing
+// each tap at the plane's own depth there keeps a surface from shadowing itself (receiver-plane
+// depth bias, Isidoro 2006). Steeper than 10 m per m (light within 6° of the plane) counts as
+// 10: such a surface takes almost none of the light.
+fn receiver_slope(n: vec3<f32>, scale: vec3<f32>) -> vec2<f32> {
+    let m = eye.light_view_proj;
+    // The normal in the light view's axes (x, y across the map, z along the light).
+    let nv = vec3<f32>(
+        dot(n, vec3<f32>(m[0].x, m[1].x, m[2].x)) / (2.0 * scale.x),
+        dot(n, vec3<f32>(m[0].y, m[1].y, m[2].y)) / (2.0 * scale.y),
+        dot(n, vec3<f32>(m[0].z, m[1].z, m[2].z)) / scale.z,
+    );
+    // Metres of depth per metre across, along the view's x and y.
+    var per_m = -nv.xy / select(nv.z, 1e-6, abs(nv.z) < 1e-6);
+    let steepness = length(per_m);
+    if (steepness > 10.0) {
+        per_m = per_m * (10.0 / steepness);
+    }
+    // v runs against y.
+    return scale.z * vec2<f32>(per_m.x / scale.x, -per_m.y / scale.y);
+}
+
+// Percentage-closer soft shadows (Fernando 2005) for a directional light of angular radius β
+// (`tan_beta` its tangent), at shadow-map point `p` (uv, depth) of a receiver with normal `n`: a
+// blocker Δ metres nearer the light than the receiver hides the source from points up to Δ tan β
+// aside, so the penumbra is read as the binary shadow averaged over a disc of that radius. For a
+// blocker parallel to the receiver that average is exactly the share of the source's disc in view;
+// elsewhere it is the usual estimate, from the mean depth of the blockers found. (1) Blocker
+// search over the disc the farthest blocker could reach (one at the map's near plane), (2) the
+// penumbra's radius from the blockers' mean depth, (3) that many texels' disc of bilinear
+// comparisons. With no blocker in the search, or a penumbra under a texel across, the sharp
+// filter reads it (`shadow_pcf`), which also keeps a thin blocker the search's taps fall between.
+fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
+    let size = vec2<f32>(textureDimensions(shadow_map));
+    let scale = light_view_scale();
+    let slope = receiver_slope(n, scale);
+    // The widest disc, in metres: SOFT_MAX_RADIUS_TEXELS texels along the map's finer side.
+    let widest_m = SOFT_MAX_RADIUS_TEXELS / (max(scale.x, scale.y) * max(size.x, size.y));
+    let search_m = min(max(p.z, 0.0) / scale.z * tan_beta, widest_m);
+    var blockers = 0.0;
+    var depth_sum = 0.0;
+    for (var i = 0u; i < SOFT_SEARCH_TAPS; i = i + 1u) {
+        let d = vogel_disc(i, SOFT_SEARCH_TAPS) * search_m * scale.xy;
+        let texel = vec2<i32>(clamp(floor((p.xy + d) * size), vec2<f32>(0.0), size - vec2<f32>(1.0)));
+        let stored = textureLoad(shadow_depths, texel, 0).x;
+        if (stored < min(p.z + dot(slope, d), 1.0)) {
+            blockers = blockers + 1.0;
+            depth_sum = depth_sum + stored;
+        }
+    }
+    let sharp = shadow_pcf(p.xy, min(p.z, 1.0));
+    if (blockers < 0.5) {
+        return sharp;
+    }
+    let radius_m = min((p.z - depth_sum / blockers) / scale.z * tan_beta, widest_m);
+    if (radius_m * min(scale.x, scale.y) * min(size.x, size.y) <= 1.0) {
+        return sharp;
+    }
+    var lit = 0.0;
+    for (var i = 0u; i < SOFT_FILTER_TAPS; i = i + 1u) {
+        let d = vogel_disc(i, SOFT_FILTER_TAPS) * radius_m * scale.xy;
+        lit = lit + textureSampleCompareLevel(shadow_map, shadow_sampler, p.xy + d, min(p.z + dot(slope, d), 1.0));
+    }
+    return lit / f32(SOFT_FILTER_TAPS);
 }
 
 // Where `world` (with normal `n`, lit from `l`) falls in the light's shadow map: uv in xy, its

@@ -121,6 +121,10 @@ pub(crate) fn eye_bind_group(
                 binding: 11,
                 resource: wgpu::BindingResource::Sampler(views.backdrop_sampler),
             },
+            wgpu::BindGroupEntry {
+                binding: 12,
+                resource: wgpu::BindingResource::TextureView(views.shadow),
+            },
         ],
     })
 }

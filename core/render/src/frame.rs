@@ -203,7 +203,14 @@ impl Renderer {
                     Some((l.position_m, point_shadow::cube_range_m(&shadow_bounds, l.position_m))),
                 ),
             },
-            None => (light_view_proj(&shadow_bounds, input.toward_light), None),
+            None => (
+                light_view_proj(
+                    &shadow_bounds,
+                    input.toward_light,
+                    self.lighting.light_angular_radius_rad,
+                ),
+                None,
+            ),
         };
         let mut cube_pass = self.lighting.shadows && cube.is_some() && self.lamp_cube_error.is_none();
         if cube_pass && self.point_shadow.size < point_shadow::POINT_SHADOW_SIZE {

@@ -367,6 +367,8 @@ impl Renderer {
                 texture_array_entry(9, false),
                 filterable_texture_entry(10),
                 filtering_sampler_entry(11),
+                // The shadow map again, read as plain floats (`shadow_depths`).
+                float_texture_entry(12, false),
             ],
         });
         let shadow_texture = device.create_texture(&wgpu::TextureDescriptor {

@@ -109,8 +109,20 @@ impl Default for Lighting {
     }
 }
 
-/// The orthographic light view over `bounds` (mesh coordinates) and its texel size in metres.
-pub fn light_view_proj(bounds: &phantogram_geometry::containment::Aabb, toward_light: Vec3) -> (Mat4, f32) {
+/// The orthographic light view over `bounds` (mesh coordinates) and its texel size in metres,
+/// for a light `angular_radius_rad` in radius (0: sharp shadows).
+///
+/// A light with a width shadows receivers beside the casters' outline too, by as far as its
+/// penumbra reaches (`scene.wgsl`'s `soft_shadow`), so the view widens by that: the distance
+/// along the light from a blocker to a receiver, at most the casters' depth along it or, for the
+/// floor at their base, their height over the light's elevation (taken as at least 0.1), times
+/// tan β; at most the casters' radius, which halves the map's resolution at worst (a source
+/// several degrees across, low over the horizon). A sun's half a degree widens it by under 1 %.
+pub fn light_view_proj(
+    bounds: &phantogram_geometry::containment::Aabb,
+    toward_light: Vec3,
+    angular_radius_rad: f32,
+) -> (Mat4, f32) {
     let l = toward_light.normalize_or(Vec3::Z);
     let centre = (bounds.min + bounds.max) * 0.5;
     let radius = (bounds.max - bounds.min).length() * 0.5 + 1e-4;
@@ -122,8 +134,10 @@ pub fn light_view_proj(bounds: &phantogram_geometry::containment::Aabb, toward_l
         lo = lo.min(p);
         hi = hi.max(p);
     }
-    // A texel of margin on every side so PCF taps at the edge stay inside.
-    let margin = (hi.x - lo.x).max(hi.y - lo.y) / SHADOW_SIZE as f32 * 2.0;
+    // Two texels of margin on every side so PCF taps at the edge stay inside, and the penumbra's
+    // reach.
+    let margin = (hi.x - lo.x).max(hi.y - lo.y) / SHADOW_SIZE as f32 * 2.0
+        + penumbra_reach_m(bounds, l, radius, angular_radius_rad);
     let proj = Mat4::orthographic_rh(
         lo.x - margin,
         hi.x + margin,
@@ -134,6 +148,17 @@ pub fn light_view_proj(bounds: &phantogram_geometry::containment::Aabb, toward_l
     );
     let texel = ((hi.x - lo.x).max(hi.y - lo.y) + 2.0 * margin) / SHADOW_SIZE as f32;
     (proj * view, texel)
+}
+
+/// How far beyond the casters' outline a light `beta_rad` in radius shadows (m), for
+/// [`light_view_proj`]: casters within `bounds` (of half-diagonal `radius`), lit along `l`.
+fn penumbra_reach_m(bounds: &phantogram_geometry::containment::Aabb, l: Vec3, radius: f32, beta_rad: f32) -> f32 {
+    if beta_rad.is_nan() || beta_rad <= 0.0 {
+        return 0.0;
+    }
+    let height = bounds.max.z - bounds.min.z;
+    let along = (2.0 * radius).max(height / l.z.abs().max(0.1));
+    (along * beta_rad.min(1.5).tan()).min(radius)
 }
 
 #[cfg(test)]

@@ -33,6 +33,7 @@ mod lamp;
 mod layer_textures;
 mod materials;
 mod models;
+mod penumbra;
 mod prefilter_gpu;
 mod projection_ground_truth;
 mod render;
