@@ -447,10 +447,20 @@ const SOFT_MAX_RADIUS_TEXELS: f32 = 64.0;
 
 // The i-th of n points spread evenly over the unit disc (Vogel's spiral: radius √((i + ½)/n),
 // turning by the golden angle), so that equal weights average over the disc.
-fn vogel_disc(i: u32, n: u32) -> vec2<f32> {
+fn vogel_disc(i: u32, n: u32, turn: f32) -> vec2<f32> {
     let r = sqrt((f32(i) + 0.5) / f32(n));
-    let a = f32(i) * 2.39996323;
+    let a = f32(i) * 2.39996323 + turn;
     return r * vec2<f32>(cos(a), sin(a));
+}
+
+// A turn of the taps' disc (radians) that varies from point to point of the receiver: Jimenez's
+// interleaved gradient noise at a quarter of a shadow-map texel, so that the taps' copies of a
+// blocker's outline (bands along a long penumbra) break up into a grain finer than the map's
+// texels. Taken from where the receiver falls in the map, not from the screen: the grain stays
+// on the surface as the eyes move, and both eyes of a stereo pair see the same.
+fn tap_turn(uv: vec2<f32>, size: vec2<f32>) -> f32 {
+    let q = floor(uv * size * 4.0);
+    return 6.2831853 * fract(52.9829189 * fract(dot(q, vec2<f32>(0.06711056, 0.00583715))));
 }
 
 // The orthographic light view's scales: uv per metre across the map (xy; the map's two sides
@@ -503,13 +513,14 @@ fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(shadow_map));
     let scale = light_view_scale();
     let slope = receiver_slope(n, scale);
+    let turn = tap_turn(p.xy, size);
     // The widest disc, in metres: SOFT_MAX_RADIUS_TEXELS texels along the map's finer side.
     let widest_m = SOFT_MAX_RADIUS_TEXELS / (max(scale.x, scale.y) * max(size.x, size.y));
     let search_m = min(max(p.z, 0.0) / scale.z * tan_beta, widest_m);
     var blockers = 0.0;
     var depth_sum = 0.0;
     for (var i = 0u; i < SOFT_SEARCH_TAPS; i = i + 1u) {
-        let d = vogel_disc(i, SOFT_SEARCH_TAPS) * search_m * scale.xy;
+        let d = vogel_disc(i, SOFT_SEARCH_TAPS, turn) * search_m * scale.xy;
         let texel = vec2<i32>(clamp(floor((p.xy + d) * size), vec2<f32>(0.0), size - vec2<f32>(1.0)));
         let stored = textureLoad(shadow_depths, texel, 0).x;
         if (stored < min(p.z + dot(slope, d), 1.0)) {
@@ -527,7 +538,7 @@ fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
     }
     var lit = 0.0;
     for (var i = 0u; i < SOFT_FILTER_TAPS; i = i + 1u) {
-        let d = vogel_disc(i, SOFT_FILTER_TAPS) * radius_m * scale.xy;
+        let d = vogel_disc(i, SOFT_FILTER_TAPS, turn) * radius_m * scale.xy;
         lit = lit + textureSampleCompareLevel(shadow_map, shadow_sampler, p.xy + d, min(p.z + dot(slope, d), 1.0));
     }
     return lit / f32(SOFT_FILTER_TAPS);
