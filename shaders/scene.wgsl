@@ -507,8 +507,9 @@ fn receiver_slope(n: vec3<f32>, scale: vec3<f32>) -> vec2<f32> {
 // elsewhere it is the usual estimate, from the mean depth of the blockers found. (1) Blocker
 // search over the disc the farthest blocker could reach (one at the map's near plane), (2) the
 // penumbra's radius from the blockers' mean depth, (3) that many texels' disc of bilinear
-// comparisons. With no blocker in the search, or a penumbra under a texel across, the sharp
-// filter reads it (`shadow_pcf`), which also keeps a thin blocker the search's taps fall between.
+// comparisons. With no blocker in the search or nothing but, or a penumbra under a texel across,
+// the sharp filter reads it (`shadow_pcf`), which also keeps a thin blocker the search's taps fall
+// between.
 fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(shadow_map));
     let scale = light_view_scale();
@@ -528,8 +529,11 @@ fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
             depth_sum = depth_sum + stored;
         }
     }
+    // No blocker in reach: lit, as the sharp filter reads it. Blockers at every tap of the search,
+    // whose disc holds the filter's (it reaches as far as a blocker at the near plane would
+    // shade): the umbra, likewise. Either spares the filter's taps.
     let sharp = shadow_pcf(p.xy, min(p.z, 1.0));
-    if (blockers < 0.5) {
+    if (blockers < 0.5 || blockers > f32(SOFT_SEARCH_TAPS) - 0.5) {
         return sharp;
     }
     let radius_m = min((p.z - depth_sum / blockers) / scale.z * tan_beta, widest_m);

@@ -23,6 +23,9 @@
 //!   cube of six views, `phantogram_render::point_shadow`), with shadows and without, and the
 //!   triangles the shadow passes drew; and over the glass amphora, whose glass the cube's six
 //!   views also draw into its shadow filter;
+//! * the amphora on its floor under a directional light of angular radius 0 (the sharp filter),
+//!   the sun's 0.0047 rad, the studio room's lamp's 0.05 and the widest room's sun's 0.1 (the
+//!   soft shadow's blocker search and disc of taps, `scene.wgsl`'s `soft_shadow`);
 //! * peak resident memory of the process (VmHWM).
 //!
 //! With `PHANTOGRAM_BENCH_FRAMES=DIR` each model's mono frame is also written to `DIR` as a PNG.
@@ -169,6 +172,7 @@ fn main() {
     }
     lamp_among_the_artifact(&mut renderer, "amphora", &models[1].1, &input, frames);
     lamp_among_the_artifact(&mut renderer, "glass amphora", &models[2].1, &input, frames);
+    sun_over_the_artifact(&mut renderer, "amphora", &models[1].1, &input, frames);
     if let Some(data) = std::env::var_os("PHANTOGRAM_DATA") {
         select_from_gallery(&std::path::PathBuf::from(data).join("models/heritage"));
     }
@@ -221,6 +225,26 @@ fn frosted(mut glass: Model) -> Model {
         material.roughness = 0.5;
     }
     glass
+}
+
+/// `name` on its floor under a directional light with a width, as a room's sun lights it
+/// (`Lighting::light_angular_radius_rad`): the soft shadow's search and filter against the sharp
+/// filter of a point-like light, in one run (see the module docs).
+fn sun_over_the_artifact(renderer: &mut Renderer, name: &str, on_floor: &Model, input: &FrameInput, frames: usize) {
+    renderer.set_model(on_floor).expect("model");
+    let mut times = Vec::new();
+    // A point; the sun (0.27° in radius); the studio room's lamp (pmndrs_studio, 2.9°); the
+    // widest a room's sun may be (`ibl::sun`, 0.1 rad).
+    for beta_rad in [0.0f32, 0.0047, 0.05, 0.1] {
+        renderer.lighting.light_angular_radius_rad = beta_rad;
+        let ((mono, stereo), _) = frame_times(renderer, input, frames);
+        times.push(format!("{beta_rad} rad: mono {mono:.1} ms, stereo {stereo:.1} ms"));
+    }
+    renderer.lighting.light_angular_radius_rad = 0.0;
+    println!(
+        "{name} on the floor, {W}x{H}, under a light of angular radius {}",
+        times.join("; ")
+    );
 }
 
 /// The raking lamp over `name` on its floor, with its cube shadows and without (see the module

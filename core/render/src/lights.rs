@@ -87,7 +87,9 @@ pub struct Lighting {
     pub light_rgb: Vec3,
     /// Angular radius of the directional light's source, radians: 0 for a point at infinity
     /// (the default key light), a room's sun's ([`phantogram_assets::ibl::sun`]) otherwise. Its
-    /// highlights widen by it (`scene.wgsl`); a lamp is a point whatever this says.
+    /// highlights widen by it, and its shadows soften over the penumbra the source's width gives
+    /// (`scene.wgsl`'s `soft_shadow`; the shadow map's view widens to hold it,
+    /// [`light_view_proj`]); a lamp is a point whatever this says.
     pub light_angular_radius_rad: f32,
     /// Scale of the environment's light ([`phantogram_assets::ibl`]).
     pub environment_intensity: f32,
