@@ -168,6 +168,37 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_wide_lights_view_widens_by_its_penumbras_reach() {
+        // Casters 60 mm across and 20 mm tall, lit from 60° up: a point-like light's view is
+        // the casters' outline and two texels; a light 0.05 rad in radius widens it on each side
+        // by 2 × the half-diagonal × tan 0.05 (the casters' depth along the light outreaches
+        // their height over the elevation here), and no source widens it beyond the
+        // half-diagonal.
+        let bounds =
+            phantogram_geometry::containment::Aabb::new(Vec3::new(-0.03, -0.03, -0.02), Vec3::new(0.03, 0.03, 0.0));
+        let toward = Vec3::new(0.0, -60f32.to_radians().cos(), 60f32.to_radians().sin());
+        let width = |beta: f32| {
+            let (m, texel) = light_view_proj(&bounds, toward, beta);
+            // The view's width across x (world x is the view's x here: the light has none).
+            (2.0 / m.x_axis.x.abs(), texel)
+        };
+        let (sharp, sharp_texel) = width(0.0);
+        let radius = (bounds.max - bounds.min).length() * 0.5 + 1e-4;
+        let outline = sharp - 4.0 * sharp_texel * SHADOW_SIZE as f32 / (SHADOW_SIZE as f32 + 4.0);
+        assert!((outline - 0.06).abs() < 1e-4, "outline {outline}");
+        let (wide, _) = width(0.05);
+        let expected = 2.0 * 2.0 * radius * 0.05f32.tan();
+        assert!(
+            ((wide - sharp) / expected - 1.0).abs() < 1e-3,
+            "widened by {} against {expected}",
+            wide - sharp
+        );
+        let (widest, _) = width(1.4);
+        assert!(((widest - sharp) / (2.0 * radius) - 1.0).abs() < 1e-3, "{widest}");
+        assert_eq!(width(f32::NAN).0, sharp);
+    }
+
+    #[test]
     fn a_lamps_shadow_view_holds_what_it_shadows() {
         let bounds =
             phantogram_geometry::containment::Aabb::new(Vec3::new(-0.02, -0.03, -0.01), Vec3::new(0.02, 0.03, 0.01));

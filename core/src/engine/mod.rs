@@ -116,9 +116,10 @@ pub struct EngineConfig {
     pub environment_path: Option<PathBuf>,
     /// Where [`Self::environment_path`]'s room has a sun (a small source with a good share of
     /// its light, [`crate::ibl::sun`]), light with it: the directional light comes from the sun,
-    /// with its colour and strength, and casts its shadow, soft as the sun's width makes it, and the image light is the room
-    /// without it (a long press, or "Light: fix to the room again", then leaves the sun where the
-    /// room has it: re-anchoring moves only the key light). While the room's own live light is
+    /// with its colour and strength, and casts its shadow, as soft as the sun's width makes it,
+    /// and the image light is the room without it (a long press, or "Light: fix to the room
+    /// again", then leaves the sun where the room has it: re-anchoring moves only the key
+    /// light). While the room's own live light is
     /// shown ([`Self::room_light`]) the key light is back. On by default; off: the room's light as
     /// it is, and the default key light over the viewer's shoulder besides (the light a room
     /// without a sun always gets).
