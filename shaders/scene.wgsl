@@ -531,14 +531,12 @@ fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
     }
     // No blocker in reach: lit, as the sharp filter reads it. Blockers at every tap of the search,
     // whose disc holds the filter's (it reaches as far as a blocker at the near plane would
-    // shade): the umbra, likewise. Either spares the filter's taps.
-    let sharp = shadow_pcf(p.xy, min(p.z, 1.0));
-    if (blockers < 0.5 || blockers > f32(SOFT_SEARCH_TAPS) - 0.5) {
-        return sharp;
-    }
-    let radius_m = min((p.z - depth_sum / blockers) / scale.z * tan_beta, widest_m);
-    if (radius_m * min(scale.x, scale.y) * min(size.x, size.y) <= 1.0) {
-        return sharp;
+    // shade): the umbra, likewise; and a penumbra under a texel. Each spares the filter's taps,
+    // and the sharp filter's reads are made only then.
+    let radius_m = min((p.z - depth_sum / max(blockers, 1.0)) / scale.z * tan_beta, widest_m);
+    let some_blocked = blockers > 0.5 && blockers < f32(SOFT_SEARCH_TAPS) - 0.5;
+    if (!some_blocked || radius_m * min(scale.x, scale.y) * min(size.x, size.y) <= 1.0) {
+        return shadow_pcf(p.xy, min(p.z, 1.0));
     }
     var lit = 0.0;
     for (var i = 0u; i < SOFT_FILTER_TAPS; i = i + 1u) {

@@ -178,24 +178,25 @@ mod tests {
             phantogram_geometry::containment::Aabb::new(Vec3::new(-0.03, -0.03, -0.02), Vec3::new(0.03, 0.03, 0.0));
         let toward = Vec3::new(0.0, -60f32.to_radians().cos(), 60f32.to_radians().sin());
         let width = |beta: f32| {
-            let (m, texel) = light_view_proj(&bounds, toward, beta);
+            let (m, _) = light_view_proj(&bounds, toward, beta);
             // The view's width across x (world x is the view's x here: the light has none).
-            (2.0 / m.x_axis.x.abs(), texel)
+            2.0 / m.x_axis.x.abs()
         };
-        let (sharp, sharp_texel) = width(0.0);
+        let sharp = width(0.0);
         let radius = (bounds.max - bounds.min).length() * 0.5 + 1e-4;
-        let outline = sharp - 4.0 * sharp_texel * SHADOW_SIZE as f32 / (SHADOW_SIZE as f32 + 4.0);
+        // Two texels of margin each side of the outline: the view is (1 + 4 / SHADOW_SIZE) of it.
+        let outline = sharp / (1.0 + 4.0 / SHADOW_SIZE as f32);
         assert!((outline - 0.06).abs() < 1e-4, "outline {outline}");
-        let (wide, _) = width(0.05);
+        let wide = width(0.05);
         let expected = 2.0 * 2.0 * radius * 0.05f32.tan();
         assert!(
             ((wide - sharp) / expected - 1.0).abs() < 1e-3,
             "widened by {} against {expected}",
             wide - sharp
         );
-        let (widest, _) = width(1.4);
+        let widest = width(1.4);
         assert!(((widest - sharp) / (2.0 * radius) - 1.0).abs() < 1e-3, "{widest}");
-        assert_eq!(width(f32::NAN).0, sharp);
+        assert_eq!(width(f32::NAN), sharp);
     }
 
     #[test]

@@ -148,17 +148,19 @@ fn disc_share_beyond(t: f32) -> f32 {
     1.0 - (t.acos() - t * (1.0 - t * t).sqrt()) / std::f32::consts::PI
 }
 
-/// Width between the profile's crossings of `low` and `high` (m), `profile` as (x, lit share)
-/// with the share falling as x rises.
+/// Where the profile last reaches `level` (m), `profile` as (x, lit share) with the share
+/// falling as x rises; NaN if it never does.
+fn crossing(profile: &[(f32, f32)], level: f32) -> f32 {
+    profile
+        .iter()
+        .rev()
+        .find(|(_, f)| *f >= level)
+        .map_or(f32::NAN, |(x, _)| *x)
+}
+
+/// Width between the profile's crossings of `low` and `high` (m).
 fn width_between(profile: &[(f32, f32)], low: f32, high: f32) -> f32 {
-    let crossing = |level: f32| {
-        profile
-            .iter()
-            .rev()
-            .find(|(_, f)| *f >= level)
-            .map_or(f32::NAN, |(x, _)| *x)
-    };
-    crossing(low) - crossing(high)
+    crossing(profile, low) - crossing(profile, high)
 }
 
 /// A profile's name, its receiver point at each coordinate (and across the profile, from −1 to
@@ -225,8 +227,7 @@ fn a_wide_sources_shadow_fades_over_the_penumbra_the_geometry_gives() {
         // against shadow acne (`shadow_map_point`: a few texels along the normal, more the
         // more the surface slants to the light). The penumbra is checked about that edge.
         let geometric: Vec<(f32, f32)> = xs.iter().map(|&x| (x, share_in_view(at(x, 0.0)))).collect();
-        let crossing = |p: &[(f32, f32)]| p.iter().rev().find(|(_, f)| *f >= 0.5).map_or(f32::NAN, |(x, _)| *x);
-        let shift = crossing(&sharp) - crossing(&geometric);
+        let shift = crossing(&sharp, 0.5) - crossing(&geometric, 0.5);
         let measured: Vec<(f32, f32, f32)> = xs
             .iter()
             .map(|&x| (x, share(0, x), share_in_view(at(x - shift, 0.0))))
