@@ -512,19 +512,13 @@ fn receiver_slope(n: vec3<f32>, scale: vec3<f32>) -> vec2<f32> {
 // between.
 fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
     let size = vec2<f32>(textureDimensions(shadow_map));
-    let scale = light_view_scale();
-    let slope = receiver_slope(n, scale);
-    let turn = tap_turn(p.xy, size);
-    // The widest disc, in metres: SOFT_MAX_RADIUS_TEXELS texels along the map's finer side.
-    let widest_m = SOFT_MAX_RADIUS_TEXELS / (max(scale.x, scale.y) * max(size.x, size.y));
-    let search_m = min(max(p.z, 0.0) / scale.z * tan_beta, widest_m);
+    let disc = soft_disc(p, n, tan_beta, size);
     var blockers = 0.0;
     var depth_sum = 0.0;
     for (var i = 0u; i < SOFT_SEARCH_TAPS; i = i + 1u) {
-        let d = vogel_disc(i, SOFT_SEARCH_TAPS, turn) * search_m * scale.xy;
-        let texel = vec2<i32>(clamp(floor((p.xy + d) * size), vec2<f32>(0.0), size - vec2<f32>(1.0)));
-        let stored = textureLoad(shadow_depths, texel, 0).x;
-        if (stored < min(p.z + dot(slope, d), 1.0)) {
+        let d = vogel_disc(i, SOFT_SEARCH_TAPS, disc.turn) * disc.search_m * disc.scale.xy;
+        let stored = textureLoad(shadow_depths, map_texel(p.xy + d, size), 0).x;
+        if (stored < min(p.z + dot(disc.slope, d), 1.0)) {
             blockers = blockers + 1.0;
             depth_sum = depth_sum + stored;
         }
@@ -533,17 +527,50 @@ fn soft_shadow(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> f32 {
     // whose disc holds the filter's (it reaches as far as a blocker at the near plane would
     // shade): the umbra, likewise; and a penumbra under a texel. Each spares the filter's taps,
     // and the sharp filter's reads are made only then.
-    let radius_m = min((p.z - depth_sum / max(blockers, 1.0)) / scale.z * tan_beta, widest_m);
-    let some_blocked = blockers > 0.5 && blockers < f32(SOFT_SEARCH_TAPS) - 0.5;
-    if (!some_blocked || radius_m * min(scale.x, scale.y) * min(size.x, size.y) <= 1.0) {
+    let radius_m = penumbra_radius_m(p.z, blockers, depth_sum, disc, tan_beta, size);
+    if (radius_m <= 0.0) {
         return shadow_pcf(p.xy, min(p.z, 1.0));
     }
     var lit = 0.0;
     for (var i = 0u; i < SOFT_FILTER_TAPS; i = i + 1u) {
-        let d = vogel_disc(i, SOFT_FILTER_TAPS, turn) * radius_m * scale.xy;
-        lit = lit + textureSampleCompareLevel(shadow_map, shadow_sampler, p.xy + d, min(p.z + dot(slope, d), 1.0));
+        let d = vogel_disc(i, SOFT_FILTER_TAPS, disc.turn) * radius_m * disc.scale.xy;
+        lit = lit + textureSampleCompareLevel(shadow_map, shadow_sampler, p.xy + d, min(p.z + dot(disc.slope, d), 1.0));
     }
     return lit / f32(SOFT_FILTER_TAPS);
+}
+
+// What a soft shadow's taps share at one receiver (`soft_shadow`, `soft_light_filter`): the
+// light view's scales and the receiver plane's slope, the taps' turn, the widest disc in metres
+// (SOFT_MAX_RADIUS_TEXELS texels along the map's finer side) and the search's disc, as far as a
+// blocker at the map's near plane would shade.
+struct SoftDisc {
+    scale: vec3<f32>,
+    slope: vec2<f32>,
+    turn: f32,
+    widest_m: f32,
+    search_m: f32,
+}
+
+fn soft_disc(p: vec3<f32>, n: vec3<f32>, tan_beta: f32, size: vec2<f32>) -> SoftDisc {
+    let scale = light_view_scale();
+    let widest_m = SOFT_MAX_RADIUS_TEXELS / (max(scale.x, scale.y) * max(size.x, size.y));
+    let search_m = min(max(p.z, 0.0) / scale.z * tan_beta, widest_m);
+    return SoftDisc(scale, receiver_slope(n, scale), tap_turn(p.xy, size), widest_m, search_m);
+}
+
+// The penumbra's radius (metres) from the blockers a search found (how many, and the sum of their
+// depths) at a receiver of depth `z`; 0 where the point is read alone: no blocker, nothing but
+// blockers (the search's disc holds the filter's), or a penumbra under a texel.
+fn penumbra_radius_m(z: f32, blockers: f32, depth_sum: f32, disc: SoftDisc, tan_beta: f32, size: vec2<f32>) -> f32 {
+    let radius_m = min((z - depth_sum / max(blockers, 1.0)) / disc.scale.z * tan_beta, disc.widest_m);
+    let some_blocked = blockers > 0.5 && blockers < f32(SOFT_SEARCH_TAPS) - 0.5;
+    let texels = radius_m * min(disc.scale.x, disc.scale.y) * min(size.x, size.y);
+    return select(0.0, radius_m, some_blocked && texels > 1.0);
+}
+
+// The texel of a light-space map of `size` texels that holds `uv` (clamped into the map).
+fn map_texel(uv: vec2<f32>, size: vec2<f32>) -> vec2<i32> {
+    return vec2<i32>(clamp(floor(uv * size), vec2<f32>(0.0), size - vec2<f32>(1.0)));
 }
 
 // Where `world` (with normal `n`, lit from `l`) falls in the light's shadow map: uv in xy, its
@@ -579,10 +606,49 @@ fn light_filter(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
     if (p.w < 0.5) {
         return vec3<f32>(1.0);
     }
+    // A light with a width: the glass's coloured shadow as soft as the opaque one.
+    if (eye.toward_light.w > 0.0 && eye.lamp_position.w < 0.5) {
+        return soft_light_filter(p.xyz, n, tan(eye.toward_light.w));
+    }
+    return filter_at(p.xy, p.z);
+}
+
+// What the glass at `uv` in the filter's one view passes to a receiver at depth `z` (all of the
+// light where none stands nearer the light).
+fn filter_at(uv: vec2<f32>, z: f32) -> vec3<f32> {
+    let f = textureLoad(shadow_filter, map_texel(uv, vec2<f32>(textureDimensions(shadow_filter))), 0, 0);
+    return select(vec3<f32>(1.0), f.rgb, z > f.a);
+}
+
+// `light_filter` under a light of angular radius β (`tan_beta` its tangent), as `soft_shadow`
+// reads the opaque shadow: glass found nearer than the receiver's plane over the search's disc
+// gives the penumbra's radius from its mean depth, and what the glass passes (or, where none
+// stands nearer, all the light) is averaged over that disc. Without it the coloured shadow kept
+// a sharp outline inside the opaque parts' soft one. Nearest texels: the filter's depths
+// (alpha) cannot be interpolated across an outline.
+fn soft_light_filter(p: vec3<f32>, n: vec3<f32>, tan_beta: f32) -> vec3<f32> {
     let size = vec2<f32>(textureDimensions(shadow_filter));
-    let texel = vec2<i32>(clamp(p.xy * size, vec2<f32>(0.0), size - vec2<f32>(1.0)));
-    let f = textureLoad(shadow_filter, texel, 0, 0);
-    return select(vec3<f32>(1.0), f.rgb, p.z > f.a);
+    let disc = soft_disc(p, n, tan_beta, size);
+    var glass = 0.0;
+    var depth_sum = 0.0;
+    for (var i = 0u; i < SOFT_SEARCH_TAPS; i = i + 1u) {
+        let d = vogel_disc(i, SOFT_SEARCH_TAPS, disc.turn) * disc.search_m * disc.scale.xy;
+        let nearest = textureLoad(shadow_filter, map_texel(p.xy + d, size), 0, 0).a;
+        if (nearest < min(p.z + dot(disc.slope, d), 1.0)) {
+            glass = glass + 1.0;
+            depth_sum = depth_sum + nearest;
+        }
+    }
+    let radius_m = penumbra_radius_m(p.z, glass, depth_sum, disc, tan_beta, size);
+    if (radius_m <= 0.0) {
+        return filter_at(p.xy, p.z);
+    }
+    var passed = vec3<f32>(0.0);
+    for (var i = 0u; i < SOFT_FILTER_TAPS; i = i + 1u) {
+        let d = vogel_disc(i, SOFT_FILTER_TAPS, disc.turn) * radius_m * disc.scale.xy;
+        passed = passed + filter_at(p.xy + d, min(p.z + dot(disc.slope, d), 1.0));
+    }
+    return passed / f32(SOFT_FILTER_TAPS);
 }
 
 // `light_filter` for a lamp seen from its cube: the filter's face and texel along the direction
@@ -612,9 +678,7 @@ fn lamp_cube_filter(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
         st = vec2<f32>(select(-r.x, r.x, r.z > 0.0), -r.y);
     }
     let uv = (st / max(major, 1e-9) + vec2<f32>(1.0)) * 0.5;
-    let size = vec2<f32>(textureDimensions(shadow_filter));
-    let texel = vec2<i32>(clamp(uv * size, vec2<f32>(0.0), size - vec2<f32>(1.0)));
-    let f = textureLoad(shadow_filter, texel, face, 0);
+    let f = textureLoad(shadow_filter, map_texel(uv, vec2<f32>(textureDimensions(shadow_filter))), face, 0);
     let depth = cube_depth(major, eye.lamp_shadow.x, eye.lamp_shadow.y);
     return select(vec3<f32>(1.0), f.rgb, depth > f.a);
 }

@@ -25,7 +25,8 @@
 //!   views also draw into its shadow filter;
 //! * the amphora on its floor under a directional light of angular radius 0 (the sharp filter),
 //!   the sun's 0.0047 rad, the studio room's lamp's 0.05 and the widest room's sun's 0.1 (the
-//!   soft shadow's blocker search and disc of taps, `scene.wgsl`'s `soft_shadow`);
+//!   soft shadow's blocker search and disc of taps, `scene.wgsl`'s `soft_shadow`), and the glass
+//!   amphora under the same lights (its coloured shadow softened likewise, `soft_light_filter`);
 //! * peak resident memory of the process (VmHWM).
 //!
 //! With `PHANTOGRAM_BENCH_FRAMES=DIR` each model's mono frame is also written to `DIR` as a PNG.
@@ -173,6 +174,7 @@ fn main() {
     lamp_among_the_artifact(&mut renderer, "amphora", &models[1].1, &input, frames);
     lamp_among_the_artifact(&mut renderer, "glass amphora", &models[2].1, &input, frames);
     sun_over_the_artifact(&mut renderer, "amphora", &models[1].1, &input, frames);
+    sun_over_the_artifact(&mut renderer, "glass amphora", &models[2].1, &input, frames);
     if let Some(data) = std::env::var_os("PHANTOGRAM_DATA") {
         select_from_gallery(&std::path::PathBuf::from(data).join("models/heritage"));
     }

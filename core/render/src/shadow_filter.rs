@@ -10,8 +10,9 @@
 //! faces of the lamp's shadow cube (`point_shadow`, same order and views, its depth the cube's),
 //! when a lamp stands among its casters. The renderer keeps one filter of each kind and binds the
 //! one the frame needs. The scene shader reads it by `light_filter` (a face's texel from the
-//! direction, `lamp_cube_filter`, for the cube) when the eye block's `shadow.w` says it holds this
-//! frame's glass; the pipelines of a model
+//! direction, `lamp_cube_filter`, for the cube; averaged over the penumbra's disc as the opaque
+//! shadow is, `soft_light_filter`, under a directional light with a width) when the eye block's
+//! `shadow.w` says it holds this frame's glass; the pipelines of a model
 //! without glass are made with that read compiled out (`GLASS_SHADOWS`: read behind the branch
 //! alone, it cost such frames 4–7 % on lavapipe, `benchmarks/render.md`), and so are the
 //! impostors' (a big scan's far parts receive glass's light unfiltered). The share is taken at

@@ -11,14 +11,16 @@
 //! estimate's and the taps' error, on the floor and on a ramp tilted 66° to the light, which,
 //! unlike the floor, stands in the shadow map: it would shadow itself over the filter's wide disc
 //! (and shrink the penumbra, its own surface taken for blockers) unless each tap is compared at
-//! the ramp's own depth there.
+//! the ramp's own depth there. And a plate of tinted glass, which the opaque shadow map does not
+//! hold (`shadow_filter`), must fade its coloured shadow over the same penumbra.
 
 use crate::furnace::{EYE, radiance_of};
 use crate::render::{H, W, add_part, push_floor_marker, still_input};
+use crate::transmission::glass;
 use phantogram::anaglyph::Method;
 use phantogram::glam::{Mat4, Vec3};
 use phantogram::ibl::Environment;
-use phantogram::model::{Material, Mesh, Model};
+use phantogram::model::{Layers, Material, Mesh, Model};
 use phantogram::projection::{DepthRange, OffAxisProjection};
 use phantogram::render::Renderer;
 use phantogram::screen::Screen;
@@ -49,14 +51,25 @@ fn floor_z() -> f32 {
     -0.031
 }
 
-/// The plate over the floor, and the ramp under its shadow's edge if `ramp`. The floor's profile is
-/// read without the ramp: the casters' bounds would then reach over it, and the light's view would
-/// hold the floor beside the plate's outline even were it not widened by the penumbra's reach.
-fn scene(ramp: bool) -> Model {
+/// What stands over the floor in a frame of [`scene`].
+#[derive(Clone, Copy, PartialEq)]
+enum Plate {
+    /// The opaque plate.
+    Alone,
+    /// The opaque plate, and the ramp under its shadow's edge.
+    OverRamp,
+    /// The plate made of glass tinted magenta: its shadow passes half the green or less.
+    Glass,
+}
+
+/// The plate over the floor, as `plate` says. The floor's profile is read without the ramp: the
+/// casters' bounds would then reach over it, and the light's view would hold the floor beside the
+/// plate's outline even were it not widened by the penumbra's reach.
+fn scene(plate: Plate) -> Model {
     let mut marker = Mesh::default();
     push_floor_marker(&mut marker);
     let mut model = Model::from_painted_mesh("penumbra", marker);
-    let plate = box_mesh(
+    let plate_mesh = box_mesh(
         Mat4::from_translation(Vec3::new(PLATE_X_M, 0.0, floor_z() + PLATE_HEIGHT_M)),
         PLATE_HALF_M,
     );
@@ -67,10 +80,14 @@ fn scene(ramp: bool) -> Model {
         roughness: 1.0,
         ..Material::default()
     };
-    if ramp {
+    if plate == Plate::OverRamp {
         add_part(&mut model, box_mesh(ramp_frame(), RAMP_HALF_M), matte.clone());
     }
-    add_part(&mut model, plate, matte);
+    let material = match plate {
+        Plate::Glass => glass([1.0, 0.5, 1.0], Layers::default()),
+        _ => matte,
+    };
+    add_part(&mut model, plate_mesh, material);
     model.add_floor(&Screen::default(), 2.0);
     model
 }
@@ -99,7 +116,7 @@ struct Lit {
 
 /// Frames of [`scene`] lit along [`TOWARD_LIGHT`] as each of `lits` says, in a dim room; `None`
 /// without a GPU.
-fn frames(lits: &[Lit], ramp: bool) -> Option<(Vec<Vec<u8>>, OffAxisProjection)> {
+fn frames(lits: &[Lit], plate: Plate) -> Option<(Vec<Vec<u8>>, OffAxisProjection)> {
     let mono = OffAxisProjection::new(&Screen::default(), EYE, DepthRange::default()).ok()?;
     let gpu = phantogram_integration::gpu_or_skip()?;
     let room = Environment {
@@ -107,7 +124,7 @@ fn frames(lits: &[Lit], ramp: bool) -> Option<(Vec<Vec<u8>>, OffAxisProjection)>
         height: 32,
         texels: vec![[0.01; 3]; 64 * 32],
     };
-    let model = scene(ramp);
+    let model = scene(plate);
     let mut renderer = Renderer::with_environment(gpu, &model, Some(&room)).expect("renderer");
     let input = still_input(&mono, &mono, &mono, TOWARD_LIGHT.normalize());
     let frames = lits
@@ -164,8 +181,8 @@ fn width_between(profile: &[(f32, f32)], low: f32, high: f32) -> f32 {
 }
 
 /// A profile's name, its receiver point at each coordinate (and across the profile, from −1 to
-/// 1), and the coordinates' span (m).
-type Profile<'a> = (&'a str, &'a dyn Fn(f32, f32) -> Vec3, (f32, f32));
+/// 1), the coordinates' span (m), and the scene it is read in.
+type Profile<'a> = (&'a str, &'a dyn Fn(f32, f32) -> Vec3, (f32, f32), Plate);
 
 #[test]
 fn a_wide_sources_shadow_fades_over_the_penumbra_the_geometry_gives() {
@@ -198,9 +215,13 @@ fn a_wide_sources_shadow_fades_over_the_penumbra_the_geometry_gives() {
     let on_ramp = |u: f32, across: f32| ramp_frame().transform_point3(Vec3::new(u, 0.003 * across, RAMP_HALF_M[2]));
     let floor_span = (edge_x - 1.5 * half_m, edge_x + 1.5 * half_m);
     let ramp_span = (-0.9 * RAMP_HALF_M[0], 0.9 * RAMP_HALF_M[0]);
-    let cases: [Profile; 2] = [("floor", &on_floor, floor_span), ("ramp", &on_ramp, ramp_span)];
-    for (name, at, (from, to)) in cases {
-        let Some((frames, proj)) = frames(&lits, name == "ramp") else {
+    let cases: [Profile; 3] = [
+        ("floor", &on_floor, floor_span, Plate::Alone),
+        ("ramp", &on_ramp, ramp_span, Plate::OverRamp),
+        ("glass", &on_floor, floor_span, Plate::Glass),
+    ];
+    for (name, at, (from, to), plate) in cases {
+        let Some((frames, proj)) = frames(&lits, plate) else {
             return;
         };
         if std::env::var_os("PHANTOGRAM_KEEP_FRAMES").is_some() {
@@ -212,7 +233,7 @@ fn a_wide_sources_shadow_fades_over_the_penumbra_the_geometry_gives() {
         let xs: Vec<f32> = (0..=200).map(|i| from + (to - from) * i as f32 / 200.0).collect();
         // The share of the light each point receives in the frames: a source's light over the
         // unshadowed light, each less the room's.
-        let share = |k: usize, x: f32| {
+        let received = |k: usize, x: f32| {
             (-4..=4)
                 .map(|j| {
                     let q = at(x, j as f32 / 4.0);
@@ -222,6 +243,17 @@ fn a_wide_sources_shadow_fades_over_the_penumbra_the_geometry_gives() {
                 .sum::<f32>()
                 / 9.0
         };
+        // Behind glass, the share of the source's disc in view is read from how far the green
+        // has fallen towards what the glass passes (the point source's, deep in the shadow at
+        // the span's end); opaque, what the glass passes is nothing.
+        let passed = if plate == Plate::Glass { received(1, to) } else { 0.0 };
+        println!("{name}: {passed:.3} of the light passes the plate");
+        // Half the green at each of the glass's two faces: a quarter, less what they reflect.
+        assert!(
+            plate != Plate::Glass || (0.1..0.5).contains(&passed),
+            "the magenta glass passes {passed} of the green"
+        );
+        let share = |k: usize, x: f32| (received(k, x) - passed) / (1.0 - passed);
         let sharp: Vec<(f32, f32)> = xs.iter().map(|&x| (x, share(1, x))).collect();
         // The point source's edge lies where the geometry puts it, moved by the normal offset
         // against shadow acne (`shadow_map_point`: a few texels along the normal, more the
