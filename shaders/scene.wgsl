@@ -433,10 +433,18 @@ fn light_visibility(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> f32 {
         return 1.0;
     }
     // A light with a width (a room's sun; a lamp is a point) shadows softly.
-    if (eye.toward_light.w > 0.0 && eye.lamp_position.w < 0.5) {
-        return soft_shadow(p.xyz, n, tan(eye.toward_light.w));
+    let tan_beta = wide_light_tan_beta();
+    if (tan_beta > 0.0) {
+        return soft_shadow(p.xyz, n, tan_beta);
     }
     return shadow_pcf(p.xy, min(p.z, 1.0));
+}
+
+// The tangent of the directional light's angular radius β where it has a width (a room's sun) and
+// shines (no lamp in its place, which is a point): its shadows and glass's are soft then
+// (`soft_shadow`, `soft_light_filter`); 0 otherwise.
+fn wide_light_tan_beta() -> f32 {
+    return select(0.0, tan(eye.toward_light.w), eye.toward_light.w > 0.0 && eye.lamp_position.w < 0.5);
 }
 
 // Taps of the soft shadow's blocker search and of its filter, and the widest either reaches, in
@@ -607,8 +615,9 @@ fn light_filter(world: vec3<f32>, n: vec3<f32>, l: vec3<f32>) -> vec3<f32> {
         return vec3<f32>(1.0);
     }
     // A light with a width: the glass's coloured shadow as soft as the opaque one.
-    if (eye.toward_light.w > 0.0 && eye.lamp_position.w < 0.5) {
-        return soft_light_filter(p.xyz, n, tan(eye.toward_light.w));
+    let tan_beta = wide_light_tan_beta();
+    if (tan_beta > 0.0) {
+        return soft_light_filter(p.xyz, n, tan_beta);
     }
     return filter_at(p.xy, p.z);
 }
